@@ -1,0 +1,63 @@
+// ctid — check macros for the error tiers (DESIGN.md §4).
+//
+//   CTID_REQUIRE(cond, "fmt {}", args...)          tier 1: throws ctid::InvalidArgument
+//   CTID_REQUIRE_OPTION(cond, "fmt {}", args...)   tier 1: throws ctid::InvalidOptions
+//   CTID_ASSERT(cond)                              tier 3: internal invariant; aborts
+//                                                  with file:line (active in every build)
+// Messages are formatted with std::format-like "{}" placeholders (a minimal
+// formatter is provided here so the public headers do not depend on fmt).
+#pragma once
+
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+#include <string>
+#include <string_view>
+
+#include "ctid/core/error.hpp"
+
+namespace ctid::detail {
+
+inline void format_into(std::ostringstream& os, std::string_view f) { os << f; }
+
+template <class T, class... Rest>
+void format_into(std::ostringstream& os, std::string_view f, const T& first, const Rest&... rest) {
+  const auto pos = f.find("{}");
+  if (pos == std::string_view::npos) {
+    os << f;
+    return;
+  }
+  os << f.substr(0, pos) << first;
+  format_into(os, f.substr(pos + 2), rest...);
+}
+
+/// Replace each "{}" in `f` by the next argument (streamed with operator<<).
+template <class... Args>
+std::string format(std::string_view f, const Args&... args) {
+  std::ostringstream os;
+  os.precision(10);
+  format_into(os, f, args...);
+  return os.str();
+}
+
+[[noreturn]] inline void assert_fail(const char* cond, const char* file, int line) {
+  std::fprintf(stderr, "ctid internal error: assertion '%s' failed at %s:%d\n", cond, file, line);
+  std::abort();
+}
+
+}  // namespace ctid::detail
+
+#define CTID_REQUIRE(cond, ...)                                              \
+  do {                                                                       \
+    if (!(cond)) throw ::ctid::InvalidArgument(::ctid::detail::format(__VA_ARGS__)); \
+  } while (0)
+
+#define CTID_REQUIRE_OPTION(cond, ...)                                       \
+  do {                                                                       \
+    if (!(cond)) throw ::ctid::InvalidOptions(::ctid::detail::format(__VA_ARGS__)); \
+  } while (0)
+
+#define CTID_ASSERT(cond)                                                    \
+  do {                                                                       \
+    if (!(cond)) ::ctid::detail::assert_fail(#cond, __FILE__, __LINE__);     \
+  } while (0)

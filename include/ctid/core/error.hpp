@@ -1,0 +1,38 @@
+// ctid — error classes of the three error tiers (DESIGN.md §4).
+//
+// Tier 1, bad user input: an exception derived from a std exception whose message
+// names the thing and the values:
+//   * InvalidArgument (std::invalid_argument): wrong sizes, NaN/Inf, non-increasing
+//     times, order too high for the data, ...
+//   * InvalidOptions (InvalidArgument): an options field out of range; thrown by
+//     `Options::validate()` and names the field and its value.
+//   * FileError (std::runtime_error): a file cannot be opened, parsed or written;
+//     the message names the path (and line/column where it applies).
+// Tier 2, the algorithm did not succeed: no exception, see Summary (status.hpp).
+// Tier 3, our own bug: CTID_ASSERT (check.hpp).
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace ctid {
+
+/// Bad input to a library function (sizes, values, data that cannot support the request).
+class InvalidArgument : public std::invalid_argument {
+ public:
+  explicit InvalidArgument(const std::string& what) : std::invalid_argument(what) {}
+};
+
+/// An options struct holds a value out of its documented range.
+class InvalidOptions : public InvalidArgument {
+ public:
+  explicit InvalidOptions(const std::string& what) : InvalidArgument(what) {}
+};
+
+/// A file could not be opened, read, parsed or written.
+class FileError : public std::runtime_error {
+ public:
+  explicit FileError(const std::string& what) : std::runtime_error(what) {}
+};
+
+}  // namespace ctid

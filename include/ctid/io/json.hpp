@@ -1,0 +1,36 @@
+// ctid — JSON model and result files (DESIGN.md §8).
+//
+// Result envelope: {"ctid_version", "method", "model": {...}, "parameters": [{name, value,
+// std, fixed}], "covariance": [[..]], "fit": {...}, "summary": {...}, "diagnostics": {...}}.
+// Models: {"type": "transfer_function", "num": [...], "den": [...], "io_delay": s} or
+// {"type": "state_space", "A": [[..]], "B": .., "C": .., "D": ..} (row-major nested arrays).
+// NaN values are written as null and read back as NaN.
+#pragma once
+
+#include <string>
+#include <variant>
+
+#include "ctid/core/types.hpp"
+#include "ctid/model/state_space.hpp"
+#include "ctid/model/transfer_function.hpp"
+
+namespace ctid {
+
+using LinearModel = std::variant<TransferFunction, StateSpace>;
+
+/// The library version string ("0.1.0").
+const char* version();
+
+std::string model_to_json(const LinearModel& model, int indent = 2);
+/// Accepts a bare model object or a result envelope with a "model" member. Throws
+/// FileError naming `source` and the member that is missing or malformed.
+LinearModel parse_model_json(const std::string& text, const std::string& source = "<json>");
+LinearModel read_model_json(const std::string& path);
+void write_model_json(const std::string& path, const LinearModel& model);
+
+std::string result_to_json(const Result<TransferFunction>& result, const std::string& method, int indent = 2);
+Result<TransferFunction> parse_result_json(const std::string& text, const std::string& source = "<json>");
+/// Atomic write (temporary file, then rename). Throws FileError.
+void write_result_json(const std::string& path, const Result<TransferFunction>& result, const std::string& method);
+
+}  // namespace ctid

@@ -1,0 +1,42 @@
+// ctid — continuous-time state space  dx/dt = A x + B u,  y = C x + D u.
+#pragma once
+
+#include <Eigen/Dense>
+
+#include "ctid/model/transfer_function.hpp"
+
+namespace ctid {
+
+class StateSpace {
+ public:
+  StateSpace() = default;
+  /// Throws InvalidArgument for inconsistent sizes or non-finite entries.
+  StateSpace(Eigen::MatrixXd A, Eigen::MatrixXd B, Eigen::MatrixXd C, Eigen::MatrixXd D);
+
+  /// Controllable canonical (companion) form of a proper SISO transfer function:
+  /// A first row = -[a1 .. an], sub-diagonal ones, B = e1, C = remainder numerator, D = direct term.
+  static StateSpace controllable_canonical(const TransferFunction& tf);
+  /// Observable canonical form: the transpose (dual) of the controllable form.
+  static StateSpace observable_canonical(const TransferFunction& tf);
+
+  const Eigen::MatrixXd& A() const { return A_; }
+  const Eigen::MatrixXd& B() const { return B_; }
+  const Eigen::MatrixXd& C() const { return C_; }
+  const Eigen::MatrixXd& D() const { return D_; }
+  int nx() const { return static_cast<int>(A_.rows()); }
+  int nu() const { return static_cast<int>(B_.cols()); }
+  int ny() const { return static_cast<int>(C_.rows()); }
+
+  Eigen::VectorXcd poles() const;
+  bool is_stable() const;
+  /// Transfer function from input `in` to output `out` (0-based), by
+  /// C (sI-A)^{-1} B = [det(sI - A + B C) - det(sI - A)] / det(sI - A).
+  TransferFunction to_transfer_function(int out = 0, int in = 0) const;
+  /// G(j w) for one (out, in) pair at each w (rad/s).
+  Eigen::VectorXcd frequency_response(const Eigen::VectorXd& w, int out = 0, int in = 0) const;
+
+ private:
+  Eigen::MatrixXd A_, B_, C_, D_;
+};
+
+}  // namespace ctid

@@ -1,0 +1,57 @@
+// ctid — exact simulation of linear continuous-time models (DESIGN.md §6).
+//
+// Between two sample times the input is either held (ZOH) or linear (FOH; BandLimited
+// inputs are treated as FOH). Over an interval of length h the state moves exactly:
+//   x(t+h) = Phi x(t) + Gamma0 u(t+) + Gamma1 (u((t+h)-) - u(t+)),
+// where Phi, Gamma0 and h*Gamma1 are the blocks of exp([[A, B, 0], [0, 0, I], [0, 0, 0]] h)
+// (Gamma1 = 0 for ZOH). Irregular sample times get a per-interval exponential; an input
+// delay splits intervals where the delayed input changes, so delays need not be a
+// multiple of the sampling period. The input is taken as zero before the first sample
+// (the system at rest with x0 unless x0 is given).
+#pragma once
+
+#include <Eigen/Dense>
+
+#include "ctid/data/iddata.hpp"
+#include "ctid/model/state_space.hpp"
+#include "ctid/model/transfer_function.hpp"
+
+namespace ctid {
+
+/// Exact discretisation of (A, B) over one interval of length h (see file comment).
+struct Discretization {
+  Eigen::MatrixXd Phi, Gamma0, Gamma1;
+  double h = 0.0;
+};
+/// Throws InvalidArgument for h <= 0 or non-finite.
+Discretization discretize(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, double h);
+
+/// Matrix exponential exp(M) (Pade with scaling and squaring).
+Eigen::MatrixXd expm(const Eigen::MatrixXd& M);
+
+struct LsimOptions {
+  Eigen::VectorXd x0;         ///< initial state (empty: zero)
+  double input_delay = 0.0;   ///< seconds, applied to every input (>= 0)
+};
+
+/// Simulate y (N x ny) for inputs u (N x nu) at times t (strictly increasing) with the
+/// intersample behaviour of each input. Throws InvalidArgument for size mismatches.
+Eigen::MatrixXd lsim(const StateSpace& sys, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
+                     const std::vector<Intersample>& intersample, const LsimOptions& options = {});
+/// Same on an experiment: uses its inputs, times and intersample behaviour.
+Eigen::MatrixXd lsim(const StateSpace& sys, const IdData& data, const LsimOptions& options = {});
+/// Simulate a SISO transfer function (with its delay) driven by input column `input`.
+Eigen::VectorXd lsim(const TransferFunction& tf, const IdData& data, int input = 0);
+/// Simulate a SISO transfer function on (u, t) with the given intersample behaviour.
+Eigen::VectorXd lsim(const TransferFunction& tf, const Eigen::VectorXd& u, const Eigen::VectorXd& t,
+                     Intersample intersample = Intersample::Zoh);
+
+/// Unit-step response at the times t (t >= 0, increasing): step applied at t = 0.
+Eigen::VectorXd step_response(const TransferFunction& tf, const Eigen::VectorXd& t);
+/// Impulse response g(t) = C e^{A (t - Td)} B for t >= Td, 0 before; a direct term
+/// (Dirac at Td) is not representable on samples and is left out.
+Eigen::VectorXd impulse_response(const TransferFunction& tf, const Eigen::VectorXd& t);
+/// n equally spaced times 0, h, ..., (n-1) h.
+Eigen::VectorXd time_grid(double h, int n);
+
+}  // namespace ctid

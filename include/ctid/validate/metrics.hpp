@@ -1,0 +1,28 @@
+// ctid — goodness-of-fit metrics (definitions in ctid::FitReport, core/types.hpp).
+#pragma once
+
+#include <Eigen/Dense>
+
+#include "ctid/core/types.hpp"
+
+namespace ctid {
+
+/// 100 (1 - ||y - yhat|| / ||y - mean(y)||). Throws InvalidArgument for size mismatch,
+/// fewer than 2 samples or a constant y.
+double fit_percent(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat);
+/// ||y - yhat|| / ||y - mean(y)||.
+double nrmse(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat);
+/// mean((y - yhat)^2).
+double mse(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat);
+/// Akaike's final prediction error V (1 + d/N) / (1 - d/N); +Inf when d >= N.
+double fpe(double mse, int n_samples, int n_parameters);
+/// N ln V + 2 d.
+double aic(double mse, int n_samples, int n_parameters);
+/// AIC + 2 d (d + 1) / (N - d - 1); +Inf when N - d - 1 <= 0.
+double aicc(double mse, int n_samples, int n_parameters);
+/// N ln V + d ln N.
+double bic(double mse, int n_samples, int n_parameters);
+/// All of the above for measured y and model output yhat with d free parameters.
+FitReport fit_report(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, int n_parameters);
+
+}  // namespace ctid

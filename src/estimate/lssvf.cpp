@@ -1,0 +1,367 @@
+// LSSVF / IVSVF — Johansson (1986) RJ 11-25, 44, 52-55, 59-61 (SEEDS-SPEC RJ-A1..A5).
+// See include/ctid/estimate/lssvf.hpp.
+#include "ctid/estimate/lssvf.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "ctid/core/check.hpp"
+#include "ctid/signal/svf.hpp"
+#include "ctid/simulate/lsim.hpp"
+#include "ctid/validate/metrics.hpp"
+#include "estimate/svf_common.hpp"
+#include "internal/least_squares.hpp"
+
+namespace ctid {
+
+void LssvfOptions::validate() const {
+  CTID_REQUIRE_OPTION(std::isfinite(tau) && tau >= 0, "lssvf: tau must be > 0, or 0 for automatic (got {})", tau);
+  CTID_REQUIRE_OPTION(std::isfinite(alpha) && alpha >= 0, "lssvf: alpha must be >= 0 (got {})", alpha);
+  CTID_REQUIRE_OPTION(std::isfinite(transient_time) && transient_time >= 0,
+                      "lssvf: transient_time must be >= 0 (got {} s)", transient_time);
+  CTID_REQUIRE_OPTION(tau_grid_size >= 2, "lssvf: tau_grid_size must be >= 2 (got {})", tau_grid_size);
+  for (const auto& [name, v] : fixed)
+    CTID_REQUIRE_OPTION(std::isfinite(v), "lssvf: fixed value of {} must be finite (got {})", name, v);
+  if (data_filter) {
+    CTID_REQUIRE_OPTION(data_filter->is_stable(), "lssvf: data_filter must be stable (got {})", data_filter->to_string());
+    CTID_REQUIRE_OPTION(data_filter->io_delay() == 0.0, "lssvf: data_filter must have no delay (got {} s)",
+                        data_filter->io_delay());
+  }
+}
+
+void IvsvfOptions::validate() const {
+  svf.validate();
+  CTID_REQUIRE_OPTION(max_iterations >= 1, "ivsvf: max_iterations must be >= 1 (got {})", max_iterations);
+  CTID_REQUIRE_OPTION(tolerance > 0 && std::isfinite(tolerance), "ivsvf: tolerance must be > 0 (got {})", tolerance);
+}
+
+std::vector<std::string> tf_parameter_names(const TfOrders& o) {
+  std::vector<std::string> names;
+  for (int i = 1; i <= o.nf; ++i) names.push_back("a" + std::to_string(i));
+  for (int j = 0; j < o.nb; ++j) names.push_back("b" + std::to_string(j));
+  return names;
+}
+
+namespace svf_detail {
+
+SvfLayout make_layout(const TfOrders& o, double tau, const std::map<std::string, double>& fixed, const char* who) {
+  SvfLayout L;
+  L.n = o.nf;
+  L.nb = o.nb;
+  L.tau = tau;
+  L.M = svf_m_tau(L.n, tau);
+  L.g = svf_g_tau(L.n);
+  L.fixed.assign(2 * L.n, false);
+  L.theta_fixed = Eigen::VectorXd::Zero(2 * L.n);
+  for (int i = 0; i < L.n - L.nb; ++i) L.fixed[L.n + i] = true;  // leading b's are zero
+  const auto names = tf_parameter_names(o);
+  for (const auto& [name, value] : fixed) {
+    int idx = -1;
+    for (std::size_t k = 0; k < names.size(); ++k)
+      if (names[k] == name) idx = static_cast<int>(k);
+    if (idx < 0) {
+      std::string known;
+      for (const auto& nm : names) known += (known.empty() ? "" : ", ") + nm;
+      throw InvalidOptions(detail::format("{}: fixed coefficient '{}' is not a parameter of this structure ({})", who, name, known));
+    }
+    const int t = L.theta_index(idx);
+    L.fixed[t] = true;
+    L.theta_fixed(t) = idx < L.n ? -value : value;
+  }
+  for (int t = 0; t < 2 * L.n; ++t)
+    if (!L.fixed[t]) L.free.push_back(t);
+  CTID_REQUIRE_OPTION(!L.free.empty(), "{}: every coefficient is fixed; nothing to estimate", who);
+  return L;
+}
+
+PreparedData prepare(const IdData& data, const TfOrders& o, double transient_time, double alpha, SvfWeights weights,
+                     const char* who) {
+  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1,
+               "{}: needs one input and one output (data has {} inputs, {} outputs); select channels first", who,
+               data.nu(), data.ny());
+  CTID_REQUIRE(o.nk == 0 || data.is_uniform(), "{}: nk = {} needs uniformly sampled data (these are irregular)", who, o.nk);
+  CTID_REQUIRE(o.nk < data.size(), "{}: nk = {} is not shorter than the record ({} samples)", who, o.nk, data.size());
+  PreparedData P;
+  const int N = data.size();
+  P.data = &data;
+  P.uniform = data.is_uniform();
+  P.h = P.uniform ? data.ts() : data.duration() / std::max(1, N - 1);
+  P.y = data.y().col(0);
+  P.u = Eigen::VectorXd::Zero(N);
+  P.u.tail(N - o.nk) = data.u().col(0).head(N - o.nk);
+  P.u_intersample = data.intersample(0);
+  P.w = Eigen::VectorXd::Zero(N);
+  const double t0 = data.t0(), tend = data.time(N - 1);
+  int first = 0;
+  while (first < N && data.time(first) - t0 < transient_time - 1e-12 * std::max(1.0, transient_time)) ++first;
+  CTID_REQUIRE(first < N, "{}: transient_time = {} s leaves no samples (record lasts {} s)", who, transient_time,
+               data.duration());
+  for (int k = first; k < N; ++k) {
+    const double hb = k > first ? data.time(k) - data.time(k - 1) : (k + 1 < N ? data.time(k + 1) - data.time(k) : P.h);
+    const double ha = k + 1 < N ? data.time(k + 1) - data.time(k) : hb;
+    double w = 1.0;
+    if (weights == SvfWeights::Riemann) w = hb / P.h;
+    else w = (k == first ? ha / 2 : (k == N - 1 ? hb / 2 : (ha + hb) / 2)) / P.h;
+    if (alpha > 0) w *= std::exp(2.0 * alpha * (data.time(k) - tend));
+    P.w(k) = w;
+  }
+  P.n_used = N - first;
+  return P;
+}
+
+internal::LinearSolution solve_ls(const PreparedData& P, const SvfLayout& L, const std::optional<TransferFunction>& filt) {
+  const int p = static_cast<int>(L.free.size());
+  internal::StreamingLeastSquares ls(p);
+  std::vector<double> row(p);
+  svf_pass(P, L, filt, nullptr, [&](const double* psi, double lhs, const double*, double w) {
+    for (int j = 0; j < p; ++j) row[j] = psi[L.free[j]];
+    ls.add(row.data(), lhs, w);
+  });
+  return ls.solve();
+}
+
+internal::LinearSolution solve_iv(const PreparedData& P, const SvfLayout& L, const std::optional<TransferFunction>& filt,
+                                  const Eigen::VectorXd& aux) {
+  const int p = static_cast<int>(L.free.size());
+  internal::InstrumentalVariables iv(p);
+  std::vector<double> row(p), zrow(p);
+  svf_pass(P, L, filt, &aux, [&](const double* psi, double lhs, const double* zeta, double w) {
+    for (int j = 0; j < p; ++j) {
+      row[j] = psi[L.free[j]];
+      zrow[j] = zeta[L.free[j]];
+    }
+    iv.add(zrow.data(), row.data(), lhs, w);
+  });
+  return iv.solve();
+}
+
+Eigen::VectorXd full_theta(const SvfLayout& L, const Eigen::VectorXd& theta_free) {
+  Eigen::VectorXd th = L.theta_fixed;
+  for (std::size_t j = 0; j < L.free.size(); ++j) th(L.free[j]) = theta_free(static_cast<Eigen::Index>(j));
+  return th;
+}
+
+TransferFunction tf_from_theta(const SvfLayout& L, const Eigen::VectorXd& th, double delay) {
+  Eigen::VectorXd den(L.n + 1), num(L.nb);
+  den(0) = 1.0;
+  den.tail(L.n) = -th.head(L.n);
+  num = th.tail(L.nb);
+  return TransferFunction(num, den, delay);
+}
+
+Result<TransferFunction> make_result(const IdData& data, const TfOrders& o, const SvfLayout& L,
+                                     const internal::LinearSolution& sol, double alpha) {
+  Result<TransferFunction> r;
+  const Eigen::VectorXd th = full_theta(L, sol.theta);
+  const double delay = o.nk > 0 ? o.nk * data.ts() : 0.0;
+  const int np = o.nf + o.nb;
+  r.parameters.names = tf_parameter_names(o);
+  r.parameters.values.resize(np);
+  r.parameters.fixed.assign(np, false);
+  r.parameters.covariance = Eigen::MatrixXd::Zero(np, np);
+  // Map between the parameter vector [a1..an, b0..b(nb-1)] and theta = [-a, b_1..b_n].
+  Eigen::VectorXd sign(np);
+  std::vector<int> tidx(np);
+  for (int i = 0; i < np; ++i) {
+    tidx[i] = L.theta_index(i);
+    sign(i) = i < L.n ? -1.0 : 1.0;
+    r.parameters.values(i) = sign(i) * th(tidx[i]);
+    r.parameters.fixed[i] = L.fixed[tidx[i]];
+  }
+  for (int i = 0; i < np; ++i)
+    for (int j = 0; j < np; ++j) {
+      int fi = -1, fj = -1;
+      for (std::size_t k = 0; k < L.free.size(); ++k) {
+        if (L.free[k] == tidx[i]) fi = static_cast<int>(k);
+        if (L.free[k] == tidx[j]) fj = static_cast<int>(k);
+      }
+      if (fi >= 0 && fj >= 0) r.parameters.covariance(i, j) = sign(i) * sign(j) * sol.covariance(fi, fj);
+    }
+  r.parameters.std = r.parameters.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  for (int i = 0; i < np; ++i)
+    if (r.parameters.fixed[i]) r.parameters.std(i) = 0.0;
+
+  r.model = tf_from_theta(L, th, delay);
+  r.diagnostics.condition_number = sol.condition;
+  r.diagnostics.scalars["tau"] = L.tau;
+  r.diagnostics.scalars["equation_error_variance"] = sol.sigma2;
+  r.diagnostics.vectors["theta_tau"] = svf_transform(L, th);
+  if (sol.rank_deficient) {
+    r.summary.termination = Termination::RankDeficient;
+    r.summary.message = detail::format(
+        "the filtered regressor is rank deficient (scaled condition number {}); the input does not excite all {} "
+        "parameters, or tau = {} s is far from the system's time scale",
+        sol.condition, L.free.size(), L.tau);
+  }
+  // Diagnostics of RJ-A4 and RJ-A5.
+  const double s0 = -1.0 / L.tau;
+  double bscale = 0;
+  for (int i = 0; i < L.nb; ++i) bscale += std::abs(th(L.n + L.n - L.nb + i)) * std::pow(std::abs(s0), L.nb - 1 - i);
+  const double b_at = r.model.num()(s0);
+  r.diagnostics.scalars["B_at_minus_1_over_tau"] = b_at;
+  if (bscale > 0 && std::abs(b_at) < 1e-2 * bscale)
+    r.diagnostics.warnings.push_back(detail::format(
+        "B(-1/tau) = {} is nearly zero: a zero of the model is close to -1/tau = {}; the regressor is nearly singular "
+        "in that direction (RJ identifiability condition); choose another tau",
+        b_at, s0));
+  if (!r.model.is_stable()) r.diagnostics.warnings.push_back("the estimated model is unstable");
+  if (alpha > 0) {
+    if (L.tau >= 1.0 / alpha)
+      r.diagnostics.warnings.push_back(detail::format(
+          "tau = {} s is not below 1/alpha = {} s: exponential weighting needs z(s - alpha) stable (RJ 55)", L.tau,
+          1.0 / alpha));
+    const Eigen::VectorXcd poles = r.model.poles();
+    for (Eigen::Index i = 0; i < poles.size(); ++i)
+      if (poles(i).real() >= -alpha) {
+        r.diagnostics.warnings.push_back(detail::format(
+            "pole {} + {}j has real part >= -alpha = {}: G(s - alpha) is not stable (RJ 55)", poles(i).real(),
+            poles(i).imag(), -alpha));
+        break;
+      }
+  }
+  // Output-error fit of the model on the estimation data.
+  const Eigen::VectorXd yhat = lsim(r.model, data, 0);
+  const int d = static_cast<int>(L.free.size());
+  if (yhat.allFinite() && data.size() > 2 && (data.y().col(0).array() - data.y().col(0).mean()).abs().maxCoeff() > 0)
+    r.fit = fit_report(data.y().col(0), yhat, d);
+  else {
+    r.fit.n_samples = data.size();
+    r.fit.n_parameters = d;
+    r.fit.fit_percent = -std::numeric_limits<double>::infinity();
+    r.fit.nrmse = r.fit.mse = std::numeric_limits<double>::infinity();
+  }
+  return r;
+}
+
+Eigen::VectorXd svf_transform(const SvfLayout& L, const Eigen::VectorXd& th) {
+  Eigen::VectorXd tt(2 * L.n);
+  tt.head(L.n) = L.M * th.head(L.n) + L.g;
+  tt.tail(L.n) = L.M * th.tail(L.n);
+  return tt;
+}
+
+double choose_tau(const IdData& data, const TfOrders& o, const LssvfOptions& opt, Eigen::VectorXd* grid_out,
+                  Eigen::VectorXd* fit_out) {
+  const PreparedData P = prepare(data, o, opt.transient_time, opt.alpha, opt.weights, "lssvf");
+  const double lo = 2.0 * P.h;
+  const double hi = std::max(lo * 4.0, data.duration() / 20.0);
+  const int G = opt.tau_grid_size;
+  Eigen::VectorXd grid(G), fits(G);
+  double best_tau = lo, best_fit = -std::numeric_limits<double>::infinity();
+  bool have = false;
+  for (int i = 0; i < G; ++i) {
+    const double tau = lo * std::pow(hi / lo, double(i) / (G - 1));
+    grid(i) = tau;
+    fits(i) = -std::numeric_limits<double>::infinity();
+    const SvfLayout L = make_layout(o, tau, opt.fixed, "lssvf");
+    const internal::LinearSolution s = solve_ls(P, L, opt.data_filter);
+    if (s.rank_deficient || !s.theta.allFinite()) continue;
+    const TransferFunction tf = tf_from_theta(L, full_theta(L, s.theta), o.nk > 0 ? o.nk * data.ts() : 0.0);
+    if (!tf.is_stable()) continue;
+    const Eigen::VectorXd yhat = lsim(tf, data, 0);
+    if (!yhat.allFinite()) continue;
+    const double f = fit_percent(data.y().col(0), yhat);
+    fits(i) = f;
+    if (f > best_fit) { best_fit = f; best_tau = tau; have = true; }
+  }
+  if (grid_out) *grid_out = grid;
+  if (fit_out) *fit_out = fits;
+  return have ? best_tau : std::sqrt(lo * hi);
+}
+
+}  // namespace svf_detail
+
+using namespace svf_detail;
+
+Result<TransferFunction> lssvf(const IdData& data, const TfOrders& orders, const LssvfOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  orders.validate();
+  options.validate();
+  Eigen::VectorXd grid, fits;
+  double tau = options.tau;
+  if (tau == 0.0) tau = choose_tau(data, orders, options, &grid, &fits);
+  const PreparedData P = prepare(data, orders, options.transient_time, options.alpha, options.weights, "lssvf");
+  const SvfLayout L = make_layout(orders, tau, options.fixed, "lssvf");
+  CTID_REQUIRE(P.n_used > static_cast<int>(L.free.size()),
+               "lssvf: {} samples in the criterion cannot determine {} free parameters", P.n_used, L.free.size());
+  const internal::LinearSolution sol = solve_ls(P, L, options.data_filter);
+  Result<TransferFunction> r = make_result(data, orders, L, sol, options.alpha);
+  if (grid.size() > 0) {
+    r.diagnostics.vectors["tau_grid"] = grid;
+    r.diagnostics.vectors["tau_grid_fit_percent"] = fits;
+  }
+  r.summary.iterations = 1;
+  r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+Result<TransferFunction> ivsvf(const IdData& data, const TfOrders& orders, const IvsvfOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  orders.validate();
+  options.validate();
+  Result<TransferFunction> r = lssvf(data, orders, options.svf);
+  if (!r.usable()) return r;
+  const double tau = r.diagnostics.scalars.at("tau");
+  const PreparedData P = prepare(data, orders, options.svf.transient_time, options.svf.alpha, options.svf.weights, "ivsvf");
+  const SvfLayout L = make_layout(orders, tau, options.svf.fixed, "ivsvf");
+  Eigen::VectorXd theta = full_theta(L, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(L.free.size())));
+  for (std::size_t j = 0; j < L.free.size(); ++j) {
+    const int t = L.free[j];
+    const int i = L.param_index(t);
+    theta(t) = (i < L.n ? -1.0 : 1.0) * r.parameters.values(i);
+  }
+  internal::LinearSolution sol;
+  bool converged = false;
+  int it = 0;
+  Termination term = Termination::MaxIterations;
+  for (it = 1; it <= options.max_iterations; ++it) {
+    TransferFunction aux = tf_from_theta(L, theta, 0.0);
+    aux = stabilized(aux);
+    // Auxiliary-model output driven by the (delayed) input P.u.
+    const Eigen::VectorXd xhat = lsim(aux, P.u, data.times(), P.u_intersample);
+    sol = solve_iv(P, L, options.svf.data_filter, xhat);
+    if (sol.rank_deficient || !sol.theta.allFinite()) {
+      term = sol.rank_deficient ? Termination::RankDeficient : Termination::NumericalFailure;
+      break;
+    }
+    const Eigen::VectorXd next = full_theta(L, sol.theta);
+    const double change = (next - theta).norm() / std::max(1e-300, next.norm());
+    theta = next;
+    if (change < options.tolerance) {
+      converged = true;
+      term = Termination::Converged;
+      break;
+    }
+  }
+  Result<TransferFunction> out = make_result(data, orders, L, sol, options.svf.alpha);
+  out.summary.iterations = std::min(it, options.max_iterations);
+  if (!converged && out.summary.termination == Termination::Completed) {
+    out.summary.termination = term;
+    if (term == Termination::MaxIterations)
+      out.summary.message = detail::format("IV iterations did not converge to a relative change of {} within {} iterations",
+                                           options.tolerance, options.max_iterations);
+    else if (out.summary.message.empty())
+      out.summary.message = "the instrumental-variable equations became singular or non-finite";
+  } else if (converged) {
+    out.summary.termination = Termination::Converged;
+  }
+  out.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace ctid
+
+namespace ctid::svf_detail {
+
+TransferFunction stabilized(const TransferFunction& tf) {
+  if (tf.is_stable()) return tf;
+  Eigen::VectorXcd p = tf.poles();
+  for (Eigen::Index i = 0; i < p.size(); ++i) {
+    if (p(i).real() > 0) p(i) = std::complex<double>(-p(i).real(), p(i).imag());
+    else if (p(i).real() == 0) p(i) = std::complex<double>(-1e-6 * std::max(1.0, std::abs(p(i))), p(i).imag());
+  }
+  return TransferFunction(tf.num(), Polynomial::from_roots(p), tf.io_delay());
+}
+
+}  // namespace ctid::svf_detail

@@ -1,0 +1,243 @@
+// Recursive LSSVF (Johansson 1986, RJ 52-53, 59-60) and the single-coefficient tracker
+// (RJ 74-79; SEEDS-SPEC RJ-A6, RJ-A7). See include/ctid/estimate/rls_svf.hpp.
+#include "ctid/estimate/rls_svf.hpp"
+
+#include <cmath>
+
+#include "ctid/core/check.hpp"
+#include "estimate/svf_common.hpp"
+
+namespace ctid {
+
+void RlsSvfOptions::validate() const {
+  CTID_REQUIRE_OPTION(std::isfinite(tau) && tau > 0, "rls_svf: tau must be > 0 (got {})", tau);
+  CTID_REQUIRE_OPTION(std::isfinite(p0) && p0 > 0, "rls_svf: p0 must be > 0 (got {})", p0);
+  CTID_REQUIRE_OPTION(forgetting > 0 && forgetting <= 1, "rls_svf: forgetting must be in (0, 1] (got {})", forgetting);
+  CTID_REQUIRE_OPTION(std::isfinite(alpha) && alpha >= 0, "rls_svf: alpha must be >= 0 (got {})", alpha);
+  CTID_REQUIRE_OPTION(std::isfinite(regression_interval) && regression_interval >= 0,
+                      "rls_svf: regression_interval must be >= 0 (got {})", regression_interval);
+}
+
+RlsSvf::RlsSvf(const TfOrders& orders, const RlsSvfOptions& options) : orders_(orders), opt_(options) {
+  orders_.validate();
+  opt_.validate();
+  CTID_REQUIRE_OPTION(orders_.nk == 0, "rls_svf: nk must be 0 for the recursive estimator (got {}); delay the input yourself",
+                      orders_.nk);
+  const svf_detail::SvfLayout L = svf_detail::make_layout(orders_, opt_.tau, opt_.fixed, "rls_svf");
+  M_ = L.M;
+  g_ = L.g;
+  fixed_ = L.fixed;
+  theta_fixed_ = L.theta_fixed;
+  free_ = L.free;
+  const int n = orders_.nf;
+  theta_tau_mode_ = opt_.fixed.empty() && orders_.nb == n;
+  const int p = theta_tau_mode_ ? 2 * n : static_cast<int>(free_.size());
+  if (opt_.theta0.size() > 0)
+    CTID_REQUIRE_OPTION(opt_.theta0.size() == orders_.n_parameters(), "rls_svf: theta0 needs {} values [a1.., b0..] (got {})",
+                        orders_.n_parameters(), opt_.theta0.size());
+  bank_ = std::make_unique<SvfFilterBank>(n, opt_.tau,
+                                          std::vector<Intersample>{Intersample::Foh, opt_.input_intersample});
+  theta_.resize(p);
+  P_.resize(p, p);
+  Pphi_.resize(p);
+  row_.resize(p);
+  psi_.resize(2 * n);
+  reset();
+}
+
+void RlsSvf::reset() {
+  const int n = orders_.nf;
+  bank_->reset();
+  P_.setIdentity();
+  P_ *= opt_.p0;
+  theta_.setZero();
+  if (opt_.theta0.size() > 0) {
+    Eigen::VectorXd th = theta_fixed_;
+    svf_detail::SvfLayout L;
+    L.n = n;
+    L.nb = orders_.nb;
+    for (int i = 0; i < orders_.n_parameters(); ++i) {
+      const int t = L.theta_index(i);
+      if (!fixed_[t]) th(t) = (i < n ? -1.0 : 1.0) * opt_.theta0(i);
+    }
+    if (theta_tau_mode_) {
+      theta_.head(n) = M_ * th.head(n) + g_;
+      theta_.tail(n) = M_ * th.tail(n);
+    } else {
+      for (std::size_t j = 0; j < free_.size(); ++j) theta_(static_cast<Eigen::Index>(j)) = th(free_[j]);
+    }
+  }
+  started_ = false;
+  n_updates_ = 0;
+}
+
+void RlsSvf::update(double t, double u, double y) {
+  CTID_REQUIRE(std::isfinite(t) && std::isfinite(u) && std::isfinite(y), "rls_svf: non-finite sample (t = {}, u = {}, y = {})",
+               t, u, y);
+  double next[2] = {y, u};
+  if (!started_) {
+    bank_->set_current(next);
+    started_ = true;
+    t_ = t_reg_ = t;
+    y_prev_ = y;
+    u_prev_ = u;
+    return;
+  }
+  CTID_REQUIRE(t > t_, "rls_svf: sample times must increase (t = {} after {})", t, t_);
+  const double prev[2] = {y_prev_, u_prev_};
+  bank_->step(t - t_, prev, next);
+  t_ = t;
+  y_prev_ = y;
+  u_prev_ = u;
+  const double ri = opt_.regression_interval;
+  if (ri > 0 && t - t_reg_ < ri * (1.0 - 1e-9)) return;
+  const double dt = t - t_reg_;
+  t_reg_ = t;
+
+  const int n = orders_.nf;
+  const int p = static_cast<int>(theta_.size());
+  const double* phy = bank_->chain(0);
+  const double* phu = bank_->chain(1);
+  double target;
+  if (theta_tau_mode_) {
+    for (int i = 0; i < n; ++i) {
+      row_(i) = phy[i];
+      row_(n + i) = phu[i];
+    }
+    target = bank_->filtered(0);
+  } else {
+    svf_detail::physical_regressor(M_, phy, phu, psi_.data());
+    target = bank_->filtered(0);
+    for (int i = 0; i < n; ++i) target -= g_(i) * phy[i];
+    for (int k = 0; k < 2 * n; ++k)
+      if (fixed_[k]) target -= theta_fixed_(k) * psi_(k);
+    for (int j = 0; j < p; ++j) row_(j) = psi_(free_[j]);
+  }
+  const double lambda = opt_.forgetting * (opt_.alpha > 0 ? std::exp(-2.0 * opt_.alpha * dt) : 1.0);
+  // RLS (RJ 59-60) with forgetting: K = P phi / (lambda + phi' P phi), P = (P - K phi' P) / lambda.
+  double den = lambda, err = target;
+  for (int i = 0; i < p; ++i) {
+    double s = 0;
+    for (int j = 0; j < p; ++j) s += P_(i, j) * row_(j);
+    Pphi_(i) = s;
+    den += row_(i) * s;
+    err -= theta_(i) * row_(i);
+  }
+  for (int i = 0; i < p; ++i) theta_(i) += Pphi_(i) / den * err;
+  const double il = 1.0 / lambda;
+  for (int j = 0; j < p; ++j)
+    for (int i = 0; i < p; ++i) P_(i, j) = (P_(i, j) - Pphi_(i) * Pphi_(j) / den) * il;
+  ++n_updates_;
+}
+
+Eigen::VectorXd RlsSvf::theta_tau() const {
+  const int n = orders_.nf;
+  if (theta_tau_mode_) return theta_;
+  Eigen::VectorXd th = theta_fixed_;
+  for (std::size_t j = 0; j < free_.size(); ++j) th(free_[j]) = theta_(static_cast<Eigen::Index>(j));
+  Eigen::VectorXd tt(2 * n);
+  tt.head(n) = M_ * th.head(n) + g_;
+  tt.tail(n) = M_ * th.tail(n);
+  return tt;
+}
+
+Eigen::VectorXd RlsSvf::parameters() const {
+  const int n = orders_.nf, nb = orders_.nb;
+  Eigen::VectorXd a, b;
+  ab_from_theta_tau(theta_tau(), opt_.tau, a, b);
+  Eigen::VectorXd out(n + nb);
+  out.head(n) = a;
+  out.tail(nb) = b.tail(nb);
+  return out;
+}
+
+TransferFunction RlsSvf::model() const {
+  const Eigen::VectorXd p = parameters();
+  const int n = orders_.nf, nb = orders_.nb;
+  Eigen::VectorXd den(n + 1);
+  den(0) = 1.0;
+  den.tail(n) = p.head(n);
+  return TransferFunction(Eigen::VectorXd(p.tail(nb)), den);
+}
+
+// ---------------------------------------------------------------------------------------
+void CoefficientTrackerOptions::validate() const {
+  CTID_REQUIRE_OPTION(std::isfinite(tau) && tau > 0, "coefficient_tracker: tau must be > 0 (got {})", tau);
+  CTID_REQUIRE_OPTION(std::isfinite(threshold) && threshold > 0, "coefficient_tracker: threshold must be > 0 (got {})",
+                      threshold);
+  CTID_REQUIRE_OPTION(std::isfinite(regression_interval) && regression_interval >= 0,
+                      "coefficient_tracker: regression_interval must be >= 0 (got {})", regression_interval);
+}
+
+CoefficientTracker::CoefficientTracker(const TransferFunction& known, const std::string& unknown,
+                                       const CoefficientTrackerOptions& o)
+    : threshold_(o.threshold), h_(o.regression_interval) {
+  o.validate();
+  n_ = known.order();
+  CTID_REQUIRE(n_ >= 1, "coefficient_tracker: the known model must have order >= 1");
+  CTID_REQUIRE(known.num().degree() < n_ || known.num().is_zero(),
+               "coefficient_tracker: the known model must be strictly proper (numerator degree {}, order {})",
+               known.num().degree(), n_);
+  const TfOrders orders{n_, n_, 0};
+  const auto names = tf_parameter_names(orders);
+  int idx = -1;
+  for (std::size_t k = 0; k < names.size(); ++k)
+    if (names[k] == unknown) idx = static_cast<int>(k);
+  if (idx < 0) {
+    std::string list;
+    for (const auto& nm : names) list += (list.empty() ? "" : ", ") + nm;
+    throw InvalidOptions(detail::format("coefficient_tracker: '{}' is not a coefficient of this model ({})", unknown, list));
+  }
+  M_ = svf_m_tau(n_, o.tau);
+  g_ = svf_g_tau(n_);
+  theta_.resize(2 * n_);
+  for (int i = 0; i < n_; ++i) {
+    theta_(i) = -known.den().coefficients()(i + 1);
+    theta_(n_ + i) = known.num().coefficient_of_power(n_ - 1 - i);
+  }
+  j_ = idx;  // parameter index equals theta index when nb = n
+  sign_ = idx < n_ ? -1.0 : 1.0;
+  estimate_ = sign_ * theta_(j_);
+  psi_.resize(2 * n_);
+  bank_ = std::make_unique<SvfFilterBank>(n_, o.tau, std::vector<Intersample>{Intersample::Foh, o.input_intersample});
+}
+
+const double* CoefficientTracker::filtered_output() const { return bank_->chain(0); }
+
+void CoefficientTracker::update(double t, double u, double y) {
+  CTID_REQUIRE(std::isfinite(t) && std::isfinite(u) && std::isfinite(y),
+               "coefficient_tracker: non-finite sample (t = {}, u = {}, y = {})", t, u, y);
+  updated_ = false;
+  double next[2] = {y, u};
+  if (!started_) {
+    bank_->set_current(next);
+    started_ = true;
+    t_ = t_reg_ = t;
+    y_prev_ = y;
+    u_prev_ = u;
+    return;
+  }
+  CTID_REQUIRE(t > t_, "coefficient_tracker: sample times must increase (t = {} after {})", t, t_);
+  const double prev[2] = {y_prev_, u_prev_};
+  bank_->step(t - t_, prev, next);
+  t_ = t;
+  y_prev_ = y;
+  u_prev_ = u;
+  if (h_ > 0 && t - t_reg_ < h_ * (1.0 - 1e-9)) return;
+  t_reg_ = t;
+  const double* phy = bank_->chain(0);
+  const double* phu = bank_->chain(1);
+  svf_detail::physical_regressor(M_, phy, phu, psi_.data());
+  double lhs = bank_->filtered(0);
+  for (int i = 0; i < n_; ++i) lhs -= g_(i) * phy[i];
+  for (int k = 0; k < 2 * n_; ++k)
+    if (k != j_) lhs -= theta_(k) * psi_(k);
+  last_psi_ = psi_(j_);
+  if (std::abs(last_psi_) >= threshold_) {
+    theta_(j_) = lhs / last_psi_;
+    estimate_ = sign_ * theta_(j_);
+    updated_ = true;
+  }
+}
+
+}  // namespace ctid

@@ -1,0 +1,116 @@
+#include "internal/least_squares.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include <Eigen/SVD>
+
+#include "ctid/core/check.hpp"
+
+namespace ctid::internal {
+
+double scaled_condition(const Eigen::MatrixXd& M) {
+  if (M.size() == 0) return 1.0;
+  Eigen::MatrixXd S = M;
+  for (Eigen::Index j = 0; j < S.cols(); ++j) {
+    const double nj = S.col(j).norm();
+    if (nj > 0) S.col(j) /= nj;
+  }
+  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(S).singularValues();
+  const double smin = sv(sv.size() - 1);
+  return smin > 0 ? sv(0) / smin : std::numeric_limits<double>::infinity();
+}
+
+StreamingLeastSquares::StreamingLeastSquares(int p, int block)
+    : p_(p), buf_(Eigen::MatrixXd::Zero(p + 1 + block, p + 1)), fill_(p + 1), qr_(p + 1 + block, p + 1) {
+  CTID_ASSERT(p >= 1 && block >= 1);
+}
+
+void StreamingLeastSquares::compress() {
+  if (fill_ == p_ + 1) return;
+  const Eigen::Index rows = fill_;
+  qr_.compute(buf_.topRows(rows));
+  const Eigen::Index k = std::min<Eigen::Index>(rows, p_ + 1);
+  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(p_ + 1, p_ + 1);
+  R.topRows(k) = qr_.matrixQR().topRows(k).triangularView<Eigen::Upper>();
+  buf_.setZero();
+  buf_.topRows(p_ + 1) = R;
+  fill_ = p_ + 1;
+}
+
+LinearSolution StreamingLeastSquares::solve(double tol) {
+  compress();
+  LinearSolution s;
+  s.n_rows = rows_;
+  // Rescale weights so that their sum equals the effective sample size (Kish); with
+  // equal weights this is the ordinary LS covariance.
+  const double neff = sumw2_ > 0 ? sumw_ * sumw_ / sumw2_ : 0.0;
+  const double c = sumw_ > 0 ? neff / sumw_ : 1.0;
+  const Eigen::MatrixXd Ra = buf_.topRows(p_ + 1) * std::sqrt(c);
+  const Eigen::MatrixXd R = Ra.topLeftCorner(p_, p_);
+  const Eigen::VectorXd z = Ra.col(p_).head(p_);
+  s.rss = Ra(p_, p_) * Ra(p_, p_);
+  s.condition = scaled_condition(R);
+  s.rank_deficient = !(s.condition < 1.0 / tol);
+  if (s.rank_deficient) {
+    s.theta = R.completeOrthogonalDecomposition().solve(z);
+  } else {
+    s.theta = R.triangularView<Eigen::Upper>().solve(z);
+  }
+  s.sigma2 = neff > p_ ? s.rss / (neff - p_) : std::numeric_limits<double>::quiet_NaN();
+  if (!s.rank_deficient) {
+    const Eigen::MatrixXd Rinv = R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(p_, p_));
+    s.covariance = s.sigma2 * Rinv * Rinv.transpose();
+  } else {
+    s.covariance = Eigen::MatrixXd::Constant(p_, p_, std::numeric_limits<double>::quiet_NaN());
+  }
+  return s;
+}
+
+InstrumentalVariables::InstrumentalVariables(int p)
+    : p_(p), zx_(Eigen::MatrixXd::Zero(p, p)), zz_(Eigen::MatrixXd::Zero(p, p)), xx_(Eigen::MatrixXd::Zero(p, p)),
+      zy_(Eigen::VectorXd::Zero(p)), xy_(Eigen::VectorXd::Zero(p)) {}
+
+void InstrumentalVariables::add(const double* z, const double* x, double y, double w) {
+  for (int i = 0; i < p_; ++i) {
+    const double wz = w * z[i], wx = w * x[i];
+    for (int j = 0; j < p_; ++j) {
+      zx_(i, j) += wz * x[j];
+      zz_(i, j) += wz * z[j];
+      xx_(i, j) += wx * x[j];
+    }
+    zy_(i) += wz * y;
+    xy_(i) += wx * y;
+  }
+  yy_ += w * y * y;
+  sumw_ += w;
+  sumw2_ += w * w;
+  ++rows_;
+}
+
+LinearSolution InstrumentalVariables::solve(double tol) const {
+  LinearSolution s;
+  s.n_rows = rows_;
+  const double neff = sumw2_ > 0 ? sumw_ * sumw_ / sumw2_ : 0.0;
+  const double c = sumw_ > 0 ? neff / sumw_ : 1.0;
+  // Column scaling of Z^T X for conditioning.
+  Eigen::VectorXd d(p_);
+  for (int j = 0; j < p_; ++j) d(j) = std::sqrt(std::max(xx_(j, j), 1e-300));
+  const Eigen::MatrixXd A = zx_ * d.cwiseInverse().asDiagonal();
+  s.condition = scaled_condition(zx_);
+  s.rank_deficient = !(s.condition < 1.0 / tol);
+  const Eigen::VectorXd ts = s.rank_deficient ? Eigen::VectorXd(A.completeOrthogonalDecomposition().solve(zy_))
+                                               : Eigen::VectorXd(A.fullPivLu().solve(zy_));
+  s.theta = ts.cwiseQuotient(d);
+  s.rss = std::max(0.0, c * (yy_ - 2.0 * s.theta.dot(xy_) + s.theta.dot(xx_ * s.theta)));
+  s.sigma2 = neff > p_ ? s.rss / (neff - p_) : std::numeric_limits<double>::quiet_NaN();
+  if (!s.rank_deficient) {
+    const Eigen::MatrixXd inv = zx_.fullPivLu().inverse();
+    s.covariance = s.sigma2 * inv * zz_ * inv.transpose() / c;
+  } else {
+    s.covariance = Eigen::MatrixXd::Constant(p_, p_, std::numeric_limits<double>::quiet_NaN());
+  }
+  return s;
+}
+
+}  // namespace ctid::internal

@@ -1,0 +1,69 @@
+// ctid internal — shared least-squares kernels used by the estimators.
+//
+// StreamingLeastSquares: weighted linear least squares min sum w_k (y_k - x_k^T theta)^2
+// over rows added one at a time, by blocked Householder QR of [sqrt(w) X, sqrt(w) y]
+// (memory O(block * p), never N x p). Solving uses the triangular factor, so the
+// accuracy is that of QR, not of the normal equations.
+//
+// InstrumentalVariables: theta = (sum w z x^T)^{-1} sum w z y with column scaling.
+#pragma once
+
+#include <Eigen/Dense>
+
+namespace ctid::internal {
+
+struct LinearSolution {
+  Eigen::VectorXd theta;
+  Eigen::MatrixXd covariance;   // sigma^2 * (X^T W X)^{-1} (LS) or the IV sandwich
+  double sigma2 = 0.0;          // residual variance estimate
+  double rss = 0.0;             // weighted residual sum of squares
+  double condition = 0.0;       // of the column-scaled problem
+  bool rank_deficient = false;
+  long long n_rows = 0;
+};
+
+class StreamingLeastSquares {
+ public:
+  explicit StreamingLeastSquares(int p, int block = 1024);
+  /// Add one row x (p values), target y, weight w >= 0.
+  void add(const double* x, double y, double w = 1.0) {
+    const double sw = std::sqrt(w);
+    for (int j = 0; j < p_; ++j) buf_(fill_, j) = sw * x[j];
+    buf_(fill_, p_) = sw * y;
+    sumw_ += w;
+    sumw2_ += w * w;
+    ++rows_;
+    if (++fill_ == buf_.rows()) compress();
+  }
+  long long rows() const { return rows_; }
+  LinearSolution solve(double rank_tolerance = 1e-12);
+
+ private:
+  void compress();
+  int p_;
+  Eigen::MatrixXd buf_;   // top p+1 rows: current triangular factor; then pending rows
+  Eigen::Index fill_;
+  Eigen::HouseholderQR<Eigen::MatrixXd> qr_;
+  long long rows_ = 0;
+  double sumw_ = 0.0, sumw2_ = 0.0;
+};
+
+class InstrumentalVariables {
+ public:
+  explicit InstrumentalVariables(int p);
+  void add(const double* z, const double* x, double y, double w = 1.0);
+  long long rows() const { return rows_; }
+  LinearSolution solve(double rank_tolerance = 1e-12) const;
+
+ private:
+  int p_;
+  Eigen::MatrixXd zx_, zz_, xx_;
+  Eigen::VectorXd zy_, xy_;
+  double yy_ = 0.0, sumw_ = 0.0, sumw2_ = 0.0;
+  long long rows_ = 0;
+};
+
+/// 2-norm condition number of a square matrix after scaling its columns to unit norm.
+double scaled_condition(const Eigen::MatrixXd& M);
+
+}  // namespace ctid::internal

@@ -1,0 +1,132 @@
+#include "ctid/io/csv.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+#include "ctid/core/check.hpp"
+#include "internal/atomic_file.hpp"
+
+namespace ctid {
+
+int CsvTable::column(const std::string& key) const {
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i] == key) return static_cast<int>(i);
+  char* end = nullptr;
+  const long pos = std::strtol(key.c_str(), &end, 10);
+  if (!key.empty() && end && *end == '\0') {
+    if (pos >= 1 && pos <= static_cast<long>(names.size())) return static_cast<int>(pos - 1);
+    throw InvalidArgument(detail::format("{}: column position {} is outside 1..{}", source, pos, names.size()));
+  }
+  std::string known;
+  for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+  throw InvalidArgument(detail::format("{}: no column named '{}' (columns: {})", source, key, known));
+}
+
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r\"");
+  if (b == std::string::npos) return "";
+  const auto e = s.find_last_not_of(" \t\r\"");
+  return s.substr(b, e - b + 1);
+}
+
+std::vector<std::string> split(const std::string& line, char delim) {
+  std::vector<std::string> out;
+  if (delim == ' ') {
+    std::istringstream is(line);
+    std::string f;
+    while (is >> f) out.push_back(f);
+    return out;
+  }
+  std::string cur;
+  for (char c : line) {
+    if (c == delim) { out.push_back(trim(cur)); cur.clear(); }
+    else cur += c;
+  }
+  out.push_back(trim(cur));
+  while (!out.empty() && out.back().empty()) out.pop_back();  // trailing delimiters
+  return out;
+}
+
+bool parse_number(const std::string& s, double& v) {
+  if (s.empty()) return false;
+  errno = 0;
+  char* end = nullptr;
+  v = std::strtod(s.c_str(), &end);
+  return end && *end == '\0';
+}
+
+}  // namespace
+
+CsvTable parse_csv(const std::string& text, const std::string& source, const CsvReadOptions& o) {
+  CsvTable t;
+  t.source = source;
+  std::istringstream in(text);
+  std::string line;
+  int lineno = 0;
+  char delim = o.delimiter == '\t' ? ' ' : o.delimiter;
+  bool first = true;
+  std::vector<std::vector<double>> rows;
+  std::size_t ncol = 0;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const auto p = line.find_first_not_of(" \t");
+    if (p == std::string::npos) continue;
+    if (o.comment_chars.find(line[p]) != std::string::npos) continue;
+    if (delim == 0) delim = line.find(',') != std::string::npos ? ',' : (line.find(';') != std::string::npos ? ';' : ' ');
+    std::vector<std::string> f = split(line, delim);
+    if (first) {
+      first = false;
+      bool numeric = true;
+      double v;
+      for (const auto& c : f) numeric = numeric && parse_number(c, v);
+      const bool header = o.header == CsvHeader::Yes || (o.header == CsvHeader::Auto && !numeric);
+      ncol = f.size();
+      if (header) {
+        for (std::size_t i = 0; i < f.size(); ++i) t.names.push_back(f[i].empty() ? std::to_string(i + 1) : f[i]);
+        continue;
+      }
+      for (std::size_t i = 0; i < f.size(); ++i) t.names.push_back(std::to_string(i + 1));
+    }
+    if (f.size() != ncol)
+      throw FileError(detail::format("{}:{}: expected {} fields, found {}", source, lineno, ncol, f.size()));
+    std::vector<double> r(ncol);
+    for (std::size_t i = 0; i < ncol; ++i) {
+      if (!parse_number(f[i], r[i]))
+        throw FileError(detail::format("{}:{}: column '{}' (field {}): cannot read '{}' as a number", source, lineno,
+                                       t.names[i], i + 1, f[i]));
+      if (!std::isfinite(r[i]))
+        throw FileError(detail::format("{}:{}: column '{}' (field {}): value '{}' is not finite", source, lineno,
+                                       t.names[i], i + 1, f[i]));
+    }
+    rows.push_back(std::move(r));
+    t.line_numbers.push_back(lineno);
+  }
+  if (rows.empty()) throw FileError(detail::format("{}: no data rows", source));
+  t.values.resize(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(ncol));
+  for (std::size_t r = 0; r < rows.size(); ++r)
+    for (std::size_t c = 0; c < ncol; ++c) t.values(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = rows[r][c];
+  return t;
+}
+
+CsvTable read_csv(const std::string& path, const CsvReadOptions& o) { return parse_csv(internal::read_file(path), path, o); }
+
+void write_csv(const std::string& path, const std::vector<std::string>& names, const Eigen::MatrixXd& values) {
+  CTID_REQUIRE(static_cast<Eigen::Index>(names.size()) == values.cols(), "write_csv: {} names for {} columns", names.size(),
+               values.cols());
+  std::ostringstream os;
+  os.precision(17);
+  for (std::size_t i = 0; i < names.size(); ++i) os << (i ? "," : "") << names[i];
+  os << "\n";
+  for (Eigen::Index r = 0; r < values.rows(); ++r) {
+    for (Eigen::Index c = 0; c < values.cols(); ++c) os << (c ? "," : "") << values(r, c);
+    os << "\n";
+  }
+  internal::write_file_atomic(path, os.str());
+}
+
+}  // namespace ctid

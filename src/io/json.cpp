@@ -1,0 +1,202 @@
+#include "ctid/io/json.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include <nlohmann/json.hpp>
+
+#include "ctid/core/check.hpp"
+#include "internal/atomic_file.hpp"
+
+namespace ctid {
+
+using nlohmann::json;
+
+const char* version() { return CTID_VERSION_STRING; }
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+double to_num(const json& j) { return j.is_null() ? kNaN : j.get<double>(); }
+
+json vec(const Eigen::VectorXd& v) {
+  json a = json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(num(v(i)));
+  return a;
+}
+json mat(const Eigen::MatrixXd& m) {
+  json a = json::array();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) a.push_back(vec(m.row(r).transpose()));
+  return a;
+}
+
+struct Reader {
+  std::string source;
+  [[noreturn]] void fail(const std::string& what) const { throw FileError(source + ": " + what); }
+  const json& member(const json& j, const char* key, const char* where) const {
+    if (!j.is_object() || !j.contains(key)) fail(detail::format("{} has no member \"{}\"", where, key));
+    return j.at(key);
+  }
+  Eigen::VectorXd vector(const json& j, const char* what) const {
+    if (!j.is_array()) fail(detail::format("\"{}\" must be an array of numbers", what));
+    Eigen::VectorXd v(static_cast<Eigen::Index>(j.size()));
+    for (std::size_t i = 0; i < j.size(); ++i) {
+      if (!j[i].is_number() && !j[i].is_null()) fail(detail::format("\"{}\"[{}] is not a number", what, i));
+      v(static_cast<Eigen::Index>(i)) = to_num(j[i]);
+    }
+    return v;
+  }
+  Eigen::MatrixXd matrix(const json& j, const char* what) const {
+    if (!j.is_array()) fail(detail::format("\"{}\" must be an array of rows", what));
+    if (j.empty()) return Eigen::MatrixXd(0, 0);
+    Eigen::MatrixXd m;
+    for (std::size_t r = 0; r < j.size(); ++r) {
+      const Eigen::VectorXd row = vector(j[r], what);
+      if (r == 0) m.resize(static_cast<Eigen::Index>(j.size()), row.size());
+      if (row.size() != m.cols()) fail(detail::format("\"{}\" rows have different lengths", what));
+      m.row(static_cast<Eigen::Index>(r)) = row.transpose();
+    }
+    return m;
+  }
+};
+
+json model_json(const LinearModel& m) {
+  if (const auto* tf = std::get_if<TransferFunction>(&m))
+    return {{"type", "transfer_function"}, {"num", vec(tf->num().coefficients())}, {"den", vec(tf->den().coefficients())},
+            {"io_delay", tf->io_delay()}};
+  const auto& ss = std::get<StateSpace>(m);
+  return {{"type", "state_space"}, {"A", mat(ss.A())}, {"B", mat(ss.B())}, {"C", mat(ss.C())}, {"D", mat(ss.D())}};
+}
+
+LinearModel model_from(const json& root, const Reader& rd) {
+  const json& m = root.is_object() && root.contains("model") ? root.at("model") : root;
+  const json& type = rd.member(m, "type", "the model");
+  if (!type.is_string()) rd.fail("model \"type\" must be a string");
+  const std::string t = type.get<std::string>();
+  try {
+    if (t == "transfer_function") {
+      const double delay = m.contains("io_delay") ? to_num(m.at("io_delay")) : 0.0;
+      return TransferFunction(rd.vector(rd.member(m, "num", "the model"), "num"), rd.vector(rd.member(m, "den", "the model"), "den"),
+                              delay);
+    }
+    if (t == "state_space")
+      return StateSpace(rd.matrix(rd.member(m, "A", "the model"), "A"), rd.matrix(rd.member(m, "B", "the model"), "B"),
+                        rd.matrix(rd.member(m, "C", "the model"), "C"), rd.matrix(rd.member(m, "D", "the model"), "D"));
+  } catch (const InvalidArgument& e) {
+    rd.fail(std::string("invalid model: ") + e.what());
+  }
+  rd.fail(detail::format("model type \"{}\" is not a linear model this command can use (transfer_function, state_space)", t));
+}
+
+json parse_text(const std::string& text, const Reader& rd) {
+  try {
+    return json::parse(text);
+  } catch (const json::parse_error& e) {
+    rd.fail(std::string("not valid JSON: ") + e.what());
+  }
+}
+
+}  // namespace
+
+std::string model_to_json(const LinearModel& m, int indent) { return model_json(m).dump(indent); }
+
+LinearModel parse_model_json(const std::string& text, const std::string& source) {
+  const Reader rd{source};
+  return model_from(parse_text(text, rd), rd);
+}
+
+LinearModel read_model_json(const std::string& path) { return parse_model_json(internal::read_file(path), path); }
+
+void write_model_json(const std::string& path, const LinearModel& m) {
+  internal::write_file_atomic(path, model_to_json(m) + "\n");
+}
+
+std::string result_to_json(const Result<TransferFunction>& r, const std::string& method, int indent) {
+  json j;
+  j["ctid_version"] = version();
+  j["method"] = method;
+  j["model"] = model_json(r.model);
+  json params = json::array();
+  for (int i = 0; i < r.parameters.size(); ++i)
+    params.push_back({{"name", r.parameters.names[i]},
+                      {"value", num(r.parameters.values(i))},
+                      {"std", num(i < r.parameters.std.size() ? r.parameters.std(i) : kNaN)},
+                      {"fixed", i < static_cast<int>(r.parameters.fixed.size()) && r.parameters.fixed[i]}});
+  j["parameters"] = params;
+  j["covariance"] = mat(r.parameters.covariance);
+  const FitReport& f = r.fit;
+  j["fit"] = {{"fit_percent", num(f.fit_percent)}, {"nrmse", num(f.nrmse)}, {"mse", num(f.mse)},   {"fpe", num(f.fpe)},
+              {"aic", num(f.aic)},                 {"aicc", num(f.aicc)},   {"bic", num(f.bic)},   {"n_samples", f.n_samples},
+              {"n_parameters", f.n_parameters}};
+  j["summary"] = {{"termination", to_string(r.summary.termination)},
+                  {"iterations", r.summary.iterations},
+                  {"seconds", r.summary.seconds},
+                  {"message", r.summary.message},
+                  {"usable", r.usable()}};
+  json d;
+  d["condition_number"] = num(r.diagnostics.condition_number);
+  d["warnings"] = r.diagnostics.warnings;
+  d["scalars"] = json::object();
+  for (const auto& [k, v] : r.diagnostics.scalars) d["scalars"][k] = num(v);
+  d["vectors"] = json::object();
+  for (const auto& [k, v] : r.diagnostics.vectors) d["vectors"][k] = vec(v);
+  j["diagnostics"] = d;
+  return j.dump(indent);
+}
+
+Result<TransferFunction> parse_result_json(const std::string& text, const std::string& source) {
+  const Reader rd{source};
+  const json j = parse_text(text, rd);
+  Result<TransferFunction> r;
+  const LinearModel m = model_from(j, rd);
+  if (!std::holds_alternative<TransferFunction>(m)) rd.fail("the result's model is not a transfer function");
+  r.model = std::get<TransferFunction>(m);
+  try {
+    const json& ps = rd.member(j, "parameters", "the result");
+    const int np = static_cast<int>(ps.size());
+    r.parameters.values.resize(np);
+    r.parameters.std.resize(np);
+    for (int i = 0; i < np; ++i) {
+      r.parameters.names.push_back(ps[i].at("name").get<std::string>());
+      r.parameters.values(i) = to_num(ps[i].at("value"));
+      r.parameters.std(i) = to_num(ps[i].at("std"));
+      r.parameters.fixed.push_back(ps[i].value("fixed", false));
+    }
+    r.parameters.covariance = j.contains("covariance") ? rd.matrix(j.at("covariance"), "covariance") : Eigen::MatrixXd();
+    const json& f = rd.member(j, "fit", "the result");
+    r.fit.fit_percent = to_num(f.at("fit_percent"));
+    r.fit.nrmse = to_num(f.at("nrmse"));
+    r.fit.mse = to_num(f.at("mse"));
+    r.fit.fpe = to_num(f.at("fpe"));
+    r.fit.aic = to_num(f.at("aic"));
+    r.fit.aicc = to_num(f.at("aicc"));
+    r.fit.bic = to_num(f.at("bic"));
+    r.fit.n_samples = f.at("n_samples").get<int>();
+    r.fit.n_parameters = f.at("n_parameters").get<int>();
+    const json& s = rd.member(j, "summary", "the result");
+    r.summary.termination = termination_from_string(s.at("termination").get<std::string>());
+    r.summary.iterations = s.at("iterations").get<int>();
+    r.summary.seconds = s.at("seconds").get<double>();
+    r.summary.message = s.at("message").get<std::string>();
+    if (j.contains("diagnostics")) {
+      const json& d = j.at("diagnostics");
+      r.diagnostics.condition_number = to_num(d.at("condition_number"));
+      r.diagnostics.warnings = d.at("warnings").get<std::vector<std::string>>();
+      for (const auto& [k, v] : d.at("scalars").items()) r.diagnostics.scalars[k] = to_num(v);
+      for (const auto& [k, v] : d.at("vectors").items()) r.diagnostics.vectors[k] = rd.vector(v, "diagnostics.vectors");
+    }
+  } catch (const json::exception& e) {
+    rd.fail(std::string("malformed result: ") + e.what());
+  } catch (const InvalidArgument& e) {
+    rd.fail(std::string("malformed result: ") + e.what());
+  }
+  return r;
+}
+
+void write_result_json(const std::string& path, const Result<TransferFunction>& r, const std::string& method) {
+  internal::write_file_atomic(path, result_to_json(r, method) + "\n");
+}
+
+}  // namespace ctid

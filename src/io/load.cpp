@@ -1,0 +1,94 @@
+#include "ctid/io/load.hpp"
+
+#include <cmath>
+
+#include "ctid/core/check.hpp"
+#include "ctid/io/mat.hpp"
+
+namespace ctid {
+
+namespace {
+
+void check_spec(const DataSpec& s, const std::string& source) {
+  CTID_REQUIRE(!s.outputs.empty(), "{}: no output column selected", source);
+  CTID_REQUIRE(s.time.empty() != (s.ts == 0.0), "{}: give either a time column or a sampling period Ts (not {})", source,
+               s.time.empty() ? "neither" : "both");
+  CTID_REQUIRE(!(s.ts < 0) && std::isfinite(s.ts), "{}: the sampling period must be positive (got Ts = {})", source, s.ts);
+}
+
+IdData assemble(const Eigen::MatrixXd& u, const Eigen::MatrixXd& y, const Eigen::VectorXd* t, const DataSpec& s,
+                const std::string& source, const std::vector<int>* lines) {
+  IdData d;
+  if (t) {
+    for (Eigen::Index k = 1; k < t->size(); ++k)
+      if (!((*t)(k) > (*t)(k - 1))) {
+        const std::string where = lines ? detail::format("{}:{}", source, (*lines)[k]) : detail::format("{}: sample {}", source, k);
+        throw FileError(detail::format("{}: time column '{}' is not strictly increasing ({} after {})", where, s.time,
+                                       (*t)(k), (*t)(k - 1)));
+      }
+    // Uniform within rounding -> keep as uniform data (exact Ts = mean step).
+    const Eigen::Index N = t->size();
+    const double h = N > 1 ? ((*t)(N - 1) - (*t)(0)) / double(N - 1) : 1.0;
+    bool uniform = N > 1;
+    for (Eigen::Index k = 1; k < N && uniform; ++k) uniform = std::abs(((*t)(k) - (*t)(k - 1)) - h) <= 1e-6 * h;
+    d = uniform ? IdData(u, y, h, (*t)(0)) : IdData(u, y, *t);
+  } else {
+    d = IdData(u, y, s.ts);
+  }
+  d.set_intersample(s.intersample);
+  d.set_input_names(s.inputs);
+  d.set_output_names(s.outputs);
+  return d;
+}
+
+}  // namespace
+
+IdData iddata_from_table(const CsvTable& tab, const DataSpec& s) {
+  check_spec(s, tab.source);
+  const Eigen::Index N = tab.values.rows();
+  Eigen::MatrixXd u(N, s.inputs.size()), y(N, s.outputs.size());
+  for (std::size_t j = 0; j < s.inputs.size(); ++j) u.col(j) = tab.values.col(tab.column(s.inputs[j]));
+  for (std::size_t j = 0; j < s.outputs.size(); ++j) y.col(j) = tab.values.col(tab.column(s.outputs[j]));
+  if (!s.time.empty()) {
+    const Eigen::VectorXd t = tab.values.col(tab.column(s.time));
+    return assemble(u, y, &t, s, tab.source, &tab.line_numbers);
+  }
+  return assemble(u, y, nullptr, s, tab.source, nullptr);
+}
+
+IdData load_iddata(const std::string& path, const DataSpec& s) {
+  const bool is_mat = path.size() > 4 && path.compare(path.size() - 4, 4, ".mat") == 0;
+  if (!is_mat) return iddata_from_table(read_csv(path, s.csv), s);
+  check_spec(s, path);
+  auto vec = [&](const std::string& name) {
+    const Eigen::MatrixXd m = read_mat_variable(path, name);
+    if (m.rows() != 1 && m.cols() != 1)
+      throw FileError(detail::format("{}: variable '{}' is {}x{}; a vector is expected", path, name, m.rows(), m.cols()));
+    return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(m.data(), m.size()));
+  };
+  std::vector<Eigen::VectorXd> ins, outs;
+  for (const auto& n : s.inputs) ins.push_back(vec(n));
+  for (const auto& n : s.outputs) outs.push_back(vec(n));
+  const Eigen::Index N = outs[0].size();
+  auto check_len = [&](const Eigen::VectorXd& v, const std::string& name) {
+    if (v.size() != N)
+      throw FileError(detail::format("{}: variable '{}' has {} samples but '{}' has {}", path, name, v.size(), s.outputs[0], N));
+  };
+  Eigen::MatrixXd u(N, ins.size()), y(N, outs.size());
+  for (std::size_t j = 0; j < ins.size(); ++j) { check_len(ins[j], s.inputs[j]); u.col(j) = ins[j]; }
+  for (std::size_t j = 0; j < outs.size(); ++j) { check_len(outs[j], s.outputs[j]); y.col(j) = outs[j]; }
+  for (Eigen::Index j = 0; j < u.cols(); ++j)
+    for (Eigen::Index k = 0; k < N; ++k)
+      if (!std::isfinite(u(k, j))) throw FileError(detail::format("{}: variable '{}' sample {} is not finite", path, s.inputs[j], k));
+  for (Eigen::Index j = 0; j < y.cols(); ++j)
+    for (Eigen::Index k = 0; k < N; ++k)
+      if (!std::isfinite(y(k, j))) throw FileError(detail::format("{}: variable '{}' sample {} is not finite", path, s.outputs[j], k));
+  if (!s.time.empty()) {
+    const Eigen::VectorXd t = vec(s.time);
+    check_len(t, s.time);
+    return assemble(u, y, &t, s, path, nullptr);
+  }
+  return assemble(u, y, nullptr, s, path, nullptr);
+}
+
+}  // namespace ctid

@@ -1,0 +1,223 @@
+#include "ctid/simulate/lsim.hpp"
+
+#include <cmath>
+#include <vector>
+
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include "ctid/core/check.hpp"
+
+namespace ctid {
+
+Eigen::MatrixXd expm(const Eigen::MatrixXd& M) {
+  CTID_REQUIRE(M.rows() == M.cols(), "expm: the matrix must be square (got {}x{})", M.rows(), M.cols());
+  CTID_REQUIRE(M.allFinite(), "expm: the matrix contains NaN or Inf");
+  if (M.rows() == 0) return M;
+  return M.exp();
+}
+
+Discretization discretize(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, double h) {
+  CTID_REQUIRE(std::isfinite(h) && h > 0, "discretize: the interval must be positive and finite (got {})", h);
+  const Eigen::Index n = A.rows(), m = B.cols();
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n + 2 * m, n + 2 * m);
+  M.topLeftCorner(n, n) = A * h;
+  M.block(0, n, n, m) = B * h;
+  M.block(n, n + m, m, m) = Eigen::MatrixXd::Identity(m, m) * h;
+  const Eigen::MatrixXd E = expm(M);
+  Discretization d;
+  d.h = h;
+  d.Phi = E.topLeftCorner(n, n);
+  d.Gamma0 = E.block(0, n, n, m);
+  // E13 = int_0^h e^{A(h-s)} B (s/h) ds after the scaling of the identity block by h.
+  d.Gamma1 = E.block(0, n + m, n, m);
+  return d;
+}
+
+namespace {
+
+// A few discretisations keyed by interval length (uniform data need one, a
+// non-integer delay two, irregular data one per interval).
+class DiscretizationCache {
+ public:
+  DiscretizationCache(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const std::vector<Intersample>& is)
+      : A_(A), B_(B), foh_(is.size()) {
+    for (std::size_t j = 0; j < is.size(); ++j) foh_[j] = is[j] != Intersample::Zoh;
+  }
+  const Discretization& get(double h) {
+    for (const auto& d : entries_)
+      if (std::abs(d.h - h) <= 1e-13 * h) return d;
+    if (entries_.size() >= 8) entries_.erase(entries_.begin());
+    Discretization d = discretize(A_, B_, h);
+    for (std::size_t j = 0; j < foh_.size(); ++j)
+      if (!foh_[j]) d.Gamma1.col(j).setZero();
+    entries_.push_back(std::move(d));
+    return entries_.back();
+  }
+
+ private:
+  const Eigen::MatrixXd& A_;
+  const Eigen::MatrixXd& B_;
+  std::vector<bool> foh_;
+  std::vector<Discretization> entries_;
+};
+
+bool is_uniform(const Eigen::VectorXd& t, double* h) {
+  if (t.size() < 2) { *h = 1.0; return true; }
+  *h = (t(t.size() - 1) - t(0)) / double(t.size() - 1);
+  for (Eigen::Index k = 1; k < t.size(); ++k)
+    if (std::abs((t(k) - t(k - 1)) - *h) > 1e-9 * *h) return false;
+  return true;
+}
+
+// Delayed input v(s) = u(s - delay). Piece j covers [t_j + delay, t_{j+1} + delay):
+// held at u_j (ZOH) or linear from u_j to u_{j+1} (FOH); zero before piece 0.
+struct DelayedInput {
+  const Eigen::MatrixXd& u;
+  const Eigen::VectorXd& t;
+  const std::vector<Intersample>& is;
+  double delay;
+  Eigen::Index size() const { return t.size(); }
+  double start(Eigen::Index j) const { return t(j) + delay; }
+  void value(Eigen::Index j, double s, Eigen::VectorXd& out) const {
+    for (Eigen::Index c = 0; c < u.cols(); ++c) {
+      if (j < 0) { out(c) = 0.0; continue; }
+      if (is[c] == Intersample::Zoh || j + 1 >= t.size()) { out(c) = u(j, c); continue; }
+      const double a = (s - delay - t(j)) / (t(j + 1) - t(j));
+      out(c) = u(j, c) + a * (u(j + 1, c) - u(j, c));
+    }
+  }
+};
+
+}  // namespace
+
+Eigen::MatrixXd lsim(const StateSpace& sys, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
+                     const std::vector<Intersample>& intersample, const LsimOptions& o) {
+  const Eigen::Index N = t.size();
+  CTID_REQUIRE(N >= 1, "lsim: at least one sample time is needed");
+  CTID_REQUIRE(u.rows() == N, "lsim: u has {} samples but there are {} sample times", u.rows(), N);
+  CTID_REQUIRE(u.cols() == sys.nu(), "lsim: the model has {} inputs but u has {} columns", sys.nu(), u.cols());
+  CTID_REQUIRE(static_cast<int>(intersample.size()) == sys.nu(), "lsim: {} intersample entries for {} inputs",
+               intersample.size(), sys.nu());
+  CTID_REQUIRE(std::isfinite(o.input_delay) && o.input_delay >= 0, "lsim: the input delay must be >= 0 (got {})", o.input_delay);
+  for (Eigen::Index k = 1; k < N; ++k)
+    CTID_REQUIRE(t(k) > t(k - 1), "lsim: sample times must be strictly increasing (t[{}] = {} after {})", k, t(k), t(k - 1));
+  const int n = sys.nx();
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
+  if (o.x0.size() > 0) {
+    CTID_REQUIRE(o.x0.size() == n, "lsim: x0 has {} entries but the model has {} states", o.x0.size(), n);
+    x = o.x0;
+  }
+  Eigen::MatrixXd y(N, sys.ny());
+  const Eigen::MatrixXd& C = sys.C();
+  const Eigen::MatrixXd& D = sys.D();
+  DiscretizationCache cache(sys.A(), sys.B(), intersample);
+  DelayedInput v{u, t, intersample, o.input_delay};
+
+  double h = 0;
+  const bool uniform = is_uniform(t, &h);
+  Eigen::VectorXd xn(n), va(sys.nu()), vb(sys.nu());
+  if (o.input_delay == 0.0 && uniform && N >= 2) {
+    // Fast path: one discretisation, no delay.
+    const Discretization& d = cache.get(h);
+    Eigen::VectorXd du(sys.nu());
+    for (Eigen::Index k = 0; k < N; ++k) {
+      y.row(k).noalias() = (C * x).transpose() + (D * u.row(k).transpose()).transpose();
+      if (k + 1 == N) break;
+      du.noalias() = (u.row(k + 1) - u.row(k)).transpose();
+      xn.noalias() = d.Phi * x;
+      xn.noalias() += d.Gamma0 * u.row(k).transpose();
+      xn.noalias() += d.Gamma1 * du;
+      x.swap(xn);
+    }
+    return y;
+  }
+
+  // General path: split each interval where the delayed input changes piece.
+  const Eigen::Index M = v.size();
+  Eigen::Index j = -1;
+  const double snap0 = 1e-10 * std::max(h, 1e-300);
+  while (j + 1 < M && v.start(j + 1) <= t(0) + snap0) ++j;
+  Eigen::VectorXd vk(sys.nu());
+  for (Eigen::Index k = 0; k < N; ++k) {
+    v.value(j, t(k), vk);
+    y.row(k).noalias() = (C * x).transpose() + (D * vk).transpose();
+    if (k + 1 == N) break;
+    const double snap = 1e-10 * (t(k + 1) - t(k));
+    double a = t(k);
+    while (a < t(k + 1)) {
+      double b = t(k + 1);
+      if (j + 1 < M && v.start(j + 1) < b - snap) b = v.start(j + 1);
+      v.value(j, a, va);
+      v.value(j, b, vb);
+      const Discretization& d = cache.get(b - a);
+      xn.noalias() = d.Phi * x;
+      xn.noalias() += d.Gamma0 * va;
+      xn.noalias() += d.Gamma1 * (vb - va);
+      x.swap(xn);
+      a = b;
+      while (j + 1 < M && v.start(j + 1) <= a + snap) ++j;
+    }
+  }
+  return y;
+}
+
+Eigen::MatrixXd lsim(const StateSpace& sys, const IdData& data, const LsimOptions& o) {
+  std::vector<Intersample> is(data.nu());
+  for (int j = 0; j < data.nu(); ++j) is[j] = data.intersample(j);
+  return lsim(sys, data.u(), data.times(), is, o);
+}
+
+Eigen::VectorXd lsim(const TransferFunction& tf, const Eigen::VectorXd& u, const Eigen::VectorXd& t, Intersample is) {
+  LsimOptions o;
+  o.input_delay = tf.io_delay();
+  return lsim(tf.to_state_space(), Eigen::MatrixXd(u), t, std::vector<Intersample>{is}, o).col(0);
+}
+
+Eigen::VectorXd lsim(const TransferFunction& tf, const IdData& data, int input) {
+  CTID_REQUIRE(input >= 0 && input < data.nu(), "lsim: input index {} out of range (data has {} inputs)", input, data.nu());
+  return lsim(tf, Eigen::VectorXd(data.u().col(input)), data.times(), data.intersample(input));
+}
+
+Eigen::VectorXd time_grid(double h, int n) {
+  CTID_REQUIRE(h > 0 && std::isfinite(h), "time_grid: step must be positive (got {})", h);
+  CTID_REQUIRE(n >= 1, "time_grid: need at least one point (got {})", n);
+  return Eigen::VectorXd::LinSpaced(n, 0.0, h * (n - 1));
+}
+
+Eigen::VectorXd step_response(const TransferFunction& tf, const Eigen::VectorXd& t) {
+  CTID_REQUIRE(t.size() >= 1 && t(0) >= 0, "step_response: times must start at t >= 0");
+  // Prepend t = 0 so the step is applied at time zero.
+  const bool has_zero = t(0) == 0.0;
+  Eigen::VectorXd tt(t.size() + (has_zero ? 0 : 1));
+  if (has_zero) tt = t;
+  else { tt(0) = 0.0; tt.tail(t.size()) = t; }
+  const Eigen::VectorXd y = lsim(tf, Eigen::VectorXd::Ones(tt.size()), tt, Intersample::Zoh);
+  return has_zero ? y : Eigen::VectorXd(y.tail(t.size()));
+}
+
+Eigen::VectorXd impulse_response(const TransferFunction& tf, const Eigen::VectorXd& t) {
+  const StateSpace ss = tf.to_state_space();
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(t.size());
+  const double td = tf.io_delay();
+  Eigen::VectorXd x;
+  Eigen::MatrixXd Phi;
+  double tx = 0, last_h = -1;
+  bool started = false;
+  for (Eigen::Index k = 0; k < t.size(); ++k) {
+    if (k > 0) CTID_REQUIRE(t(k) > t(k - 1), "impulse_response: times must increase (t[{}] = {})", k, t(k));
+    if (t(k) < td) continue;
+    if (!started) {
+      x = expm(ss.A() * (t(k) - td)) * ss.B().col(0);
+      started = true;
+    } else {
+      const double h = t(k) - tx;
+      if (h != last_h) { Phi = expm(ss.A() * h); last_h = h; }
+      x = Phi * x;
+    }
+    tx = t(k);
+    g(k) = (ss.C() * x)(0);
+  }
+  return g;
+}
+
+}  // namespace ctid
