@@ -22,13 +22,14 @@ Discretization discretize(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, do
   Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n + 2 * m, n + 2 * m);
   M.topLeftCorner(n, n) = A * h;
   M.block(0, n, n, m) = B * h;
-  M.block(n, n + m, m, m) = Eigen::MatrixXd::Identity(m, m) * h;
+  // Unscaled identity: the exponential is exp(h [[A, B, 0], [0, 0, I/h], [0, 0, 0]]).
+  M.block(n, n + m, m, m) = Eigen::MatrixXd::Identity(m, m);
   const Eigen::MatrixXd E = expm(M);
   Discretization d;
   d.h = h;
   d.Phi = E.topLeftCorner(n, n);
   d.Gamma0 = E.block(0, n, n, m);
-  // E13 = int_0^h e^{A(h-s)} B (s/h) ds after the scaling of the identity block by h.
+  // E13 = int_0^h e^{A(h-s)} B (s/h) ds: the response to a unit change of slope over the interval.
   d.Gamma1 = E.block(0, n + m, n, m);
   return d;
 }

@@ -1,0 +1,97 @@
+// Exact simulation against closed-form responses (issue: "to 1e-10").
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "ctid/core/error.hpp"
+#include "ctid/simulate/lsim.hpp"
+#include "test_util.hpp"
+
+using namespace ctid;
+
+namespace {
+const TransferFunction kFirst(Eigen::VectorXd{{2.0}}, Eigen::VectorXd{{1.0, 0.5}});              // 2/(s + 0.5)
+const TransferFunction kSecond(Eigen::VectorXd{{1.0, 3.0}}, Eigen::VectorXd{{1.0, 1.2, 4.0}});    // (s+3)/(s^2+1.2s+4)
+// Resonant fourth order: (s^2 + 0.1 s + 1)(s^2 + 0.4 s + 25) with a zero at -2.
+const TransferFunction kFourth(Polynomial{25.0, 50.0},
+                               Polynomial{1.0, 0.1, 1.0} * Polynomial{1.0, 0.4, 25.0});
+}  // namespace
+
+TEST(Lsim, StepFirstOrderClosedForm) {
+  const Eigen::VectorXd t = time_grid(0.05, 400);
+  const Eigen::VectorXd y = step_response(kFirst, t);
+  for (Eigen::Index k = 0; k < t.size(); ++k) EXPECT_NEAR(y(k), 4.0 * (1 - std::exp(-0.5 * t(k))), 1e-10);
+}
+
+TEST(Lsim, StepSecondAndResonantFourthOrderClosedForm) {
+  for (const auto* g : {&kSecond, &kFourth}) {
+    const Eigen::VectorXd t = time_grid(0.01, 3000);
+    const Eigen::VectorXd y = step_response(*g, t);
+    for (Eigen::Index k = 0; k < t.size(); k += 7) EXPECT_NEAR(y(k), test::step_by_residues(*g, t(k)), 1e-10) << k;
+  }
+}
+
+TEST(Lsim, FohRampIsExact) {
+  // u(t) = t, linear between samples: y = t - 1 + e^{-t} for 1/(s+1).
+  const TransferFunction g(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 1.0}});
+  const Eigen::VectorXd t = time_grid(0.3, 50);
+  const Eigen::VectorXd y = lsim(g, t, t, Intersample::Foh);
+  for (Eigen::Index k = 0; k < t.size(); ++k) EXPECT_NEAR(y(k), t(k) - 1 + std::exp(-t(k)), 1e-12);
+}
+
+TEST(Lsim, ZohPiecewiseConstantWithNonIntegerDelay) {
+  TransferFunction g = kSecond;
+  g.set_io_delay(0.537);  // 5.37 samples
+  const double h = 0.1;
+  const Eigen::VectorXd t = time_grid(h, 300);
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> U(-1, 1);
+  Eigen::VectorXd u(t.size());
+  for (auto& v : u) v = U(rng);
+  const Eigen::VectorXd y = lsim(g, u, t, Intersample::Zoh);
+  for (Eigen::Index k = 0; k < t.size(); ++k) EXPECT_NEAR(y(k), test::zoh_response(g, t, u, t(k)), 1e-10) << k;
+}
+
+TEST(Lsim, IrregularTimesZoh) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> dt(0.01, 0.1), U(-1, 1);
+  Eigen::VectorXd t(500), u(500);
+  t(0) = 0;
+  for (Eigen::Index k = 1; k < t.size(); ++k) t(k) = t(k - 1) + dt(rng);
+  for (auto& v : u) v = U(rng);
+  for (double delay : {0.0, 0.123}) {
+    TransferFunction g = kFourth;
+    g.set_io_delay(delay);
+    const Eigen::VectorXd y = lsim(g, u, t, Intersample::Zoh);
+    for (Eigen::Index k = 0; k < t.size(); k += 3) EXPECT_NEAR(y(k), test::zoh_response(g, t, u, t(k)), 1e-10) << k;
+  }
+}
+
+TEST(Lsim, InitialStateFreeResponse) {
+  // dx/dt = -2 x, x(0) = 3 -> y = 3 e^{-2t}
+  const StateSpace ss(Eigen::MatrixXd{{-2.0}}, Eigen::MatrixXd{{1.0}}, Eigen::MatrixXd{{1.0}}, Eigen::MatrixXd{{0.0}});
+  LsimOptions o;
+  o.x0 = Eigen::VectorXd{{3.0}};
+  const Eigen::VectorXd t = time_grid(0.1, 20);
+  const Eigen::MatrixXd y = lsim(ss, Eigen::MatrixXd::Zero(20, 1), t, {Intersample::Zoh}, o);
+  for (int k = 0; k < 20; ++k) EXPECT_NEAR(y(k, 0), 3 * std::exp(-2 * t(k)), 1e-13);
+}
+
+TEST(Lsim, ImpulseResponseFirstOrderWithDelay) {
+  TransferFunction g = kFirst;
+  g.set_io_delay(0.25);
+  const Eigen::VectorXd t = time_grid(0.1, 50);
+  const Eigen::VectorXd h = impulse_response(g, t);
+  for (Eigen::Index k = 0; k < t.size(); ++k)
+    EXPECT_NEAR(h(k), t(k) < 0.25 ? 0.0 : 2.0 * std::exp(-0.5 * (t(k) - 0.25)), 1e-12);
+}
+
+TEST(Lsim, BadInputsAreReported) {
+  const Eigen::VectorXd t = time_grid(0.1, 10);
+  EXPECT_THROW(lsim(kFirst, Eigen::VectorXd::Ones(9), t), InvalidArgument);
+  Eigen::VectorXd tb = t;
+  tb(5) = tb(4);
+  EXPECT_THROW(lsim(kFirst, Eigen::VectorXd::Ones(10), tb), InvalidArgument);
+  EXPECT_THROW(discretize(Eigen::MatrixXd{{-1.0}}, Eigen::MatrixXd{{1.0}}, 0.0), InvalidArgument);
+}
