@@ -1,0 +1,109 @@
+#include <cmath>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "ctid/core/error.hpp"
+#include "ctid/data/iddata.hpp"
+#include "ctid/data/input_design.hpp"
+
+using namespace ctid;
+
+TEST(IdData, UniformAndIrregularTimes) {
+  IdData d(Eigen::VectorXd::LinSpaced(5, 0, 4), Eigen::VectorXd::Ones(5), 0.5, 2.0);
+  EXPECT_TRUE(d.is_uniform());
+  EXPECT_DOUBLE_EQ(d.time(4), 4.0);
+  EXPECT_DOUBLE_EQ(d.duration(), 2.0);
+  IdData r(Eigen::VectorXd::Ones(3), Eigen::VectorXd::Ones(3), Eigen::VectorXd{{0.0, 0.1, 0.35}});
+  EXPECT_FALSE(r.is_uniform());
+  EXPECT_THROW(r.ts(), InvalidArgument);
+  EXPECT_DOUBLE_EQ(r.time(2), 0.35);
+}
+
+TEST(IdData, BadInputMessagesNameTheValues) {
+  try {
+    IdData(Eigen::VectorXd::Ones(1000), Eigen::VectorXd::Ones(999), 0.1);
+    FAIL();
+  } catch (const InvalidArgument& e) {
+    EXPECT_STREQ(e.what(), "IdData: u and y need the same number of samples (u has 1000, y has 999)");
+  }
+  Eigen::VectorXd y = Eigen::VectorXd::Ones(4);
+  y(2) = NAN;
+  EXPECT_THROW(IdData(Eigen::VectorXd::Ones(4), y, 0.1), InvalidArgument);
+  EXPECT_THROW(IdData(Eigen::VectorXd::Ones(4), Eigen::VectorXd::Ones(4), 0.0), InvalidArgument);
+  try {
+    IdData(Eigen::VectorXd::Ones(3), Eigen::VectorXd::Ones(3), Eigen::VectorXd{{0.0, 0.2, 0.1}});
+    FAIL();
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("t[2] = 0.1 follows t[1] = 0.2"), std::string::npos) << e.what();
+  }
+}
+
+TEST(IdData, SliceSplitSelectDetrend) {
+  const int N = 100;
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(N, 0, 9.9);
+  Eigen::MatrixXd u(N, 2);
+  u.col(0) = 3.0 + 2.0 * t.array();
+  u.col(1) = Eigen::VectorXd::Constant(N, 5.0);
+  IdData d(u, Eigen::VectorXd(1.0 + t.array().sin()), 0.1);
+  d.set_input_names({"flow", "valve"});
+  EXPECT_EQ(d.input_index("valve"), 1);
+  EXPECT_THROW(d.input_index("temp"), InvalidArgument);
+  const auto [est, val] = d.split(0.7);
+  EXPECT_EQ(est.size(), 70);
+  EXPECT_EQ(val.size(), 30);
+  EXPECT_DOUBLE_EQ(val.time(0), 7.0);
+  const IdData s = d.select({1}, {0});
+  EXPECT_EQ(s.nu(), 1);
+  EXPECT_EQ(s.input_names()[0], "valve");
+  TrendInfo info;
+  const IdData lin = d.detrend(Detrend::Linear, &info);
+  EXPECT_NEAR(info.u_slope(0), 2.0, 1e-12);
+  EXPECT_NEAR(info.u_offset(0), 3.0, 1e-12);
+  EXPECT_LT(lin.u().col(0).cwiseAbs().maxCoeff(), 1e-12);
+  const IdData mean = d.detrend(Detrend::Mean);
+  EXPECT_NEAR(mean.y().mean(), 0.0, 1e-14);
+  EXPECT_THROW(d.slice(50, 40), InvalidArgument);
+}
+
+TEST(InputDesign, PrbsHasMaximalPeriod) {
+  // A maximum-length sequence repeats after exactly 2^n - 1 bits and has 2^(n-1) ones per period.
+  for (int n = 2; n <= 16; ++n) {
+    PrbsOptions o;
+    o.register_length = n;
+    const int P = (1 << n) - 1;
+    const Eigen::VectorXd s = prbs(2 * P, o);
+    EXPECT_EQ(s.head(P), s.tail(P)) << n;
+    EXPECT_EQ(static_cast<int>((s.head(P).array() > 0).count()), 1 << (n - 1)) << n;
+    for (int p = 1; p < P; ++p)  // no shorter period
+      if (P % p == 0) EXPECT_NE(s.head(P - p), s.segment(p, P - p)) << n << " " << p;
+  }
+  PrbsOptions o;
+  o.register_length = 10;
+  o.clock_period = 7;
+  EXPECT_EQ(prbs(7161, o).size(), 7161);  // 1023 bits x 7 samples (Rao-Garnier set-up)
+  o.register_length = 40;
+  EXPECT_THROW(prbs(10, o), InvalidArgument);
+}
+
+TEST(InputDesign, NoiseAtRequestedSnrIsReproducible) {
+  const Eigen::VectorXd x = (Eigen::VectorXd::LinSpaced(20000, 0, 200)).array().sin();
+  const Eigen::VectorXd y1 = add_noise_snr(x, 10.0, 42), y2 = add_noise_snr(x, 10.0, 42);
+  EXPECT_EQ(y1, y2);
+  const double snr = 10 * std::log10((x.array() - x.mean()).square().mean() / (y1 - x).array().square().mean());
+  EXPECT_NEAR(snr, 10.0, 0.1);  // 20000 samples: the noise-variance estimate has ~1 % error (0.04 dB)
+  EXPECT_THROW(add_noise_snr(Eigen::VectorXd::Ones(10), 10, 1), InvalidArgument);
+}
+
+TEST(InputDesign, MultisineStepsRandomBinary) {
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(11, 0, 1);
+  const Eigen::VectorXd m = multisine(t, {2.0}, {3.0}, {0.0});
+  EXPECT_NEAR(m(10), 3 * std::sin(2.0), 1e-15);
+  const Eigen::VectorXd s = steps(t, {0.25, 0.55}, {1.0, -2.0});
+  EXPECT_EQ(s(2), 0.0);
+  EXPECT_EQ(s(3), 1.0);
+  EXPECT_EQ(s(6), -2.0);
+  const Eigen::VectorXd rb = random_binary(1000, 9, 5, 2.0);
+  EXPECT_EQ(std::set<double>(rb.begin(), rb.end()), (std::set<double>{-2.0, 2.0}));
+  for (int k = 0; k < 1000; ++k) EXPECT_EQ(rb(k), rb(k - k % 5));
+}

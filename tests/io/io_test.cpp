@@ -1,0 +1,180 @@
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+
+#include <gtest/gtest.h>
+
+#include "ctid/core/error.hpp"
+#include "ctid/io/csv.hpp"
+#include "ctid/io/json.hpp"
+#include "ctid/io/load.hpp"
+#include "ctid/io/mat.hpp"
+#include "test_util.hpp"
+
+using namespace ctid;
+namespace fs = std::filesystem;
+
+namespace {
+std::string write_text(const std::string& name, const std::string& text) {
+  const std::string p = test::temp_path(name);
+  std::ofstream(p) << text;
+  return p;
+}
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(Csv, DelimitersHeadersComments) {
+  const CsvTable a = parse_csv("# a comment\nt,u,y\n0,1,2\n0.1,3,4\n", "a.csv");
+  EXPECT_EQ(a.names, (std::vector<std::string>{"t", "u", "y"}));
+  EXPECT_EQ(a.values(1, 2), 4.0);
+  EXPECT_EQ(a.line_numbers[1], 4);
+  const CsvTable b = parse_csv("u;y\n1;2\n", "b.csv");
+  EXPECT_EQ(b.values(0, 1), 2.0);
+  // DaISy style: no header, tab separated, trailing tab, CRLF.
+  const CsvTable c = parse_csv("   6.41e+00\t4.76e+00\t\r\n   3.41e+00\t4.77e+00\t\r\n", "c.dat");
+  EXPECT_EQ(c.names, (std::vector<std::string>{"1", "2"}));
+  EXPECT_EQ(c.values(1, 0), 3.41);
+  EXPECT_EQ(c.column("2"), 1);
+  EXPECT_EQ(a.column("y"), 2);
+  EXPECT_NE(error_of([&] { a.column("z"); }).find("no column named 'z' (columns: t, u, y)"), std::string::npos);
+}
+
+TEST(Csv, ErrorsNameFileLineAndColumn) {
+  EXPECT_EQ(error_of([] { parse_csv("u,y\n1,2\n3\n", "f.csv"); }), "f.csv:3: expected 2 fields, found 1");
+  EXPECT_EQ(error_of([] { parse_csv("u,y\n1,abc\n", "f.csv"); }),
+            "f.csv:2: column 'y' (field 2): cannot read 'abc' as a number");
+  EXPECT_EQ(error_of([] { parse_csv("u,y\n1,nan\n", "f.csv"); }), "f.csv:2: column 'y' (field 2): value 'nan' is not finite");
+  EXPECT_EQ(error_of([] { parse_csv("u,y\n", "f.csv"); }), "f.csv: no data rows");
+  EXPECT_THROW(read_csv("/nonexistent/x.csv"), FileError);
+}
+
+TEST(Csv, WriteReadRoundTripIsExact) {
+  Eigen::MatrixXd m(3, 2);
+  m << 0.1, -1e-300, 1.0 / 3.0, 123456789.123456789, -2.5, 6.02214076e23;
+  const std::string p = test::temp_path("rt.csv");
+  write_csv(p, {"a", "b"}, m);
+  const CsvTable t = read_csv(p);
+  EXPECT_EQ(t.values, m);
+  // A failed write leaves nothing behind.
+  EXPECT_THROW(write_csv("/nonexistent_dir/x.csv", {"a", "b"}, m), FileError);
+}
+
+TEST(Load, TimeColumnUniformIrregularAndNonIncreasing) {
+  const std::string uni = write_text("uni.csv", "t,u,y\n0,1,2\n0.1,3,4\n0.2,5,6\n");
+  DataSpec s;
+  s.inputs = {"u"};
+  s.outputs = {"y"};
+  s.time = "t";
+  const IdData d = load_iddata(uni, s);
+  EXPECT_TRUE(d.is_uniform());
+  EXPECT_NEAR(d.ts(), 0.1, 1e-15);
+  EXPECT_EQ(d.output_names()[0], "y");
+  const IdData irr = load_iddata(write_text("irr.csv", "t,u,y\n0,1,2\n0.1,3,4\n0.35,5,6\n"), s);
+  EXPECT_FALSE(irr.is_uniform());
+  const std::string bad = write_text("bad.csv", "t,u,y\n0,1,2\n0.2,3,4\n0.1,5,6\n");
+  const std::string msg = error_of([&] { load_iddata(bad, s); });
+  EXPECT_NE(msg.find("bad.csv:4: time column 't' is not strictly increasing (0.1 after 0.2)"), std::string::npos) << msg;
+  EXPECT_THROW(load_iddata(bad, s), FileError);
+  s.time.clear();
+  EXPECT_THROW(load_iddata(uni, s), InvalidArgument);  // neither time column nor Ts
+  s.ts = 0.5;
+  s.inputs = {"flow"};
+  EXPECT_NE(error_of([&] { load_iddata(uni, s); }).find("no column named 'flow'"), std::string::npos);
+}
+
+TEST(Json, ModelAndResultRoundTrip) {
+  const TransferFunction g(Eigen::VectorXd{{-6400.0, 1600.0}}, Eigen::VectorXd{{1.0, 5.0, 408.0, 416.0, 1600.0}}, 0.25);
+  const LinearModel back = parse_model_json(model_to_json(g));
+  const auto& tf = std::get<TransferFunction>(back);
+  EXPECT_EQ(tf.num().coefficients(), g.num().coefficients());
+  EXPECT_EQ(tf.den().coefficients(), g.den().coefficients());
+  EXPECT_EQ(tf.io_delay(), 0.25);
+  const StateSpace ss = g.to_state_space();
+  const StateSpace ss2 = std::get<StateSpace>(parse_model_json(model_to_json(ss)));
+  EXPECT_EQ(ss2.A(), ss.A());
+  EXPECT_EQ(ss2.C(), ss.C());
+
+  Result<TransferFunction> r;
+  r.model = g;
+  r.parameters.names = {"a1", "b0"};
+  r.parameters.values = Eigen::VectorXd{{5.0, -6400.0}};
+  r.parameters.std = Eigen::VectorXd{{0.1, NAN}};
+  r.parameters.fixed = {false, true};
+  r.parameters.covariance = Eigen::MatrixXd{{0.01, 0}, {0, 0}};
+  r.fit = FitReport{93.2, 0.068, 1e-3, 1.1e-3, -100, -99, -95, 1000, 6};
+  r.summary = Summary{Termination::Converged, "ok", 12, 0.004};
+  r.diagnostics.condition_number = 12.5;
+  r.diagnostics.warnings = {"w1"};
+  r.diagnostics.scalars["tau"] = 0.5;
+  r.diagnostics.vectors["theta_tau"] = Eigen::VectorXd{{1.0, 2.0}};
+  const std::string text = result_to_json(r, "lssvf");
+  const Result<TransferFunction> q = parse_result_json(text);
+  EXPECT_EQ(q.parameters.names, r.parameters.names);
+  EXPECT_EQ(q.parameters.values, r.parameters.values);
+  EXPECT_TRUE(std::isnan(q.parameters.std(1)));
+  EXPECT_EQ(q.parameters.fixed, r.parameters.fixed);
+  EXPECT_EQ(q.fit.fit_percent, 93.2);
+  EXPECT_EQ(q.fit.n_parameters, 6);
+  EXPECT_EQ(q.summary.termination, Termination::Converged);
+  EXPECT_EQ(q.summary.iterations, 12);
+  EXPECT_EQ(q.diagnostics.scalars.at("tau"), 0.5);
+  EXPECT_EQ(q.diagnostics.vectors.at("theta_tau"), r.diagnostics.vectors.at("theta_tau"));
+  EXPECT_EQ(q.diagnostics.warnings, r.diagnostics.warnings);
+  EXPECT_NE(text.find("\"method\": \"lssvf\""), std::string::npos);
+  // The envelope is accepted where a model is expected.
+  EXPECT_EQ(std::get<TransferFunction>(parse_model_json(text)).io_delay(), 0.25);
+}
+
+TEST(Json, MalformedFilesAreFileErrors) {
+  EXPECT_NE(error_of([] { parse_model_json("{", "m.json"); }).find("m.json: not valid JSON"), std::string::npos);
+  EXPECT_EQ(error_of([] { parse_model_json("{\"type\": \"transfer_function\", \"den\": [1, 2]}", "m.json"); }),
+            "m.json: the model has no member \"num\"");
+  EXPECT_NE(error_of([] { parse_model_json("{\"type\": \"transfer_function\", \"num\": [1, 2, 3], \"den\": [1, 2]}", "m.json"); })
+                .find("improper"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { parse_model_json("{\"type\": \"narx\"}", "m.json"); }).find("\"narx\""), std::string::npos);
+  EXPECT_THROW(read_model_json("/nonexistent.json"), FileError);
+}
+
+TEST(Mat, WriteReadAndLoad) {
+  const std::string p = test::temp_path("d.mat");
+  Eigen::MatrixXd u = Eigen::VectorXd::LinSpaced(50, 0, 1), y = u.array().square();
+  write_mat(p, {{"u", u}, {"y", y}, {"grid", Eigen::MatrixXd::Ones(2, 3)}});
+  const auto names = mat_variable_names(p);
+  EXPECT_EQ(names.size(), 3u);
+  EXPECT_EQ(read_mat_variable(p, "y"), y);
+  EXPECT_EQ(read_mat_variable(p, "grid").cols(), 3);
+  DataSpec s;
+  s.inputs = {"u"};
+  s.outputs = {"y"};
+  s.ts = 0.02;
+  const IdData d = load_iddata(p, s);
+  EXPECT_EQ(d.size(), 50);
+  EXPECT_EQ(d.y()(49, 0), 1.0);
+  EXPECT_NE(error_of([&] { read_mat_variable(p, "nope"); }).find("no variable named 'nope'"), std::string::npos);
+  s.outputs = {"grid"};
+  EXPECT_THROW(load_iddata(p, s), FileError);
+  EXPECT_THROW(mat_variable_names("/nonexistent.mat"), FileError);
+}
+
+TEST(RealData, DaisyHairDryerReads) {
+  const std::string path = std::string(CTID_EXAMPLES_DATA_DIR) + "/dryer.dat";
+  if (!fs::exists(path)) GTEST_SKIP() << "bundled data not present";
+  DataSpec s;
+  s.inputs = {"1"};
+  s.outputs = {"2"};
+  s.ts = 0.08;
+  const IdData d = load_iddata(path, s);
+  // DaISy README: 1000 samples; means 5.0 V in, 4.89 out.
+  EXPECT_EQ(d.size(), 1000);
+  EXPECT_NEAR(d.u().mean(), 5.0, 0.05);
+  EXPECT_NEAR(d.y().mean(), 4.89, 0.01);
+}
