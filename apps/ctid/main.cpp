@@ -1,1 +1,51 @@
-int main(){}
+// ctid — command-line tool. Subcommands: fit, simulate, validate, demo (DESIGN.md §8).
+// Exit codes: 0 ok, 1 estimate not usable, 2 usage, 3 input file error; one line on stderr.
+#include <cstdio>
+#include <functional>
+
+#include "common.hpp"
+
+namespace ctid::cli {
+std::function<int()> g_run;
+}
+
+int main(int argc, char** argv) {
+  using namespace ctid::cli;
+  CLI::App app{"ctid — continuous-time system identification"};
+  app.set_version_flag("--version", std::string("ctid ") + ctid::version());
+  app.require_subcommand(1);
+  setup_fit(*app.add_subcommand("fit", "Estimate a continuous-time model from input/output data"));
+  setup_simulate(*app.add_subcommand("simulate", "Simulate a model file on the inputs of a data file"));
+  setup_validate(*app.add_subcommand("validate", "Compare a model with measured data (fit, residual tests)"));
+  setup_demo(*app.add_subcommand("demo", "Identify a bundled real data set and print the model"));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "ctid: %s\n", e.what());
+    return kUsage;
+  }
+  try {
+    return g_run ? g_run() : kUsage;
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "ctid: %s\n", e.what());
+    return kUsage;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "ctid: %s\n", e.what());
+    return kInputFile;
+  } catch (const ctid::FileError& e) {
+    std::fprintf(stderr, "ctid: %s\n", e.what());
+    return kInputFile;
+  } catch (const ctid::InvalidArgument& e) {
+    std::fprintf(stderr, "ctid: %s\n", e.what());
+    return kUsage;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "ctid: unexpected error: %s\n", e.what());
+    return kNotUsable;
+  }
+}

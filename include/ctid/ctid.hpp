@@ -11,6 +11,7 @@
 #include "ctid/estimate/orders.hpp"
 #include "ctid/estimate/rls_svf.hpp"
 #include "ctid/io/csv.hpp"
+#include "ctid/io/file.hpp"
 #include "ctid/io/json.hpp"
 #include "ctid/io/load.hpp"
 #include "ctid/io/mat.hpp"

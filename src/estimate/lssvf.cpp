@@ -229,7 +229,7 @@ Result<TransferFunction> make_result(const IdData& data, const TfOrders& o, cons
     r.fit.n_samples = data.size();
     r.fit.n_parameters = d;
     r.fit.fit_percent = -std::numeric_limits<double>::infinity();
-    r.fit.nrmse = r.fit.mse = std::numeric_limits<double>::infinity();
+    r.fit.nrmse = r.fit.mse = r.fit.fpe = r.fit.aic = r.fit.aicc = r.fit.bic = std::numeric_limits<double>::infinity();
   }
   return r;
 }
@@ -345,6 +345,12 @@ Result<TransferFunction> ivsvf(const IdData& data, const TfOrders& orders, const
       out.summary.message = "the instrumental-variable equations became singular or non-finite";
   } else if (converged) {
     out.summary.termination = Termination::Converged;
+  }
+  if (out.summary.succeeded() && r.model.is_stable() && !out.model.is_stable()) {
+    out.summary.termination = Termination::Unstable;
+    out.summary.message =
+        "the IV iterations moved from a stable LSSVF start to an unstable model; try another tau or a lower order "
+        "(the LSSVF estimate may be preferable)";
   }
   out.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "ctid/core/check.hpp"
-#include "internal/atomic_file.hpp"
+#include "ctid/io/file.hpp"
 
 namespace ctid {
 
@@ -113,7 +113,7 @@ CsvTable parse_csv(const std::string& text, const std::string& source, const Csv
   return t;
 }
 
-CsvTable read_csv(const std::string& path, const CsvReadOptions& o) { return parse_csv(internal::read_file(path), path, o); }
+CsvTable read_csv(const std::string& path, const CsvReadOptions& o) { return parse_csv(read_text_file(path), path, o); }
 
 void write_csv(const std::string& path, const std::vector<std::string>& names, const Eigen::MatrixXd& values) {
   CTID_REQUIRE(static_cast<Eigen::Index>(names.size()) == values.cols(), "write_csv: {} names for {} columns", names.size(),
@@ -126,7 +126,7 @@ void write_csv(const std::string& path, const std::vector<std::string>& names, c
     for (Eigen::Index c = 0; c < values.cols(); ++c) os << (c ? "," : "") << values(r, c);
     os << "\n";
   }
-  internal::write_file_atomic(path, os.str());
+  write_text_file(path, os.str());
 }
 
 }  // namespace ctid

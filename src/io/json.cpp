@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "ctid/core/check.hpp"
-#include "internal/atomic_file.hpp"
+#include "ctid/io/file.hpp"
 
 namespace ctid {
 
@@ -107,10 +107,10 @@ LinearModel parse_model_json(const std::string& text, const std::string& source)
   return model_from(parse_text(text, rd), rd);
 }
 
-LinearModel read_model_json(const std::string& path) { return parse_model_json(internal::read_file(path), path); }
+LinearModel read_model_json(const std::string& path) { return parse_model_json(read_text_file(path), path); }
 
 void write_model_json(const std::string& path, const LinearModel& m) {
-  internal::write_file_atomic(path, model_to_json(m) + "\n");
+  write_text_file(path, model_to_json(m) + "\n");
 }
 
 std::string result_to_json(const Result<TransferFunction>& r, const std::string& method, int indent) {
@@ -196,7 +196,7 @@ Result<TransferFunction> parse_result_json(const std::string& text, const std::s
 }
 
 void write_result_json(const std::string& path, const Result<TransferFunction>& r, const std::string& method) {
-  internal::write_file_atomic(path, result_to_json(r, method) + "\n");
+  write_text_file(path, result_to_json(r, method) + "\n");
 }
 
 }  // namespace ctid

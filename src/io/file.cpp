@@ -1,4 +1,4 @@
-#include "internal/atomic_file.hpp"
+#include "ctid/io/file.hpp"
 
 #include <cerrno>
 #include <cstdio>
@@ -9,9 +9,9 @@
 
 #include "ctid/core/check.hpp"
 
-namespace ctid::internal {
+namespace ctid {
 
-void write_file_atomic(const std::string& path, const std::string& content) {
+void write_text_file(const std::string& path, const std::string& content) {
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
   {
     std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
@@ -30,7 +30,7 @@ void write_file_atomic(const std::string& path, const std::string& content) {
   }
 }
 
-std::string read_file(const std::string& path) {
+std::string read_text_file(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
   if (!f) throw FileError(detail::format("cannot open '{}': {}", path, std::strerror(errno)));
   std::ostringstream ss;
@@ -38,4 +38,4 @@ std::string read_file(const std::string& path) {
   return ss.str();
 }
 
-}  // namespace ctid::internal
+}  // namespace ctid

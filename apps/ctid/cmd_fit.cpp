@@ -1,0 +1,151 @@
+// ctid fit DATA --method lssvf|ivsvf|rls-svf ...
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <limits>
+
+#include "common.hpp"
+
+namespace ctid::cli {
+extern std::function<int()> g_run;
+
+namespace {
+
+struct FitArgs {
+  DataArgs data;
+  std::string method = "lssvf";
+  int nb = -1, nf = 1, nk = 0;
+  std::vector<std::string> sets;
+  std::string json;
+  bool force = false;
+};
+
+// Apply --set keys to LSSVF options; consumed keys are erased.
+void apply_svf_sets(std::map<std::string, std::string>& s, LssvfOptions& o) {
+  for (auto it = s.begin(); it != s.end();) {
+    const auto& [k, v] = *it;
+    bool used = true;
+    if (k == "tau") o.tau = to_double(k, v);
+    else if (k == "alpha") o.alpha = to_double(k, v);
+    else if (k == "transient") o.transient_time = to_double(k, v);
+    else if (k == "tau_grid") o.tau_grid_size = to_int(k, v);
+    else if (k == "weights") {
+      if (v == "riemann") o.weights = SvfWeights::Riemann;
+      else if (v == "trapezoidal") o.weights = SvfWeights::Trapezoidal;
+      else throw UsageError("--set weights: use riemann or trapezoidal (got '" + v + "')");
+    } else if (k.rfind("fix.", 0) == 0) o.fixed[k.substr(4)] = to_double(k, v);
+    else used = false;
+    it = used ? s.erase(it) : std::next(it);
+  }
+}
+
+void reject_unknown(const std::map<std::string, std::string>& s, const std::string& method, const std::string& known) {
+  if (s.empty()) return;
+  throw UsageError("--set " + s.begin()->first + ": not a setting of " + method + " (settings: " + known + ")");
+}
+
+Result<TransferFunction> run_rls(const IdData& d, const TfOrders& orders, std::map<std::string, std::string> s) {
+  RlsSvfOptions o;
+  for (auto it = s.begin(); it != s.end();) {
+    const auto& [k, v] = *it;
+    bool used = true;
+    if (k == "tau") o.tau = to_double(k, v);
+    else if (k == "p0") o.p0 = to_double(k, v);
+    else if (k == "forgetting") o.forgetting = to_double(k, v);
+    else if (k == "alpha") o.alpha = to_double(k, v);
+    else if (k == "regression_interval") o.regression_interval = to_double(k, v);
+    else if (k.rfind("fix.", 0) == 0) o.fixed[k.substr(4)] = to_double(k, v);
+    else used = false;
+    it = used ? s.erase(it) : std::next(it);
+  }
+  reject_unknown(s, "rls-svf", "tau, p0, forgetting, alpha, regression_interval, fix.NAME");
+  if (d.nu() != 1 || d.ny() != 1) throw UsageError("rls-svf needs one --input and one --output");
+  if (orders.nk > 0) throw UsageError("rls-svf: --nk must be 0 (delay the input column instead)");
+  o.input_intersample = d.intersample(0);
+  const auto start = std::chrono::steady_clock::now();
+  RlsSvf rls(orders, o);
+  for (int k = 0; k < d.size(); ++k) rls.update(d.time(k), d.u()(k, 0), d.y()(k, 0));
+  Result<TransferFunction> r;
+  r.model = rls.model();
+  r.parameters.names = tf_parameter_names(orders);
+  r.parameters.values = rls.parameters();
+  r.parameters.std = Eigen::VectorXd::Constant(orders.n_parameters(), std::numeric_limits<double>::quiet_NaN());
+  r.parameters.fixed.assign(orders.n_parameters(), false);
+  for (int i = 0; i < orders.n_parameters(); ++i) r.parameters.fixed[i] = o.fixed.count(r.parameters.names[i]) > 0;
+  r.diagnostics.scalars["tau"] = o.tau;
+  r.summary.iterations = static_cast<int>(rls.n_updates());
+  r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const Eigen::VectorXd yhat = lsim(r.model, d, 0);
+  if (yhat.allFinite()) r.fit = fit_report(d.y().col(0), yhat, orders.n_parameters() - static_cast<int>(o.fixed.size()));
+  if (!r.model.is_stable()) r.diagnostics.warnings.push_back("the estimated model is unstable");
+  return r;
+}
+
+int run(const FitArgs& a) {
+  check_output_path(a.json, {a.data.path}, a.force);
+  const IdData d = a.data.load(true);
+  if (d.nu() != 1 || d.ny() != 1)
+    throw UsageError(detail::format("{} estimates single-input single-output models (selected {} inputs, {} outputs)",
+                                    a.method, d.nu(), d.ny()));
+  TfOrders orders{a.nb < 0 ? a.nf : a.nb, a.nf, a.nk};
+  auto sets = parse_sets(a.sets);
+  Result<TransferFunction> r;
+  try {
+    orders.validate();
+    if (a.method == "lssvf") {
+      LssvfOptions o;
+      apply_svf_sets(sets, o);
+      reject_unknown(sets, "lssvf", "tau, alpha, transient, weights, tau_grid, fix.NAME");
+      r = lssvf(d, orders, o);
+    } else if (a.method == "ivsvf") {
+      IvsvfOptions o;
+      apply_svf_sets(sets, o.svf);
+      for (auto it = sets.begin(); it != sets.end();) {
+        if (it->first == "max_iterations") o.max_iterations = to_int(it->first, it->second);
+        else if (it->first == "tolerance") o.tolerance = to_double(it->first, it->second);
+        else { ++it; continue; }
+        it = sets.erase(it);
+      }
+      reject_unknown(sets, "ivsvf", "tau, alpha, transient, weights, tau_grid, fix.NAME, max_iterations, tolerance");
+      r = ivsvf(d, orders, o);
+    } else {
+      r = run_rls(d, orders, sets);
+    }
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+  print_result(r, a.method, d);
+  if (!a.json.empty()) {
+    write_result_json(a.json, r, a.method);
+    std::printf("wrote %s\n", a.json.c_str());
+  }
+  if (!r.usable()) {
+    std::fprintf(stderr, "ctid: the estimate is not usable: %s\n",
+                 r.summary.message.empty() ? to_string(r.summary.termination) : r.summary.message.c_str());
+    return kNotUsable;
+  }
+  return kOk;
+}
+
+}  // namespace
+
+void setup_fit(CLI::App& app) {
+  auto a = std::make_shared<FitArgs>();
+  app.add_option("DATA", a->data.path, "CSV/.dat table (header row optional) or .mat file")->required();
+  app.add_option("--method", a->method, "Estimator: lssvf, ivsvf or rls-svf")
+      ->check(CLI::IsMember({"lssvf", "ivsvf", "rls-svf"}))
+      ->capture_default_str();
+  a->data.add_to(app, true);
+  app.add_option("--nb", a->nb, "Number of numerator coefficients (default: nf)");
+  app.add_option("--nf", a->nf, "Model order (denominator coefficients after the leading 1)")->capture_default_str();
+  app.add_option("--nk", a->nk, "Input delay in samples")->capture_default_str();
+  app.add_option("--set", a->sets,
+                 "Method setting KEY=VALUE (repeatable). lssvf/ivsvf: tau (s, 0 = automatic), alpha, transient (s), "
+                 "weights=riemann|trapezoidal, fix.NAME=value (e.g. fix.a2=4); ivsvf also max_iterations, tolerance; "
+                 "rls-svf: tau, p0, forgetting, alpha, regression_interval, fix.NAME");
+  app.add_option("--json", a->json, "Write the result (model, parameters, fit) to this JSON file");
+  app.add_flag("--force", a->force, "Overwrite an existing output file");
+  app.callback([a] { g_run = [a] { return run(*a); }; });
+}
+
+}  // namespace ctid::cli

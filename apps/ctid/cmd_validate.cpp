@@ -1,0 +1,85 @@
+// ctid validate MODEL.json DATA [--json OUT.json]
+#include <cstdio>
+#include <functional>
+
+#include <nlohmann/json.hpp>
+
+#include "common.hpp"
+
+namespace ctid::cli {
+extern std::function<int()> g_run;
+
+namespace {
+struct ValArgs {
+  std::string model;
+  DataArgs data;
+  std::string json;
+  int lags = 25;
+  bool force = false;
+};
+
+nlohmann::json corr_json(const CorrelationTest& c) {
+  return {{"lags", std::vector<int>(c.lags.begin(), c.lags.end())},
+          {"values", std::vector<double>(c.values.begin(), c.values.end())},
+          {"bound_99", c.bound},
+          {"n_outside", c.n_outside},
+          {"passed", c.passed()}};
+}
+
+int run(const ValArgs& a) {
+  check_output_path(a.json, {a.data.path, a.model}, a.force);
+  LinearModel m;
+  try {
+    m = read_model_json(a.model);
+  } catch (const FileError& e) {
+    throw InputError(e.what());
+  }
+  const auto* tf = std::get_if<TransferFunction>(&m);
+  if (!tf) throw UsageError("validate supports transfer-function models");
+  const IdData d = a.data.load(true);
+  if (d.nu() != 1 || d.ny() != 1) throw UsageError("validate needs one --input and one --output");
+  if (a.lags < 1 || a.lags >= d.size()) throw UsageError(detail::format("--lags must be in [1, {}]", d.size() - 1));
+  const Eigen::VectorXd yhat = lsim(*tf, d, 0);
+  const Eigen::VectorXd y = d.y().col(0);
+  const int np = tf->num().degree() + 1 + tf->order();
+  FitReport f;
+  try {
+    f = fit_report(y, yhat, np);
+  } catch (const InvalidArgument& e) {
+    throw InputError(a.data.path + ": " + e.what());
+  }
+  const Eigen::VectorXd e = y - yhat;
+  const CorrelationTest ac = residual_autocorrelation(e, a.lags);
+  const CorrelationTest xc = input_residual_crosscorrelation(d.u().col(0), e, a.lags);
+  std::printf("model:  G(s) = %s\n", tf->to_string(6).c_str());
+  std::printf("fit: %.2f %%   NRMSE %.4g   MSE %.4g   (%d samples)\n", f.fit_percent, f.nrmse, f.mse, f.n_samples);
+  std::printf("residual whiteness (lags 1..%d): %d outside the 99 %% bound %.3g -> %s\n", a.lags, ac.n_outside, ac.bound,
+              ac.passed() ? "passed" : "not white");
+  std::printf("input-residual independence (lags -%d..%d): %d outside -> %s\n", a.lags, a.lags, xc.n_outside,
+              xc.passed() ? "passed" : "correlated (unmodelled dynamics)");
+  if (!a.json.empty()) {
+    nlohmann::json j;
+    j["ctid_version"] = version();
+    j["model"] = nlohmann::json::parse(model_to_json(*tf));
+    j["fit"] = {{"fit_percent", f.fit_percent}, {"nrmse", f.nrmse}, {"mse", f.mse}, {"n_samples", f.n_samples}};
+    j["residual_autocorrelation"] = corr_json(ac);
+    j["input_residual_crosscorrelation"] = corr_json(xc);
+    write_text_file(a.json, j.dump(2) + "\n");
+    std::printf("wrote %s\n", a.json.c_str());
+  }
+  return kOk;
+}
+}  // namespace
+
+void setup_validate(CLI::App& app) {
+  auto a = std::make_shared<ValArgs>();
+  app.add_option("MODEL", a->model, "Model JSON (a result file or a bare model)")->required();
+  app.add_option("DATA", a->data.path, "Measured data table or .mat file")->required();
+  a->data.add_to(app, true);
+  app.add_option("--lags", a->lags, "Lags of the residual correlation tests")->capture_default_str();
+  app.add_option("--json", a->json, "Write fit and residual tests to this JSON file");
+  app.add_flag("--force", a->force, "Overwrite an existing output file");
+  app.callback([a] { g_run = [a] { return run(*a); }; });
+}
+
+}  // namespace ctid::cli

@@ -1,0 +1,133 @@
+#include "common.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+namespace ctid::cli {
+
+void DataArgs::add_to(CLI::App& app, bool need_output) {
+  app.add_option("--input", inputs, "Input column(s): name or 1-based position (repeatable)");
+  if (need_output) app.add_option("--output", outputs, "Output column: name or 1-based position");
+  auto* t = app.add_option("--time", time, "Time column (strictly increasing; irregular sampling allowed)");
+  auto* s = app.add_option("--ts", ts, "Sampling period in seconds (when there is no time column)");
+  t->excludes(s);
+  app.add_option("--intersample", intersample, "Input intersample behaviour: zoh, foh or bl")->capture_default_str();
+  app.add_option("--detrend", detrend, "Remove none, mean or linear trend before use")->capture_default_str();
+}
+
+IdData DataArgs::load(bool need_output) const {
+  if (detrend != "none" && detrend != "mean" && detrend != "linear")
+    throw UsageError("--detrend must be none, mean or linear (got '" + detrend + "')");
+  if (time.empty() && ts == 0.0) throw UsageError("give the time axis: --time COLUMN or --ts SECONDS");
+  if (!(ts >= 0) || !std::isfinite(ts)) throw UsageError("--ts must be a positive number of seconds (got " + std::to_string(ts) + ")");
+  DataSpec spec;
+  spec.time = time;
+  spec.ts = ts;
+  try {
+    spec.intersample = intersample_from_string(intersample);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+  spec.inputs = inputs;
+  spec.outputs = outputs;
+  try {
+    const bool is_mat = path.size() > 4 && path.substr(path.size() - 4) == ".mat";
+    if (!is_mat && (inputs.empty() || (need_output && outputs.empty()))) {
+      // Default columns: everything that is not the time column, inputs first, output last.
+      const CsvTable tab = read_csv(path);
+      std::vector<std::string> rest;
+      const int tcol = time.empty() ? -1 : tab.column(time);
+      for (int c = 0; c < static_cast<int>(tab.names.size()); ++c)
+        if (c != tcol) rest.push_back(tab.names[c]);
+      if (need_output && outputs.empty()) {
+        if (rest.size() != 2 && inputs.empty()) {
+          std::string cols;
+          for (const auto& n : tab.names) cols += (cols.empty() ? "" : ", ") + n;
+          throw UsageError(path + ": choose columns with --input and --output (columns: " + cols + ")");
+        }
+        spec.outputs = {rest.back()};
+        rest.pop_back();
+      }
+      if (inputs.empty()) {
+        if (rest.empty()) throw UsageError(path + ": no column left for the input; use --input");
+        spec.inputs = need_output ? rest : std::vector<std::string>{rest.front()};
+      }
+      if (!need_output) spec.outputs = {spec.inputs.front()};  // placeholder output for loading only
+      IdData d = iddata_from_table(tab, spec);
+      return detrend == "none" ? d : d.detrend(detrend == "mean" ? Detrend::Mean : Detrend::Linear);
+    }
+    if (!need_output) spec.outputs = {inputs.front()};
+    IdData d = load_iddata(path, spec);
+    return detrend == "none" ? d : d.detrend(detrend == "mean" ? Detrend::Mean : Detrend::Linear);
+  } catch (const FileError& e) {
+    throw InputError(e.what());
+  } catch (const InvalidArgument& e) {
+    const std::string what = e.what();
+    // An unknown column is a usage problem; everything else is about the file's content.
+    if (what.find("no column named") != std::string::npos || what.find("no variable named") != std::string::npos ||
+        what.find("column position") != std::string::npos)
+      throw UsageError(what);
+    throw InputError(path + ": " + what);
+  }
+}
+
+void check_output_path(const std::string& out, const std::vector<std::string>& inputs, bool force) {
+  namespace fs = std::filesystem;
+  if (out.empty()) return;
+  std::error_code ec;
+  for (const auto& in : inputs)
+    if (!in.empty() && fs::exists(in) && fs::exists(out) && fs::equivalent(in, out, ec))
+      throw UsageError("refusing to write '" + out + "': it is one of the input files");
+  if (fs::exists(out) && !force) throw UsageError("'" + out + "' exists; use --force to overwrite it");
+}
+
+std::map<std::string, std::string> parse_sets(const std::vector<std::string>& sets) {
+  std::map<std::string, std::string> m;
+  for (const auto& s : sets) {
+    const auto eq = s.find('=');
+    if (eq == std::string::npos || eq == 0) throw UsageError("--set needs KEY=VALUE (got '" + s + "')");
+    m[s.substr(0, eq)] = s.substr(eq + 1);
+  }
+  return m;
+}
+
+double to_double(const std::string& key, const std::string& value) {
+  char* end = nullptr;
+  const double v = std::strtod(value.c_str(), &end);
+  if (value.empty() || *end != '\0' || !std::isfinite(v)) throw UsageError("--set " + key + ": '" + value + "' is not a number");
+  return v;
+}
+
+int to_int(const std::string& key, const std::string& value) {
+  const double v = to_double(key, value);
+  if (v != std::floor(v)) throw UsageError("--set " + key + ": '" + value + "' is not a whole number");
+  return static_cast<int>(v);
+}
+
+void print_result(const Result<TransferFunction>& r, const std::string& method, const IdData& d) {
+  std::printf("method: %s   samples: %d   %s\n", method.c_str(), d.size(),
+              d.is_uniform() ? ("Ts = " + detail::format("{}", d.ts()) + " s").c_str() : "irregular sampling");
+  std::printf("model:  G(s) = %s\n", r.model.to_string(6).c_str());
+  std::printf("parameters (value +- one standard deviation):\n");
+  for (int i = 0; i < r.parameters.size(); ++i) {
+    const bool fixed = r.parameters.fixed[i];
+    const double sd = i < r.parameters.std.size() ? r.parameters.std(i) : NAN;
+    if (fixed)
+      std::printf("  %-4s = %14.6g   (fixed)\n", r.parameters.names[i].c_str(), r.parameters.values(i));
+    else if (std::isfinite(sd))
+      std::printf("  %-4s = %14.6g +- %-12.4g\n", r.parameters.names[i].c_str(), r.parameters.values(i), sd);
+    else
+      std::printf("  %-4s = %14.6g\n", r.parameters.names[i].c_str(), r.parameters.values(i));
+  }
+  for (const auto& [k, v] : r.diagnostics.scalars)
+    if (k == "tau") std::printf("filter time constant tau = %.6g s\n", v);
+  std::printf("fit: %.2f %%   NRMSE %.4g   MSE %.4g   AIC %.6g   BIC %.6g\n", r.fit.fit_percent, r.fit.nrmse, r.fit.mse,
+              r.fit.aic, r.fit.bic);
+  if (r.diagnostics.condition_number > 0) std::printf("condition number %.3g   ", r.diagnostics.condition_number);
+  std::printf("termination: %s   %.3g s\n", to_string(r.summary.termination), r.summary.seconds);
+  if (!r.summary.message.empty()) std::printf("note: %s\n", r.summary.message.c_str());
+  for (const auto& w : r.diagnostics.warnings) std::printf("warning: %s\n", w.c_str());
+}
+
+}  // namespace ctid::cli

@@ -1,0 +1,60 @@
+// ctid command line — shared pieces: exit codes, data loading options, output files.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "ctid/ctid.hpp"
+
+namespace ctid::cli {
+
+// Exit codes (DESIGN.md §4).
+constexpr int kOk = 0;
+constexpr int kNotUsable = 1;
+constexpr int kUsage = 2;
+constexpr int kInputFile = 3;
+
+/// A usage problem detected after parsing (bad --set key, inconsistent options): exit 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+/// A problem with an input file or its contents: exit 3.
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Options that select an experiment from a data file.
+struct DataArgs {
+  std::string path;
+  std::vector<std::string> inputs;
+  std::vector<std::string> outputs;
+  std::string time;
+  double ts = 0.0;
+  std::string intersample = "zoh";
+  std::string detrend = "none";
+  void add_to(CLI::App& app, bool need_output);
+  /// Load, select and detrend; maps every failure to InputError (file/content) or
+  /// UsageError (inconsistent options).
+  IdData load(bool need_output) const;
+};
+
+/// Output file guard: refuses to overwrite an input file, and an existing file unless --force.
+void check_output_path(const std::string& out, const std::vector<std::string>& inputs, bool force);
+
+/// "KEY=VALUE" pairs from --set.
+std::map<std::string, std::string> parse_sets(const std::vector<std::string>& sets);
+double to_double(const std::string& key, const std::string& value);
+int to_int(const std::string& key, const std::string& value);
+
+/// Print a transfer-function result (model, parameters with std, fit, summary, warnings).
+void print_result(const Result<TransferFunction>& r, const std::string& method, const IdData& data);
+
+void setup_fit(CLI::App& app);
+void setup_simulate(CLI::App& app);
+void setup_validate(CLI::App& app);
+void setup_demo(CLI::App& app);
+
+}  // namespace ctid::cli

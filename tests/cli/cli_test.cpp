@@ -1,0 +1,178 @@
+// The command line: exit codes and messages of DESIGN.md §4/§8, and no partial output files.
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sys/wait.h>
+
+#include <gtest/gtest.h>
+
+#include "ctid/ctid.hpp"
+#include "test_util.hpp"
+
+namespace fs = std::filesystem;
+using namespace ctid;
+
+namespace {
+struct CliRun {
+  int code;
+  std::string out, err;
+};
+
+CliRun ctid_run(const std::string& args) {
+  const std::string errf = test::temp_path("stderr.txt");
+  const std::string cmd = std::string(CTID_CLI_PATH) + " " + args + " 2>" + errf;
+  CliRun r{0, "", ""};
+  FILE* p = popen(cmd.c_str(), "r");
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), p)) r.out += buf.data();
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream f(errf);
+  r.err.assign(std::istreambuf_iterator<char>(f), {});
+  return r;
+}
+
+std::string write(const std::string& name, const std::string& text) {
+  const std::string p = test::temp_path(name);
+  std::ofstream(p) << text;
+  return p;
+}
+
+// A clean second-order data set (noise-free, 20 s at 10 ms) written as CSV with a time column.
+std::string good_csv() {
+  static const std::string path = [] {
+    const TransferFunction g(Eigen::VectorXd{{3.0}}, Eigen::VectorXd{{1.0, 1.2, 4.0}});
+    const int N = 2000;
+    PrbsOptions po;
+    po.register_length = 9;
+    po.clock_period = 10;
+    const Eigen::VectorXd u = prbs(N, po), t = time_grid(0.01, N);
+    Eigen::MatrixXd m(N, 3);
+    m << t, u, lsim(g, u, t);
+    const std::string p = test::temp_path("good.csv");
+    write_csv(p, {"time", "force", "position"}, m);
+    return p;
+  }();
+  return path;
+}
+}  // namespace
+
+TEST(Cli, HelpAndVersion) {
+  for (const char* sub : {"fit", "simulate", "validate", "demo"}) {
+    const CliRun r = ctid_run(std::string(sub) + " --help");
+    EXPECT_EQ(r.code, 0) << sub;
+    EXPECT_NE(r.out.find("--"), std::string::npos) << sub;
+  }
+  EXPECT_NE(ctid_run("--version").out.find(ctid::version()), std::string::npos);
+  EXPECT_EQ(ctid_run("").code, 2);
+}
+
+TEST(Cli, FitWritesJsonThatSimulateAndValidateRead) {
+  const std::string json = test::temp_path("fit.json");
+  fs::remove(json);
+  CliRun r = ctid_run("fit " + good_csv() + " --time time --input force --output position --nf 2 --nb 1 --method lssvf --set tau=0.3 --json " + json);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("a1"), std::string::npos);
+  const Result<TransferFunction> res = parse_result_json(read_text_file(json));
+  // Noise-free data at 10 ms: O(Ts^2) output-interpolation error, about 1e-4 relative.
+  EXPECT_NEAR(res.parameters.value("a1"), 1.2, 1e-3);
+  EXPECT_NEAR(res.parameters.value("a2"), 4.0, 1e-3);
+  EXPECT_NEAR(res.parameters.value("b0"), 3.0, 1e-3);
+  // The same file again without --force is refused, and left as it was.
+  const std::string before = read_text_file(json);
+  r = ctid_run("fit " + good_csv() + " --time time --input force --output position --nf 2 --nb 1 --json " + json);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("exists; use --force"), std::string::npos);
+  EXPECT_EQ(read_text_file(json), before);
+
+  const std::string sim = test::temp_path("sim.csv");
+  fs::remove(sim);
+  r = ctid_run("simulate " + json + " " + good_csv() + " --time time --input force --out " + sim);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const CsvTable t = read_csv(sim);
+  EXPECT_EQ(t.names, (std::vector<std::string>{"t", "force", "y"}));
+  const CsvTable g = read_csv(good_csv());
+  EXPECT_LT((t.values.col(2) - g.values.col(2)).cwiseAbs().maxCoeff(), 1e-3);
+
+  const std::string vj = test::temp_path("val.json");
+  fs::remove(vj);
+  r = ctid_run("validate " + json + " " + good_csv() + " --time time --input force --output position --json " + vj);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("fit: 99.9"), std::string::npos) << r.out;
+  EXPECT_NE(read_text_file(vj).find("residual_autocorrelation"), std::string::npos);
+}
+
+TEST(Cli, IvsvfAndRlsMethods) {
+  CliRun r = ctid_run("fit " + good_csv() + " --time time --input force --output position --nf 2 --nb 1 --method ivsvf");
+  EXPECT_EQ(r.code, 0) << r.err;
+  const std::string json = test::temp_path("rls.json");
+  fs::remove(json);
+  r = ctid_run("fit " + good_csv() + " --time time --nf 2 --nb 1 --method rls-svf --set tau=0.3 --set p0=1e8 --json " + json);
+  ASSERT_EQ(r.code, 0) << r.err;
+  // Default columns: time excluded, first remaining column the input, last the output.
+  // Noise-free data at 10 ms: measured a1 = 1.19971 (O(Ts^2) interpolation error); tolerance 1e-3.
+  const auto res = parse_result_json(read_text_file(json));
+  EXPECT_NEAR(res.parameters.value("a1"), 1.2, 1e-3);
+  EXPECT_NEAR(res.parameters.value("b0"), 3.0, 1e-3);
+}
+
+TEST(Cli, BadInputGivesOneLineAndTheDocumentedExitCode) {
+  const std::string base = " --time time --input force --output position ";
+  struct Case {
+    std::string args;
+    int code;
+    std::string message;
+  };
+  const std::string nan_csv = write("nan.csv", "time,force,position\n0,1,2\n0.1,nan,3\n0.2,1,2\n");
+  const std::string text_csv = write("text.csv", "time,force,position\n0,1,2\n0.1,abc,3\n");
+  const std::string nonincr = write("nonincr.csv", "time,force,position\n0,1,2\n0.2,1,3\n0.1,1,2\n");
+  const std::string tiny = write("tiny.csv", "time,force,position\n0,1,2\n0.1,2,3\n0.2,1,2\n");
+  const std::vector<Case> cases = {
+      {"fit /nonexistent/data.csv" + base, 3, "cannot open '/nonexistent/data.csv'"},
+      {"fit " + good_csv() + " --time time --input flow --output position", 2, "no column named 'flow'"},
+      {"fit " + text_csv + base, 3, "text.csv:3: column 'force' (field 2): cannot read 'abc' as a number"},
+      {"fit " + nan_csv + base, 3, "nan.csv:3: column 'force' (field 2): value 'nan' is not finite"},
+      {"fit " + tiny + base + "--nf 2 --set tau=0.1", 2, "3 samples in the criterion cannot determine 4 free parameters"},
+      {"fit " + nonincr + base, 3, "nonincr.csv:4: time column 'time' is not strictly increasing (0.1 after 0.2)"},
+      {"fit " + good_csv() + base + "--nf 0", 2, "nf (model order) must be >= 1 (got 0)"},
+      {"fit " + good_csv() + base + "--nf -2", 2, "nf (model order) must be >= 1 (got -2)"},
+      {"fit " + good_csv() + base + "--set tau=-0.5", 2, "tau must be > 0, or 0 for automatic (got -0.5)"},
+      {"fit " + good_csv() + base + "--method rls-svf --set tau=0", 2, "tau must be > 0 (got 0)"},
+      {"fit " + good_csv() + base + "--set bogus=1", 2, "--set bogus: not a setting of lssvf"},
+      {"fit " + good_csv() + base + "--method magic", 2, "magic"},
+      {"fit " + good_csv() + " --input force --output position", 2, "--time COLUMN or --ts SECONDS"},
+      {"simulate /nonexistent.json " + good_csv() + " --time time --input force", 3, "cannot open '/nonexistent.json'"},
+  };
+  for (const Case& c : cases) {
+    const CliRun r = ctid_run(c.args);
+    EXPECT_EQ(r.code, c.code) << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << "\nstderr: " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;  // one clear line
+  }
+}
+
+TEST(Cli, NoPartialOutputOnFailure) {
+  const std::string json = test::temp_path("never.json");
+  fs::remove(json);
+  const std::string text_csv = write("text2.csv", "time,force,position\n0,1,2\n0.1,abc,3\n");
+  CliRun r = ctid_run("fit " + text_csv + " --time time --input force --output position --json " + json);
+  EXPECT_EQ(r.code, 3);
+  EXPECT_FALSE(fs::exists(json));
+  // Unusable estimate (no excitation): exit 1; the input file is never overwritten.
+  const std::string flat = write("flat.csv", "time,force,position\n0,0,0\n0.1,0,0\n0.2,0,0\n0.3,0,0\n0.4,0,0\n0.5,0,0\n");
+  r = ctid_run("fit " + flat + " --time time --input force --output position --set tau=1");
+  EXPECT_EQ(r.code, 1) << r.err;
+  r = ctid_run("fit " + flat + " --time time --input force --output position --set tau=1 --json " + flat + " --force");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("one of the input files"), std::string::npos);
+  EXPECT_EQ(read_csv(flat).values.rows(), 6);
+}
+
+TEST(Cli, DemoRunsOnBundledData) {
+  const CliRun r = ctid_run("demo");
+  ASSERT_EQ(r.code, 0) << r.err;
+  // The DaISy dryer: a second-order model with 0.16 s delay; validation fit measured 88.3 %.
+  EXPECT_NE(r.out.find("validation on the last 500 samples: fit 8"), std::string::npos) << r.out;
+}
