@@ -45,6 +45,15 @@ std::vector<std::string> tf_parameter_names(const TfOrders& o) {
 
 namespace svf_detail {
 
+int parameter_index(const TfOrders& o, const std::string& name, const char* who) {
+  const auto names = tf_parameter_names(o);
+  for (std::size_t k = 0; k < names.size(); ++k)
+    if (names[k] == name) return static_cast<int>(k);
+  std::string known;
+  for (const auto& nm : names) known += (known.empty() ? "" : ", ") + nm;
+  throw InvalidOptions(detail::format("{}: '{}' is not a coefficient of this structure ({})", who, name, known));
+}
+
 SvfLayout make_layout(const TfOrders& o, double tau, const std::map<std::string, double>& fixed, const char* who) {
   SvfLayout L;
   L.n = o.nf;
@@ -55,16 +64,8 @@ SvfLayout make_layout(const TfOrders& o, double tau, const std::map<std::string,
   L.fixed.assign(2 * L.n, false);
   L.theta_fixed = Eigen::VectorXd::Zero(2 * L.n);
   for (int i = 0; i < L.n - L.nb; ++i) L.fixed[L.n + i] = true;  // leading b's are zero
-  const auto names = tf_parameter_names(o);
   for (const auto& [name, value] : fixed) {
-    int idx = -1;
-    for (std::size_t k = 0; k < names.size(); ++k)
-      if (names[k] == name) idx = static_cast<int>(k);
-    if (idx < 0) {
-      std::string known;
-      for (const auto& nm : names) known += (known.empty() ? "" : ", ") + nm;
-      throw InvalidOptions(detail::format("{}: fixed coefficient '{}' is not a parameter of this structure ({})", who, name, known));
-    }
+    const int idx = parameter_index(o, name, who);
     const int t = L.theta_index(idx);
     L.fixed[t] = true;
     L.theta_fixed(t) = idx < L.n ? -value : value;

@@ -18,9 +18,10 @@ void RlsSvfOptions::validate() const {
                       "rls_svf: regression_interval must be >= 0 (got {})", regression_interval);
 }
 
-RlsSvf::RlsSvf(const TfOrders& orders, const RlsSvfOptions& options) : orders_(orders), opt_(options) {
-  orders_.validate();
-  opt_.validate();
+RlsSvf::RlsSvf(const TfOrders& orders, const RlsSvfOptions& options)
+    : orders_((orders.validate(), orders)),
+      opt_((options.validate(), options)),
+      stream_(orders.nf, options.tau, options.input_intersample, options.regression_interval, "rls_svf") {
   CTID_REQUIRE_OPTION(orders_.nk == 0, "rls_svf: nk must be 0 for the recursive estimator (got {}); delay the input yourself",
                       orders_.nk);
   const svf_detail::SvfLayout L = svf_detail::make_layout(orders_, opt_.tau, opt_.fixed, "rls_svf");
@@ -35,8 +36,6 @@ RlsSvf::RlsSvf(const TfOrders& orders, const RlsSvfOptions& options) : orders_(o
   if (opt_.theta0.size() > 0)
     CTID_REQUIRE_OPTION(opt_.theta0.size() == orders_.n_parameters(), "rls_svf: theta0 needs {} values [a1.., b0..] (got {})",
                         orders_.n_parameters(), opt_.theta0.size());
-  bank_ = std::make_unique<SvfFilterBank>(n, opt_.tau,
-                                          std::vector<Intersample>{Intersample::Foh, opt_.input_intersample});
   theta_.resize(p);
   P_.resize(p, p);
   Pphi_.resize(p);
@@ -47,7 +46,7 @@ RlsSvf::RlsSvf(const TfOrders& orders, const RlsSvfOptions& options) : orders_(o
 
 void RlsSvf::reset() {
   const int n = orders_.nf;
-  bank_->reset();
+  stream_.reset();
   P_.setIdentity();
   P_ *= opt_.p0;
   theta_.setZero();
@@ -67,47 +66,26 @@ void RlsSvf::reset() {
       for (std::size_t j = 0; j < free_.size(); ++j) theta_(static_cast<Eigen::Index>(j)) = th(free_[j]);
     }
   }
-  started_ = false;
   n_updates_ = 0;
 }
 
 void RlsSvf::update(double t, double u, double y) {
-  CTID_REQUIRE(std::isfinite(t) && std::isfinite(u) && std::isfinite(y), "rls_svf: non-finite sample (t = {}, u = {}, y = {})",
-               t, u, y);
-  double next[2] = {y, u};
-  if (!started_) {
-    bank_->set_current(next);
-    started_ = true;
-    t_ = t_reg_ = t;
-    y_prev_ = y;
-    u_prev_ = u;
-    return;
-  }
-  CTID_REQUIRE(t > t_, "rls_svf: sample times must increase (t = {} after {})", t, t_);
-  const double prev[2] = {y_prev_, u_prev_};
-  bank_->step(t - t_, prev, next);
-  t_ = t;
-  y_prev_ = y;
-  u_prev_ = u;
-  const double ri = opt_.regression_interval;
-  if (ri > 0 && t - t_reg_ < ri * (1.0 - 1e-9)) return;
-  const double dt = t - t_reg_;
-  t_reg_ = t;
-
+  if (!stream_.push(t, u, y)) return;
+  const double dt = stream_.regression_step();
   const int n = orders_.nf;
   const int p = static_cast<int>(theta_.size());
-  const double* phy = bank_->chain(0);
-  const double* phu = bank_->chain(1);
+  const double* phy = stream_.bank().chain(0);
+  const double* phu = stream_.bank().chain(1);
   double target;
   if (theta_tau_mode_) {
     for (int i = 0; i < n; ++i) {
       row_(i) = phy[i];
       row_(n + i) = phu[i];
     }
-    target = bank_->filtered(0);
+    target = stream_.bank().filtered(0);
   } else {
     svf_detail::physical_regressor(M_, phy, phu, psi_.data());
-    target = bank_->filtered(0);
+    target = stream_.bank().filtered(0);
     for (int i = 0; i < n; ++i) target -= g_(i) * phy[i];
     for (int k = 0; k < 2 * n; ++k)
       if (fixed_[k]) target -= theta_fixed_(k) * psi_(k);
@@ -171,23 +149,15 @@ void CoefficientTrackerOptions::validate() const {
 
 CoefficientTracker::CoefficientTracker(const TransferFunction& known, const std::string& unknown,
                                        const CoefficientTrackerOptions& o)
-    : threshold_(o.threshold), h_(o.regression_interval) {
-  o.validate();
+    : stream_((o.validate(), std::max(1, known.order())), o.tau, o.input_intersample, o.regression_interval,
+              "coefficient_tracker"),
+      threshold_(o.threshold) {
   n_ = known.order();
   CTID_REQUIRE(n_ >= 1, "coefficient_tracker: the known model must have order >= 1");
   CTID_REQUIRE(known.num().degree() < n_ || known.num().is_zero(),
                "coefficient_tracker: the known model must be strictly proper (numerator degree {}, order {})",
                known.num().degree(), n_);
-  const TfOrders orders{n_, n_, 0};
-  const auto names = tf_parameter_names(orders);
-  int idx = -1;
-  for (std::size_t k = 0; k < names.size(); ++k)
-    if (names[k] == unknown) idx = static_cast<int>(k);
-  if (idx < 0) {
-    std::string list;
-    for (const auto& nm : names) list += (list.empty() ? "" : ", ") + nm;
-    throw InvalidOptions(detail::format("coefficient_tracker: '{}' is not a coefficient of this model ({})", unknown, list));
-  }
+  const int idx = svf_detail::parameter_index(TfOrders{n_, n_, 0}, unknown, "coefficient_tracker");
   M_ = svf_m_tau(n_, o.tau);
   g_ = svf_g_tau(n_);
   theta_.resize(2 * n_);
@@ -199,36 +169,15 @@ CoefficientTracker::CoefficientTracker(const TransferFunction& known, const std:
   sign_ = idx < n_ ? -1.0 : 1.0;
   estimate_ = sign_ * theta_(j_);
   psi_.resize(2 * n_);
-  bank_ = std::make_unique<SvfFilterBank>(n_, o.tau, std::vector<Intersample>{Intersample::Foh, o.input_intersample});
 }
 
-const double* CoefficientTracker::filtered_output() const { return bank_->chain(0); }
-
 void CoefficientTracker::update(double t, double u, double y) {
-  CTID_REQUIRE(std::isfinite(t) && std::isfinite(u) && std::isfinite(y),
-               "coefficient_tracker: non-finite sample (t = {}, u = {}, y = {})", t, u, y);
   updated_ = false;
-  double next[2] = {y, u};
-  if (!started_) {
-    bank_->set_current(next);
-    started_ = true;
-    t_ = t_reg_ = t;
-    y_prev_ = y;
-    u_prev_ = u;
-    return;
-  }
-  CTID_REQUIRE(t > t_, "coefficient_tracker: sample times must increase (t = {} after {})", t, t_);
-  const double prev[2] = {y_prev_, u_prev_};
-  bank_->step(t - t_, prev, next);
-  t_ = t;
-  y_prev_ = y;
-  u_prev_ = u;
-  if (h_ > 0 && t - t_reg_ < h_ * (1.0 - 1e-9)) return;
-  t_reg_ = t;
-  const double* phy = bank_->chain(0);
-  const double* phu = bank_->chain(1);
+  if (!stream_.push(t, u, y)) return;
+  const double* phy = stream_.bank().chain(0);
+  const double* phu = stream_.bank().chain(1);
   svf_detail::physical_regressor(M_, phy, phu, psi_.data());
-  double lhs = bank_->filtered(0);
+  double lhs = stream_.bank().filtered(0);
   for (int i = 0; i < n_; ++i) lhs -= g_(i) * phy[i];
   for (int k = 0; k < 2 * n_; ++k)
     if (k != j_) lhs -= theta_(k) * psi_(k);

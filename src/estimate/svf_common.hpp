@@ -41,6 +41,8 @@ struct PreparedData {
   int n_used = 0;
 };
 
+/// Index of a parameter name (a1.., b0..) for the orders; InvalidOptions listing the names.
+int parameter_index(const TfOrders& o, const std::string& name, const char* who);
 SvfLayout make_layout(const TfOrders& o, double tau, const std::map<std::string, double>& fixed, const char* who);
 PreparedData prepare(const IdData& data, const TfOrders& o, double transient_time, double alpha, SvfWeights weights,
                      const char* who);

@@ -182,6 +182,40 @@ void SvfFilterBank::step(double h, const double* prev, const double* next) {
   }
 }
 
+SvfStream::SvfStream(int n, double tau, Intersample input, double interval, const char* who)
+    : bank_(n, tau, {Intersample::Foh, input}), interval_(interval), who_(who) {
+  CTID_REQUIRE(std::isfinite(interval) && interval >= 0, "{}: the regression interval must be >= 0 (got {})", who, interval);
+}
+
+void SvfStream::reset() {
+  bank_.reset();
+  started_ = false;
+}
+
+bool SvfStream::push(double t, double u, double y) {
+  CTID_REQUIRE(std::isfinite(t) && std::isfinite(u) && std::isfinite(y), "{}: non-finite sample (t = {}, u = {}, y = {})",
+               who_, t, u, y);
+  const double next[2] = {y, u};
+  if (!started_) {
+    bank_.set_current(next);
+    started_ = true;
+    t_ = t_reg_ = t;
+    y_prev_ = y;
+    u_prev_ = u;
+    return false;
+  }
+  CTID_REQUIRE(t > t_, "{}: sample times must increase (t = {} after {})", who_, t, t_);
+  const double prev[2] = {y_prev_, u_prev_};
+  bank_.step(t - t_, prev, next);
+  t_ = t;
+  y_prev_ = y;
+  u_prev_ = u;
+  if (interval_ > 0 && t - t_reg_ < interval_ * (1.0 - 1e-9)) return false;
+  reg_step_ = t - t_reg_;
+  t_reg_ = t;
+  return true;
+}
+
 Eigen::MatrixXd svf_filter(const IdData& data, int n, double tau, int input, int output,
                            const std::optional<TransferFunction>& F) {
   CTID_REQUIRE(output < data.ny(), "svf_filter: output index {} out of range ({} outputs)", output, data.ny());

@@ -12,7 +12,6 @@
 #pragma once
 
 #include <map>
-#include <memory>
 #include <string>
 #include <vector>
 
@@ -60,12 +59,12 @@ class RlsSvf {
   /// Current covariance-like matrix P (in the recursion's own coordinates).
   const Eigen::MatrixXd& P() const { return P_; }
   long long n_updates() const { return n_updates_; }
-  double time() const { return t_; }
+  double time() const { return stream_.time(); }
 
  private:
   TfOrders orders_;
   RlsSvfOptions opt_;
-  std::unique_ptr<SvfFilterBank> bank_;
+  SvfStream stream_;
   Eigen::MatrixXd M_;
   Eigen::VectorXd g_, theta_fixed_;
   std::vector<bool> fixed_;
@@ -74,8 +73,6 @@ class RlsSvf {
   Eigen::VectorXd theta_;   // in the recursion's coordinates
   Eigen::MatrixXd P_;
   Eigen::VectorXd Pphi_, row_, psi_;
-  double t_ = 0.0, t_reg_ = 0.0, u_prev_ = 0.0, y_prev_ = 0.0;
-  bool started_ = false;
   long long n_updates_ = 0;
 };
 
@@ -102,16 +99,16 @@ class CoefficientTracker {
   /// The filtered regressor psi_j at the last update (RJ's phi for a_1).
   double regressor() const { return last_psi_; }
   /// Filter outputs [z^k y] of the last sample (k = 1..n), e.g. for a filtered velocity.
-  const double* filtered_output() const;
+  const double* filtered_output() const { return stream_.bank().chain(0); }
 
  private:
-  std::unique_ptr<SvfFilterBank> bank_;
+  SvfStream stream_;
   Eigen::MatrixXd M_;
   Eigen::VectorXd g_, theta_, psi_;
   int n_ = 0, j_ = 0;
-  double threshold_, h_, t_ = 0, t_reg_ = 0, u_prev_ = 0, y_prev_ = 0, estimate_ = 0, last_psi_ = 0;
+  double threshold_, estimate_ = 0, last_psi_ = 0;
   double sign_ = 1.0;
-  bool started_ = false, updated_ = false;
+  bool updated_ = false;
 };
 
 }  // namespace ctid

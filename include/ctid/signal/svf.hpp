@@ -44,7 +44,9 @@ Eigen::VectorXd theta_tau_from_ab(const Eigen::VectorXd& a, const Eigen::VectorX
 void ab_from_theta_tau(const Eigen::VectorXd& theta_tau, double tau, Eigen::VectorXd& a, Eigen::VectorXd& b);
 
 /// Filter bank producing [z s, z^2 s, .., z^n s] for several sampled signals at once.
-/// No allocation in step(): coefficients are recomputed in place when the interval changes.
+/// Without an extra filter, step() allocates nothing (closed-form coefficients are
+/// recomputed in place when the interval changes); with one, a new interval length
+/// costs a matrix exponential.
 class SvfFilterBank {
  public:
   /// n >= 1 filters per signal, tau > 0 (s), one intersample behaviour per signal
@@ -87,6 +89,32 @@ class SvfFilterBank {
   Eigen::MatrixXd xs_;            // (nF + n) x n_signals
   Eigen::VectorXd tmp_;
   std::vector<double> chain_out_, filt_out_, work_;
+};
+
+/// A two-signal bank [y (FOH), u] fed one sample at a time, for on-line estimators:
+/// keeps the previous sample and tells when a regression instant is reached (every
+/// sample, or at most every `regression_interval` seconds). push() allocates nothing.
+class SvfStream {
+ public:
+  /// who: the estimator's name for error messages. Throws InvalidArgument.
+  SvfStream(int n, double tau, Intersample input, double regression_interval, const char* who);
+  /// Feed one sample; returns true at a regression instant (never for the first sample,
+  /// where the filters are still at rest). Throws InvalidArgument for a non-finite value
+  /// or a time that does not increase.
+  bool push(double t, double u, double y);
+  /// Seconds between the last two regression instants.
+  double regression_step() const { return reg_step_; }
+  /// [z^k y] (signal 0) and [z^k u] (signal 1); filtered(0) is the current y.
+  const SvfFilterBank& bank() const { return bank_; }
+  double time() const { return t_; }
+  void reset();
+
+ private:
+  SvfFilterBank bank_;
+  double interval_;
+  const char* who_;
+  double t_ = 0, t_reg_ = 0, reg_step_ = 0, u_prev_ = 0, y_prev_ = 0;
+  bool started_ = false;
 };
 
 /// Filter a whole experiment: returns [z y, .., z^n y] (N x n) for output `output`,
