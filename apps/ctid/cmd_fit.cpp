@@ -75,8 +75,7 @@ Result<TransferFunction> run_rls(const IdData& d, const TfOrders& orders, std::m
   r.diagnostics.scalars["tau"] = o.tau;
   r.summary.iterations = static_cast<int>(rls.n_updates());
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const Eigen::VectorXd yhat = lsim(r.model, d, 0);
-  if (yhat.allFinite()) r.fit = fit_report(d.y().col(0), yhat, orders.n_parameters() - static_cast<int>(o.fixed.size()));
+  r.fit = fit_report_or_inf(d.y().col(0), lsim(r.model, d, 0), orders.n_parameters() - static_cast<int>(o.fixed.size()));
   if (!r.model.is_stable()) r.diagnostics.warnings.push_back("the estimated model is unstable");
   return r;
 }

@@ -86,39 +86,35 @@ PreparedData prepare(const IdData& data, const TfOrders& o, double transient_tim
   PreparedData P;
   const int N = data.size();
   P.data = &data;
+  P.ys = data.y().col(0).data();
+  P.us = data.u().col(0).data();
+  P.nk = o.nk;
   P.uniform = data.is_uniform();
   P.h = P.uniform ? data.ts() : data.duration() / std::max(1, N - 1);
-  P.y = data.y().col(0);
-  P.u = Eigen::VectorXd::Zero(N);
-  P.u.tail(N - o.nk) = data.u().col(0).head(N - o.nk);
   P.u_intersample = data.intersample(0);
-  P.w = Eigen::VectorXd::Zero(N);
-  const double t0 = data.t0(), tend = data.time(N - 1);
+  P.alpha = alpha;
+  P.weights = weights;
+  P.t_end = data.time(N - 1);
+  const double t0 = data.t0();
   int first = 0;
   while (first < N && data.time(first) - t0 < transient_time - 1e-12 * std::max(1.0, transient_time)) ++first;
   CTID_REQUIRE(first < N, "{}: transient_time = {} s leaves no samples (record lasts {} s)", who, transient_time,
                data.duration());
-  for (int k = first; k < N; ++k) {
-    const double hb = k > first ? data.time(k) - data.time(k - 1) : (k + 1 < N ? data.time(k + 1) - data.time(k) : P.h);
-    const double ha = k + 1 < N ? data.time(k + 1) - data.time(k) : hb;
-    double w = 1.0;
-    if (weights == SvfWeights::Riemann) w = hb / P.h;
-    else w = (k == first ? ha / 2 : (k == N - 1 ? hb / 2 : (ha + hb) / 2)) / P.h;
-    if (alpha > 0) w *= std::exp(2.0 * alpha * (data.time(k) - tend));
-    P.w(k) = w;
-  }
+  P.first = first;
   P.n_used = N - first;
   return P;
 }
 
 internal::LinearSolution solve_ls(const PreparedData& P, const SvfLayout& L, const std::optional<TransferFunction>& filt) {
+  // Fast pass with the Gram matrix; a second pass with blocked QR when the problem is
+  // ill-conditioned enough for the normal equations to lose accuracy.
   const int p = static_cast<int>(L.free.size());
+  internal::GramLeastSquares gram(p);
+  svf_pass(P, L, filt, nullptr, [&](const double* row, double lhs, const double*, double w) { gram.add(row, lhs, w); });
+  internal::LinearSolution s = gram.solve();
+  if (s.condition < internal::kGramConditionLimit && s.theta.allFinite()) return s;
   internal::StreamingLeastSquares ls(p);
-  std::vector<double> row(p);
-  svf_pass(P, L, filt, nullptr, [&](const double* psi, double lhs, const double*, double w) {
-    for (int j = 0; j < p; ++j) row[j] = psi[L.free[j]];
-    ls.add(row.data(), lhs, w);
-  });
+  svf_pass(P, L, filt, nullptr, [&](const double* row, double lhs, const double*, double w) { ls.add(row, lhs, w); });
   return ls.solve();
 }
 
@@ -126,14 +122,7 @@ internal::LinearSolution solve_iv(const PreparedData& P, const SvfLayout& L, con
                                   const Eigen::VectorXd& aux) {
   const int p = static_cast<int>(L.free.size());
   internal::InstrumentalVariables iv(p);
-  std::vector<double> row(p), zrow(p);
-  svf_pass(P, L, filt, &aux, [&](const double* psi, double lhs, const double* zeta, double w) {
-    for (int j = 0; j < p; ++j) {
-      row[j] = psi[L.free[j]];
-      zrow[j] = zeta[L.free[j]];
-    }
-    iv.add(zrow.data(), row.data(), lhs, w);
-  });
+  svf_pass(P, L, filt, &aux, [&](const double* row, double lhs, const double* zrow, double w) { iv.add(zrow, row, lhs, w); });
   return iv.solve();
 }
 
@@ -222,16 +211,7 @@ Result<TransferFunction> make_result(const IdData& data, const TfOrders& o, cons
       }
   }
   // Output-error fit of the model on the estimation data.
-  const Eigen::VectorXd yhat = lsim(r.model, data, 0);
-  const int d = static_cast<int>(L.free.size());
-  if (yhat.allFinite() && data.size() > 2 && (data.y().col(0).array() - data.y().col(0).mean()).abs().maxCoeff() > 0)
-    r.fit = fit_report(data.y().col(0), yhat, d);
-  else {
-    r.fit.n_samples = data.size();
-    r.fit.n_parameters = d;
-    r.fit.fit_percent = -std::numeric_limits<double>::infinity();
-    r.fit.nrmse = r.fit.mse = r.fit.fpe = r.fit.aic = r.fit.aicc = r.fit.bic = std::numeric_limits<double>::infinity();
-  }
+  r.fit = simulation_fit(r.model, data, static_cast<int>(L.free.size()));
   return r;
 }
 
@@ -320,7 +300,7 @@ Result<TransferFunction> ivsvf(const IdData& data, const TfOrders& orders, const
     TransferFunction aux = tf_from_theta(L, theta, 0.0);
     aux = stabilized(aux);
     // Auxiliary-model output driven by the (delayed) input P.u.
-    const Eigen::VectorXd xhat = lsim(aux, P.u, data.times(), P.u_intersample);
+    const Eigen::VectorXd xhat = lsim(aux, P.delayed_u(), data.times(), P.u_intersample);
     sol = solve_iv(P, L, options.svf.data_filter, xhat);
     if (sol.rank_deficient || !sol.theta.allFinite()) {
       term = sol.rank_deficient ? Termination::RankDeficient : Termination::NumericalFailure;
@@ -360,6 +340,16 @@ Result<TransferFunction> ivsvf(const IdData& data, const TfOrders& orders, const
 }  // namespace ctid
 
 namespace ctid::svf_detail {
+
+FitReport simulation_fit(const TransferFunction& model, const IdData& data, int n_free) {
+  if (data.size() < 2) {
+    FitReport f;
+    f.n_samples = data.size();
+    f.n_parameters = n_free;
+    return f;
+  }
+  return fit_report_or_inf(data.y().col(0), lsim(model, data, 0), n_free);
+}
 
 TransferFunction stabilized(const TransferFunction& tf) {
   if (tf.is_stable()) return tf;

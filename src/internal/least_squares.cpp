@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 
 #include "ctid/core/check.hpp"
@@ -61,6 +62,43 @@ LinearSolution StreamingLeastSquares::solve(double tol) {
   if (!s.rank_deficient) {
     const Eigen::MatrixXd Rinv = R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(p_, p_));
     s.covariance = s.sigma2 * Rinv * Rinv.transpose();
+  } else {
+    s.covariance = Eigen::MatrixXd::Constant(p_, p_, std::numeric_limits<double>::quiet_NaN());
+  }
+  return s;
+}
+
+GramLeastSquares::GramLeastSquares(int p) : p_(p), g_(static_cast<std::size_t>(p + 1) * (p + 1), 0.0) {
+  CTID_ASSERT(p >= 1);
+}
+
+LinearSolution GramLeastSquares::solve(double tol) const {
+  LinearSolution s;
+  s.n_rows = rows_;
+  const int q = p_ + 1;
+  Eigen::MatrixXd G(q, q);
+  for (int j = 0; j < q; ++j)
+    for (int i = 0; i <= j; ++i) G(i, j) = G(j, i) = g_[static_cast<std::size_t>(j) * q + i];
+  const double neff = sumw2_ > 0 ? sumw_ * sumw_ / sumw2_ : 0.0;
+  const double c = sumw_ > 0 ? neff / sumw_ : 1.0;
+  G *= c;
+  const Eigen::MatrixXd Gxx = G.topLeftCorner(p_, p_);
+  const Eigen::VectorXd gxy = G.col(p_).head(p_);
+  // Scale to unit diagonal: cond(X_scaled) = sqrt(cond(D^-1/2 Gxx D^-1/2)).
+  Eigen::VectorXd d = Gxx.diagonal().cwiseMax(1e-300).cwiseSqrt();
+  const Eigen::MatrixXd Gs = d.cwiseInverse().asDiagonal() * Gxx * d.cwiseInverse().asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Gs, Eigen::EigenvaluesOnly);
+  const double lmin = es.eigenvalues()(0), lmax = es.eigenvalues()(p_ - 1);
+  s.condition = lmin > 0 ? std::sqrt(lmax / lmin) : std::numeric_limits<double>::infinity();
+  s.rank_deficient = !(s.condition < 1.0 / tol);
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(Gs);
+  const Eigen::VectorXd ts = ldlt.solve(gxy.cwiseQuotient(d));
+  s.theta = ts.cwiseQuotient(d);
+  s.rss = std::max(0.0, G(p_, p_) - gxy.dot(s.theta));
+  s.sigma2 = neff > p_ ? s.rss / (neff - p_) : std::numeric_limits<double>::quiet_NaN();
+  if (!s.rank_deficient) {
+    const Eigen::MatrixXd inv = ldlt.solve(Eigen::MatrixXd::Identity(p_, p_));
+    s.covariance = s.sigma2 * d.cwiseInverse().asDiagonal() * inv * d.cwiseInverse().asDiagonal();
   } else {
     s.covariance = Eigen::MatrixXd::Constant(p_, p_, std::numeric_limits<double>::quiet_NaN());
   }

@@ -8,6 +8,8 @@
 // InstrumentalVariables: theta = (sum w z x^T)^{-1} sum w z y with column scaling.
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Dense>
 
 namespace ctid::internal {
@@ -47,6 +49,38 @@ class StreamingLeastSquares {
   long long rows_ = 0;
   double sumw_ = 0.0, sumw2_ = 0.0;
 };
+
+/// Weighted least squares by accumulating the augmented Gram matrix [X y]^T W [X y]
+/// (about (p+1)(p+2)/2 multiply-adds per row, no buffer). Accurate to about
+/// eps * cond^2 in the column-scaled condition number; callers re-solve with
+/// StreamingLeastSquares when `condition` exceeds kGramConditionLimit.
+class GramLeastSquares {
+ public:
+  explicit GramLeastSquares(int p);
+  void add(const double* x, double y, double w = 1.0) {
+    const int q = p_ + 1;
+    for (int j = 0; j < q; ++j) {
+      const double wj = w * (j < p_ ? x[j] : y);
+      double* col = &g_[static_cast<std::size_t>(j) * q];
+      for (int i = 0; i <= j; ++i) col[i] += wj * (i < p_ ? x[i] : y);
+    }
+    sumw_ += w;
+    sumw2_ += w * w;
+    ++rows_;
+  }
+  long long rows() const { return rows_; }
+  LinearSolution solve(double rank_tolerance = 1e-12) const;
+
+ private:
+  int p_;
+  std::vector<double> g_;  // (p+1) x (p+1), upper triangle, column-major
+  long long rows_ = 0;
+  double sumw_ = 0.0, sumw2_ = 0.0;
+};
+
+/// Above this column-scaled condition number the Gram solution loses more than about
+/// 8 digits; use the QR kernel instead.
+constexpr double kGramConditionLimit = 1e4;
 
 class InstrumentalVariables {
  public:

@@ -72,10 +72,9 @@ SvfFilterBank::SvfFilterBank(int n, double tau, std::vector<Intersample> is, con
   const std::size_t S = is_.size();
   chain_out_.assign(S * n_, 0.0);
   filt_out_.assign(S, 0.0);
-  work_.assign(n_, 0.0);
-  e_.assign(n_, 0.0);
-  g0_.assign(n_, 0.0);
-  g1_.assign(n_, 0.0);
+  coef_.e.assign(n_, 0.0);  // sized once: step() never allocates
+  coef_.g0.assign(n_, 0.0);
+  coef_.g1.assign(n_, 0.0);
   if (F) {
     CTID_REQUIRE(F->is_stable(), "SvfFilterBank: the extra data filter must be stable (poles of {})", F->to_string());
     CTID_REQUIRE(F->io_delay() == 0.0, "SvfFilterBank: the extra data filter must have no delay");
@@ -123,14 +122,21 @@ void SvfFilterBank::update_coefficients(double h) {
     G1_ = d.Gamma1.col(0);
     return;
   }
-  const double x = h / tau_;
+  coef_.compute(n_, h, tau_);
+}
+
+void SvfChainCoefficients::compute(int n, double h, double tau) {
+  e.resize(n);
+  g0.resize(n);
+  g1.resize(n);
+  const double x = h / tau;
   // e_j = e^{-x} x^j / j!
   double ej = std::exp(-x);
-  for (int j = 0; j < n_; ++j) {
-    e_[j] = ej;
+  for (int j = 0; j < n; ++j) {
+    e[j] = ej;
     ej *= x / (j + 1);
   }
-  for (int k = 1; k <= n_; ++k) {
+  for (int k = 1; k <= n; ++k) {
     if (x <= 30.0) {
       // Series from j = k: no cancellation for small x.
       double term = std::exp(-x + k * std::log(x) - std::lgamma(k + 1.0));
@@ -141,8 +147,8 @@ void SvfFilterBank::update_coefficients(double h) {
         if (term < 1e-18 * p) break;
         term *= x / (j + 1);
       }
-      g0_[k - 1] = p;
-      g1_[k - 1] = q;
+      g0[k - 1] = p;
+      g1[k - 1] = q;
     } else {
       // Complements: P(k, x) = 1 - e^{-x} sum_{j<k} x^j/j!.
       auto P = [&](int kk) {
@@ -150,8 +156,8 @@ void SvfFilterBank::update_coefficients(double h) {
         for (int j = 0; j < kk; ++j) { s += t; t *= x / (j + 1); }
         return 1.0 - s;
       };
-      g0_[k - 1] = P(k);
-      g1_[k - 1] = P(k) - (double(k) / x) * P(k + 1);
+      g0[k - 1] = P(k);
+      g1[k - 1] = P(k) - (double(k) / x) * P(k + 1);
     }
   }
 }
@@ -171,13 +177,13 @@ void SvfFilterBank::step(double h, const double* prev, const double* next) {
       continue;
     }
     double* x = &chain_out_[i * n_];
-    // x_new[k] = sum_{m <= k} e_{k-m} x[m] + g0_k s0 + g1_k ds   (lower-triangular Toeplitz)
+    // x_new[k] = sum_{m <= k} e_{k-m} x[m] + g0_k s0 + g1_k ds (lower-triangular Toeplitz):
+    // updating from the last state down uses only old values.
     for (int k = n_ - 1; k >= 0; --k) {
-      double acc = g0_[k] * s0 + g1_[k] * ds;
-      for (int m = 0; m <= k; ++m) acc += e_[k - m] * x[m];
-      work_[k] = acc;
+      double acc = coef_.g0[k] * s0 + coef_.g1[k] * ds;
+      for (int m = 0; m <= k; ++m) acc += coef_.e[k - m] * x[m];
+      x[k] = acc;
     }
-    for (int k = 0; k < n_; ++k) x[k] = work_[k];
     filt_out_[i] = next[i];
   }
 }

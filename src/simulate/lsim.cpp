@@ -62,6 +62,15 @@ class DiscretizationCache {
   std::vector<Discretization> entries_;
 };
 
+// Sample times: explicit, or t0 + k h without materialising them.
+struct TimeAxis {
+  const Eigen::VectorXd* t = nullptr;
+  double t0 = 0, h = 0;
+  Eigen::Index n = 0;
+  double operator()(Eigen::Index k) const { return t ? (*t)(k) : t0 + double(k) * h; }
+  Eigen::Index size() const { return n; }
+};
+
 bool is_uniform(const Eigen::VectorXd& t, double* h) {
   if (t.size() < 2) { *h = 1.0; return true; }
   *h = (t(t.size() - 1) - t(0)) / double(t.size() - 1);
@@ -73,8 +82,8 @@ bool is_uniform(const Eigen::VectorXd& t, double* h) {
 // Delayed input v(s) = u(s - delay). Piece j covers [t_j + delay, t_{j+1} + delay):
 // held at u_j (ZOH) or linear from u_j to u_{j+1} (FOH); zero before piece 0.
 struct DelayedInput {
-  const Eigen::MatrixXd& u;
-  const Eigen::VectorXd& t;
+  const Eigen::Ref<const Eigen::MatrixXd>& u;
+  const TimeAxis& t;
   const std::vector<Intersample>& is;
   double delay;
   Eigen::Index size() const { return t.size(); }
@@ -91,8 +100,36 @@ struct DelayedInput {
 
 }  // namespace
 
-Eigen::MatrixXd lsim(const StateSpace& sys, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
-                     const std::vector<Intersample>& intersample, const LsimOptions& o) {
+namespace {
+// Uniform, delay-free SISO simulation with a compile-time state dimension (row-major
+// Phi, column vectors G0, G1, row C): the hot loop of fit reports.
+template <int n>
+void siso_fixed(const double* Phi_rm, const double* g0, const double* g1, const double* c, double d, const double* x0,
+                const Eigen::Ref<const Eigen::MatrixXd>& u, Eigen::Ref<Eigen::MatrixXd> y) {
+  double P[n * n], G0[n], G1[n], C[n], x[n];
+  for (int i = 0; i < n * n; ++i) P[i] = Phi_rm[i];
+  for (int i = 0; i < n; ++i) { G0[i] = g0[i]; G1[i] = g1[i]; C[i] = c[i]; x[i] = x0[i]; }
+  const Eigen::Index N = u.rows();
+  for (Eigen::Index k = 0; k < N; ++k) {
+    const double uk = u(k, 0);
+    double yk = d * uk;
+    for (int i = 0; i < n; ++i) yk += C[i] * x[i];
+    y(k, 0) = yk;
+    if (k + 1 == N) break;
+    const double du = u(k + 1, 0) - uk;
+    double xn[n];
+    for (int i = 0; i < n; ++i) {
+      double acc = G0[i] * uk + G1[i] * du;
+      for (int l = 0; l < n; ++l) acc += P[i * n + l] * x[l];
+      xn[i] = acc;
+    }
+    for (int i = 0; i < n; ++i) x[i] = xn[i];
+  }
+}
+
+// Simulate into y (N x ny, sized by the caller).
+void lsim_core(const StateSpace& sys, const Eigen::Ref<const Eigen::MatrixXd>& u, const TimeAxis& t, bool uniform,
+               double h, const std::vector<Intersample>& intersample, const LsimOptions& o, Eigen::Ref<Eigen::MatrixXd> y) {
   const Eigen::Index N = t.size();
   CTID_REQUIRE(N >= 1, "lsim: at least one sample time is needed");
   CTID_REQUIRE(u.rows() == N, "lsim: u has {} samples but there are {} sample times", u.rows(), N);
@@ -100,72 +137,130 @@ Eigen::MatrixXd lsim(const StateSpace& sys, const Eigen::MatrixXd& u, const Eige
   CTID_REQUIRE(static_cast<int>(intersample.size()) == sys.nu(), "lsim: {} intersample entries for {} inputs",
                intersample.size(), sys.nu());
   CTID_REQUIRE(std::isfinite(o.input_delay) && o.input_delay >= 0, "lsim: the input delay must be >= 0 (got {})", o.input_delay);
-  for (Eigen::Index k = 1; k < N; ++k)
-    CTID_REQUIRE(t(k) > t(k - 1), "lsim: sample times must be strictly increasing (t[{}] = {} after {})", k, t(k), t(k - 1));
   const int n = sys.nx();
   Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
   if (o.x0.size() > 0) {
     CTID_REQUIRE(o.x0.size() == n, "lsim: x0 has {} entries but the model has {} states", o.x0.size(), n);
     x = o.x0;
   }
-  Eigen::MatrixXd y(N, sys.ny());
-  const Eigen::MatrixXd& C = sys.C();
-  const Eigen::MatrixXd& D = sys.D();
+  const int ny = sys.ny(), nu = sys.nu();
+  CTID_ASSERT(y.rows() == N && y.cols() == ny);
   DiscretizationCache cache(sys.A(), sys.B(), intersample);
   DelayedInput v{u, t, intersample, o.input_delay};
+  // Row-major copies of C and D and plain work arrays: the per-sample loops below do
+  // no allocation and no dynamic-size expression evaluation.
+  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> C = sys.C(), D = sys.D();
+  std::vector<double> xv(x.data(), x.data() + n), xn(n), va(nu), vb(nu);
+  auto output = [&](Eigen::Index k, const double* in) {
+    for (int j = 0; j < ny; ++j) {
+      double acc = 0;
+      for (int i = 0; i < n; ++i) acc += C(j, i) * xv[i];
+      for (int c = 0; c < nu; ++c) acc += D(j, c) * in[c];
+      y(k, j) = acc;
+    }
+  };
+  // x <- Phi x + Gamma0 a + Gamma1 (b - a), with Phi etc. row-major in `rm`.
+  struct RowMajor {
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> Phi, G0, G1;
+    double h = -1;
+  } rm;
+  auto load = [&](const Discretization& d) {
+    if (d.h == rm.h) return;
+    rm.Phi = d.Phi;
+    rm.G0 = d.Gamma0;
+    rm.G1 = d.Gamma1;
+    rm.h = d.h;
+  };
+  auto advance = [&](const double* a, const double* b) {
+    for (int i = 0; i < n; ++i) {
+      double acc = 0;
+      for (int l = 0; l < n; ++l) acc += rm.Phi(i, l) * xv[l];
+      for (int c = 0; c < nu; ++c) acc += rm.G0(i, c) * a[c] + rm.G1(i, c) * (b[c] - a[c]);
+      xn[i] = acc;
+    }
+    xv.swap(xn);
+  };
 
-  double h = 0;
-  const bool uniform = is_uniform(t, &h);
-  Eigen::VectorXd xn(n), va(sys.nu()), vb(sys.nu());
+  if (o.input_delay == 0.0 && uniform && N >= 2 && nu == 1 && ny == 1 && n >= 1 && n <= 4) {
+    load(cache.get(h));
+    switch (n) {
+      case 1: siso_fixed<1>(rm.Phi.data(), rm.G0.data(), rm.G1.data(), C.data(), D(0, 0), xv.data(), u, y); break;
+      case 2: siso_fixed<2>(rm.Phi.data(), rm.G0.data(), rm.G1.data(), C.data(), D(0, 0), xv.data(), u, y); break;
+      case 3: siso_fixed<3>(rm.Phi.data(), rm.G0.data(), rm.G1.data(), C.data(), D(0, 0), xv.data(), u, y); break;
+      default: siso_fixed<4>(rm.Phi.data(), rm.G0.data(), rm.G1.data(), C.data(), D(0, 0), xv.data(), u, y); break;
+    }
+    return;
+  }
   if (o.input_delay == 0.0 && uniform && N >= 2) {
     // Fast path: one discretisation, no delay.
-    const Discretization& d = cache.get(h);
-    Eigen::VectorXd du(sys.nu());
+    load(cache.get(h));
     for (Eigen::Index k = 0; k < N; ++k) {
-      y.row(k).noalias() = (C * x).transpose() + (D * u.row(k).transpose()).transpose();
+      for (int c = 0; c < nu; ++c) va[c] = u(k, c);
+      output(k, va.data());
       if (k + 1 == N) break;
-      du.noalias() = (u.row(k + 1) - u.row(k)).transpose();
-      xn.noalias() = d.Phi * x;
-      xn.noalias() += d.Gamma0 * u.row(k).transpose();
-      xn.noalias() += d.Gamma1 * du;
-      x.swap(xn);
+      for (int c = 0; c < nu; ++c) vb[c] = u(k + 1, c);
+      advance(va.data(), vb.data());
     }
-    return y;
+    return;
   }
 
   // General path: split each interval where the delayed input changes piece.
+  Eigen::VectorXd ea(nu), eb(nu);
   const Eigen::Index M = v.size();
   Eigen::Index j = -1;
   const double snap0 = 1e-10 * std::max(h, 1e-300);
   while (j + 1 < M && v.start(j + 1) <= t(0) + snap0) ++j;
-  Eigen::VectorXd vk(sys.nu());
   for (Eigen::Index k = 0; k < N; ++k) {
-    v.value(j, t(k), vk);
-    y.row(k).noalias() = (C * x).transpose() + (D * vk).transpose();
+    v.value(j, t(k), ea);
+    output(k, ea.data());
     if (k + 1 == N) break;
     const double snap = 1e-10 * (t(k + 1) - t(k));
     double a = t(k);
     while (a < t(k + 1)) {
       double b = t(k + 1);
       if (j + 1 < M && v.start(j + 1) < b - snap) b = v.start(j + 1);
-      v.value(j, a, va);
-      v.value(j, b, vb);
-      const Discretization& d = cache.get(b - a);
-      xn.noalias() = d.Phi * x;
-      xn.noalias() += d.Gamma0 * va;
-      xn.noalias() += d.Gamma1 * (vb - va);
-      x.swap(xn);
+      v.value(j, a, ea);
+      v.value(j, b, eb);
+      load(cache.get(b - a));
+      advance(ea.data(), eb.data());
       a = b;
       while (j + 1 < M && v.start(j + 1) <= a + snap) ++j;
     }
   }
+}
+
+TimeAxis axis_of(const IdData& d) {
+  TimeAxis a;
+  a.n = d.size();
+  if (d.is_uniform()) {
+    a.t0 = d.t0();
+    a.h = d.ts();
+  } else {
+    a.t = nullptr;
+  }
+  return a;
+}
+}  // namespace
+
+Eigen::MatrixXd lsim(const StateSpace& sys, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
+                     const std::vector<Intersample>& intersample, const LsimOptions& o) {
+  for (Eigen::Index k = 1; k < t.size(); ++k)
+    CTID_REQUIRE(t(k) > t(k - 1), "lsim: sample times must be strictly increasing (t[{}] = {} after {})", k, t(k), t(k - 1));
+  double h = 0;
+  const bool uniform = is_uniform(t, &h);
+  const TimeAxis axis{&t, 0.0, 0.0, t.size()};
+  Eigen::MatrixXd y(t.size(), sys.ny());
+  lsim_core(sys, u, axis, uniform, h, intersample, o, y);
   return y;
 }
 
 Eigen::MatrixXd lsim(const StateSpace& sys, const IdData& data, const LsimOptions& o) {
   std::vector<Intersample> is(data.nu());
   for (int j = 0; j < data.nu(); ++j) is[j] = data.intersample(j);
-  return lsim(sys, data.u(), data.times(), is, o);
+  if (!data.is_uniform()) return lsim(sys, data.u(), data.times(), is, o);
+  Eigen::MatrixXd y(data.size(), sys.ny());
+  lsim_core(sys, data.u(), axis_of(data), true, data.ts(), is, o, y);
+  return y;
 }
 
 Eigen::VectorXd lsim(const TransferFunction& tf, const Eigen::VectorXd& u, const Eigen::VectorXd& t, Intersample is) {
@@ -176,7 +271,12 @@ Eigen::VectorXd lsim(const TransferFunction& tf, const Eigen::VectorXd& u, const
 
 Eigen::VectorXd lsim(const TransferFunction& tf, const IdData& data, int input) {
   CTID_REQUIRE(input >= 0 && input < data.nu(), "lsim: input index {} out of range (data has {} inputs)", input, data.nu());
-  return lsim(tf, Eigen::VectorXd(data.u().col(input)), data.times(), data.intersample(input));
+  if (!data.is_uniform()) return lsim(tf, Eigen::VectorXd(data.u().col(input)), data.times(), data.intersample(input));
+  LsimOptions o;
+  o.input_delay = tf.io_delay();
+  Eigen::VectorXd y(data.size());
+  lsim_core(tf.to_state_space(), data.u().col(input), axis_of(data), true, data.ts(), {data.intersample(input)}, o, y);
+  return y;
 }
 
 Eigen::VectorXd time_grid(double h, int n) {

@@ -36,17 +36,47 @@ double aicc(double v, int N, int d) {
 }
 double bic(double v, int N, int d) { return N * std::log(v) + d * std::log(double(N)); }
 
-FitReport fit_report(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, int d) {
+namespace {
+// Two passes: the mean of y, then the sums of squares of y - mean and of y - yhat.
+FitReport fill(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, int d, double* sd_out) {
   FitReport r;
   r.n_samples = static_cast<int>(y.size());
   r.n_parameters = d;
-  r.mse = mse(y, yhat);
-  r.nrmse = nrmse(y, yhat);
+  const double m = y.mean();
+  double se = 0, sd = 0;
+  for (Eigen::Index k = 0; k < y.size(); ++k) {
+    const double e = y(k) - yhat(k), c = y(k) - m;
+    se += e * e;
+    sd += c * c;
+  }
+  *sd_out = sd;
+  r.mse = se / double(y.size());
+  r.nrmse = std::sqrt(se / sd);
   r.fit_percent = 100.0 * (1.0 - r.nrmse);
   r.fpe = fpe(r.mse, r.n_samples, d);
   r.aic = aic(r.mse, r.n_samples, d);
   r.aicc = aicc(r.mse, r.n_samples, d);
   r.bic = bic(r.mse, r.n_samples, d);
+  return r;
+}
+}  // namespace
+
+FitReport fit_report(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, int d) {
+  check_pair(y, yhat, "fit_report");
+  double sd = 0;
+  FitReport r = fill(y, yhat, d, &sd);
+  CTID_REQUIRE(sd > 0, "fit_report: the measured output is constant; the normalisation is zero");
+  return r;
+}
+
+FitReport fit_report_or_inf(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, int d) {
+  check_pair(y, yhat, "fit_report");
+  double sd = 0;
+  FitReport r = fill(y, yhat, d, &sd);
+  if (!(sd > 0) || !std::isfinite(r.mse)) {
+    r.fit_percent = -kInf;
+    r.nrmse = r.mse = r.fpe = r.aic = r.aicc = r.bic = kInf;
+  }
   return r;
 }
 

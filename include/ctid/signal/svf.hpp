@@ -43,6 +43,15 @@ Eigen::VectorXd theta_tau_from_ab(const Eigen::VectorXd& a, const Eigen::VectorX
 /// Exact inverse: physical a, b from theta_tau (length 2n).
 void ab_from_theta_tau(const Eigen::VectorXd& theta_tau, double tau, Eigen::VectorXd& a, Eigen::VectorXd& b);
 
+/// Exact step of the plain chain over an interval h (closed form, see file comment):
+/// x_k <- sum_{m<=k} e[k-m] x_m + g0[k] s(t) + g1[k] (s(t+h) - s(t)), k = 0..n-1.
+struct SvfChainCoefficients {
+  std::vector<double> e, g0, g1;
+  /// Resize to n and compute for interval h and time constant tau (no allocation
+  /// after the first call with this n).
+  void compute(int n, double h, double tau);
+};
+
 /// Filter bank producing [z s, z^2 s, .., z^n s] for several sampled signals at once.
 /// Without an extra filter, step() allocates nothing (closed-form coefficients are
 /// recomputed in place when the interval changes); with one, a new interval length
@@ -77,8 +86,7 @@ class SvfFilterBank {
   double tau_;
   std::vector<Intersample> is_;
   double h_ = -1.0;
-  // closed-form chain coefficients
-  std::vector<double> e_, g0_, g1_;
+  SvfChainCoefficients coef_;
   // generic bank (extra filter): states [x_F; x_chain] per signal
   bool generic_ = false;
   Eigen::MatrixXd Ab_, Bb_, Cf_;  // bank dynamics; Cf_ = output row of F (size nF)
@@ -88,7 +96,7 @@ class SvfFilterBank {
   Eigen::VectorXd G0_, G1_;
   Eigen::MatrixXd xs_;            // (nF + n) x n_signals
   Eigen::VectorXd tmp_;
-  std::vector<double> chain_out_, filt_out_, work_;
+  std::vector<double> chain_out_, filt_out_;
 };
 
 /// A two-signal bank [y (FOH), u] fed one sample at a time, for on-line estimators:

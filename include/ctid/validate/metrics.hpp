@@ -23,6 +23,10 @@ double aicc(double mse, int n_samples, int n_parameters);
 /// N ln V + d ln N.
 double bic(double mse, int n_samples, int n_parameters);
 /// All of the above for measured y and model output yhat with d free parameters.
+/// Throws InvalidArgument for size mismatch, fewer than 2 samples or a constant y.
 FitReport fit_report(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, int n_parameters);
+/// The same, but a non-finite model output (an unstable simulation) or a constant y gives
+/// fit_percent = -Inf and +Inf errors instead of an exception. Used for estimators' reports.
+FitReport fit_report_or_inf(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, int n_parameters);
 
 }  // namespace ctid
