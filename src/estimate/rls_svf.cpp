@@ -16,6 +16,9 @@ void RlsSvfOptions::validate() const {
   CTID_REQUIRE_OPTION(std::isfinite(alpha) && alpha >= 0, "rls_svf: alpha must be >= 0 (got {})", alpha);
   CTID_REQUIRE_OPTION(std::isfinite(regression_interval) && regression_interval >= 0,
                       "rls_svf: regression_interval must be >= 0 (got {})", regression_interval);
+  for (const auto& [name, v] : fixed)
+    CTID_REQUIRE_OPTION(std::isfinite(v), "rls_svf: fixed value of {} must be finite (got {})", name, v);
+  CTID_REQUIRE_OPTION(theta0.allFinite(), "rls_svf: theta0 must be finite");
 }
 
 RlsSvf::RlsSvf(const TfOrders& orders, const RlsSvfOptions& options)

@@ -126,6 +126,7 @@ TEST(Cli, BadInputGivesOneLineAndTheDocumentedExitCode) {
     std::string message;
   };
   const std::string nan_csv = write("nan.csv", "time,force,position\n0,1,2\n0.1,nan,3\n0.2,1,2\n");
+  const std::string inf_csv = write("inf.csv", "time,force,position\n0,1,-Inf\n0.1,2,3\n");
   const std::string text_csv = write("text.csv", "time,force,position\n0,1,2\n0.1,abc,3\n");
   const std::string nonincr = write("nonincr.csv", "time,force,position\n0,1,2\n0.2,1,3\n0.1,1,2\n");
   const std::string tiny = write("tiny.csv", "time,force,position\n0,1,2\n0.1,2,3\n0.2,1,2\n");
@@ -134,6 +135,7 @@ TEST(Cli, BadInputGivesOneLineAndTheDocumentedExitCode) {
       {"fit " + good_csv() + " --time time --input flow --output position", 2, "no column named 'flow'"},
       {"fit " + text_csv + base, 3, "text.csv:3: column 'force' (field 2): cannot read 'abc' as a number"},
       {"fit " + nan_csv + base, 3, "nan.csv:3: column 'force' (field 2): value 'nan' is not finite"},
+      {"fit " + inf_csv + base, 3, "inf.csv:2: column 'position' (field 3): value '-Inf' is not finite"},
       {"fit " + tiny + base + "--nf 2 --set tau=0.1", 2, "3 samples in the criterion cannot determine 4 free parameters"},
       {"fit " + nonincr + base, 3, "nonincr.csv:4: time column 'time' is not strictly increasing (0.1 after 0.2)"},
       {"fit " + good_csv() + base + "--nf 0", 2, "nf (model order) must be >= 1 (got 0)"},

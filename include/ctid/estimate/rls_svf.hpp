@@ -90,7 +90,9 @@ struct CoefficientTrackerOptions {
 class CoefficientTracker {
  public:
   /// known: the model with every coefficient known (the unknown one's value is the
-  /// initial estimate); it must be strictly proper. unknown: "a1".."an", "b0"..
+  /// initial estimate); it must be strictly proper, of order n. unknown: "a1".."a<n>" or
+  /// "b0".."b<n-1>", where b0 multiplies s^(n-1) (the numerator is taken with n
+  /// coefficients, leading ones zero). Throws InvalidOptions for another name.
   CoefficientTracker(const TransferFunction& known, const std::string& unknown, const CoefficientTrackerOptions& options);
   void update(double t, double u, double y);
   double estimate() const { return estimate_; }
