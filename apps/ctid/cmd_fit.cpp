@@ -22,9 +22,7 @@ struct FitArgs {
 
 // Apply --set keys to LSSVF options; consumed keys are erased.
 void apply_svf_sets(std::map<std::string, std::string>& s, LssvfOptions& o) {
-  for (auto it = s.begin(); it != s.end();) {
-    const auto& [k, v] = *it;
-    bool used = true;
+  consume_sets(s, [&](const std::string& k, const std::string& v) {
     if (k == "tau") o.tau = to_double(k, v);
     else if (k == "alpha") o.alpha = to_double(k, v);
     else if (k == "transient") o.transient_time = to_double(k, v);
@@ -34,9 +32,9 @@ void apply_svf_sets(std::map<std::string, std::string>& s, LssvfOptions& o) {
       else if (v == "trapezoidal") o.weights = SvfWeights::Trapezoidal;
       else throw UsageError("--set weights: use riemann or trapezoidal (got '" + v + "')");
     } else if (k.rfind("fix.", 0) == 0) o.fixed[k.substr(4)] = to_double(k, v);
-    else used = false;
-    it = used ? s.erase(it) : std::next(it);
-  }
+    else return false;
+    return true;
+  });
 }
 
 void reject_unknown(const std::map<std::string, std::string>& s, const std::string& method, const std::string& known) {
@@ -46,18 +44,16 @@ void reject_unknown(const std::map<std::string, std::string>& s, const std::stri
 
 Result<TransferFunction> run_rls(const IdData& d, const TfOrders& orders, std::map<std::string, std::string> s) {
   RlsSvfOptions o;
-  for (auto it = s.begin(); it != s.end();) {
-    const auto& [k, v] = *it;
-    bool used = true;
+  consume_sets(s, [&](const std::string& k, const std::string& v) {
     if (k == "tau") o.tau = to_double(k, v);
     else if (k == "p0") o.p0 = to_double(k, v);
     else if (k == "forgetting") o.forgetting = to_double(k, v);
     else if (k == "alpha") o.alpha = to_double(k, v);
     else if (k == "regression_interval") o.regression_interval = to_double(k, v);
     else if (k.rfind("fix.", 0) == 0) o.fixed[k.substr(4)] = to_double(k, v);
-    else used = false;
-    it = used ? s.erase(it) : std::next(it);
-  }
+    else return false;
+    return true;
+  });
   reject_unknown(s, "rls-svf", "tau, p0, forgetting, alpha, regression_interval, fix.NAME");
   if (d.nu() != 1 || d.ny() != 1) throw UsageError("rls-svf needs one --input and one --output");
   if (orders.nk > 0) throw UsageError("rls-svf: --nk must be 0 (delay the input column instead)");
@@ -99,12 +95,12 @@ int run(const FitArgs& a) {
     } else if (a.method == "ivsvf") {
       IvsvfOptions o;
       apply_svf_sets(sets, o.svf);
-      for (auto it = sets.begin(); it != sets.end();) {
-        if (it->first == "max_iterations") o.max_iterations = to_int(it->first, it->second);
-        else if (it->first == "tolerance") o.tolerance = to_double(it->first, it->second);
-        else { ++it; continue; }
-        it = sets.erase(it);
-      }
+      consume_sets(sets, [&](const std::string& k, const std::string& v) {
+        if (k == "max_iterations") o.max_iterations = to_int(k, v);
+        else if (k == "tolerance") o.tolerance = to_double(k, v);
+        else return false;
+        return true;
+      });
       reject_unknown(sets, "ivsvf", "tau, alpha, transient, weights, tau_grid, fix.NAME, max_iterations, tolerance");
       r = ivsvf(d, orders, o);
     } else {

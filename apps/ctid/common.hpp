@@ -46,6 +46,12 @@ void check_output_path(const std::string& out, const std::vector<std::string>& i
 
 /// "KEY=VALUE" pairs from --set.
 std::map<std::string, std::string> parse_sets(const std::vector<std::string>& sets);
+/// Apply every KEY=VALUE that `handler(key, value)` recognises (returns true) and erase
+/// it, so that what is left can be reported as unknown.
+template <class F>
+void consume_sets(std::map<std::string, std::string>& sets, F&& handler) {
+  for (auto it = sets.begin(); it != sets.end();) it = handler(it->first, it->second) ? sets.erase(it) : std::next(it);
+}
 double to_double(const std::string& key, const std::string& value);
 int to_int(const std::string& key, const std::string& value);
 

@@ -229,17 +229,8 @@ void lsim_core(const StateSpace& sys, const Eigen::Ref<const Eigen::MatrixXd>& u
   }
 }
 
-TimeAxis axis_of(const IdData& d) {
-  TimeAxis a;
-  a.n = d.size();
-  if (d.is_uniform()) {
-    a.t0 = d.t0();
-    a.h = d.ts();
-  } else {
-    a.t = nullptr;
-  }
-  return a;
-}
+// The time axis of uniformly sampled data, without materialising the times.
+TimeAxis axis_of(const IdData& d) { return TimeAxis{nullptr, d.t0(), d.ts(), d.size()}; }
 }  // namespace
 
 Eigen::MatrixXd lsim(const StateSpace& sys, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
