@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config
-  libeigen3-dev nlohmann-json3-dev libcli11-dev libfmt-dev libmatio-dev
+  libeigen3-dev nlohmann-json3-dev libcli11-dev libmatio-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 

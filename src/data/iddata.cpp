@@ -61,8 +61,13 @@ void IdData::check_and_init() {
   intersample_.assign(nu(), Intersample::Zoh);
   input_names_.clear();
   output_names_.clear();
-  for (int j = 0; j < nu(); ++j) input_names_.push_back("u" + std::to_string(j + 1));
-  for (int j = 0; j < ny(); ++j) output_names_.push_back("y" + std::to_string(j + 1));
+  auto channel = [](char prefix, int j) {  // "u1", "y2", ... (append: avoids a GCC 12 -Wrestrict false positive)
+    std::string s(1, prefix);
+    s += std::to_string(j + 1);
+    return s;
+  };
+  for (int j = 0; j < nu(); ++j) input_names_.push_back(channel('u', j));
+  for (int j = 0; j < ny(); ++j) output_names_.push_back(channel('y', j));
   input_units_.assign(nu(), "");
   output_units_.assign(ny(), "");
 }
