@@ -11,6 +11,7 @@
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/validate/metrics.hpp"
 #include "estimate/svf_common.hpp"
+#include "estimate/tf_common.hpp"
 #include "internal/least_squares.hpp"
 
 namespace ctid {
@@ -298,7 +299,7 @@ Result<TransferFunction> ivsvf(const IdData& data, const TfOrders& orders, const
   Termination term = Termination::MaxIterations;
   for (it = 1; it <= options.max_iterations; ++it) {
     TransferFunction aux = tf_from_theta(L, theta, 0.0);
-    aux = stabilized(aux);
+    aux = tf_detail::stabilized(aux);
     // Auxiliary-model output driven by the (delayed) input P.u.
     const Eigen::VectorXd xhat = lsim(aux, P.delayed_u(), data.times(), P.u_intersample);
     sol = solve_iv(P, L, options.svf.data_filter, xhat);
@@ -349,16 +350,6 @@ FitReport simulation_fit(const TransferFunction& model, const IdData& data, int 
     return f;
   }
   return fit_report_or_inf(data.y().col(0), lsim(model, data, 0), n_free);
-}
-
-TransferFunction stabilized(const TransferFunction& tf) {
-  if (tf.is_stable()) return tf;
-  Eigen::VectorXcd p = tf.poles();
-  for (Eigen::Index i = 0; i < p.size(); ++i) {
-    if (p(i).real() > 0) p(i) = std::complex<double>(-p(i).real(), p(i).imag());
-    else if (p(i).real() == 0) p(i) = std::complex<double>(-1e-6 * std::max(1.0, std::abs(p(i))), p(i).imag());
-  }
-  return TransferFunction(tf.num(), Polynomial::from_roots(p), tf.io_delay());
 }
 
 }  // namespace ctid::svf_detail

@@ -89,8 +89,6 @@ double choose_tau(const IdData& data, const TfOrders& o, const LssvfOptions& opt
 /// simulation diverges.
 FitReport simulation_fit(const TransferFunction& model, const IdData& data, int n_free);
 
-/// Mirror unstable poles into the left half plane (auxiliary models must be stable).
-TransferFunction stabilized(const TransferFunction& tf);
 
 /// psi = F_tau^T phi (physical-coefficient regressor, RJ 25) from the chain outputs;
 /// M is M_tau (n x n lower triangular), psi has 2n entries.

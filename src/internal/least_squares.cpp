@@ -105,20 +105,27 @@ LinearSolution GramLeastSquares::solve(double tol) const {
   return s;
 }
 
-InstrumentalVariables::InstrumentalVariables(int p)
-    : p_(p), zx_(Eigen::MatrixXd::Zero(p, p)), zz_(Eigen::MatrixXd::Zero(p, p)), xx_(Eigen::MatrixXd::Zero(p, p)),
+InstrumentalVariables::InstrumentalVariables(int p, bool with_rss)
+    : p_(p), with_rss_(with_rss), zx_(Eigen::MatrixXd::Zero(p, p)), zz_(Eigen::MatrixXd::Zero(p, p)), xx_(Eigen::MatrixXd::Zero(p, p)),
       zy_(Eigen::VectorXd::Zero(p)), xy_(Eigen::VectorXd::Zero(p)) {}
 
 void InstrumentalVariables::add(const double* z, const double* x, double y, double w) {
-  for (int i = 0; i < p_; ++i) {
-    const double wz = w * z[i], wx = w * x[i];
+  // Column-major storage: (i, j) at j * p + i; the symmetric zz and xx keep their upper triangle.
+  double* zx = zx_.data();
+  double* zz = zz_.data();
+  for (int j = 0; j < p_; ++j) {
+    const double wxj = w * x[j], wzj = w * z[j];
+    for (int i = 0; i < p_; ++i) zx[j * p_ + i] += z[i] * wxj;
+    for (int i = 0; i <= j; ++i) zz[j * p_ + i] += z[i] * wzj;
+    zy_(j) += wzj * y;
+  }
+  if (with_rss_) {
+    double* xx = xx_.data();
     for (int j = 0; j < p_; ++j) {
-      zx_(i, j) += wz * x[j];
-      zz_(i, j) += wz * z[j];
-      xx_(i, j) += wx * x[j];
+      const double wxj = w * x[j];
+      for (int i = 0; i <= j; ++i) xx[j * p_ + i] += x[i] * wxj;
+      xy_(j) += wxj * y;
     }
-    zy_(i) += wz * y;
-    xy_(i) += wx * y;
   }
   yy_ += w * y * y;
   sumw_ += w;
@@ -132,19 +139,21 @@ LinearSolution InstrumentalVariables::solve(double tol) const {
   const double neff = sumw2_ > 0 ? sumw_ * sumw_ / sumw2_ : 0.0;
   const double c = sumw_ > 0 ? neff / sumw_ : 1.0;
   // Column scaling of Z^T X for conditioning.
+  const Eigen::MatrixXd zzf = zz(), xxf = xx_.selfadjointView<Eigen::Upper>();
   Eigen::VectorXd d(p_);
-  for (int j = 0; j < p_; ++j) d(j) = std::sqrt(std::max(xx_(j, j), 1e-300));
+  for (int j = 0; j < p_; ++j) d(j) = std::sqrt(std::max(with_rss_ ? xxf(j, j) : zx_.col(j).norm(), 1e-300));
   const Eigen::MatrixXd A = zx_ * d.cwiseInverse().asDiagonal();
   s.condition = scaled_condition(zx_);
   s.rank_deficient = !(s.condition < 1.0 / tol);
   const Eigen::VectorXd ts = s.rank_deficient ? Eigen::VectorXd(A.completeOrthogonalDecomposition().solve(zy_))
                                                : Eigen::VectorXd(A.fullPivLu().solve(zy_));
   s.theta = ts.cwiseQuotient(d);
-  s.rss = std::max(0.0, c * (yy_ - 2.0 * s.theta.dot(xy_) + s.theta.dot(xx_ * s.theta)));
+  s.rss = with_rss_ ? std::max(0.0, c * (yy_ - 2.0 * s.theta.dot(xy_) + s.theta.dot(xxf * s.theta)))
+                    : std::numeric_limits<double>::quiet_NaN();
   s.sigma2 = neff > p_ ? s.rss / (neff - p_) : std::numeric_limits<double>::quiet_NaN();
   if (!s.rank_deficient) {
     const Eigen::MatrixXd inv = zx_.fullPivLu().inverse();
-    s.covariance = s.sigma2 * inv * zz_ * inv.transpose() / c;
+    s.covariance = s.sigma2 * inv * zzf * inv.transpose() / c;
   } else {
     s.covariance = Eigen::MatrixXd::Constant(p_, p_, std::numeric_limits<double>::quiet_NaN());
   }

@@ -84,13 +84,17 @@ constexpr double kGramConditionLimit = 1e4;
 
 class InstrumentalVariables {
  public:
-  explicit InstrumentalVariables(int p);
+  /// with_rss = false skips the X^T X terms (then LinearSolution::rss and sigma2 are NaN).
+  explicit InstrumentalVariables(int p, bool with_rss = true);
   void add(const double* z, const double* x, double y, double w = 1.0);
   long long rows() const { return rows_; }
   LinearSolution solve(double rank_tolerance = 1e-12) const;
+  /// sum w z z^T (upper and lower triangles filled).
+  Eigen::MatrixXd zz() const { return zz_.selfadjointView<Eigen::Upper>(); }
 
  private:
   int p_;
+  bool with_rss_;
   Eigen::MatrixXd zx_, zz_, xx_;
   Eigen::VectorXd zy_, xy_;
   double yy_ = 0.0, sumw_ = 0.0, sumw2_ = 0.0;

@@ -101,20 +101,25 @@ struct DelayedInput {
 }  // namespace
 
 namespace {
-// Uniform, delay-free SISO simulation with a compile-time state dimension (row-major
-// Phi, column vectors G0, G1, row C): the hot loop of fit reports.
+// Uniform, delay-free single-input simulation with a compile-time state dimension
+// (row-major Phi and C, column vectors G0, G1, D): the hot loop of fit reports and of the
+// filtered-derivative banks of the refined IV and output-error estimators.
 template <int n>
-void siso_fixed(const double* Phi_rm, const double* g0, const double* g1, const double* c, double d, const double* x0,
-                const Eigen::Ref<const Eigen::MatrixXd>& u, Eigen::Ref<Eigen::MatrixXd> y) {
-  double P[n * n], G0[n], G1[n], C[n], x[n];
+void simo_fixed(const double* Phi_rm, const double* g0, const double* g1, const double* c_rm, const double* dvec,
+                const double* x0, const Eigen::Ref<const Eigen::MatrixXd>& u, Eigen::Ref<Eigen::MatrixXd> y) {
+  double P[n * n], G0[n], G1[n], x[n];
   for (int i = 0; i < n * n; ++i) P[i] = Phi_rm[i];
-  for (int i = 0; i < n; ++i) { G0[i] = g0[i]; G1[i] = g1[i]; C[i] = c[i]; x[i] = x0[i]; }
+  for (int i = 0; i < n; ++i) { G0[i] = g0[i]; G1[i] = g1[i]; x[i] = x0[i]; }
   const Eigen::Index N = u.rows();
+  const Eigen::Index ny = y.cols();
   for (Eigen::Index k = 0; k < N; ++k) {
     const double uk = u(k, 0);
-    double yk = d * uk;
-    for (int i = 0; i < n; ++i) yk += C[i] * x[i];
-    y(k, 0) = yk;
+    for (Eigen::Index j = 0; j < ny; ++j) {
+      const double* cj = c_rm + j * n;
+      double yk = dvec[j] * uk;
+      for (int i = 0; i < n; ++i) yk += cj[i] * x[i];
+      y(k, j) = yk;
+    }
     if (k + 1 == N) break;
     const double du = u(k + 1, 0) - uk;
     double xn[n];
@@ -181,13 +186,18 @@ void lsim_core(const StateSpace& sys, const Eigen::Ref<const Eigen::MatrixXd>& u
     xv.swap(xn);
   };
 
-  if (o.input_delay == 0.0 && uniform && N >= 2 && nu == 1 && ny == 1 && n >= 1 && n <= 4) {
+  if (o.input_delay == 0.0 && uniform && N >= 2 && nu == 1 && n >= 1 && n <= 8) {
     load(cache.get(h));
+    const double* a[] = {rm.Phi.data(), rm.G0.data(), rm.G1.data(), C.data(), D.data()};
     switch (n) {
-      case 1: siso_fixed<1>(rm.Phi.data(), rm.G0.data(), rm.G1.data(), C.data(), D(0, 0), xv.data(), u, y); break;
-      case 2: siso_fixed<2>(rm.Phi.data(), rm.G0.data(), rm.G1.data(), C.data(), D(0, 0), xv.data(), u, y); break;
-      case 3: siso_fixed<3>(rm.Phi.data(), rm.G0.data(), rm.G1.data(), C.data(), D(0, 0), xv.data(), u, y); break;
-      default: siso_fixed<4>(rm.Phi.data(), rm.G0.data(), rm.G1.data(), C.data(), D(0, 0), xv.data(), u, y); break;
+      case 1: simo_fixed<1>(a[0], a[1], a[2], a[3], a[4], xv.data(), u, y); break;
+      case 2: simo_fixed<2>(a[0], a[1], a[2], a[3], a[4], xv.data(), u, y); break;
+      case 3: simo_fixed<3>(a[0], a[1], a[2], a[3], a[4], xv.data(), u, y); break;
+      case 4: simo_fixed<4>(a[0], a[1], a[2], a[3], a[4], xv.data(), u, y); break;
+      case 5: simo_fixed<5>(a[0], a[1], a[2], a[3], a[4], xv.data(), u, y); break;
+      case 6: simo_fixed<6>(a[0], a[1], a[2], a[3], a[4], xv.data(), u, y); break;
+      case 7: simo_fixed<7>(a[0], a[1], a[2], a[3], a[4], xv.data(), u, y); break;
+      default: simo_fixed<8>(a[0], a[1], a[2], a[3], a[4], xv.data(), u, y); break;
     }
     return;
   }

@@ -1,0 +1,46 @@
+// ctid — continuous-time output-error (prediction-error for white output noise) estimation
+// of a transfer function, and `tfest` = SRIVC start + output-error refinement.
+//
+// Minimises sum_k (y(t_k) - yhat(t_k; theta))^2 with yhat the exact simulation of
+// e^{-sT} B(s)/A(s) u from rest, by Levenberg-Marquardt with exact sensitivities
+// (dy/da_i = -s^{n-i} B/A^2 u, dy/db_j = s^{nb-1-j}/A u, dy/dT = -s B/A u; see
+// signal/prefilter.hpp), simple bounds and fixed parameters. Ljung (1999), System
+// Identification, ch. 7 and 10 (the continuous-time OE form of MATLAB's tfest refinement).
+// Covariance sigma^2 (S^T S)^{-1} with S the sensitivity matrix of the free parameters.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "ctid/core/types.hpp"
+#include "ctid/data/iddata.hpp"
+#include "ctid/estimate/orders.hpp"
+#include "ctid/estimate/srivc.hpp"
+#include "ctid/model/transfer_function.hpp"
+
+namespace ctid {
+
+struct OeOptions {
+  int max_iterations = 100;
+  double tolerance = 1e-12;      ///< relative cost decrease / parameter change that stops the search
+  /// Starting model; empty: LSSVF with an automatic filter (oe) or SRIVC (tfest).
+  std::optional<TransferFunction> initial;
+  /// Parameters held at a value, by name ("a1", "b0", "delay").
+  std::map<std::string, double> fixed;
+  /// Bounds by name: {lower, upper}; absent = unbounded (the delay is always >= 0).
+  std::map<std::string, std::pair<double, double>> bounds;
+  bool estimate_delay = false;   ///< add the input delay T (s) as a parameter "delay"
+  double delay = 0.0;            ///< initial / fixed delay (s), added to nk Ts
+  SrivcOptions srivc;            ///< options of the SRIVC start (tfest); its delay search is used when estimate_delay
+  void validate() const;
+};
+
+/// Output-error estimate of a SISO transfer function. Throws InvalidArgument /
+/// InvalidOptions for bad data or options (incl. unknown parameter names).
+Result<TransferFunction> oe(const IdData& data, const TfOrders& orders, const OeOptions& options = {});
+/// SRIVC (with delay search when estimate_delay) followed by output-error refinement.
+Result<TransferFunction> tfest(const IdData& data, const TfOrders& orders, const OeOptions& options = {});
+
+}  // namespace ctid

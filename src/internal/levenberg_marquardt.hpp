@@ -1,0 +1,36 @@
+// ctid internal — Levenberg-Marquardt for small dense nonlinear least squares
+// min 1/2 ||r(x)||^2 with simple bounds, driven by exact Jacobians supplied by the caller
+// (Marquardt scaling by diag(J^T J); bounds by projection of each trial step).
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include <Eigen/Dense>
+
+namespace ctid::internal {
+
+struct LmOptions {
+  int max_iterations = 100;
+  double ftol = 1e-12;     // stop when the relative cost decrease of an accepted step is below
+  double xtol = 1e-10;     // stop when max |dx_i| / max(|x_i|, 1e-8) is below
+  double lambda0 = 1e-3;
+};
+
+struct LmResult {
+  Eigen::VectorXd x;
+  double cost = 0.0;                // 1/2 ||r||^2 at x
+  Eigen::MatrixXd jtj;              // J^T J at x
+  int iterations = 0;
+  bool converged = false;
+  std::string message;
+};
+
+/// evaluate(x, r, J) fills r (and J when J != nullptr); returns false when the model
+/// cannot be evaluated at x (e.g. an unstable simulation), which rejects the step.
+using LmEvaluate = std::function<bool(const Eigen::VectorXd& x, Eigen::VectorXd& r, Eigen::MatrixXd* J)>;
+
+LmResult levenberg_marquardt(const LmEvaluate& evaluate, Eigen::VectorXd x0, const Eigen::VectorXd& lower,
+                             const Eigen::VectorXd& upper, const LmOptions& options);
+
+}  // namespace ctid::internal
