@@ -16,6 +16,7 @@ struct FitArgs {
   std::string method = "lssvf";
   int nb = -1, nf = 1, nk = 0;
   std::vector<std::string> sets;
+  bool delay = false;
   std::string json;
   bool force = false;
 };
@@ -76,6 +77,42 @@ Result<TransferFunction> run_rls(const IdData& d, const TfOrders& orders, std::m
   return r;
 }
 
+// Settings shared by srivc / oe / tfest.
+bool apply_srivc_set(const std::string& k, const std::string& v, SrivcOptions& o) {
+  if (k == "max_iterations") o.max_iterations = to_int(k, v);
+  else if (k == "tolerance") o.tolerance = to_double(k, v);
+  else if (k == "delay") o.delay = to_double(k, v);
+  else if (k == "delay_min") o.delay_min = to_double(k, v);
+  else if (k == "delay_max") o.delay_max = to_double(k, v);
+  else if (k == "delay_grid") o.delay_grid = to_int(k, v);
+  else return false;
+  return true;
+}
+
+Result<TransferFunction> run_oe(const IdData& d, const TfOrders& orders, std::map<std::string, std::string> sets,
+                                bool delay, bool tf_est) {
+  OeOptions o;
+  o.estimate_delay = delay;
+  consume_sets(sets, [&](const std::string& k, const std::string& v) {
+    if (k == "max_iterations") o.max_iterations = to_int(k, v);
+    else if (k == "tolerance") o.tolerance = to_double(k, v);
+    else if (k == "delay") o.delay = to_double(k, v);
+    else if (k.rfind("fix.", 0) == 0) o.fixed[k.substr(4)] = to_double(k, v);
+    else if (k.rfind("lower.", 0) == 0) {
+      auto& b = o.bounds.try_emplace(k.substr(6), -INFINITY, INFINITY).first->second;
+      b.first = to_double(k, v);
+    } else if (k.rfind("upper.", 0) == 0) {
+      auto& b = o.bounds.try_emplace(k.substr(6), -INFINITY, INFINITY).first->second;
+      b.second = to_double(k, v);
+    } else if (k == "delay_min" || k == "delay_max" || k == "delay_grid") return apply_srivc_set(k, v, o.srivc);
+    else return false;
+    return true;
+  });
+  reject_unknown(sets, tf_est ? "tfest" : "oe",
+                 "max_iterations, tolerance, delay, delay_min, delay_max, delay_grid, fix.NAME, lower.NAME, upper.NAME");
+  return tf_est ? tfest(d, orders, o) : oe(d, orders, o);
+}
+
 int run(const FitArgs& a) {
   check_output_path(a.json, {a.data.path}, a.force);
   const IdData d = a.data.load(true);
@@ -83,6 +120,8 @@ int run(const FitArgs& a) {
     throw UsageError(detail::format("{} estimates single-input single-output models (selected {} inputs, {} outputs)",
                                     a.method, d.nu(), d.ny()));
   TfOrders orders{a.nb < 0 ? a.nf : a.nb, a.nf, a.nk};
+  if (a.delay && (a.method == "lssvf" || a.method == "ivsvf" || a.method == "rls-svf"))
+    throw UsageError("--delay (delay estimation) needs --method srivc, oe or tfest");
   auto sets = parse_sets(a.sets);
   Result<TransferFunction> r;
   try {
@@ -103,6 +142,14 @@ int run(const FitArgs& a) {
       });
       reject_unknown(sets, "ivsvf", "tau, alpha, transient, weights, tau_grid, fix.NAME, max_iterations, tolerance");
       r = ivsvf(d, orders, o);
+    } else if (a.method == "srivc") {
+      SrivcOptions o;
+      o.estimate_delay = a.delay;
+      consume_sets(sets, [&](const std::string& k, const std::string& v) { return apply_srivc_set(k, v, o); });
+      reject_unknown(sets, "srivc", "max_iterations, tolerance, delay, delay_min, delay_max, delay_grid");
+      r = srivc(d, orders, o);
+    } else if (a.method == "oe" || a.method == "tfest") {
+      r = run_oe(d, orders, sets, a.delay, a.method == "tfest");
     } else {
       r = run_rls(d, orders, sets);
     }
@@ -127,8 +174,8 @@ int run(const FitArgs& a) {
 void setup_fit(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
   app.add_option("DATA", a->data.path, "CSV/.dat table (header row optional) or .mat file")->required();
-  app.add_option("--method", a->method, "Estimator: lssvf, ivsvf or rls-svf")
-      ->check(CLI::IsMember({"lssvf", "ivsvf", "rls-svf"}))
+  app.add_option("--method", a->method, "Estimator: srivc, tfest, oe, lssvf, ivsvf or rls-svf")
+      ->check(CLI::IsMember({"lssvf", "ivsvf", "rls-svf", "srivc", "oe", "tfest"}))
       ->capture_default_str();
   a->data.add_to(app, true);
   app.add_option("--nb", a->nb, "Number of numerator coefficients (default: nf)");
@@ -137,7 +184,11 @@ void setup_fit(CLI::App& app) {
   app.add_option("--set", a->sets,
                  "Method setting KEY=VALUE (repeatable). lssvf/ivsvf: tau (s, 0 = automatic), alpha, transient (s), "
                  "weights=riemann|trapezoidal, fix.NAME=value (e.g. fix.a2=4); ivsvf also max_iterations, tolerance; "
-                 "rls-svf: tau, p0, forgetting, alpha, regression_interval, fix.NAME");
+                 "rls-svf: tau, p0, forgetting, alpha, regression_interval, fix.NAME; srivc: max_iterations, tolerance, "
+                 "delay (s), delay_min, delay_max, delay_grid; oe/tfest: the same plus fix.NAME, lower.NAME, upper.NAME");
+  app.add_flag("--delay", a->delay,
+               "Estimate a (non-integer) input delay (srivc, oe, tfest): grid search over [delay_min, delay_max], then "
+               "refinement");
   app.add_option("--json", a->json, "Write the result (model, parameters, fit) to this JSON file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
   app.callback([a] { g_run = [a] { return run(*a); }; });

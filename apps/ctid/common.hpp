@@ -62,5 +62,6 @@ void setup_fit(CLI::App& app);
 void setup_simulate(CLI::App& app);
 void setup_validate(CLI::App& app);
 void setup_demo(CLI::App& app);
+void setup_order(CLI::App& app);
 
 }  // namespace ctid::cli

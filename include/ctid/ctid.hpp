@@ -9,6 +9,7 @@
 #include "ctid/data/input_design.hpp"
 #include "ctid/estimate/lssvf.hpp"
 #include "ctid/estimate/oe.hpp"
+#include "ctid/estimate/order_selection.hpp"
 #include "ctid/estimate/orders.hpp"
 #include "ctid/estimate/rls_svf.hpp"
 #include "ctid/estimate/srivc.hpp"

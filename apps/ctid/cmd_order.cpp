@@ -1,0 +1,72 @@
+// ctid order DATA --nb 1:2 --nf 3:5 [--nk 0:0] [--rank yic|rt2|aic|bic]
+#include <cstdio>
+#include <functional>
+
+#include "common.hpp"
+
+namespace ctid::cli {
+extern std::function<int()> g_run;
+
+namespace {
+struct OrderArgs {
+  DataArgs data;
+  std::string nb = "1:2", nf = "1:3", nk = "0:0", rank = "yic";
+};
+
+OrderRange parse_range(const std::string& flag, const std::string& s) {
+  const auto colon = s.find(':');
+  try {
+    std::size_t used = 0;
+    if (colon == std::string::npos) {
+      const int v = std::stoi(s, &used);
+      if (used != s.size()) throw std::invalid_argument(s);
+      return {v, v};
+    }
+    const int a = std::stoi(s.substr(0, colon), &used);
+    if (used != colon) throw std::invalid_argument(s);
+    const std::string rest = s.substr(colon + 1);
+    const int b = std::stoi(rest, &used);
+    if (used != rest.size()) throw std::invalid_argument(s);
+    return {a, b};
+  } catch (const std::exception&) {
+    throw UsageError(flag + " takes N or MIN:MAX (got '" + s + "')");
+  }
+}
+
+int run(const OrderArgs& a) {
+  OrderSelectionOptions o;
+  try {
+    o.rank_by = order_criterion_from_string(a.rank);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+  const OrderRange nb = parse_range("--nb", a.nb), nf = parse_range("--nf", a.nf), nk = parse_range("--nk", a.nk);
+  const IdData d = a.data.load(true);
+  if (d.nu() != 1 || d.ny() != 1) throw UsageError("order selection needs one --input and one --output");
+  std::vector<OrderCandidate> c;
+  try {
+    c = select_order(d, nb, nf, nk, o);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+  std::printf("rank  nb nf nk        YIC       RT2         AIC         BIC    fit %%  SRIVC\n");
+  int i = 0;
+  for (const auto& k : c)
+    std::printf("%4d  %2d %2d %2d %10.3f %9.4f %11.1f %11.1f %8.2f  %s\n", ++i, k.orders.nb, k.orders.nf, k.orders.nk, k.yic,
+                k.rt2, k.aic, k.bic, k.fit_percent, k.termination.c_str());
+  return c.empty() || !c.front().usable ? kNotUsable : kOk;
+}
+}  // namespace
+
+void setup_order(CLI::App& app) {
+  auto a = std::make_shared<OrderArgs>();
+  app.add_option("DATA", a->data.path, "CSV/.dat table or .mat file")->required();
+  a->data.add_to(app, true);
+  app.add_option("--nb", a->nb, "Numerator coefficients: N or MIN:MAX")->capture_default_str();
+  app.add_option("--nf", a->nf, "Model orders: N or MIN:MAX")->capture_default_str();
+  app.add_option("--nk", a->nk, "Input delays in samples: N or MIN:MAX")->capture_default_str();
+  app.add_option("--rank", a->rank, "Ranking criterion: yic, rt2, aic or bic")->capture_default_str();
+  app.callback([a] { g_run = [a] { return run(*a); }; });
+}
+
+}  // namespace ctid::cli
