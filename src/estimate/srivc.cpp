@@ -157,7 +157,7 @@ Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const
     // output-error cost over one grid step on either side.
     const double step = (dmax - options.delay_min) / double(G - 1);
     double lo = std::max(options.delay_min, delay - step), hi = std::min(dmax, delay + step);
-    for (int outer = 0; outer < 8; ++outer) {
+    for (int outer = 0; outer < 40; ++outer) {
       theta = srivc_fixed_delay(data, orders, delay, theta, options, options.max_iterations).theta;
       auto cost = [&](double dl) { return output_error_mse(tf_of(theta, orders, dl), data); };
       const double gr = 0.5 * (std::sqrt(5.0) - 1.0);
@@ -167,10 +167,13 @@ Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const
         else { a = c; c = e; fc = fe; e = a + gr * (b - a); fe = cost(e); }
       }
       const double next = 0.5 * (a + b);
-      const bool done = std::abs(next - delay) < 1e-5 * h;
+      const double moved = std::abs(next - delay);
+      const bool done = moved < 1e-7 * h;
       delay = next;
-      lo = std::max(options.delay_min, delay - step / 4);
-      hi = std::min(dmax, delay + step / 4);
+      // The alternation converges linearly; shrink the bracket around the current delay.
+      const double half = std::max(4.0 * moved, 1e-3 * h);
+      lo = std::max(options.delay_min, delay - std::min(half, step));
+      hi = std::min(dmax, delay + std::min(half, step));
       if (done) break;
     }
   } else {

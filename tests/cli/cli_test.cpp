@@ -178,3 +178,38 @@ TEST(Cli, DemoRunsOnBundledData) {
   // The DaISy dryer: a second-order model with 0.16 s delay; validation fit measured 88.3 %.
   EXPECT_NE(r.out.find("validation on the last 500 samples: fit 8"), std::string::npos) << r.out;
 }
+
+TEST(Cli, SrivcTfestWithDelayAndOrderSelection) {
+  // Noise-free second order with a 0.137 s delay (13.7 samples) at 10 ms.
+  const TransferFunction g(Eigen::VectorXd{{3.0}}, Eigen::VectorXd{{1.0, 1.2, 4.0}}, 0.137);
+  const int N = 3000;
+  const Eigen::VectorXd u = prbs(N, {.register_length = 9, .clock_period = 10}), t = time_grid(0.01, N);
+  Eigen::MatrixXd m(N, 3);
+  m << t, u, lsim(g, u, t);
+  const std::string csv = test::temp_path("delayed.csv");
+  write_csv(csv, {"t", "u", "y"}, m);
+  for (const char* method : {"srivc", "tfest"}) {
+    const std::string json = test::temp_path(std::string(method) + ".json");
+    fs::remove(json);
+    const CliRun r = ctid_run("fit " + csv + " --time t --method " + method + " --nb 1 --nf 2 --delay --set delay_max=0.5 --json " + json);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto res = parse_result_json(read_text_file(json));
+    // Noise-free: SRIVC's fixed point and the OE optimum are the true model (1e-6 tolerance).
+    EXPECT_NEAR(res.model.io_delay(), 0.137, 1e-6) << method;
+    EXPECT_NEAR(res.parameters.value("a2"), 4.0, 4e-6) << method;
+  }
+  // Order selection on the same system with an integer delay of 14 samples.
+  const TransferFunction g14(Eigen::VectorXd{{3.0}}, Eigen::VectorXd{{1.0, 1.2, 4.0}}, 0.14);
+  m.col(2) = lsim(g14, u, t);
+  const std::string csv14 = test::temp_path("delayed14.csv");
+  write_csv(csv14, {"t", "u", "y"}, m);
+  const CliRun o = ctid_run("order " + csv14 + " --time t --nb 1:2 --nf 1:3 --nk 13:14");
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.out.find("   1   1  2 14"), std::string::npos) << o.out;  // rank 1 is [1 2 14]
+  EXPECT_EQ(ctid_run("order " + csv + " --time t --nf 3:1").code, 2);
+  EXPECT_EQ(ctid_run("order " + csv + " --time t --nf x").code, 2);
+  const CliRun bad = ctid_run("fit " + csv + " --time t --method srivc --delay --set delay_min=2 --set delay_max=1");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("delay range [2, 1] s is empty"), std::string::npos) << bad.err;
+  EXPECT_EQ(ctid_run("fit " + csv + " --time t --method lssvf --delay").code, 2);
+}
