@@ -14,7 +14,7 @@ namespace {
 struct FitArgs {
   DataArgs data;
   std::string method = "lssvf";
-  int nb = -1, nf = 1, nk = 0;
+  std::vector<int> nb, nf{1}, nk{0};
   std::vector<std::string> sets;
   bool delay = false;
   std::string json;
@@ -116,10 +116,47 @@ Result<TransferFunction> run_oe(const IdData& d, const TfOrders& orders, std::ma
 int run(const FitArgs& a) {
   check_output_path(a.json, {a.data.path}, a.force);
   const IdData d = a.data.load(true);
-  if (d.nu() != 1 || d.ny() != 1)
-    throw UsageError(detail::format("{} estimates single-input single-output models (selected {} inputs, {} outputs)",
-                                    a.method, d.nu(), d.ny()));
-  TfOrders orders{a.nb < 0 ? a.nf : a.nb, a.nf, a.nk};
+  if (d.ny() != 1) throw UsageError(detail::format("{} estimates single-output models (selected {} outputs)", a.method, d.ny()));
+  // Orders per input: one value for every input, or one per input.
+  auto per_input = [&](const std::vector<int>& v, const char* flag, int i) {
+    if (v.size() != 1 && static_cast<int>(v.size()) != d.nu())
+      throw UsageError(detail::format("{} has {} values for {} inputs (give one value, or one per input)", flag, v.size(),
+                                      d.nu()));
+    return v.size() == 1 ? v[0] : v[i];
+  };
+  std::vector<TfOrders> all;
+  for (int i = 0; i < d.nu(); ++i) {
+    const int nf_i = per_input(a.nf, "--nf", i);
+    all.push_back({a.nb.empty() ? nf_i : per_input(a.nb, "--nb", i), nf_i, per_input(a.nk, "--nk", i)});
+  }
+  if (d.nu() > 1) {
+    if (a.method != "srivc")
+      throw UsageError(detail::format("{} estimates single-input models; use --method srivc for {} inputs", a.method, d.nu()));
+    if (a.delay) throw UsageError("--delay is available for single-input models");
+    SrivcMisoOptions o;
+    auto sets = parse_sets(a.sets);
+    consume_sets(sets, [&](const std::string& k, const std::string& v) {
+      if (k == "max_iterations") o.max_iterations = to_int(k, v);
+      else if (k == "tolerance") o.tolerance = to_double(k, v);
+      else if (k == "common_denominator") o.common_denominator = to_int(k, v) != 0;
+      else return false;
+      return true;
+    });
+    reject_unknown(sets, "srivc (MISO)", "max_iterations, tolerance, common_denominator");
+    Result<MisoModel> r;
+    try {
+      r = srivc_miso(d, all, o);
+    } catch (const InvalidArgument& e) {
+      throw UsageError(e.what());
+    }
+    print_result(r, "srivc", d);
+    if (!a.json.empty()) {
+      write_result_json(a.json, r, "srivc");
+      std::printf("wrote %s\n", a.json.c_str());
+    }
+    return r.usable() ? kOk : kNotUsable;
+  }
+  TfOrders orders = all[0];
   if (a.delay && (a.method == "lssvf" || a.method == "ivsvf" || a.method == "rls-svf"))
     throw UsageError("--delay (delay estimation) needs --method srivc, oe or tfest");
   auto sets = parse_sets(a.sets);
@@ -178,9 +215,12 @@ void setup_fit(CLI::App& app) {
       ->check(CLI::IsMember({"lssvf", "ivsvf", "rls-svf", "srivc", "oe", "tfest"}))
       ->capture_default_str();
   a->data.add_to(app, true);
-  app.add_option("--nb", a->nb, "Number of numerator coefficients (default: nf)");
-  app.add_option("--nf", a->nf, "Model order (denominator coefficients after the leading 1)")->capture_default_str();
-  app.add_option("--nk", a->nk, "Input delay in samples")->capture_default_str();
+  app.add_option("--nb", a->nb, "Number of numerator coefficients (default: nf); one per input with several inputs (1,2)")
+      ->delimiter(',');
+  app.add_option("--nf", a->nf, "Model order (denominator coefficients after the leading 1); per input allowed")
+      ->delimiter(',')
+      ->capture_default_str();
+  app.add_option("--nk", a->nk, "Input delay in samples; per input allowed")->delimiter(',')->capture_default_str();
   app.add_option("--set", a->sets,
                  "Method setting KEY=VALUE (repeatable). lssvf/ivsvf: tau (s, 0 = automatic), alpha, transient (s), "
                  "weights=riemann|trapezoidal, fix.NAME=value (e.g. fix.a2=4); ivsvf also max_iterations, tolerance; "

@@ -32,6 +32,11 @@ int run(const SimArgs& a) {
     if (d.nu() != 1) throw UsageError(detail::format("the transfer function has 1 input but {} input columns were selected", d.nu()));
     y = lsim(*tf, d, 0);
     ynames = {"y"};
+  } else if (const auto* mm = std::get_if<MisoModel>(&m)) {
+    if (d.nu() != mm->nu())
+      throw UsageError(detail::format("the model has {} inputs but {} input columns were selected", mm->nu(), d.nu()));
+    y = lsim(*mm, d);
+    ynames = {"y"};
   } else {
     const auto& ss = std::get<StateSpace>(m);
     if (d.nu() != ss.nu())

@@ -34,14 +34,18 @@ int run(const ValArgs& a) {
   } catch (const FileError& e) {
     throw InputError(e.what());
   }
-  const auto* tf = std::get_if<TransferFunction>(&m);
-  if (!tf) throw UsageError("validate supports transfer-function models");
+  if (std::holds_alternative<StateSpace>(m)) throw UsageError("validate supports transfer-function and MISO models");
   const IdData d = a.data.load(true);
-  if (d.nu() != 1 || d.ny() != 1) throw UsageError("validate needs one --input and one --output");
+  const MisoModel miso = std::holds_alternative<MisoModel>(m) ? std::get<MisoModel>(m)
+                                                              : MisoModel{{std::get<TransferFunction>(m)}};
+  if (d.ny() != 1 || d.nu() != miso.nu())
+    throw UsageError(detail::format("the model has {} inputs and 1 output; {} inputs and {} outputs were selected", miso.nu(),
+                                    d.nu(), d.ny()));
   if (a.lags < 1 || a.lags >= d.size()) throw UsageError(detail::format("--lags must be in [1, {}]", d.size() - 1));
-  const Eigen::VectorXd yhat = lsim(*tf, d, 0);
+  const Eigen::VectorXd yhat = lsim(miso, d);
   const Eigen::VectorXd y = d.y().col(0);
-  const int np = tf->num().degree() + 1 + tf->order();
+  int np = 0;
+  for (const auto& c : miso.channels) np += c.num().degree() + 1 + c.order();
   FitReport f;
   try {
     f = fit_report(y, yhat, np);
@@ -50,20 +54,23 @@ int run(const ValArgs& a) {
   }
   const Eigen::VectorXd e = y - yhat;
   const CorrelationTest ac = residual_autocorrelation(e, a.lags);
-  const CorrelationTest xc = input_residual_crosscorrelation(d.u().col(0), e, a.lags);
-  std::printf("model:  G(s) = %s\n", tf->to_string(6).c_str());
+  std::vector<CorrelationTest> xcs;
+  for (int i = 0; i < d.nu(); ++i) xcs.push_back(input_residual_crosscorrelation(d.u().col(i), e, a.lags));
+  std::printf("model:  %s\n", miso.to_string(6).c_str());
   std::printf("fit: %.2f %%   NRMSE %.4g   MSE %.4g   (%d samples)\n", f.fit_percent, f.nrmse, f.mse, f.n_samples);
   std::printf("residual whiteness (lags 1..%d): %d outside the 99 %% bound %.3g -> %s\n", a.lags, ac.n_outside, ac.bound,
               ac.passed() ? "passed" : "not white");
-  std::printf("input-residual independence (lags -%d..%d): %d outside -> %s\n", a.lags, a.lags, xc.n_outside,
-              xc.passed() ? "passed" : "correlated (unmodelled dynamics)");
+  for (int i = 0; i < d.nu(); ++i)
+    std::printf("input %s - residual independence (lags -%d..%d): %d outside -> %s\n", d.input_names()[i].c_str(), a.lags,
+                a.lags, xcs[i].n_outside, xcs[i].passed() ? "passed" : "correlated (unmodelled dynamics)");
   if (!a.json.empty()) {
     nlohmann::json j;
     j["ctid_version"] = version();
-    j["model"] = nlohmann::json::parse(model_to_json(*tf));
+    j["model"] = nlohmann::json::parse(model_to_json(m));
     j["fit"] = {{"fit_percent", f.fit_percent}, {"nrmse", f.nrmse}, {"mse", f.mse}, {"n_samples", f.n_samples}};
     j["residual_autocorrelation"] = corr_json(ac);
-    j["input_residual_crosscorrelation"] = corr_json(xc);
+    j["input_residual_crosscorrelation"] = nlohmann::json::array();
+    for (const auto& xc : xcs) j["input_residual_crosscorrelation"].push_back(corr_json(xc));
     write_text_file(a.json, j.dump(2) + "\n");
     std::printf("wrote %s\n", a.json.c_str());
   }

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <type_traits>
 
 namespace ctid::cli {
 
@@ -105,10 +106,12 @@ int to_int(const std::string& key, const std::string& value) {
   return static_cast<int>(v);
 }
 
-void print_result(const Result<TransferFunction>& r, const std::string& method, const IdData& d) {
+namespace {
+template <class M>
+void print_any(const Result<M>& r, const std::string& method, const IdData& d) {
   std::printf("method: %s   samples: %d   %s\n", method.c_str(), d.size(),
               d.is_uniform() ? ("Ts = " + detail::format("{}", d.ts()) + " s").c_str() : "irregular sampling");
-  std::printf("model:  G(s) = %s\n", r.model.to_string(6).c_str());
+  std::printf("model:  %s%s\n", std::is_same_v<M, MisoModel> ? "y = " : "G(s) = ", r.model.to_string(6).c_str());
   std::printf("parameters (value +- one standard deviation):\n");
   for (int i = 0; i < r.parameters.size(); ++i) {
     const bool fixed = r.parameters.fixed[i];
@@ -129,5 +132,9 @@ void print_result(const Result<TransferFunction>& r, const std::string& method, 
   if (!r.summary.message.empty()) std::printf("note: %s\n", r.summary.message.c_str());
   for (const auto& w : r.diagnostics.warnings) std::printf("warning: %s\n", w.c_str());
 }
+}  // namespace
+
+void print_result(const Result<TransferFunction>& r, const std::string& method, const IdData& d) { print_any(r, method, d); }
+void print_result(const Result<MisoModel>& r, const std::string& method, const IdData& d) { print_any(r, method, d); }
 
 }  // namespace ctid::cli

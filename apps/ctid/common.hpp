@@ -55,8 +55,9 @@ void consume_sets(std::map<std::string, std::string>& sets, F&& handler) {
 double to_double(const std::string& key, const std::string& value);
 int to_int(const std::string& key, const std::string& value);
 
-/// Print a transfer-function result (model, parameters with std, fit, summary, warnings).
+/// Print a result (model, parameters with std, fit, summary, warnings).
 void print_result(const Result<TransferFunction>& r, const std::string& method, const IdData& data);
+void print_result(const Result<MisoModel>& r, const std::string& method, const IdData& data);
 
 void setup_fit(CLI::App& app);
 void setup_simulate(CLI::App& app);

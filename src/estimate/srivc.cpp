@@ -30,10 +30,19 @@ void SrivcOptions::validate() const {
 
 using namespace tf_detail;
 
+namespace srivc_detail {
+struct IvChannel {
+  Eigen::VectorXd u;
+  Intersample intersample;
+  double delay;
+  int nb;
+};
+}  // namespace srivc_detail
+
 namespace {
 
 struct SrivcRun {
-  Eigen::VectorXd theta;        // [a1..an, b0..bm]
+  Eigen::VectorXd theta;        // [a1..an, b(1)..., b(K)...]
   internal::LinearSolution sol; // of the last IV step
   Eigen::MatrixXd zz;           // sum zeta zeta^T of the last step
   int iterations = 0;
@@ -41,44 +50,86 @@ struct SrivcRun {
   bool rank_deficient = false;
 };
 
-// SRIVC iterations at a fixed total delay.
+double relative_change(const Eigen::VectorXd& next, const Eigen::VectorXd& prev) {
+  double change = 0;
+  for (Eigen::Index i = 0; i < next.size(); ++i)
+    change = std::max(change, std::abs(next(i) - prev(i)) / std::max(std::abs(next(i)), 1e-8));
+  return change;
+}
+
+}  // namespace
+
+namespace srivc_detail {
+
+// One SRIVC instrumental-variable step for y = sum_i B_i/A u_i (common denominator):
+// prefilter 1/A (A stabilised), regressors from the measured y and inputs, instruments from
+// the auxiliary-model output sum_i B_i/A u_i. theta = [a (n), b_1 (nb_1), ..., b_K (nb_K)].
+SrivcRun iv_step(const Eigen::VectorXd& y, const Eigen::VectorXd& t, const std::vector<IvChannel>& ch, int n,
+                 const Eigen::VectorXd& theta) {
+  int p = n;
+  for (const auto& c : ch) p += c.nb;
+  Eigen::VectorXd den(n + 1);
+  den(0) = 1.0;
+  den.tail(n) = theta.head(n);
+  const Polynomial A = stabilized(TransferFunction(Polynomial{1.0}, Polynomial(den))).den();
+  const TransferFunction F(Polynomial{1.0}, A);
+  const Eigen::MatrixXd yf = filtered_derivatives(F, n, y, t, Intersample::Foh);
+  Eigen::MatrixXd xf = Eigen::MatrixXd::Zero(t.size(), n);
+  std::vector<Eigen::MatrixXd> uf;
+  int off = n;
+  for (const auto& c : ch) {
+    const Eigen::VectorXd b = theta.segment(off, c.nb);
+    off += c.nb;
+    uf.push_back(filtered_derivatives(F, c.nb - 1, c.u, t, c.intersample, c.delay));
+    if (b.cwiseAbs().maxCoeff() > 0)
+      xf += filtered_derivatives(TransferFunction(Polynomial(b), A * A), n - 1, c.u, t, c.intersample, c.delay);
+  }
+  internal::InstrumentalVariables iv(p, /*with_rss=*/false);
+  std::vector<double> phi(p), zeta(p);
+  for (Eigen::Index k = 0; k < t.size(); ++k) {
+    for (int i = 1; i <= n; ++i) {
+      phi[i - 1] = -yf(k, n - i);
+      zeta[i - 1] = -xf(k, n - i);
+    }
+    int o = n;
+    for (std::size_t c = 0; c < ch.size(); ++c) {
+      const int m = ch[c].nb - 1;
+      for (int j = 0; j <= m; ++j) phi[o + j] = zeta[o + j] = uf[c](k, m - j);
+      o += ch[c].nb;
+    }
+    iv.add(zeta.data(), phi.data(), yf(k, n), 1.0);
+  }
+  SrivcRun run;
+  run.sol = iv.solve();
+  run.zz = iv.zz();
+  run.theta = run.sol.theta;
+  run.rank_deficient = run.sol.rank_deficient || !run.sol.theta.allFinite();
+  return run;
+}
+
+}  // namespace srivc_detail
+
+using srivc_detail::IvChannel;
+
+namespace {
+
+// SRIVC iterations at a fixed total delay (SISO).
 SrivcRun srivc_fixed_delay(const IdData& d, const TfOrders& o, double delay, Eigen::VectorXd theta, const SrivcOptions& opt,
                            int max_iterations) {
-  const int n = o.nf, m = o.nb - 1, p = o.nf + o.nb;
   const Eigen::VectorXd t = d.times();
-  const Eigen::VectorXd y = d.y().col(0), u = d.u().col(0);
-  const Intersample uis = d.intersample(0);
+  const Eigen::VectorXd y = d.y().col(0);
+  const std::vector<IvChannel> ch{{d.u().col(0), d.intersample(0), delay, o.nb}};
   SrivcRun run;
   run.theta = theta;
   for (int it = 1; it <= max_iterations; ++it) {
-    run.iterations = it;
-    const TransferFunction model = stabilized(tf_of(run.theta, o, 0.0));
-    const Polynomial& A = model.den();
-    const TransferFunction F(Polynomial{1.0}, A);                   // prefilter 1/A
-    const TransferFunction Fx(model.num(), A * A);                  // auxiliary model, prefiltered: B/A^2
-    const Eigen::MatrixXd yf = filtered_derivatives(F, n, y, t, Intersample::Foh);
-    const Eigen::MatrixXd uf = filtered_derivatives(F, m, u, t, uis, delay);
-    const Eigen::MatrixXd xf = filtered_derivatives(Fx, n - 1, u, t, uis, delay);
-    internal::InstrumentalVariables iv(p, /*with_rss=*/false);
-    std::vector<double> phi(p), zeta(p);
-    for (Eigen::Index k = 0; k < t.size(); ++k) {
-      for (int i = 1; i <= n; ++i) {
-        phi[i - 1] = -yf(k, n - i);
-        zeta[i - 1] = -xf(k, n - i);
-      }
-      for (int j = 0; j <= m; ++j) phi[n + j] = zeta[n + j] = uf(k, m - j);
-      iv.add(zeta.data(), phi.data(), yf(k, n), 1.0);
+    SrivcRun step = srivc_detail::iv_step(y, t, ch, o.nf, run.theta);
+    step.iterations = it;
+    if (step.rank_deficient) {
+      step.theta = run.theta;
+      return step;
     }
-    run.sol = iv.solve();
-    run.zz = iv.zz();
-    if (run.sol.rank_deficient || !run.sol.theta.allFinite()) {
-      run.rank_deficient = true;
-      return run;
-    }
-    double change = 0;
-    for (int i = 0; i < p; ++i)
-      change = std::max(change, std::abs(run.sol.theta(i) - run.theta(i)) / std::max(std::abs(run.sol.theta(i)), 1e-8));
-    run.theta = run.sol.theta;
+    const double change = relative_change(step.theta, run.theta);
+    run = step;
     if (change < opt.tolerance) {
       run.converged = true;
       return run;
@@ -219,6 +270,159 @@ Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const
   if (r.summary.succeeded() && !r.model.is_stable()) {
     r.summary.termination = Termination::Unstable;
     r.summary.message = "SRIVC converged to an unstable model (the prefilter was stabilised during the iterations)";
+  }
+  r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+}  // namespace ctid
+
+namespace ctid {
+
+void SrivcMisoOptions::validate() const {
+  CTID_REQUIRE_OPTION(max_iterations >= 1, "srivc_miso: max_iterations must be >= 1 (got {})", max_iterations);
+  CTID_REQUIRE_OPTION(tolerance > 0 && std::isfinite(tolerance), "srivc_miso: tolerance must be > 0 (got {})", tolerance);
+  for (std::size_t i = 0; i < delays.size(); ++i)
+    CTID_REQUIRE_OPTION(std::isfinite(delays[i]) && delays[i] >= 0, "srivc_miso: delay of input {} must be >= 0 (got {} s)",
+                        i + 1, delays[i]);
+}
+
+Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& orders, const SrivcMisoOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  opt.validate();
+  const int K = data.nu();
+  CTID_REQUIRE(data.ny() == 1, "srivc_miso: needs one output (data has {})", data.ny());
+  CTID_REQUIRE(K >= 1 && static_cast<int>(orders.size()) == K, "srivc_miso: {} inputs but {} sets of orders", K,
+               orders.size());
+  CTID_REQUIRE_OPTION(opt.delays.empty() || static_cast<int>(opt.delays.size()) == K,
+                      "srivc_miso: {} delays for {} inputs", opt.delays.size(), K);
+  int p = 0;
+  for (int i = 0; i < K; ++i) {
+    orders[i].validate(/*allow_biproper=*/true);
+    CTID_REQUIRE(orders[i].nk == 0 || data.is_uniform(), "srivc_miso: nk needs uniformly sampled data");
+    CTID_REQUIRE_OPTION(!opt.common_denominator || orders[i].nf == orders[0].nf,
+                        "srivc_miso: a common denominator needs equal nf for every input (input 1 has {}, input {} has {})",
+                        orders[0].nf, i + 1, orders[i].nf);
+    p += orders[i].nb + (opt.common_denominator ? 0 : orders[i].nf);
+  }
+  if (opt.common_denominator) p += orders[0].nf;
+  CTID_REQUIRE(data.size() > p, "srivc_miso: {} samples cannot determine {} parameters", data.size(), p);
+
+  const Eigen::VectorXd t = data.times();
+  const Eigen::VectorXd y = data.y().col(0);
+  std::vector<IvChannel> ch;
+  for (int i = 0; i < K; ++i)
+    ch.push_back({data.u().col(i), data.intersample(i),
+                  (opt.delays.empty() ? 0.0 : opt.delays[i]) + (orders[i].nk > 0 ? orders[i].nk * data.ts() : 0.0),
+                  orders[i].nb});
+  // Start: SISO SRIVC of y on each input alone (the other inputs act as noise).
+  std::vector<Eigen::VectorXd> th(K);
+  for (int i = 0; i < K; ++i) {
+    IdData di = data.select({i}, {0});
+    SrivcOptions so;
+    so.delay = ch[i].delay;
+    so.max_iterations = 10;
+    th[i] = srivc(di, {orders[i].nb, orders[i].nf, 0}, so).parameters.values;
+  }
+  auto channel_model = [&](int i, const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    return tf_detail::make_tf(a, b, ch[i].delay);
+  };
+  Result<MisoModel> r;
+  SrivcRun last;
+  bool converged = false, failed = false;
+  int it = 0;
+  if (opt.common_denominator) {
+    const int n = orders[0].nf;
+    Eigen::VectorXd theta(p);
+    theta.head(n) = th[0].head(n);
+    int off = n;
+    for (int i = 0; i < K; ++i) {
+      theta.segment(off, orders[i].nb) = th[i].tail(orders[i].nb);
+      off += orders[i].nb;
+    }
+    for (it = 1; it <= opt.max_iterations; ++it) {
+      last = srivc_detail::iv_step(y, t, ch, n, theta);
+      if (last.rank_deficient) { failed = true; break; }
+      const double change = relative_change(last.theta, theta);
+      theta = last.theta;
+      if (change < opt.tolerance) { converged = true; break; }
+    }
+    off = n;
+    for (int i = 0; i < K; ++i) {
+      r.model.channels.push_back(channel_model(i, theta.head(n), theta.segment(off, orders[i].nb)));
+      off += orders[i].nb;
+    }
+    r.parameters.values = theta;
+    for (int k = 1; k <= n; ++k) r.parameters.names.push_back("a" + std::to_string(k));
+    for (int i = 0; i < K; ++i)
+      for (int j = 0; j < orders[i].nb; ++j) r.parameters.names.push_back("u" + std::to_string(i + 1) + ".b" + std::to_string(j));
+    r.parameters.covariance = last.zz;  // sum zeta zeta^T; scaled by sigma^2 below
+  } else {
+    // Backfitting: channel i is refitted on y minus the other channels' model outputs.
+    Eigen::MatrixXd zz_blocks = Eigen::MatrixXd::Zero(p, p);
+    std::vector<Eigen::VectorXd> xhat(K);
+    for (int i = 0; i < K; ++i)
+      xhat[i] = lsim(channel_model(i, th[i].head(orders[i].nf), th[i].tail(orders[i].nb)), data, i);
+    for (it = 1; it <= opt.max_iterations; ++it) {
+      double change = 0;
+      int off = 0;
+      for (int i = 0; i < K; ++i) {
+        Eigen::VectorXd yi = y;
+        for (int k = 0; k < K; ++k)
+          if (k != i) yi -= xhat[k];
+        SrivcRun s = srivc_detail::iv_step(yi, t, {ch[i]}, orders[i].nf, th[i]);
+        if (s.rank_deficient) { failed = true; break; }
+        change = std::max(change, relative_change(s.theta, th[i]));
+        th[i] = s.theta;
+        xhat[i] = lsim(channel_model(i, th[i].head(orders[i].nf), th[i].tail(orders[i].nb)), data, i);
+        const int pi = orders[i].nf + orders[i].nb;
+        zz_blocks.block(off, off, pi, pi) = s.zz;
+        off += pi;
+        last = s;
+      }
+      if (failed) break;
+      if (change < opt.tolerance) { converged = true; break; }
+    }
+    r.parameters.values.resize(p);
+    int off = 0;
+    for (int i = 0; i < K; ++i) {
+      const int pi = orders[i].nf + orders[i].nb;
+      r.parameters.values.segment(off, pi) = th[i];
+      off += pi;
+      r.model.channels.push_back(channel_model(i, th[i].head(orders[i].nf), th[i].tail(orders[i].nb)));
+      const std::string u = "u" + std::to_string(i + 1) + ".";
+      for (int k = 1; k <= orders[i].nf; ++k) r.parameters.names.push_back(u + "a" + std::to_string(k));
+      for (int j = 0; j < orders[i].nb; ++j) r.parameters.names.push_back(u + "b" + std::to_string(j));
+    }
+    r.parameters.covariance = zz_blocks;  // scaled below (block-diagonal approximation across channels)
+  }
+  r.parameters.fixed.assign(p, false);
+  r.fit = fit_report_or_inf(y, lsim(r.model, data), p);
+  const double sigma2 = r.fit.mse * data.size() / std::max(1, data.size() - p);
+  if (!failed && std::isfinite(sigma2)) {
+    const Eigen::MatrixXd zz = r.parameters.covariance;
+    r.parameters.covariance = sigma2 * zz.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
+    r.parameters.std = r.parameters.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  } else {
+    r.parameters.covariance = Eigen::MatrixXd::Constant(p, p, NAN);
+    r.parameters.std = Eigen::VectorXd::Constant(p, NAN);
+  }
+  r.diagnostics.condition_number = last.sol.condition;
+  r.diagnostics.scalars["noise_variance"] = sigma2;
+  r.summary.iterations = std::min(it, opt.max_iterations);
+  if (failed) {
+    r.summary.termination = Termination::RankDeficient;
+    r.summary.message = "the instrumental-variable matrix is singular; the inputs do not excite every parameter";
+  } else if (!converged) {
+    r.summary.termination = Termination::MaxIterations;
+    r.summary.message = detail::format("no convergence to a relative change of {} in {} sweeps", opt.tolerance,
+                                       opt.max_iterations);
+  } else {
+    r.summary.termination = Termination::Converged;
+  }
+  if (r.summary.succeeded() && !r.model.is_stable()) {
+    r.summary.termination = Termination::Unstable;
+    r.summary.message = "SRIVC converged to an unstable model";
   }
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;

@@ -62,10 +62,18 @@ struct Reader {
   }
 };
 
+json tf_json(const TransferFunction& tf) {
+  return {{"type", "transfer_function"}, {"num", vec(tf.num().coefficients())}, {"den", vec(tf.den().coefficients())},
+          {"io_delay", tf.io_delay()}};
+}
+
 json model_json(const LinearModel& m) {
-  if (const auto* tf = std::get_if<TransferFunction>(&m))
-    return {{"type", "transfer_function"}, {"num", vec(tf->num().coefficients())}, {"den", vec(tf->den().coefficients())},
-            {"io_delay", tf->io_delay()}};
+  if (const auto* tf = std::get_if<TransferFunction>(&m)) return tf_json(*tf);
+  if (const auto* mi = std::get_if<MisoModel>(&m)) {
+    json ch = json::array();
+    for (const auto& c : mi->channels) ch.push_back(tf_json(c));
+    return {{"type", "miso"}, {"channels", ch}};
+  }
   const auto& ss = std::get<StateSpace>(m);
   return {{"type", "state_space"}, {"A", mat(ss.A())}, {"B", mat(ss.B())}, {"C", mat(ss.C())}, {"D", mat(ss.D())}};
 }
@@ -80,6 +88,17 @@ LinearModel model_from(const json& root, const Reader& rd) {
       const double delay = m.contains("io_delay") ? to_num(m.at("io_delay")) : 0.0;
       return TransferFunction(rd.vector(rd.member(m, "num", "the model"), "num"), rd.vector(rd.member(m, "den", "the model"), "den"),
                               delay);
+    }
+    if (t == "miso") {
+      const json& ch = rd.member(m, "channels", "the model");
+      if (!ch.is_array() || ch.empty()) rd.fail("\"channels\" must be a non-empty array of transfer functions");
+      MisoModel mm;
+      for (const auto& c : ch) {
+        const LinearModel one = model_from(c, rd);
+        if (!std::holds_alternative<TransferFunction>(one)) rd.fail("every MISO channel must be a transfer_function");
+        mm.channels.push_back(std::get<TransferFunction>(one));
+      }
+      return mm;
     }
     if (t == "state_space")
       return StateSpace(rd.matrix(rd.member(m, "A", "the model"), "A"), rd.matrix(rd.member(m, "B", "the model"), "B"),
@@ -113,11 +132,13 @@ void write_model_json(const std::string& path, const LinearModel& m) {
   write_text_file(path, model_to_json(m) + "\n");
 }
 
-std::string result_to_json(const Result<TransferFunction>& r, const std::string& method, int indent) {
+namespace {
+template <class M>
+std::string result_json(const Result<M>& r, const std::string& method, int indent) {
   json j;
   j["ctid_version"] = version();
   j["method"] = method;
-  j["model"] = model_json(r.model);
+  j["model"] = model_json(LinearModel(r.model));
   json params = json::array();
   for (int i = 0; i < r.parameters.size(); ++i)
     params.push_back({{"name", r.parameters.names[i]},
@@ -144,6 +165,17 @@ std::string result_to_json(const Result<TransferFunction>& r, const std::string&
   for (const auto& [k, v] : r.diagnostics.vectors) d["vectors"][k] = vec(v);
   j["diagnostics"] = d;
   return j.dump(indent);
+}
+}  // namespace
+
+std::string result_to_json(const Result<TransferFunction>& r, const std::string& method, int indent) {
+  return result_json(r, method, indent);
+}
+std::string result_to_json(const Result<MisoModel>& r, const std::string& method, int indent) {
+  return result_json(r, method, indent);
+}
+void write_result_json(const std::string& path, const Result<MisoModel>& r, const std::string& method) {
+  write_text_file(path, result_to_json(r, method) + "\n");
 }
 
 Result<TransferFunction> parse_result_json(const std::string& text, const std::string& source) {

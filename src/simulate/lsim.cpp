@@ -280,6 +280,13 @@ Eigen::VectorXd lsim(const TransferFunction& tf, const IdData& data, int input) 
   return y;
 }
 
+Eigen::VectorXd lsim(const MisoModel& m, const IdData& data) {
+  CTID_REQUIRE(m.nu() == data.nu(), "lsim: the model has {} inputs but the data have {}", m.nu(), data.nu());
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(data.size());
+  for (int i = 0; i < m.nu(); ++i) y += lsim(m.channels[i], data, i);
+  return y;
+}
+
 Eigen::VectorXd time_grid(double h, int n) {
   CTID_REQUIRE(h > 0 && std::isfinite(h), "time_grid: step must be positive (got {})", h);
   CTID_REQUIRE(n >= 1, "time_grid: need at least one point (got {})", n);

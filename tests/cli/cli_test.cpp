@@ -213,3 +213,30 @@ TEST(Cli, SrivcTfestWithDelayAndOrderSelection) {
   EXPECT_NE(bad.err.find("delay range [2, 1] s is empty"), std::string::npos) << bad.err;
   EXPECT_EQ(ctid_run("fit " + csv + " --time t --method lssvf --delay").code, 2);
 }
+
+TEST(Cli, MisoFitSimulateValidate) {
+  // Two inputs, different denominators and delays of 3 and 5 samples, noise-free.
+  const TransferFunction g1(Eigen::VectorXd{{4.0}}, Eigen::VectorXd{{1.0, 2.0, 4.0}}, 0.03);
+  const TransferFunction g2(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 1.0, 1.0}}, 0.05);
+  const int N = 4000;
+  Eigen::MatrixXd u(N, 2);
+  u.col(0) = prbs(N, {.register_length = 10, .clock_period = 15});
+  u.col(1) = prbs(N, {.register_length = 11, .clock_period = 20, .initial_state = 77});
+  const Eigen::VectorXd t = time_grid(0.01, N);
+  Eigen::MatrixXd m(N, 4);
+  m << t, u, lsim(MisoModel{{g1, g2}}, IdData(u, Eigen::VectorXd::Zero(N), 0.01));
+  const std::string csv = test::temp_path("miso.csv");
+  write_csv(csv, {"t", "u1", "u2", "y"}, m);
+  const std::string json = test::temp_path("miso.json");
+  fs::remove(json);
+  CliRun r = ctid_run("fit " + csv + " --time t --input u1 --input u2 --output y --method srivc --nb 1 --nf 2 --nk 3,5 --json " + json);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const MisoModel mm = std::get<MisoModel>(read_model_json(json));
+  ASSERT_EQ(mm.nu(), 2);
+  EXPECT_NEAR(mm.channels[1].den().coefficients()(1), 1.0, 1e-6);
+  r = ctid_run("validate " + json + " " + csv + " --time t --input u1 --input u2 --output y");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("fit: 100.00"), std::string::npos) << r.out;
+  EXPECT_EQ(ctid_run("fit " + csv + " --time t --input u1 --input u2 --output y --method srivc --nf 2,2,2").code, 2);
+  EXPECT_EQ(ctid_run("fit " + csv + " --time t --input u1 --input u2 --output y --method oe --nf 2").code, 2);
+}

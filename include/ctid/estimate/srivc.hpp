@@ -19,6 +19,7 @@
 #include "ctid/core/types.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/estimate/orders.hpp"
+#include "ctid/model/miso.hpp"
 #include "ctid/model/transfer_function.hpp"
 
 namespace ctid {
@@ -42,5 +43,22 @@ struct SrivcOptions {
 /// SISO SRIVC. orders.nb may be nf + 1 (biproper). Throws InvalidArgument for data that
 /// are not SISO or too short, InvalidOptions for bad options.
 Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const SrivcOptions& options = {});
+
+struct SrivcMisoOptions {
+  int max_iterations = 100;   ///< sweeps over all channels (>= 1)
+  double tolerance = 1e-7;    ///< as SrivcOptions::tolerance, on all parameters
+  /// true: y = (sum_i B_i u_i)/A with one A (all nf equal); false: y = sum_i B_i/A_i u_i,
+  /// estimated by backfitting (Garnier, Gilson, Young & Huselstein 2007, IFAC SYSID).
+  bool common_denominator = false;
+  /// Per-input delays in seconds added to nk Ts (empty: zero); each >= 0.
+  std::vector<double> delays;
+  void validate() const;
+};
+
+/// MISO SRIVC, one TfOrders per input. Parameter names: common denominator
+/// "a1".."a<n>", then "u<i>.b<j>"; separate denominators "u<i>.a<k>", "u<i>.b<j>".
+/// Throws InvalidArgument / InvalidOptions when the orders do not match the inputs (count,
+/// different nf with a common denominator) or the data are too short.
+Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& orders, const SrivcMisoOptions& options = {});
 
 }  // namespace ctid

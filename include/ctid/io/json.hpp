@@ -3,7 +3,8 @@
 // Result envelope: {"ctid_version", "method", "model": {...}, "parameters": [{name, value,
 // std, fixed}], "covariance": [[..]], "fit": {...}, "summary": {...}, "diagnostics": {...}}.
 // Models: {"type": "transfer_function", "num": [...], "den": [...], "io_delay": s} or
-// {"type": "state_space", "A": [[..]], "B": .., "C": .., "D": ..} (row-major nested arrays).
+// {"type": "state_space", "A": [[..]], "B": .., "C": .., "D": ..} (row-major nested arrays) or
+// {"type": "miso", "channels": [transfer_function, ...]} (y = sum of the channels).
 // NaN values are written as null and read back as NaN.
 #pragma once
 
@@ -11,12 +12,13 @@
 #include <variant>
 
 #include "ctid/core/types.hpp"
+#include "ctid/model/miso.hpp"
 #include "ctid/model/state_space.hpp"
 #include "ctid/model/transfer_function.hpp"
 
 namespace ctid {
 
-using LinearModel = std::variant<TransferFunction, StateSpace>;
+using LinearModel = std::variant<TransferFunction, StateSpace, MisoModel>;
 
 /// The library version string ("0.1.0").
 const char* version();
@@ -32,5 +34,7 @@ std::string result_to_json(const Result<TransferFunction>& result, const std::st
 Result<TransferFunction> parse_result_json(const std::string& text, const std::string& source = "<json>");
 /// Atomic write (temporary file, then rename). Throws FileError.
 void write_result_json(const std::string& path, const Result<TransferFunction>& result, const std::string& method);
+std::string result_to_json(const Result<MisoModel>& result, const std::string& method, int indent = 2);
+void write_result_json(const std::string& path, const Result<MisoModel>& result, const std::string& method);
 
 }  // namespace ctid

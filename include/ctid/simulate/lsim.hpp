@@ -13,6 +13,7 @@
 #include <Eigen/Dense>
 
 #include "ctid/data/iddata.hpp"
+#include "ctid/model/miso.hpp"
 #include "ctid/model/state_space.hpp"
 #include "ctid/model/transfer_function.hpp"
 
@@ -45,6 +46,10 @@ Eigen::VectorXd lsim(const TransferFunction& tf, const IdData& data, int input =
 /// Simulate a SISO transfer function on (u, t) with the given intersample behaviour.
 Eigen::VectorXd lsim(const TransferFunction& tf, const Eigen::VectorXd& u, const Eigen::VectorXd& t,
                      Intersample intersample = Intersample::Zoh);
+
+/// Simulate a MISO model: the sum of its channels, channel i driven by input column i.
+/// Throws InvalidArgument when the data do not have one input per channel.
+Eigen::VectorXd lsim(const MisoModel& model, const IdData& data);
 
 /// Unit-step response at the times t (t >= 0, increasing): step applied at t = 0.
 Eigen::VectorXd step_response(const TransferFunction& tf, const Eigen::VectorXd& t);
