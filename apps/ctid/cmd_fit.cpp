@@ -17,6 +17,7 @@ struct FitArgs {
   std::vector<int> nb, nf{1}, nk{0};
   std::vector<std::string> sets;
   bool delay = false;
+  std::string controller, reference;
   std::string json;
   bool force = false;
 };
@@ -113,8 +114,52 @@ Result<TransferFunction> run_oe(const IdData& d, const TfOrders& orders, std::ma
   return tf_est ? tfest(d, orders, o) : oe(d, orders, o);
 }
 
+// Closed-loop SRIVC: the reference column is loaded with the data and split off.
+int run_closed_loop(const FitArgs& a) {
+  if (a.method != "srivc") throw UsageError("--closed-loop-controller needs --method srivc");
+  if (a.reference.empty()) throw UsageError("--closed-loop-controller needs --reference COLUMN");
+  if (a.data.inputs.size() != 1) throw UsageError("closed-loop identification needs exactly one --input (the plant input)");
+  LinearModel c;
+  try {
+    c = read_model_json(a.controller);
+  } catch (const FileError& e) {
+    throw InputError(e.what());
+  }
+  if (!std::holds_alternative<TransferFunction>(c)) throw UsageError(a.controller + ": the controller must be a transfer_function");
+  DataArgs da = a.data;
+  da.inputs.push_back(a.reference);
+  const IdData both = da.load(true);
+  const IdData d = both.select({0}, {0});
+  const Eigen::VectorXd r = both.u().col(1);
+  ClosedLoopOptions o;
+  o.controller = std::get<TransferFunction>(c);
+  auto sets = parse_sets(a.sets);
+  consume_sets(sets, [&](const std::string& k, const std::string& v) {
+    if (k == "max_iterations") o.max_iterations = to_int(k, v);
+    else if (k == "tolerance") o.tolerance = to_double(k, v);
+    else if (k == "setpoint") o.reference_at_plant_input = to_int(k, v) == 0;
+    else return false;
+    return true;
+  });
+  reject_unknown(sets, "srivc (closed loop)", "max_iterations, tolerance, setpoint (1: u = C (r - y))");
+  Result<TransferFunction> r2;
+  try {
+    const int nf = a.nf[0];
+    r2 = srivc_closed_loop(d, r, {a.nb.empty() ? nf : a.nb[0], nf, a.nk[0]}, o);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+  print_result(r2, "clsrivc", d);
+  if (!a.json.empty()) {
+    write_result_json(a.json, r2, "clsrivc");
+    std::printf("wrote %s\n", a.json.c_str());
+  }
+  return r2.usable() ? kOk : kNotUsable;
+}
+
 int run(const FitArgs& a) {
   check_output_path(a.json, {a.data.path}, a.force);
+  if (!a.controller.empty()) return run_closed_loop(a);
   const IdData d = a.data.load(true);
   if (d.ny() != 1) throw UsageError(detail::format("{} estimates single-output models (selected {} outputs)", a.method, d.ny()));
   // Orders per input: one value for every input, or one per input.
@@ -229,6 +274,9 @@ void setup_fit(CLI::App& app) {
   app.add_flag("--delay", a->delay,
                "Estimate a (non-integer) input delay (srivc, oe, tfest): grid search over [delay_min, delay_max], then "
                "refinement");
+  app.add_option("--closed-loop-controller", a->controller,
+                 "Closed-loop data: JSON file of the known controller C(s) (transfer_function); with --reference");
+  app.add_option("--reference", a->reference, "Closed-loop data: the reference column (added at the plant input unless --set setpoint=1)");
   app.add_option("--json", a->json, "Write the result (model, parameters, fit) to this JSON file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
   app.callback([a] { g_run = [a] { return run(*a); }; });

@@ -37,6 +37,15 @@ struct IvChannel {
   double delay;
   int nb;
 };
+// Closed-loop instruments (CLSRIVC): the noise-free loop driven by the reference r with the
+// known controller C; the reference enters at the plant input (u = r - C y) or as a setpoint
+// (u = C (r - y)).
+struct ClosedLoopInstruments {
+  Eigen::VectorXd r;
+  Intersample intersample = Intersample::Zoh;
+  TransferFunction controller;
+  bool at_plant_input = true;
+};
 }  // namespace srivc_detail
 
 namespace {
@@ -45,6 +54,7 @@ struct SrivcRun {
   Eigen::VectorXd theta;        // [a1..an, b(1)..., b(K)...]
   internal::LinearSolution sol; // of the last IV step
   Eigen::MatrixXd zz;           // sum zeta zeta^T of the last step
+  Eigen::MatrixXd zx;           // sum zeta phi^T of the last step
   int iterations = 0;
   bool converged = false;
   bool rank_deficient = false;
@@ -65,7 +75,7 @@ namespace srivc_detail {
 // prefilter 1/A (A stabilised), regressors from the measured y and inputs, instruments from
 // the auxiliary-model output sum_i B_i/A u_i. theta = [a (n), b_1 (nb_1), ..., b_K (nb_K)].
 SrivcRun iv_step(const Eigen::VectorXd& y, const Eigen::VectorXd& t, const std::vector<IvChannel>& ch, int n,
-                 const Eigen::VectorXd& theta) {
+                 const Eigen::VectorXd& theta, const ClosedLoopInstruments* cl = nullptr) {
   int p = n;
   for (const auto& c : ch) p += c.nb;
   Eigen::VectorXd den(n + 1);
@@ -75,14 +85,25 @@ SrivcRun iv_step(const Eigen::VectorXd& y, const Eigen::VectorXd& t, const std::
   const TransferFunction F(Polynomial{1.0}, A);
   const Eigen::MatrixXd yf = filtered_derivatives(F, n, y, t, Intersample::Foh);
   Eigen::MatrixXd xf = Eigen::MatrixXd::Zero(t.size(), n);
-  std::vector<Eigen::MatrixXd> uf;
+  std::vector<Eigen::MatrixXd> uf, uz;  // regressors and instruments of the input part
   int off = n;
   for (const auto& c : ch) {
     const Eigen::VectorXd b = theta.segment(off, c.nb);
     off += c.nb;
     uf.push_back(filtered_derivatives(F, c.nb - 1, c.u, t, c.intersample, c.delay));
-    if (b.cwiseAbs().maxCoeff() > 0)
+    if (cl) {
+      // Noise-free loop: u^ = S r (or C S r), x^ = B/A u^, S = A Dc / (A Dc + B Nc); prefiltered by 1/A.
+      const Polynomial& Nc = cl->controller.num();
+      const Polynomial& Dc = cl->controller.den();
+      const Polynomial B(b);
+      const Polynomial Pcl = stabilized(TransferFunction(Polynomial{1.0}, A * Dc + B * Nc)).den();
+      const Polynomial Su = cl->at_plant_input ? A * Dc : A * Nc;  // u^ = Su / Pcl r
+      const Polynomial Sx = cl->at_plant_input ? B * Dc : B * Nc;  // x^ = Sx / Pcl r
+      uz.push_back(filtered_derivatives(TransferFunction(Su, Pcl * A), c.nb - 1, cl->r, t, cl->intersample));
+      xf = filtered_derivatives(TransferFunction(Sx, Pcl * A), n - 1, cl->r, t, cl->intersample);
+    } else if (b.cwiseAbs().maxCoeff() > 0) {
       xf += filtered_derivatives(TransferFunction(Polynomial(b), A * A), n - 1, c.u, t, c.intersample, c.delay);
+    }
   }
   internal::InstrumentalVariables iv(p, /*with_rss=*/false);
   std::vector<double> phi(p), zeta(p);
@@ -94,7 +115,10 @@ SrivcRun iv_step(const Eigen::VectorXd& y, const Eigen::VectorXd& t, const std::
     int o = n;
     for (std::size_t c = 0; c < ch.size(); ++c) {
       const int m = ch[c].nb - 1;
-      for (int j = 0; j <= m; ++j) phi[o + j] = zeta[o + j] = uf[c](k, m - j);
+      for (int j = 0; j <= m; ++j) {
+        phi[o + j] = uf[c](k, m - j);
+        zeta[o + j] = cl ? uz[c](k, m - j) : phi[o + j];
+      }
       o += ch[c].nb;
     }
     iv.add(zeta.data(), phi.data(), yf(k, n), 1.0);
@@ -102,6 +126,7 @@ SrivcRun iv_step(const Eigen::VectorXd& y, const Eigen::VectorXd& t, const std::
   SrivcRun run;
   run.sol = iv.solve();
   run.zz = iv.zz();
+  run.zx = iv.zx();
   run.theta = run.sol.theta;
   run.rank_deficient = run.sol.rank_deficient || !run.sol.theta.allFinite();
   return run;
@@ -423,6 +448,90 @@ Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& or
   if (r.summary.succeeded() && !r.model.is_stable()) {
     r.summary.termination = Termination::Unstable;
     r.summary.message = "SRIVC converged to an unstable model";
+  }
+  r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+}  // namespace ctid
+
+namespace ctid {
+
+void ClosedLoopOptions::validate() const {
+  CTID_REQUIRE_OPTION(max_iterations >= 1, "srivc_closed_loop: max_iterations must be >= 1 (got {})", max_iterations);
+  CTID_REQUIRE_OPTION(tolerance > 0 && std::isfinite(tolerance), "srivc_closed_loop: tolerance must be > 0 (got {})",
+                      tolerance);
+  CTID_REQUIRE_OPTION(controller.io_delay() == 0.0, "srivc_closed_loop: the controller must have no delay (got {} s)",
+                      controller.io_delay());
+}
+
+Result<TransferFunction> srivc_closed_loop(const IdData& data, const Eigen::VectorXd& reference, const TfOrders& orders,
+                                           const ClosedLoopOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  orders.validate(/*allow_biproper=*/false);
+  opt.validate();
+  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "srivc_closed_loop: needs one input and one output (data has {} inputs, {} outputs)",
+               data.nu(), data.ny());
+  CTID_REQUIRE(reference.size() == data.size(), "srivc_closed_loop: the reference has {} samples but the data have {}",
+               reference.size(), data.size());
+  CTID_REQUIRE(reference.allFinite(), "srivc_closed_loop: the reference contains NaN or Inf");
+  CTID_REQUIRE_OPTION(orders.nk == 0, "srivc_closed_loop: nk must be 0 (got {})", orders.nk);
+  const int p = orders.nf + orders.nb;
+  CTID_REQUIRE(data.size() > p, "srivc_closed_loop: {} samples cannot determine {} parameters", data.size(), p);
+  srivc_detail::ClosedLoopInstruments cl{reference, opt.reference_intersample, opt.controller, opt.reference_at_plant_input};
+  const Eigen::VectorXd t = data.times();
+  const Eigen::VectorXd y = data.y().col(0);
+  const std::vector<IvChannel> ch{{data.u().col(0), data.intersample(0), 0.0, orders.nb}};
+  // Start: open-loop SRIVC (biased in closed loop, but a stable model near the truth).
+  SrivcOptions so;
+  so.max_iterations = 10;
+  Eigen::VectorXd theta = srivc(data, orders, so).parameters.values;
+  SrivcRun run;
+  bool converged = false;
+  int it = 0;
+  for (it = 1; it <= opt.max_iterations; ++it) {
+    SrivcRun step = srivc_detail::iv_step(y, t, ch, orders.nf, theta, &cl);
+    if (step.rank_deficient) {
+      run = step;
+      break;
+    }
+    const double change = relative_change(step.theta, theta);
+    theta = step.theta;
+    run = step;
+    if (change < opt.tolerance) {
+      converged = true;
+      break;
+    }
+  }
+  Result<TransferFunction> r;
+  r.model = tf_of(theta, orders, 0.0);
+  r.parameters.names = tf_parameter_names(orders);
+  r.parameters.values = theta;
+  r.parameters.fixed.assign(p, false);
+  r.fit = fit_report_or_inf(y, lsim(r.model, data, 0), p);
+  // Covariance sigma^2 (Z^T Phi)^{-1} (Z^T Z) (Phi^T Z)^{-1} (IV sandwich: the instruments differ
+  // from the regressors in closed loop).
+  const double sigma2 = r.fit.mse * data.size() / std::max(1, data.size() - p);
+  if (!run.rank_deficient && std::isfinite(sigma2) && run.zx.size() == p * p) {
+    const Eigen::MatrixXd inv = run.zx.fullPivLu().inverse();
+    r.parameters.covariance = sigma2 * inv * run.zz * inv.transpose();
+    r.parameters.std = r.parameters.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  } else {
+    r.parameters.covariance = Eigen::MatrixXd::Constant(p, p, NAN);
+    r.parameters.std = Eigen::VectorXd::Constant(p, NAN);
+  }
+  r.diagnostics.condition_number = run.sol.condition;
+  r.diagnostics.scalars["noise_variance"] = sigma2;
+  r.summary.iterations = std::min(it, opt.max_iterations);
+  if (run.rank_deficient) {
+    r.summary.termination = Termination::RankDeficient;
+    r.summary.message = "the closed-loop instrument matrix is singular; the reference does not excite every parameter";
+  } else if (!converged) {
+    r.summary.termination = Termination::MaxIterations;
+    r.summary.message = detail::format("no convergence to a relative change of {} in {} iterations", opt.tolerance,
+                                       opt.max_iterations);
+  } else {
+    r.summary.termination = Termination::Converged;
   }
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;

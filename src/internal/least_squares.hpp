@@ -91,6 +91,8 @@ class InstrumentalVariables {
   LinearSolution solve(double rank_tolerance = 1e-12) const;
   /// sum w z z^T (upper and lower triangles filled).
   Eigen::MatrixXd zz() const { return zz_.selfadjointView<Eigen::Upper>(); }
+  /// sum w z x^T.
+  const Eigen::MatrixXd& zx() const { return zx_; }
 
  private:
   int p_;

@@ -240,3 +240,37 @@ TEST(Cli, MisoFitSimulateValidate) {
   EXPECT_EQ(ctid_run("fit " + csv + " --time t --input u1 --input u2 --output y --method srivc --nf 2,2,2").code, 2);
   EXPECT_EQ(ctid_run("fit " + csv + " --time t --input u1 --input u2 --output y --method oe --nf 2").code, 2);
 }
+
+TEST(Cli, ClosedLoopFit) {
+  // Noise-free sampled-data loop (digital PI, ZOH plant input): CLSRIVC returns the plant.
+  const TransferFunction G(Eigen::VectorXd{{1.0, 1.0}}, Eigen::VectorXd{{1.0, 0.5, 1.0}});
+  const StateSpace ss = G.to_state_space();
+  const double Ts = 0.005;
+  const int N = 8000;
+  const Discretization D = discretize(ss.A(), ss.B(), Ts);
+  const Eigen::VectorXd r = prbs(N, {.register_length = 10, .clock_period = 20});
+  Eigen::MatrixXd m(N, 4);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(2);
+  double integral = 0;
+  for (int k = 0; k < N; ++k) {
+    const double y = (ss.C() * x)(0);
+    const double u = r(k) - (10 * y + 15 * integral);
+    integral += Ts * y;
+    m.row(k) << k * Ts, r(k), u, y;
+    x = D.Phi * x + D.Gamma0 * u;
+  }
+  const std::string csv = test::temp_path("loop.csv");
+  write_csv(csv, {"t", "r", "u", "y"}, m);
+  const std::string c = test::temp_path("pi.json");
+  write_model_json(c, TransferFunction(Eigen::VectorXd{{10.0, 15.0}}, Eigen::VectorXd{{1.0, 0.0}}));
+  const std::string json = test::temp_path("loop_fit.json");
+  fs::remove(json);
+  const CliRun run = ctid_run("fit " + csv + " --time t --input u --output y --method srivc --nb 2 --nf 2 --closed-loop-controller " +
+                              c + " --reference r --json " + json);
+  ASSERT_EQ(run.code, 0) << run.err;
+  const auto res = parse_result_json(read_text_file(json));
+  EXPECT_NEAR(res.parameters.value("a1"), 0.5, 1e-6);
+  EXPECT_NEAR(res.parameters.value("b1"), 1.0, 1e-6);
+  EXPECT_EQ(ctid_run("fit " + csv + " --time t --input u --output y --method srivc --closed-loop-controller " + c).code, 2);
+  EXPECT_EQ(ctid_run("fit " + csv + " --time t --input u --output y --method srivc --closed-loop-controller /nonexistent.json --reference r").code, 3);
+}

@@ -55,6 +55,26 @@ struct SrivcMisoOptions {
   void validate() const;
 };
 
+struct ClosedLoopOptions {
+  /// The known controller C(s) (proper, no delay).
+  TransferFunction controller;
+  /// true: u = r - C y (reference added at the plant input); false: u = C (r - y) (setpoint).
+  bool reference_at_plant_input = true;
+  Intersample reference_intersample = Intersample::Zoh;
+  int max_iterations = 50;
+  double tolerance = 1e-7;
+  void validate() const;
+};
+
+/// Closed-loop SRIVC (CLSRIVC; Gilson, Garnier, Young & Van den Hof 2008, "Instrumental
+/// variable methods for closed-loop continuous-time model identification", in Garnier & Wang
+/// (eds) 2008, ch. 5): the plant G = B/A is estimated from the measured plant input u and
+/// output y with instruments built from the reference r through the noise-free closed loop
+/// with the known controller, which keeps the estimate consistent although u is correlated
+/// with the noise. Strictly proper plant, no delay.
+Result<TransferFunction> srivc_closed_loop(const IdData& data, const Eigen::VectorXd& reference, const TfOrders& orders,
+                                           const ClosedLoopOptions& options);
+
 /// MISO SRIVC, one TfOrders per input. Parameter names: common denominator
 /// "a1".."a<n>", then "u<i>.b<j>"; separate denominators "u<i>.a<k>", "u<i>.b<j>".
 /// Throws InvalidArgument / InvalidOptions when the orders do not match the inputs (count,
