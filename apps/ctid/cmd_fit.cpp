@@ -18,6 +18,8 @@ struct FitArgs {
   std::vector<std::string> sets;
   bool delay = false;
   std::string controller, reference;
+  bool frequency = false;
+  std::string w = "w", re = "re", im = "im", u_re, u_im, y_re, y_im;
   std::string json;
   bool force = false;
 };
@@ -157,9 +159,70 @@ int run_closed_loop(const FitArgs& a) {
   return r2.usable() ? kOk : kNotUsable;
 }
 
+// Frequency-response data: columns w, re, im (G) or the spectra U and Y.
+int run_frequency(const FitArgs& a) {
+  if (a.method != "tfest" && a.method != "oe" && a.method != "srivc")
+    throw UsageError("frequency data are fitted with --method tfest (Sanathanan-Koerner + output error)");
+  FrequencyData fd;
+  try {
+    const CsvTable t = read_csv(a.data.path);
+    auto col = [&](const std::string& name) { return Eigen::VectorXd(t.values.col(t.column(name))); };
+    const Eigen::VectorXd w = col(a.w);
+    try {
+      if (!a.u_re.empty() || !a.y_re.empty()) {
+        if (a.u_re.empty() || a.u_im.empty() || a.y_re.empty() || a.y_im.empty())
+          throw UsageError("spectra need all of --u-re --u-im --y-re --y-im");
+        const Eigen::VectorXcd U = col(a.u_re).cast<std::complex<double>>() + std::complex<double>(0, 1) * col(a.u_im);
+        const Eigen::VectorXcd Y = col(a.y_re).cast<std::complex<double>>() + std::complex<double>(0, 1) * col(a.y_im);
+        fd = FrequencyData::from_spectra(w, U, Y);
+      } else {
+        fd = FrequencyData(w, col(a.re).cast<std::complex<double>>() + std::complex<double>(0, 1) * col(a.im));
+      }
+    } catch (const InvalidArgument& e) {
+      throw InputError(a.data.path + ": " + e.what());
+    }
+  } catch (const FileError& e) {
+    throw InputError(e.what());
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+  FrequencyFitOptions o;
+  o.estimate_delay = a.delay;
+  auto sets = parse_sets(a.sets);
+  consume_sets(sets, [&](const std::string& k, const std::string& v) {
+    if (k == "max_iterations") o.max_iterations = to_int(k, v);
+    else if (k == "tolerance") o.tolerance = to_double(k, v);
+    else if (k == "sk_iterations") o.sk_iterations = to_int(k, v);
+    else if (k == "delay") o.delay = to_double(k, v);
+    else if (k == "refine") o.refine = to_int(k, v) != 0;
+    else return false;
+    return true;
+  });
+  reject_unknown(sets, "frequency-domain tfest", "max_iterations, tolerance, sk_iterations, delay, refine");
+  Result<TransferFunction> r;
+  try {
+    const int nf = a.nf[0];
+    r = tf_from_frequency(fd, {a.nb.empty() ? nf : a.nb[0], nf, a.nk[0]}, o);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+  std::printf("method: tfest (frequency data)   frequencies: %d   from %.4g to %.4g rad/s\n", fd.size(), fd.w()(0),
+              fd.w()(fd.size() - 1));
+  std::printf("model:  G(s) = %s\n", r.model.to_string(6).c_str());
+  for (int i = 0; i < r.parameters.size(); ++i)
+    std::printf("  %-5s = %14.6g +- %-12.4g\n", r.parameters.names[i].c_str(), r.parameters.values(i), r.parameters.std(i));
+  std::printf("fit (complex response): %.2f %%   termination: %s\n", r.fit.fit_percent, to_string(r.summary.termination));
+  if (!a.json.empty()) {
+    write_result_json(a.json, r, "tfest-frequency");
+    std::printf("wrote %s\n", a.json.c_str());
+  }
+  return r.usable() ? kOk : kNotUsable;
+}
+
 int run(const FitArgs& a) {
   check_output_path(a.json, {a.data.path}, a.force);
   if (!a.controller.empty()) return run_closed_loop(a);
+  if (a.frequency) return run_frequency(a);
   const IdData d = a.data.load(true);
   if (d.ny() != 1) throw UsageError(detail::format("{} estimates single-output models (selected {} outputs)", a.method, d.ny()));
   // Orders per input: one value for every input, or one per input.
@@ -277,6 +340,16 @@ void setup_fit(CLI::App& app) {
   app.add_option("--closed-loop-controller", a->controller,
                  "Closed-loop data: JSON file of the known controller C(s) (transfer_function); with --reference");
   app.add_option("--reference", a->reference, "Closed-loop data: the reference column (added at the plant input unless --set setpoint=1)");
+  app.add_flag("--frequency", a->frequency,
+               "DATA holds frequency-response data: columns --w (rad/s), --re, --im of G(jw), or the spectra --u-re --u-im "
+               "--y-re --y-im");
+  app.add_option("--w", a->w, "Frequency column (rad/s) of frequency data")->capture_default_str();
+  app.add_option("--re", a->re, "Real part of G(jw)")->capture_default_str();
+  app.add_option("--im", a->im, "Imaginary part of G(jw)")->capture_default_str();
+  app.add_option("--u-re", a->u_re, "Input spectrum, real part");
+  app.add_option("--u-im", a->u_im, "Input spectrum, imaginary part");
+  app.add_option("--y-re", a->y_re, "Output spectrum, real part");
+  app.add_option("--y-im", a->y_im, "Output spectrum, imaginary part");
   app.add_option("--json", a->json, "Write the result (model, parameters, fit) to this JSON file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
   app.callback([a] { g_run = [a] { return run(*a); }; });

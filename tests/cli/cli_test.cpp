@@ -274,3 +274,25 @@ TEST(Cli, ClosedLoopFit) {
   EXPECT_EQ(ctid_run("fit " + csv + " --time t --input u --output y --method srivc --closed-loop-controller " + c).code, 2);
   EXPECT_EQ(ctid_run("fit " + csv + " --time t --input u --output y --method srivc --closed-loop-controller /nonexistent.json --reference r").code, 3);
 }
+
+TEST(Cli, FrequencyData) {
+  const TransferFunction g(Eigen::VectorXd{{-6400.0, 1600.0}}, Eigen::VectorXd{{1.0, 5.0, 408.0, 416.0, 1600.0}});
+  Eigen::VectorXd w(100);
+  for (int k = 0; k < 100; ++k) w(k) = 0.1 * std::pow(1000.0, k / 99.0);
+  const Eigen::VectorXcd G = g.frequency_response(w);
+  Eigen::MatrixXd m(100, 3);
+  m << w, G.real(), G.imag();
+  const std::string csv = test::temp_path("freq.csv");
+  write_csv(csv, {"w", "re", "im"}, m);
+  const std::string json = test::temp_path("freq.json");
+  fs::remove(json);
+  const CliRun r = ctid_run("fit " + csv + " --frequency --method tfest --nb 2 --nf 4 --json " + json);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NEAR(parse_result_json(read_text_file(json)).parameters.value("a2"), 408.0, 408e-6);
+  std::swap(m(10, 0), m(11, 0));  // non-increasing w
+  const std::string bad = test::temp_path("freq_bad.csv");
+  write_csv(bad, {"w", "re", "im"}, m);
+  const CliRun b = ctid_run("fit " + bad + " --frequency --nb 2 --nf 4 --method tfest");
+  EXPECT_EQ(b.code, 3);
+  EXPECT_NE(b.err.find("frequencies must be strictly increasing (w[11]"), std::string::npos) << b.err;
+}
