@@ -10,7 +10,7 @@ int main() {
   const Eigen::VectorXd y = add_noise_snr(lsim(truth, u, time_grid(0.01, 6000)), 20.0, /*seed=*/1);
   const IdData data(u, y, /*Ts=*/0.01);
 
-  const Result<TransferFunction> r = ivsvf(data, {.nb = 2, .nf = 2});
+  const Result<TransferFunction> r = srivc(data, {.nb = 2, .nf = 2});
   std::printf("G(s) = %s, fit %.1f %%\n", r.model.to_string(4).c_str(), r.fit.fit_percent);
   for (int i = 0; i < r.parameters.size(); ++i)
     std::printf("  %s = %.4f +- %.4f\n", r.parameters.names[i].c_str(), r.parameters.values(i), r.parameters.std(i));
