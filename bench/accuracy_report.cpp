@@ -109,6 +109,9 @@ int main(int argc, char** argv) {
 
   std::printf("### 1. Rao-Garnier benchmark (SRIVC)\n\n");
   rao_case("1a", 7161, 0.01, 10.0, R);
+  // The sample std of R runs has a relative standard error of about 1/sqrt(2(R-1)) (7 % at 100
+  // runs); 5 R runs show the ratio to the CRLB more precisely.
+  rao_case("1a, 5x the runs", 7161, 0.01, 10.0, 5 * R);
   rao_case("1b (first 1000 samples)", 1000, 0.01, 10.0, R);
   rao_case("1c (0 dB)", 7161, 0.01, 0.0, R);
   rao_case("1d (Ts = 0.05 s, PRBS held 1 sample)", 7161 / 5, 0.05, 10.0, R);
@@ -251,15 +254,27 @@ int main(int argc, char** argv) {
     std::normal_distribution<double> nd(0.0, 1.5);
     Eigen::MatrixXd est(R, 6);
     double fit = 0;
+    int good = 0;
+    std::string local;
     for (int s = 0; s < R; ++s) {
       Eigen::VectorXcd Gn = G;
       for (auto& v : Gn) v += std::complex<double>(nd(rng), nd(rng));
       const auto r = tf_from_frequency(FrequencyData(w, Gn), {2, 4, 0});
-      est.row(s) = r.parameters.values.transpose();
-      fit += r.fit.fit_percent / R;
+      // A run whose least-squares cost exceeds the cost at the true parameters has ended in a
+      // local minimum (known here because the data are simulated).
+      const double c_est = (Gn - r.model.frequency_response(w)).squaredNorm(), c_true = (Gn - G).squaredNorm();
+      if (c_est > c_true) {
+        local += detail::format(" run {} (cost {} vs {} at the truth; G = {});", s, c_est, c_true, r.model.to_string(4));
+        continue;
+      }
+      est.row(good++) = r.parameters.values.transpose();
+      fit += r.fit.fit_percent;
     }
-    std::printf("Rao-Garnier G(jw) at 250 log-spaced w in [0.1, 100] rad/s, complex noise std 1.5 per part, %d runs; mean fit to the noisy response %.1f %%.\n\n", R, fit);
-    table(kRaoNames, kRaoTheta, est, nullptr);
+    std::printf("Rao-Garnier G(jw) at 250 log-spaced w in [0.1, 100] rad/s, complex noise std 1.5 per part, %d runs: %d reached "
+                "a least-squares cost at or below that of the true parameters (statistics over those; mean fit to the noisy "
+                "response %.1f %%).%s%s\n\n",
+                R, good, fit / std::max(1, good), local.empty() ? "" : " Local minima:", local.c_str());
+    table(kRaoNames, kRaoTheta, est.topRows(good), nullptr);
   }
 
   {

@@ -141,6 +141,14 @@ Result<TransferFunction> tf_from_frequency(const FrequencyData& data, const TfOr
   Eigen::VectorXd lo = Eigen::VectorXd::Constant(p, -INFINITY), hi = Eigen::VectorXd::Constant(p, INFINITY);
   if (opt.estimate_delay) lo(n + nb) = 0.0;
   auto evaluate = [&](const Eigen::VectorXd& x, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
+    if (opt.require_stable && n > 0) {
+      Eigen::VectorXd den(n + 1);
+      den(0) = 1.0;
+      den.tail(n) = x.head(n);
+      const Eigen::VectorXcd poles = Polynomial(den).roots();
+      for (Eigen::Index i = 0; i < poles.size(); ++i)
+        if (!(poles(i).real() < 0)) return false;
+    }
     const double T = opt.estimate_delay ? x(n + nb) : opt.delay;
     r.resize(2 * K);
     if (J) J->resize(2 * K, p);

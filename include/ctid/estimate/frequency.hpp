@@ -23,6 +23,10 @@ struct FrequencyFitOptions {
   double tolerance = 1e-12;
   bool estimate_delay = false;   ///< add an input delay T (s) to the refinement ("delay")
   double delay = 0.0;            ///< fixed or initial delay (s)
+  /// Keep the refinement among stable models (steps to an unstable denominator are
+  /// rejected). Frequency data alone do not constrain stability; without this, noisy data
+  /// can pull a pole far into the right half plane where it mimics a constant.
+  bool require_stable = true;
   void validate() const;
 };
 
