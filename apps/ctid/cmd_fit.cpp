@@ -41,6 +41,22 @@ void apply_svf_sets(std::map<std::string, std::string>& s, LssvfOptions& o) {
   });
 }
 
+// Print, write the JSON file if asked, and map usability to the exit code.
+template <class M>
+int finish(const Result<M>& r, const std::string& method, const IdData& d, const std::string& json) {
+  print_result(r, method, d);
+  if (!json.empty()) {
+    write_result_json(json, r, method);
+    std::printf("wrote %s\n", json.c_str());
+  }
+  if (!r.usable()) {
+    std::fprintf(stderr, "ctid: the estimate is not usable: %s\n",
+                 r.summary.message.empty() ? to_string(r.summary.termination) : r.summary.message.c_str());
+    return kNotUsable;
+  }
+  return kOk;
+}
+
 void reject_unknown(const std::map<std::string, std::string>& s, const std::string& method, const std::string& known) {
   if (s.empty()) return;
   throw UsageError("--set " + s.begin()->first + ": not a setting of " + method + " (settings: " + known + ")");
@@ -151,12 +167,7 @@ int run_closed_loop(const FitArgs& a) {
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }
-  print_result(r2, "clsrivc", d);
-  if (!a.json.empty()) {
-    write_result_json(a.json, r2, "clsrivc");
-    std::printf("wrote %s\n", a.json.c_str());
-  }
-  return r2.usable() ? kOk : kNotUsable;
+  return finish(r2, "clsrivc", d, a.json);
 }
 
 // Frequency-response data: columns w, re, im (G) or the spectra U and Y.
@@ -257,12 +268,7 @@ int run(const FitArgs& a) {
     } catch (const InvalidArgument& e) {
       throw UsageError(e.what());
     }
-    print_result(r, "srivc", d);
-    if (!a.json.empty()) {
-      write_result_json(a.json, r, "srivc");
-      std::printf("wrote %s\n", a.json.c_str());
-    }
-    return r.usable() ? kOk : kNotUsable;
+    return finish(r, "srivc", d, a.json);
   }
   TfOrders orders = all[0];
   if (a.delay && (a.method == "lssvf" || a.method == "ivsvf" || a.method == "rls-svf"))
@@ -301,17 +307,7 @@ int run(const FitArgs& a) {
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }
-  print_result(r, a.method, d);
-  if (!a.json.empty()) {
-    write_result_json(a.json, r, a.method);
-    std::printf("wrote %s\n", a.json.c_str());
-  }
-  if (!r.usable()) {
-    std::fprintf(stderr, "ctid: the estimate is not usable: %s\n",
-                 r.summary.message.empty() ? to_string(r.summary.termination) : r.summary.message.c_str());
-    return kNotUsable;
-  }
-  return kOk;
+  return finish(r, a.method, d, a.json);
 }
 
 }  // namespace

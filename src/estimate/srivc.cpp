@@ -67,6 +67,25 @@ double relative_change(const Eigen::VectorXd& next, const Eigen::VectorXd& prev)
   return change;
 }
 
+// How an IV iteration ended, shared by the SRIVC variants.
+template <class M>
+void set_termination(Result<M>& r, bool rank_deficient, bool converged, double tolerance, int max_iterations,
+                     const std::string& singular_message) {
+  if (rank_deficient) {
+    r.summary.termination = Termination::RankDeficient;
+    r.summary.message = singular_message;
+  } else if (!converged) {
+    r.summary.termination = Termination::MaxIterations;
+    r.summary.message = detail::format("no convergence to a relative change of {} in {} iterations", tolerance, max_iterations);
+  } else {
+    r.summary.termination = Termination::Converged;
+  }
+  if (r.summary.succeeded() && !r.model.is_stable()) {
+    r.summary.termination = Termination::Unstable;
+    r.summary.message = "SRIVC converged to an unstable model (the prefilter was kept stable during the iterations)";
+  }
+}
+
 }  // namespace
 
 namespace srivc_detail {
@@ -280,29 +299,13 @@ Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const
     r.diagnostics.vectors["delay_grid_mse"] = grid_cost;
   }
   r.summary.iterations = run.iterations;
-  if (run.rank_deficient) {
-    r.summary.termination = Termination::RankDeficient;
-    r.summary.message = detail::format("the instrumental-variable matrix is singular (condition {}); the input does not "
-                                       "excite {} parameters",
-                                       run.sol.condition, p);
-  } else if (!run.converged) {
-    r.summary.termination = Termination::MaxIterations;
-    r.summary.message = detail::format("no convergence to a relative change of {} in {} iterations", options.tolerance,
-                                       options.max_iterations);
-  } else {
-    r.summary.termination = Termination::Converged;
-  }
-  if (r.summary.succeeded() && !r.model.is_stable()) {
-    r.summary.termination = Termination::Unstable;
-    r.summary.message = "SRIVC converged to an unstable model (the prefilter was stabilised during the iterations)";
-  }
+  set_termination(r, run.rank_deficient, run.converged, options.tolerance, options.max_iterations,
+                  detail::format("the instrumental-variable matrix is singular (condition {}); the input does not excite {} "
+                                 "parameters",
+                                 run.sol.condition, p));
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }
-
-}  // namespace ctid
-
-namespace ctid {
 
 void SrivcMisoOptions::validate() const {
   CTID_REQUIRE_OPTION(max_iterations >= 1, "srivc_miso: max_iterations must be >= 1 (got {})", max_iterations);
@@ -435,27 +438,11 @@ Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& or
   r.diagnostics.condition_number = last.sol.condition;
   r.diagnostics.scalars["noise_variance"] = sigma2;
   r.summary.iterations = std::min(it, opt.max_iterations);
-  if (failed) {
-    r.summary.termination = Termination::RankDeficient;
-    r.summary.message = "the instrumental-variable matrix is singular; the inputs do not excite every parameter";
-  } else if (!converged) {
-    r.summary.termination = Termination::MaxIterations;
-    r.summary.message = detail::format("no convergence to a relative change of {} in {} sweeps", opt.tolerance,
-                                       opt.max_iterations);
-  } else {
-    r.summary.termination = Termination::Converged;
-  }
-  if (r.summary.succeeded() && !r.model.is_stable()) {
-    r.summary.termination = Termination::Unstable;
-    r.summary.message = "SRIVC converged to an unstable model";
-  }
+  set_termination(r, failed, converged, opt.tolerance, opt.max_iterations,
+                  "the instrumental-variable matrix is singular; the inputs do not excite every parameter");
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }
-
-}  // namespace ctid
-
-namespace ctid {
 
 void ClosedLoopOptions::validate() const {
   CTID_REQUIRE_OPTION(max_iterations >= 1, "srivc_closed_loop: max_iterations must be >= 1 (got {})", max_iterations);
@@ -523,16 +510,8 @@ Result<TransferFunction> srivc_closed_loop(const IdData& data, const Eigen::Vect
   r.diagnostics.condition_number = run.sol.condition;
   r.diagnostics.scalars["noise_variance"] = sigma2;
   r.summary.iterations = std::min(it, opt.max_iterations);
-  if (run.rank_deficient) {
-    r.summary.termination = Termination::RankDeficient;
-    r.summary.message = "the closed-loop instrument matrix is singular; the reference does not excite every parameter";
-  } else if (!converged) {
-    r.summary.termination = Termination::MaxIterations;
-    r.summary.message = detail::format("no convergence to a relative change of {} in {} iterations", opt.tolerance,
-                                       opt.max_iterations);
-  } else {
-    r.summary.termination = Termination::Converged;
-  }
+  set_termination(r, run.rank_deficient, converged, opt.tolerance, opt.max_iterations,
+                  "the closed-loop instrument matrix is singular; the reference does not excite every parameter");
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

@@ -137,6 +137,7 @@ TEST(Cli, BadInputGivesOneLineAndTheDocumentedExitCode) {
       {"fit " + nan_csv + base, 3, "nan.csv:3: column 'force' (field 2): value 'nan' is not finite"},
       {"fit " + inf_csv + base, 3, "inf.csv:2: column 'position' (field 3): value '-Inf' is not finite"},
       {"fit " + tiny + base + "--nf 2 --set tau=0.1", 2, "3 samples in the criterion cannot determine 4 free parameters"},
+      {"fit " + tiny + base + "--method srivc --nb 2 --nf 4", 2, "srivc: 3 samples cannot determine 6 parameters"},
       {"fit " + nonincr + base, 3, "nonincr.csv:4: time column 'time' is not strictly increasing (0.1 after 0.2)"},
       {"fit " + good_csv() + base + "--nf 0", 2, "nf (model order) must be >= 1 (got 0)"},
       {"fit " + good_csv() + base + "--nf -2", 2, "nf (model order) must be >= 1 (got -2)"},
