@@ -1,0 +1,168 @@
+// Stage 1 of Gawthrop & Wang (2005): FSF compression; see include/ctid/estimate/fsf.hpp.
+#include "ctid/estimate/fsf.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <vector>
+
+#include <unsupported/Eigen/FFT>
+
+#include "ctid/core/check.hpp"
+#include "ctid/model/state_space.hpp"
+#include "ctid/model/transfer_function.hpp"
+#include "ctid/simulate/lsim.hpp"
+#include "internal/least_squares.hpp"
+
+namespace ctid {
+
+using cd = std::complex<double>;
+
+void FsfOptions::validate() const {
+  CTID_REQUIRE_OPTION(std::isfinite(T) && T > 0, "fsf: T (settling time) must be > 0 (got {} s)", T);
+  CTID_REQUIRE_OPTION(n >= 1 && n % 2 == 1, "fsf: the number of filters n must be odd and >= 1 (got {})", n);
+  CTID_REQUIRE_OPTION(std::isfinite(a) && a >= 0, "fsf: the window exponent a must be >= 0 (got {})", a);
+  CTID_REQUIRE_OPTION(std::isfinite(b) && b >= 0, "fsf: the weighting exponent b must be >= 0 (got {})", b);
+  CTID_REQUIRE_OPTION(b <= a, "fsf: b = {} must not exceed a = {} (e^{(b-a)t} must not grow)", b, a);
+  for (Eigen::Index i = 0; i < weights.size(); ++i)
+    CTID_REQUIRE_OPTION(std::isfinite(weights(i)) && weights(i) >= 0, "fsf: weight {} must be finite and >= 0 (got {})", i,
+                        weights(i));
+}
+
+Result<FsfModel> fsf(const IdData& data, const FsfOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
+  o.validate();
+  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "fsf: needs one input and one output (data has {} inputs, {} outputs)",
+               data.nu(), data.ny());
+  CTID_REQUIRE(data.is_uniform(), "fsf: needs uniformly sampled data");
+  const double Ts = data.ts();
+  const double Nd = o.T / Ts;
+  const int N = static_cast<int>(std::lround(Nd));
+  CTID_REQUIRE(std::abs(Nd - N) <= 1e-9 * std::max(1.0, Nd) && N >= 1,
+               "fsf: T = {} s is not a whole multiple of the sampling period {} s (T/Ts = {})", o.T, Ts, Nd);
+  const int M = data.size();
+  CTID_REQUIRE(N <= M, "fsf: T = {} s ({} samples) is longer than the record ({} samples, {} s)", o.T, N, M, M * Ts);
+  CTID_REQUIRE(o.n <= N, "fsf: n = {} filters exceed N = T/Ts = {}", o.n, N);
+  CTID_REQUIRE(o.weights.size() == 0 || o.weights.size() == M, "fsf: {} weights for {} samples", o.weights.size(), M);
+  const int m = (o.n - 1) / 2, p = o.n;
+  CTID_REQUIRE(M > p, "fsf: {} samples cannot determine {} parameters", M, p);
+  const Eigen::VectorXd u = data.u().col(0), y = data.y().col(0);
+
+  // Overlap-save: FFT size F >= 2N (power of two), S = F - N + 1 new outputs per block.
+  int F = 1;
+  while (F < 2 * N) F *= 2;
+  const int S = F - N + 1;
+  Eigen::FFT<double> fft;
+  // Filter spectra: h_k(l) = e^{a l Ts} e^{j 2 pi k l / N} / N, l < N (k = 0..m).
+  std::vector<std::vector<cd>> H(m + 1);
+  {
+    std::vector<cd> h(F);
+    for (int k = 0; k <= m; ++k) {
+      std::fill(h.begin(), h.end(), cd(0));
+      for (int l = 0; l < N; ++l)
+        h[l] = std::exp(o.a * l * Ts) * std::exp(cd(0, 2.0 * std::numbers::pi * k * l / N)) / double(N);
+      fft.fwd(H[k], h);
+    }
+  }
+  std::vector<cd> x(F), X(F), Yk(F);
+  std::vector<std::vector<cd>> out(m + 1, std::vector<cd>(F));
+  std::vector<double> row(p);
+  const double t0 = data.t0();
+  // One pass over the record feeding the weighted rows to a least-squares kernel.
+  auto pass = [&](auto& kernel) {
+    for (int i0 = 0; i0 < M; i0 += S) {
+      // Input segment u[i0 - N + 1 .. i0 + S - 1] (zero before the record and after its end).
+      for (int q = 0; q < F; ++q) {
+        const int idx = i0 - N + 1 + q;
+        x[q] = (idx >= 0 && idx < M) ? cd(u(idx), 0.0) : cd(0.0);
+      }
+      fft.fwd(X, x);
+      for (int k = 0; k <= m; ++k) {
+        for (int q = 0; q < F; ++q) Yk[q] = X[q] * H[k][q];
+        fft.inv(out[k], Yk);
+      }
+      const int count = std::min(S, M - i0);
+      for (int j = 0; j < count; ++j) {
+        const int i = i0 + j, q = N - 1 + j;
+        const double c = std::exp((o.b - o.a) * (data.time(i) - t0));  // e^{(b-a) t_i} <= 1
+        row[0] = c * out[0][q].real();
+        for (int k = 1; k <= m; ++k) {
+          row[2 * k - 1] = c * 2.0 * out[k][q].real();
+          row[2 * k] = -c * 2.0 * out[k][q].imag();
+        }
+        kernel.add(row.data(), c * y(i), o.weights.size() ? o.weights(i) : 1.0);
+      }
+    }
+  };
+  internal::GramLeastSquares gram(p);
+  pass(gram);
+  internal::LinearSolution sol = gram.solve();
+  if (!(sol.condition < internal::kGramConditionLimit)) {
+    // Ill-conditioned (e.g. n close to N with little excitation): blocked QR in a second pass.
+    internal::StreamingLeastSquares ls(p);
+    pass(ls);
+    sol = ls.solve();
+  }
+
+  Result<FsfModel> r;
+  r.model = FsfModel(Ts, N, o.n, sol.theta, sol.covariance, o.a);
+  r.parameters.names.push_back("theta0");
+  for (int k = 1; k <= m; ++k) {
+    r.parameters.names.push_back("re_theta" + std::to_string(k));
+    r.parameters.names.push_back("im_theta" + std::to_string(k));
+  }
+  r.parameters.values = sol.theta;
+  r.parameters.covariance = sol.covariance;
+  r.parameters.std = sol.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  r.parameters.fixed.assign(p, false);
+  r.fit.n_samples = M;
+  r.fit.n_parameters = p;
+  r.fit.mse = sol.rss / std::max(1.0, double(sol.n_rows));
+  r.diagnostics.condition_number = sol.condition;
+  r.diagnostics.scalars["N"] = N;
+  r.diagnostics.scalars["a"] = o.a;
+  r.diagnostics.scalars["b"] = o.b;
+  r.diagnostics.scalars["residual_rms"] = std::sqrt(r.fit.mse);
+  if (o.b > 0 && M > N)
+    r.diagnostics.warnings.push_back(detail::format(
+        "b = {} > 0 with a record ({} s) longer than T = {} s: the weighting amplifies the FSF truncation errors of late "
+        "data by up to e^(bT); estimates can be badly biased (SEEDS-SPEC GW-A2). Prefer b = 0",
+        o.b, M * Ts, o.T));
+  if (sol.rank_deficient) {
+    r.summary.termination = Termination::RankDeficient;
+    r.summary.message = detail::format("the FSF regressor is rank deficient (condition {}); the input does not excite the "
+                                       "{} filter frequencies (k Omega up to {} rad/s)",
+                                       sol.condition, o.n, m * 2.0 * std::numbers::pi / o.T);
+  }
+  r.summary.iterations = 1;
+  r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+double fsf_settling_time(const TransferFunction& g, double a, double tol, double t_max) {
+  CTID_REQUIRE(std::isfinite(a) && a >= 0, "fsf_settling_time: a must be >= 0 (got {})", a);
+  // Poles of G(s + a) are p - a; the envelope of the impulse response decays with the slowest one.
+  const Eigen::VectorXcd p = g.poles();
+  double slowest = -INFINITY;
+  for (Eigen::Index i = 0; i < p.size(); ++i) slowest = std::max(slowest, p(i).real() - a);
+  CTID_REQUIRE(slowest < 0, "fsf_settling_time: G(s + {}) is not stable (slowest pole real part {}); increase a", a,
+               slowest + a);
+  // Simulate the shifted impulse response on a grid fine enough for the fastest pole.
+  double fastest = 0;
+  for (Eigen::Index i = 0; i < p.size(); ++i) fastest = std::max(fastest, std::abs(p(i) - a));
+  const double h = 0.05 / std::max(fastest, 1e-9);
+  const double horizon = std::min(t_max, 20.0 / -slowest);
+  const int N = std::max(10, static_cast<int>(horizon / h));
+  const StateSpace ss = g.to_state_space();
+  const TransferFunction shifted = StateSpace(ss.A() - a * Eigen::MatrixXd::Identity(ss.nx(), ss.nx()), ss.B(), ss.C(), ss.D())
+                                       .to_transfer_function();
+  const Eigen::VectorXd t = time_grid(horizon / N, N + 1);
+  const Eigen::VectorXd imp = impulse_response(shifted, t).cwiseAbs();
+  const double peak = imp.maxCoeff();
+  for (Eigen::Index i = imp.size() - 1; i >= 0; --i)
+    if (imp(i) > tol * peak) return std::min(t_max, t(std::min<Eigen::Index>(i + 1, t.size() - 1)));
+  return t(0);
+}
+
+}  // namespace ctid
