@@ -49,9 +49,10 @@ Result<FsfModel> fsf(const IdData& data, const FsfOptions& o) {
   CTID_REQUIRE(M > p, "fsf: {} samples cannot determine {} parameters", M, p);
   const Eigen::VectorXd u = data.u().col(0), y = data.y().col(0);
 
-  // Overlap-save: FFT size F >= 2N (power of two), S = F - N + 1 new outputs per block.
+  // Overlap-save: FFT size F (power of two, about 8N but not much beyond the record), S = F - N + 1
+  // new outputs per block; larger blocks amortise the n/2 + 1 transforms per block over more samples.
   int F = 1;
-  while (F < 2 * N) F *= 2;
+  while (F < 2 * N || (F < 8 * N && F < M + N)) F *= 2;
   const int S = F - N + 1;
   Eigen::FFT<double> fft;
   // Filter spectra: h_k(l) = e^{a l Ts} e^{j 2 pi k l / N} / N, l < N (k = 0..m).

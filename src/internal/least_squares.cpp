@@ -68,17 +68,22 @@ LinearSolution StreamingLeastSquares::solve(double tol) {
   return s;
 }
 
-GramLeastSquares::GramLeastSquares(int p) : p_(p), g_(static_cast<std::size_t>(p + 1) * (p + 1), 0.0) {
-  CTID_ASSERT(p >= 1);
+GramLeastSquares::GramLeastSquares(int p, int block)
+    : p_(p), g_(Eigen::MatrixXd::Zero(p + 1, p + 1)), buf_(p + 1, block) {
+  CTID_ASSERT(p >= 1 && block >= 1);
 }
 
-LinearSolution GramLeastSquares::solve(double tol) const {
+void GramLeastSquares::flush() {
+  if (fill_ == 0) return;
+  g_.selfadjointView<Eigen::Lower>().rankUpdate(buf_.leftCols(fill_));
+  fill_ = 0;
+}
+
+LinearSolution GramLeastSquares::solve(double tol) {
+  flush();
   LinearSolution s;
   s.n_rows = rows_;
-  const int q = p_ + 1;
-  Eigen::MatrixXd G(q, q);
-  for (int j = 0; j < q; ++j)
-    for (int i = 0; i <= j; ++i) G(i, j) = G(j, i) = g_[static_cast<std::size_t>(j) * q + i];
+  Eigen::MatrixXd G = g_.selfadjointView<Eigen::Lower>();
   const double neff = sumw2_ > 0 ? sumw_ * sumw_ / sumw2_ : 0.0;
   const double c = sumw_ > 0 ? neff / sumw_ : 1.0;
   G *= c;

@@ -56,24 +56,28 @@ class StreamingLeastSquares {
 /// StreamingLeastSquares when `condition` exceeds kGramConditionLimit.
 class GramLeastSquares {
  public:
-  explicit GramLeastSquares(int p);
+  explicit GramLeastSquares(int p, int block = 128);
   void add(const double* x, double y, double w = 1.0) {
-    const int q = p_ + 1;
-    for (int j = 0; j < q; ++j) {
-      const double wj = w * (j < p_ ? x[j] : y);
-      double* col = &g_[static_cast<std::size_t>(j) * q];
-      for (int i = 0; i <= j; ++i) col[i] += wj * (i < p_ ? x[i] : y);
-    }
+    // Buffer the weighted augmented row sqrt(w) [x, y]; a block is folded into the Gram
+    // matrix by one symmetric rank-k update (vectorised), not row by row.
+    const double sw = std::sqrt(w);
+    double* r = &buf_(0, fill_);
+    for (int j = 0; j < p_; ++j) r[j] = sw * x[j];
+    r[p_] = sw * y;
     sumw_ += w;
     sumw2_ += w * w;
     ++rows_;
+    if (++fill_ == buf_.cols()) flush();
   }
   long long rows() const { return rows_; }
-  LinearSolution solve(double rank_tolerance = 1e-12) const;
+  LinearSolution solve(double rank_tolerance = 1e-12);
 
  private:
+  void flush();
   int p_;
-  std::vector<double> g_;  // (p+1) x (p+1), upper triangle, column-major
+  Eigen::MatrixXd g_;    // (p+1) x (p+1) Gram matrix of [X y] (lower triangle maintained)
+  Eigen::MatrixXd buf_;  // (p+1) x block, one weighted row per column
+  Eigen::Index fill_ = 0;
   long long rows_ = 0;
   double sumw_ = 0.0, sumw2_ = 0.0;
 };
