@@ -1,0 +1,50 @@
+// ctid — stage 2 of Gawthrop & Wang (2005): Levenberg-Marquardt estimation of the physical
+// parameters Theta of a partially known model (GW 22-23, time domain; GW 30, frequency
+// domain), with the exponential shift s -> s + a of the unstable case (GW §3.2); and the
+// direct output-error route on raw data for comparison. Sensitivities are exact
+// (PhysicalModel::sensitivities, simulated exactly). SEEDS-SPEC GW-A3, GW-A4.
+#pragma once
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "ctid/core/types.hpp"
+#include "ctid/data/iddata.hpp"
+#include "ctid/model/fsf.hpp"
+#include "ctid/model/physical_model.hpp"
+
+namespace ctid {
+
+struct PhysicalParameter {
+  std::string name;
+  double initial = std::numeric_limits<double>::quiet_NaN();  ///< required
+  double lower = -std::numeric_limits<double>::infinity();
+  double upper = std::numeric_limits<double>::infinity();
+  bool fixed = false;
+};
+
+struct PhysicalFitOptions {
+  int max_iterations = 100;
+  double tolerance = 1e-12;
+  int step_points = 1000;   ///< samples of the compressed step response on [0, T] (step route)
+  void validate() const;
+};
+
+/// Fit to the compressed step response of `compressed` (whose shift a is applied to the
+/// model). `parameters` gives every parameter of `model` (same names, any order). Throws
+/// InvalidArgument / InvalidOptions for a missing or unknown parameter, a missing initial
+/// value, or empty bounds. The model returned is the unshifted G(s; Theta).
+Result<TransferFunction> fit_physical_step(const PhysicalModel& model, const std::vector<PhysicalParameter>& parameters,
+                                           const FsfModel& compressed, const PhysicalFitOptions& options = {});
+/// Fit to the compressed frequency response theta_k = G(jk Omega + a), k = 0..m (GW 30).
+Result<TransferFunction> fit_physical_frequency(const PhysicalModel& model, const std::vector<PhysicalParameter>& parameters,
+                                                const FsfModel& compressed, const PhysicalFitOptions& options = {});
+/// Output error on the raw record, windowed by e^{-at} when a > 0: the shifted model
+/// G(s + a) is fitted to y_a = e^{-at} y, simulated exactly for the windowed held input
+/// e^{-at} u_k (the window's generator is part of the simulated state). a > 0 needs uniform
+/// sampling and a ZOH input.
+Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std::vector<PhysicalParameter>& parameters,
+                                          const IdData& data, double a = 0.0, const PhysicalFitOptions& options = {});
+
+}  // namespace ctid

@@ -1,0 +1,52 @@
+// ctid — physical (grey-box) linear models: a transfer-function expression in s whose
+// symbols are named physical parameters, e.g. "k1/(s^2 - k2)", "K/s^2",
+// "(R*C*s + 1)/(L*C*s^2 + R*C*s + 1)". Gawthrop & Wang (2005) §3 (partially known model).
+//
+// Grammar: expr := term {(+|-) term};  term := factor {(*|/) factor};
+//          factor := unary [^ non-negative integer];  unary := [+|-] unary | primary;
+//          primary := number | name | "(" expr ")".  The name `s` is the Laplace variable.
+// The expression is expanded once into N(s; Theta)/D(s; Theta) with coefficients carried
+// as values plus exact gradients with respect to Theta (forward automatic differentiation),
+// so transfer_function() and its parameter derivatives are exact.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "ctid/model/transfer_function.hpp"
+
+namespace ctid {
+
+class PhysicalModel {
+ public:
+  /// Parse `expression`. Every symbol other than `s` must be in `parameters` (the order of
+  /// Theta). Throws InvalidArgument with the column (1-based) of a syntax error or an unknown
+  /// symbol, and for an expression that is not a proper rational function of s.
+  PhysicalModel(const std::string& expression, std::vector<std::string> parameters);
+  /// Names of the symbols used in an expression (other than s), in order of appearance;
+  /// throws InvalidArgument on a syntax error.
+  static std::vector<std::string> symbols(const std::string& expression);
+
+  const std::string& expression() const { return expr_; }
+  const std::vector<std::string>& parameter_names() const { return names_; }
+  int n_parameters() const { return static_cast<int>(names_.size()); }
+
+  /// G(s; Theta). Throws InvalidArgument when Theta has the wrong size, is not finite, or
+  /// makes the denominator vanish.
+  TransferFunction transfer_function(const Eigen::VectorXd& theta) const;
+  /// G(s + a; Theta) (the exponentially shifted model of Gawthrop & Wang's unstable case).
+  TransferFunction shifted(const Eigen::VectorXd& theta, double a) const;
+  /// dG/dTheta_k(s + a) = (N_k D - N D_k)/D^2, one transfer function per parameter.
+  std::vector<TransferFunction> sensitivities(const Eigen::VectorXd& theta, double a = 0.0) const;
+
+ private:
+  struct Compiled;
+  std::string expr_;
+  std::vector<std::string> names_;
+  std::shared_ptr<const Compiled> c_;
+};
+
+}  // namespace ctid

@@ -1,0 +1,229 @@
+// Stage 2 of Gawthrop & Wang (2005); see include/ctid/estimate/physical.hpp.
+#include "ctid/estimate/physical.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <complex>
+
+#include "ctid/core/check.hpp"
+#include "ctid/model/state_space.hpp"
+#include "ctid/simulate/lsim.hpp"
+#include "ctid/validate/metrics.hpp"
+#include "internal/levenberg_marquardt.hpp"
+
+namespace ctid {
+
+void PhysicalFitOptions::validate() const {
+  CTID_REQUIRE_OPTION(max_iterations >= 1, "physical: max_iterations must be >= 1 (got {})", max_iterations);
+  CTID_REQUIRE_OPTION(tolerance > 0, "physical: tolerance must be > 0 (got {})", tolerance);
+  CTID_REQUIRE_OPTION(step_points >= 2, "physical: step_points must be >= 2 (got {})", step_points);
+}
+
+namespace {
+
+// Residuals r(Theta) and their Jacobian from the shifted model and its sensitivities.
+using ResidualFn = std::function<void(const TransferFunction& g, const std::vector<TransferFunction>* sens,
+                                      Eigen::VectorXd& r, Eigen::MatrixXd* J)>;
+
+Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<PhysicalParameter>& params, double a,
+                             const PhysicalFitOptions& opt, const ResidualFn& residual, int n_data, const char* route) {
+  const auto start = std::chrono::steady_clock::now();
+  opt.validate();
+  const int P = model.n_parameters();
+  Eigen::VectorXd full(P);
+  std::vector<bool> fixed(P, false), given(P, false);
+  Eigen::VectorXd lo_full(P), hi_full(P);
+  for (const auto& p : params) {
+    int idx = -1;
+    for (int i = 0; i < P; ++i)
+      if (model.parameter_names()[i] == p.name) idx = i;
+    if (idx < 0) {
+      std::string list;
+      for (const auto& nm : model.parameter_names()) list += (list.empty() ? "" : ", ") + nm;
+      throw InvalidOptions(detail::format("physical: '{}' is not a parameter of \"{}\" (parameters: {})", p.name,
+                                          model.expression(), list));
+    }
+    CTID_REQUIRE_OPTION(std::isfinite(p.initial), "physical: parameter '{}' has no (finite) initial value", p.name);
+    CTID_REQUIRE_OPTION(!(p.lower > p.upper), "physical: bounds of '{}' are empty ([{}, {}])", p.name, p.lower, p.upper);
+    full(idx) = std::min(std::max(p.initial, p.lower), p.upper);
+    fixed[idx] = p.fixed;
+    lo_full(idx) = p.lower;
+    hi_full(idx) = p.upper;
+    given[idx] = true;
+  }
+  for (int i = 0; i < P; ++i)
+    CTID_REQUIRE_OPTION(given[i], "physical: parameter '{}' of \"{}\" needs an initial value", model.parameter_names()[i],
+                        model.expression());
+  std::vector<int> free;
+  for (int i = 0; i < P; ++i)
+    if (!fixed[i]) free.push_back(i);
+  CTID_REQUIRE_OPTION(!free.empty(), "physical: every parameter is fixed; nothing to estimate");
+  const int p = static_cast<int>(free.size());
+  CTID_REQUIRE(n_data > p, "physical: {} residuals cannot determine {} parameters", n_data, p);
+  Eigen::VectorXd x0(p), lo(p), hi(p);
+  for (int j = 0; j < p; ++j) {
+    x0(j) = full(free[j]);
+    lo(j) = lo_full(free[j]);
+    hi(j) = hi_full(free[j]);
+  }
+  auto theta_of = [&](const Eigen::VectorXd& x) {
+    Eigen::VectorXd t = full;
+    for (int j = 0; j < p; ++j) t(free[j]) = x(j);
+    return t;
+  };
+  std::vector<double> history;
+  auto evaluate = [&](const Eigen::VectorXd& x, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
+    const Eigen::VectorXd th = theta_of(x);
+    TransferFunction g;
+    try {
+      g = model.shifted(th, a);
+    } catch (const InvalidArgument&) {
+      return false;  // e.g. the denominator vanishes at this point
+    }
+    if (J) {
+      const std::vector<TransferFunction> all = model.sensitivities(th, a);
+      std::vector<TransferFunction> sens;
+      for (int j = 0; j < p; ++j) sens.push_back(all[free[j]]);
+      residual(g, &sens, r, J);
+    } else {
+      residual(g, nullptr, r, nullptr);
+    }
+    if (!r.allFinite() || (J && !J->allFinite())) return false;
+    if (J) history.push_back(0.5 * r.squaredNorm());
+    return true;
+  };
+  internal::LmOptions lmo;
+  lmo.max_iterations = opt.max_iterations;
+  lmo.ftol = lmo.xtol = opt.tolerance;
+  const internal::LmResult lm = internal::levenberg_marquardt(evaluate, x0, lo, hi, lmo);
+
+  Result<TransferFunction> res;
+  const Eigen::VectorXd th = theta_of(lm.x);
+  res.model = model.transfer_function(th);
+  res.parameters.names = model.parameter_names();
+  res.parameters.values = th;
+  res.parameters.fixed = fixed;
+  res.parameters.covariance = Eigen::MatrixXd::Zero(P, P);
+  res.parameters.std = Eigen::VectorXd::Zero(P);
+  const double sigma2 = 2.0 * lm.cost / std::max(1, n_data - p);
+  if (lm.jtj.rows() == p && std::isfinite(sigma2)) {
+    const Eigen::MatrixXd C = sigma2 * lm.jtj.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
+    for (int i = 0; i < p; ++i)
+      for (int j = 0; j < p; ++j) res.parameters.covariance(free[i], free[j]) = C(i, j);
+    res.parameters.std = res.parameters.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  }
+  res.fit.n_samples = n_data;
+  res.fit.n_parameters = p;
+  res.fit.mse = 2.0 * lm.cost / n_data;
+  res.diagnostics.scalars["shift_a"] = a;
+  res.diagnostics.scalars["cost"] = lm.cost;
+  res.diagnostics.vectors["cost_history"] = Eigen::Map<Eigen::VectorXd>(history.data(), static_cast<Eigen::Index>(history.size()));
+  res.diagnostics.warnings.push_back(detail::format(
+      "{} route: parameter standard deviations assume independent residuals; they are indicative", route));
+  res.summary.iterations = lm.iterations;
+  if (!std::isfinite(lm.cost)) {
+    res.summary.termination = Termination::NumericalFailure;
+    res.summary.message = "the model cannot be evaluated at the initial parameters";
+  } else {
+    res.summary.termination = lm.converged ? Termination::Converged : Termination::MaxIterations;
+    res.summary.message = lm.converged ? "" : lm.message;
+  }
+  res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return res;
+}
+
+}  // namespace
+
+Result<TransferFunction> fit_physical_step(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
+                                           const FsfModel& fsf, const PhysicalFitOptions& opt) {
+  opt.validate();
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(opt.step_points, 0.0, fsf.T());
+  const Eigen::VectorXd target = fsf.step_response(t);
+  ResidualFn res = [&](const TransferFunction& g, const std::vector<TransferFunction>* sens, Eigen::VectorXd& r,
+                       Eigen::MatrixXd* J) {
+    r = step_response(g, t) - target;  // e = y_model - y_s (GW 22)
+    if (J) {
+      J->resize(t.size(), static_cast<Eigen::Index>(sens->size()));
+      for (std::size_t j = 0; j < sens->size(); ++j) J->col(static_cast<Eigen::Index>(j)) = step_response((*sens)[j], t);
+    }
+  };
+  return fit(model, params, fsf.shift(), opt, res, static_cast<int>(t.size()), "step");
+}
+
+Result<TransferFunction> fit_physical_frequency(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
+                                                const FsfModel& fsf, const PhysicalFitOptions& opt) {
+  const int m = fsf.m();
+  Eigen::VectorXd w(m + 1);
+  Eigen::VectorXcd target(m + 1);
+  for (int k = 0; k <= m; ++k) {
+    w(k) = k * fsf.omega();
+    target(k) = fsf.theta_k(k);
+  }
+  ResidualFn res = [&](const TransferFunction& g, const std::vector<TransferFunction>* sens, Eigen::VectorXd& r,
+                       Eigen::MatrixXd* J) {
+    const Eigen::VectorXcd e = g.frequency_response(w) - target;  // E(jw) of GW 30, real and imaginary parts
+    r.resize(2 * (m + 1));
+    r << e.real(), e.imag();
+    if (J) {
+      J->resize(2 * (m + 1), static_cast<Eigen::Index>(sens->size()));
+      for (std::size_t j = 0; j < sens->size(); ++j) {
+        const Eigen::VectorXcd d = (*sens)[j].frequency_response(w);
+        J->col(static_cast<Eigen::Index>(j)) << d.real(), d.imag();
+      }
+    }
+  };
+  return fit(model, params, fsf.shift(), opt, res, 2 * (m + 1), "frequency");
+}
+
+namespace {
+// Exact response of g (already shifted to G(s + a)) to the windowed held input
+// u_a(t) = e^{-a t} u_k on [t_k, t_{k+1}): the input's generator v' = -a v is appended to the
+// state and reset to e^{-a (t_k - t_0)} u_k at every sample (uniform sampling).
+Eigen::VectorXd windowed_zoh_response(const TransferFunction& g, const Eigen::VectorXd& u, double h, double a) {
+  const StateSpace ss = g.to_state_space();
+  const int n = ss.nx();
+  Eigen::MatrixXd Aa = Eigen::MatrixXd::Zero(n + 1, n + 1);
+  Aa.topLeftCorner(n, n) = ss.A();
+  Aa.topRightCorner(n, 1) = ss.B();
+  Aa(n, n) = -a;
+  const Eigen::MatrixXd Phi = expm(Aa * h);
+  Eigen::VectorXd y(u.size()), z = Eigen::VectorXd::Zero(n + 1), zn(n + 1);
+  for (Eigen::Index k = 0; k < u.size(); ++k) {
+    const double v = std::exp(-a * h * double(k)) * u(k);
+    y(k) = (ss.C() * z.head(n))(0) + ss.D()(0, 0) * v;
+    z(n) = v;
+    zn.noalias() = Phi * z;
+    z = zn;
+  }
+  return y;
+}
+}  // namespace
+
+Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
+                                          const IdData& data, double a, const PhysicalFitOptions& opt) {
+  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "physical: needs one input and one output (data has {} inputs, {} outputs)",
+               data.nu(), data.ny());
+  CTID_REQUIRE(std::isfinite(a) && a >= 0, "physical: the window a must be >= 0 (got {})", a);
+  CTID_REQUIRE(a == 0.0 || (data.is_uniform() && data.intersample(0) == Intersample::Zoh),
+               "physical: the windowed raw route (a > 0) needs uniformly sampled data with a held (ZOH) input");
+  const Eigen::VectorXd t = data.times();
+  const Eigen::VectorXd u = data.u().col(0);
+  Eigen::VectorXd y = data.y().col(0);
+  if (a > 0) y = y.cwiseProduct((-a * (t.array() - t(0))).exp().matrix());  // y_a = e^{-at} y
+  // Model output for the (windowed) input: exact for the held input in both cases.
+  auto simulate = [&](const TransferFunction& g) -> Eigen::VectorXd {
+    if (a > 0) return windowed_zoh_response(g, u, data.ts(), a);
+    return lsim(g, data, 0);
+  };
+  ResidualFn res = [&](const TransferFunction& g, const std::vector<TransferFunction>* sens, Eigen::VectorXd& r,
+                       Eigen::MatrixXd* J) {
+    r = simulate(g) - y;
+    if (J) {
+      J->resize(t.size(), static_cast<Eigen::Index>(sens->size()));
+      for (std::size_t j = 0; j < sens->size(); ++j) J->col(static_cast<Eigen::Index>(j)) = simulate((*sens)[j]);
+    }
+  };
+  return fit(model, params, a, opt, res, data.size(), "raw");
+}
+
+}  // namespace ctid

@@ -1,0 +1,301 @@
+// Physical transfer-function expressions: a recursive-descent parser producing an AST,
+// evaluated with polynomials whose coefficients carry exact gradients. See physical_model.hpp.
+#include "ctid/model/physical_model.hpp"
+
+#include <cctype>
+#include <cmath>
+#include <functional>
+
+#include "ctid/core/check.hpp"
+
+namespace ctid {
+
+namespace {
+
+// ---- AST -----------------------------------------------------------------------------
+struct Node {
+  enum Kind { Number, Symbol, S, Neg, Add, Sub, Mul, Div, Pow } kind;
+  double value = 0;      // Number; exponent for Pow
+  int symbol = -1;       // Symbol: index into the parameter list
+  std::unique_ptr<Node> a, b;
+};
+
+class Parser {
+ public:
+  Parser(const std::string& text, const std::vector<std::string>* params, std::vector<std::string>* seen)
+      : t_(text), params_(params), seen_(seen) {}
+  std::unique_ptr<Node> parse() {
+    auto n = expr();
+    skip();
+    if (pos_ < t_.size()) fail(detail::format("unexpected '{}'", t_[pos_]));
+    return n;
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& what) const {
+    throw InvalidArgument(detail::format("expression \"{}\": {} at column {}", t_, what, pos_ + 1));
+  }
+  void skip() {
+    while (pos_ < t_.size() && std::isspace(static_cast<unsigned char>(t_[pos_]))) ++pos_;
+  }
+  bool accept(char c) {
+    skip();
+    if (pos_ < t_.size() && t_[pos_] == c) {
+      ++pos_;
+      return true;
+    }
+    return false;
+  }
+  static std::unique_ptr<Node> make(Node::Kind k, std::unique_ptr<Node> a = nullptr, std::unique_ptr<Node> b = nullptr) {
+    auto n = std::make_unique<Node>();
+    n->kind = k;
+    n->a = std::move(a);
+    n->b = std::move(b);
+    return n;
+  }
+  std::unique_ptr<Node> expr() {
+    auto n = term();
+    for (;;) {
+      if (accept('+')) n = make(Node::Add, std::move(n), term());
+      else if (accept('-')) n = make(Node::Sub, std::move(n), term());
+      else return n;
+    }
+  }
+  std::unique_ptr<Node> term() {
+    auto n = factor();
+    for (;;) {
+      if (accept('*')) n = make(Node::Mul, std::move(n), factor());
+      else if (accept('/')) n = make(Node::Div, std::move(n), factor());
+      else return n;
+    }
+  }
+  std::unique_ptr<Node> factor() {
+    auto n = unary();
+    if (accept('^')) {
+      skip();
+      const std::size_t start = pos_;
+      while (pos_ < t_.size() && std::isdigit(static_cast<unsigned char>(t_[pos_]))) ++pos_;
+      if (start == pos_) fail("expected a non-negative integer exponent after '^'");
+      auto p = make(Node::Pow, std::move(n));
+      p->value = std::stod(t_.substr(start, pos_ - start));
+      if (p->value > 64) fail("exponent larger than 64");
+      return p;
+    }
+    return n;
+  }
+  std::unique_ptr<Node> unary() {
+    if (accept('-')) return make(Node::Neg, unary());
+    if (accept('+')) return unary();
+    return primary();
+  }
+  std::unique_ptr<Node> primary() {
+    skip();
+    if (pos_ >= t_.size()) fail("unexpected end of expression");
+    const char c = t_[pos_];
+    if (c == '(') {
+      ++pos_;
+      auto n = expr();
+      if (!accept(')')) fail("expected ')'");
+      return n;
+    }
+    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') {
+      const char* begin = t_.c_str() + pos_;
+      char* end = nullptr;
+      const double v = std::strtod(begin, &end);
+      if (end == begin) fail("malformed number");
+      pos_ += static_cast<std::size_t>(end - begin);
+      auto n = make(Node::Number);
+      n->value = v;
+      return n;
+    }
+    if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
+      const std::size_t start = pos_;
+      while (pos_ < t_.size() && (std::isalnum(static_cast<unsigned char>(t_[pos_])) || t_[pos_] == '_')) ++pos_;
+      const std::string name = t_.substr(start, pos_ - start);
+      if (name == "s") return make(Node::S);
+      if (seen_) {
+        bool known = false;
+        for (const auto& x : *seen_) known = known || x == name;
+        if (!known) seen_->push_back(name);
+      }
+      auto n = make(Node::Symbol);
+      if (params_) {
+        for (std::size_t i = 0; i < params_->size(); ++i)
+          if ((*params_)[i] == name) n->symbol = static_cast<int>(i);
+        if (n->symbol < 0) {
+          std::string list;
+          for (const auto& p : *params_) list += (list.empty() ? "" : ", ") + p;
+          pos_ = start;
+          fail(detail::format("unknown symbol '{}' (parameters: {})", name, list.empty() ? "none" : list));
+        }
+      }
+      return n;
+    }
+    fail(detail::format("unexpected '{}'", c));
+  }
+
+  const std::string& t_;
+  const std::vector<std::string>* params_;
+  std::vector<std::string>* seen_;
+  std::size_t pos_ = 0;
+};
+
+// ---- values: polynomials in s with coefficients carrying gradients ----------------------
+struct Dual {
+  double v = 0;
+  Eigen::VectorXd g;  // d v / d Theta
+};
+Dual operator+(const Dual& a, const Dual& b) { return {a.v + b.v, a.g + b.g}; }
+Dual operator*(const Dual& a, const Dual& b) { return {a.v * b.v, a.v * b.g + b.v * a.g}; }
+
+using DPoly = std::vector<Dual>;  // ascending powers of s
+
+DPoly padd(const DPoly& a, const DPoly& b, double sign, int P) {
+  DPoly r(std::max(a.size(), b.size()), Dual{0, Eigen::VectorXd::Zero(P)});
+  for (std::size_t i = 0; i < a.size(); ++i) r[i] = r[i] + a[i];
+  for (std::size_t i = 0; i < b.size(); ++i) r[i] = r[i] + Dual{sign * b[i].v, sign * b[i].g};
+  return r;
+}
+DPoly pmul(const DPoly& a, const DPoly& b, int P) {
+  DPoly r(a.size() + b.size() - 1, Dual{0, Eigen::VectorXd::Zero(P)});
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (std::size_t j = 0; j < b.size(); ++j) r[i + j] = r[i + j] + a[i] * b[j];
+  return r;
+}
+struct Ratio {
+  DPoly num, den;
+};
+
+Ratio eval(const Node& n, const Eigen::VectorXd& theta) {
+  const int P = static_cast<int>(theta.size());
+  auto constant = [&](double v) { return DPoly{Dual{v, Eigen::VectorXd::Zero(P)}}; };
+  switch (n.kind) {
+    case Node::Number: return {constant(n.value), constant(1.0)};
+    case Node::Symbol: {
+      Dual d{theta(n.symbol), Eigen::VectorXd::Zero(P)};
+      d.g(n.symbol) = 1.0;
+      return {DPoly{d}, constant(1.0)};
+    }
+    case Node::S: return {DPoly{Dual{0, Eigen::VectorXd::Zero(P)}, Dual{1, Eigen::VectorXd::Zero(P)}}, constant(1.0)};
+    case Node::Neg: {
+      Ratio r = eval(*n.a, theta);
+      return {padd(DPoly{}, r.num, -1.0, P), r.den};
+    }
+    case Node::Add:
+    case Node::Sub: {
+      const Ratio x = eval(*n.a, theta), y = eval(*n.b, theta);
+      return {padd(pmul(x.num, y.den, P), pmul(y.num, x.den, P), n.kind == Node::Add ? 1.0 : -1.0, P), pmul(x.den, y.den, P)};
+    }
+    case Node::Mul: {
+      const Ratio x = eval(*n.a, theta), y = eval(*n.b, theta);
+      return {pmul(x.num, y.num, P), pmul(x.den, y.den, P)};
+    }
+    case Node::Div: {
+      const Ratio x = eval(*n.a, theta), y = eval(*n.b, theta);
+      return {pmul(x.num, y.den, P), pmul(x.den, y.num, P)};
+    }
+    case Node::Pow: {
+      const Ratio x = eval(*n.a, theta);
+      Ratio r{constant(1.0), constant(1.0)};
+      for (int k = 0; k < static_cast<int>(n.value); ++k) r = {pmul(r.num, x.num, P), pmul(r.den, x.den, P)};
+      return r;
+    }
+  }
+  CTID_ASSERT(false);
+}
+
+}  // namespace
+
+struct PhysicalModel::Compiled {
+  std::unique_ptr<Node> root;
+};
+
+PhysicalModel::PhysicalModel(const std::string& expression, std::vector<std::string> parameters)
+    : expr_(expression), names_(std::move(parameters)) {
+  for (std::size_t i = 0; i < names_.size(); ++i) {
+    CTID_REQUIRE(names_[i] != "s", "PhysicalModel: 's' is the Laplace variable, not a parameter name");
+    for (std::size_t j = 0; j < i; ++j)
+      CTID_REQUIRE(names_[i] != names_[j], "PhysicalModel: parameter '{}' is declared twice", names_[i]);
+  }
+  auto c = std::make_shared<Compiled>();
+  c->root = Parser(expr_, &names_, nullptr).parse();
+  c_ = c;
+}
+
+std::vector<std::string> PhysicalModel::symbols(const std::string& expression) {
+  std::vector<std::string> seen;
+  Parser(expression, nullptr, &seen).parse();
+  return seen;
+}
+
+namespace {
+// N(s + a) and D(s + a) with gradients, trimmed and normalised so that D is monic.
+void expand(const Node& root, const std::string& expr, const Eigen::VectorXd& theta, double a, Eigen::VectorXd& num,
+            Eigen::VectorXd& den, Eigen::MatrixXd& dnum, Eigen::MatrixXd& dden) {
+  const int P = static_cast<int>(theta.size());
+  Ratio r = eval(root, theta);
+  auto shift = [&](const DPoly& p) {  // p(s + a) = sum_i c_i (s + a)^i
+    if (a == 0.0) return p;
+    DPoly out(p.size(), Dual{0, Eigen::VectorXd::Zero(P)});
+    DPoly pw{Dual{1, Eigen::VectorXd::Zero(P)}};
+    const DPoly lin{Dual{a, Eigen::VectorXd::Zero(P)}, Dual{1, Eigen::VectorXd::Zero(P)}};
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      for (std::size_t j = 0; j < pw.size(); ++j) out[j] = out[j] + p[i] * pw[j];
+      pw = pmul(pw, lin, P);
+    }
+    return out;
+  };
+  r.num = shift(r.num);
+  r.den = shift(r.den);
+  auto degree = [](const DPoly& p) {
+    int d = static_cast<int>(p.size()) - 1;
+    while (d > 0 && p[d].v == 0.0) --d;
+    return d;
+  };
+  const int dn = degree(r.num), dd = degree(r.den);
+  const Dual lead = r.den[dd];
+  CTID_REQUIRE(lead.v != 0.0, "expression \"{}\": the denominator vanishes for these parameter values", expr);
+  CTID_REQUIRE(dn <= dd || (dn == 0 && r.num[0].v == 0.0),
+               "expression \"{}\": not a proper transfer function (numerator degree {} > denominator degree {})", expr, dn, dd);
+  // Descending coefficients divided by the leading denominator coefficient (quotient rule).
+  num.resize(dn + 1);
+  den.resize(dd + 1);
+  dnum.resize(dn + 1, P);
+  dden.resize(dd + 1, P);
+  auto divide = [&](const Dual& c, double& v, Eigen::MatrixXd& g, int row) {
+    v = c.v / lead.v;
+    g.row(row) = ((c.g * lead.v - c.v * lead.g) / (lead.v * lead.v)).transpose();
+  };
+  for (int i = 0; i <= dn; ++i) divide(r.num[dn - i], num(i), dnum, i);
+  for (int i = 0; i <= dd; ++i) divide(r.den[dd - i], den(i), dden, i);
+}
+}  // namespace
+
+TransferFunction PhysicalModel::shifted(const Eigen::VectorXd& theta, double a) const {
+  CTID_REQUIRE(theta.size() == n_parameters(), "PhysicalModel: {} parameter values for {} parameters", theta.size(),
+               n_parameters());
+  CTID_REQUIRE(theta.allFinite(), "PhysicalModel: parameter values must be finite");
+  Eigen::VectorXd num, den;
+  Eigen::MatrixXd dn, dd;
+  expand(*c_->root, expr_, theta, a, num, den, dn, dd);
+  return TransferFunction(num, den);
+}
+
+TransferFunction PhysicalModel::transfer_function(const Eigen::VectorXd& theta) const { return shifted(theta, 0.0); }
+
+std::vector<TransferFunction> PhysicalModel::sensitivities(const Eigen::VectorXd& theta, double a) const {
+  CTID_REQUIRE(theta.size() == n_parameters(), "PhysicalModel: {} parameter values for {} parameters", theta.size(),
+               n_parameters());
+  Eigen::VectorXd num, den;
+  Eigen::MatrixXd dn, dd;
+  expand(*c_->root, expr_, theta, a, num, den, dn, dd);
+  const Polynomial N(num), D(den);
+  std::vector<TransferFunction> out;
+  for (int k = 0; k < n_parameters(); ++k) {
+    const Polynomial Nk(Eigen::VectorXd(dn.col(k))), Dk(Eigen::VectorXd(dd.col(k)));
+    out.emplace_back(Nk * D - N * Dk, D * D);
+  }
+  return out;
+}
+
+}  // namespace ctid

@@ -1,0 +1,164 @@
+// Stage 2 of Gawthrop & Wang (2005): physical-model expressions, exact sensitivities and the
+// stand-in experiments of SEEDS-SPEC GW.3.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "ctid/core/error.hpp"
+#include "ctid/data/input_design.hpp"
+#include "ctid/estimate/fsf.hpp"
+#include "ctid/estimate/physical.hpp"
+#include "ctid/model/state_space.hpp"
+#include "ctid/simulate/lsim.hpp"
+
+using namespace ctid;
+
+namespace {
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Unstable circuit stand-in: 1/(s^2 - 1) under digital PD (SEEDS-SPEC GW.3).
+IdData circuit(double noise_sd, std::uint64_t seed) {
+  const double Ts = 0.01;
+  const int M = 4000;
+  const StateSpace ss = TransferFunction(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 0.0, -1.0}}).to_state_space();
+  const Discretization D = discretize(ss.A(), ss.B(), Ts);
+  std::mt19937_64 rng(1);
+  std::uniform_int_distribution<int> coin(0, 1);
+  const Eigen::VectorXd e = white_noise(M, noise_sd, seed);
+  Eigen::VectorXd u(M), y(M), x = Eigen::VectorXd::Zero(2);
+  double w = 0.5, d = 0, yprev = 0;
+  for (int i = 0; i < M; ++i) {
+    if (i % 150 == 0) w = coin(rng) ? 0.5 : -0.5;
+    y(i) = (ss.C() * x)(0) + e(i);
+    d = (0.1 * d + (y(i) - yprev)) / (0.1 + Ts);
+    yprev = y(i);
+    u(i) = 3.0 * (w - y(i) - d);
+    x = D.Phi * x + D.Gamma0 * u(i);
+  }
+  return IdData(u, y, Ts);
+}
+}  // namespace
+
+TEST(PhysicalModel, ExpressionsExpandToTheRightTransferFunction) {
+  const PhysicalModel m("(R*C*s + 1)/(L*C*s^2 + R*C*s + 1)", {"R", "L", "C"});
+  const TransferFunction g = m.transfer_function(Eigen::VectorXd{{2.0, 0.5, 4.0}});
+  // (8 s + 1)/(2 s^2 + 8 s + 1) -> monic: (4 s + 0.5)/(s^2 + 4 s + 0.5)
+  EXPECT_LT((g.num().coefficients() - Eigen::VectorXd{{4.0, 0.5}}).norm(), 1e-14);
+  EXPECT_LT((g.den().coefficients() - Eigen::VectorXd{{1.0, 4.0, 0.5}}).norm(), 1e-14);
+  const PhysicalModel u("k1/(s^2 - k2)", {"k1", "k2"});
+  const TransferFunction sh = u.shifted(Eigen::VectorXd{{1.0, 1.0}}, 2.0);  // 1/((s+2)^2 - 1)
+  EXPECT_LT((sh.den().coefficients() - Eigen::VectorXd{{1.0, 4.0, 3.0}}).norm(), 1e-14);
+  EXPECT_EQ(PhysicalModel::symbols("K/s^2 + -2*x"), (std::vector<std::string>{"K", "x"}));
+  EXPECT_NEAR(PhysicalModel("K/(s+1)^3", {"K"}).transfer_function(Eigen::VectorXd{{2.0}}).dc_gain(), 2.0, 1e-14);
+}
+
+TEST(PhysicalModel, ErrorsNameTheColumn) {
+  EXPECT_EQ(error_of([] { PhysicalModel("k1/(s^2 - k3)", {"k1", "k2"}); }),
+            "expression \"k1/(s^2 - k3)\": unknown symbol 'k3' (parameters: k1, k2) at column 11");
+  EXPECT_EQ(error_of([] { PhysicalModel("k1/(s^2 -", {"k1"}); }), "expression \"k1/(s^2 -\": unexpected end of expression at column 10");
+  EXPECT_EQ(error_of([] { PhysicalModel("k1/(s^2))", {"k1"}); }), "expression \"k1/(s^2))\": unexpected ')' at column 9");
+  EXPECT_NE(error_of([] { PhysicalModel("k*s^2/(s+1)", {"k"}).transfer_function(Eigen::VectorXd{{1.0}}); }).find("not a proper"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { PhysicalModel("k/s^x", {"k", "x"}); }).find("exponent"), std::string::npos);
+}
+
+TEST(PhysicalModel, SensitivitiesMatchFiniteDifferences) {
+  // dG/dTheta_k (s + a) from the gradient-carrying expansion vs central differences of G(s + a):
+  // compared on the frequency response at a few points (relative error ~ h^2 ~ 1e-10).
+  const PhysicalModel m("(R*C*s + 1)/(L*C*s^2 + R*C*s + 1)", {"R", "L", "C"});
+  const Eigen::VectorXd th{{2.0, 0.5, 4.0}}, w{{0.1, 1.0, 7.0}};
+  for (double a : {0.0, 1.5}) {
+    const auto sens = m.sensitivities(th, a);
+    for (int k = 0; k < 3; ++k) {
+      const double h = 1e-5 * std::abs(th(k));
+      Eigen::VectorXd p = th, q = th;
+      p(k) += h;
+      q(k) -= h;
+      const Eigen::VectorXcd fd = (m.shifted(p, a).frequency_response(w) - m.shifted(q, a).frequency_response(w)) / (2 * h);
+      EXPECT_LT((fd - sens[k].frequency_response(w)).norm() / fd.norm(), 1e-8) << k << " a=" << a;
+    }
+  }
+}
+
+TEST(GawthropWang, UnstableCircuitTwoStageReachesThePhysicalParameters) {
+  // SEEDS-SPEC GW.3: a = 2, b = 0, T = 8 s, LM from (2, 0). The spec's verified noise-free results:
+  // (0.973, 1.040) for n = 11 and (0.987, 1.013) for n = 21 — reproduced here to 1e-3; the issue's
+  // criterion is within 5 % of (1, 1). The frequency route (GW 30) agrees with the time-domain one
+  // (measured differences 3.5 % for n = 11, 0.3 % for n = 21; bound 5 %), and the raw-data route
+  // (windowed output error, simulated exactly) gives (1, 1).
+  const IdData d = circuit(0.0, 0);
+  const PhysicalModel m("k1/(s^2 - k2)", {"k1", "k2"});
+  const std::vector<PhysicalParameter> start{{"k1", 2.0}, {"k2", 0.0}};
+  const Eigen::VectorXd spec11{{0.973, 1.040}}, spec21{{0.987, 1.013}};
+  for (int n : {11, 21}) {
+    const auto c = fsf(d, {.T = 8.0, .n = n, .a = 2.0});
+    const auto r = fit_physical_step(m, start, c.model);
+    ASSERT_EQ(r.summary.termination, Termination::Converged) << r.summary.message;
+    EXPECT_LT((r.parameters.values - (n == 11 ? spec11 : spec21)).cwiseAbs().maxCoeff(), 1e-3) << n;
+    EXPECT_LT((r.parameters.values.array() - 1.0).abs().maxCoeff(), 0.05);
+    EXPECT_LE(r.summary.iterations, 10);  // the paper: about 4 LM steps
+    const auto f = fit_physical_frequency(m, start, c.model);
+    EXPECT_LT((f.parameters.values - r.parameters.values).cwiseAbs().maxCoeff(), 0.05) << n;
+    EXPECT_LT((f.parameters.values.array() - 1.0).abs().maxCoeff(), 0.05) << n;
+  }
+  const auto raw = fit_physical_raw(m, start, d, 2.0);
+  EXPECT_LT((raw.parameters.values.array() - 1.0).abs().maxCoeff(), 1e-6);
+  // With output noise (sigma = 0.05), ten seeds: mean within 5 % of (1, 1) (spec: 0.971, 1.026).
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(2);
+  for (int s = 1; s <= 10; ++s)
+    mean += fit_physical_step(m, start, fsf(circuit(0.05, s), {.T = 8.0, .n = 21, .a = 2.0}).model).parameters.values / 10;
+  EXPECT_LT((mean.array() - 1.0).abs().maxCoeff(), 0.05);
+}
+
+TEST(GawthropWang, BallAndBeamWithinOnePercentAndBPositiveDegrades) {
+  // SEEDS-SPEC GW.3: 2.5/s^2 under PID u = sat(Kp(w-y) - Kd s/(1+Tf s) y + Ki int(w-y)), |u| <= 1.5,
+  // Kp = 1, Kd = 0.8, Ki = 0.1, Tf = 0.05, Ts = 0.01, square-wave set-point +-0.5 (20 s period),
+  // measurement noise 0.02, 60 s; a = 1, T = 10 s, n = 21. Spec: b = 0 gives K = 2.488 +- 0.008
+  // (criterion: within 1 % of 2.5); b = 0.9 fails and is warned about.
+  const double Ts = 0.01;
+  const int M = 6000;
+  const StateSpace ss = TransferFunction(Eigen::VectorXd{{2.5}}, Eigen::VectorXd{{1.0, 0.0, 0.0}}).to_state_space();
+  const Discretization D = discretize(ss.A(), ss.B(), Ts);
+  const Eigen::VectorXd e = white_noise(M, 0.02, 11);
+  Eigen::VectorXd u(M), y(M), x = Eigen::VectorXd::Zero(2);
+  double d = 0, yprev = 0, integral = 0;
+  for (int i = 0; i < M; ++i) {
+    const double w = std::fmod(i * Ts, 20.0) < 10.0 ? 0.5 : -0.5;
+    y(i) = (ss.C() * x)(0) + e(i);
+    d = (0.05 * d + 0.8 * (y(i) - yprev)) / (0.05 + Ts);
+    yprev = y(i);
+    integral += Ts * (w - y(i));
+    u(i) = std::clamp(1.0 * (w - y(i)) - d + 0.1 * integral, -1.5, 1.5);
+    x = D.Phi * x + D.Gamma0 * u(i);
+  }
+  const IdData data(u, y, Ts);
+  const PhysicalModel m("K/s^2", {"K"});
+  const auto c0 = fsf(data, {.T = 10.0, .n = 21, .a = 1.0});
+  EXPECT_TRUE(c0.diagnostics.warnings.empty());
+  const auto r0 = fit_physical_step(m, {{"K", 1.0}}, c0.model);
+  EXPECT_NEAR(r0.parameters.value("K"), 2.5, 0.025);
+  // Linear in K: the paper reports one LM step; LM needs a few more to meet its stopping test.
+  EXPECT_LE(r0.summary.iterations, 6);
+  EXPECT_NEAR(r0.diagnostics.vectors.at("cost_history")(1), r0.diagnostics.scalars.at("cost"), 1e-3 * r0.diagnostics.vectors.at("cost_history")(0));
+  const auto c9 = fsf(data, {.T = 10.0, .n = 21, .a = 1.0, .b = 0.9});
+  ASSERT_FALSE(c9.diagnostics.warnings.empty());
+  const auto r9 = fit_physical_step(m, {{"K", 1.0}}, c9.model);
+  EXPECT_GT(std::abs(r9.parameters.value("K") - 2.5), 0.25);  // spec: K ~ 0.57 with b = 0.9
+}
+
+TEST(GawthropWang, BadParameterSets) {
+  const PhysicalModel m("k1/(s^2 - k2)", {"k1", "k2"});
+  const FsfModel f(0.01, 100, 5, Eigen::VectorXd::Ones(5), {}, 2.0);
+  EXPECT_THROW(fit_physical_step(m, {{"k1", 1.0}}, f), InvalidOptions);                 // k2 without initial value
+  EXPECT_THROW(fit_physical_step(m, {{"k1", 1.0}, {"k9", 1.0}}, f), InvalidOptions);    // unknown name
+  EXPECT_THROW(fit_physical_step(m, {{"k1", NAN}, {"k2", 0.0}}, f), InvalidOptions);    // no value
+  EXPECT_THROW(fit_physical_step(m, {{"k1", 1.0, 2.0, 1.0}, {"k2", 0.0}}, f), InvalidOptions);  // empty bounds
+}
