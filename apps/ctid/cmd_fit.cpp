@@ -19,6 +19,8 @@ struct FitArgs {
   bool delay = false;
   std::string controller, reference;
   bool frequency = false;
+  std::string model_expr, via = "fsf", responses;
+  std::vector<std::string> params;
   std::string w = "w", re = "re", im = "im", u_re, u_im, y_re, y_im;
   std::string json;
   bool force = false;
@@ -230,6 +232,141 @@ int run_frequency(const FitArgs& a) {
   return r.usable() ? kOk : kNotUsable;
 }
 
+// Gawthrop & Wang: FSF compression settings shared by --method fsf and --method physical.
+FsfOptions fsf_options(std::map<std::string, std::string>& sets, bool* unstable) {
+  FsfOptions o;
+  o.T = 0;
+  consume_sets(sets, [&](const std::string& k, const std::string& v) {
+    if (k == "T") o.T = to_double(k, v);
+    else if (k == "n") o.n = to_int(k, v);
+    else if (k == "a") o.a = to_double(k, v);
+    else if (k == "b") o.b = to_double(k, v);
+    else if (k == "unstable" && unstable) *unstable = to_int(k, v) != 0;
+    else return false;
+    return true;
+  });
+  if (o.T == 0) throw UsageError("the FSF window needs --set T=SECONDS (settling time of the, possibly shifted, system)");
+  if (unstable && *unstable && !(o.a > 0))
+    throw UsageError(detail::format("the plant is declared unstable: give a window a > 0 larger than its fastest unstable "
+                                    "pole (got a = {})",
+                                    o.a));
+  return o;
+}
+
+void write_fsf_responses(const std::string& prefix, const FsfModel& f) {
+  const int K = 501;
+  Eigen::MatrixXd tm(K, 4);
+  for (int i = 0; i < K; ++i) {
+    const Eigen::VectorXd t{{f.T() * i / (K - 1)}};
+    tm.row(i) << t(0), f.step_response(t)(0), f.step_response_std(t)(0), f.impulse_response(t)(0);
+  }
+  write_csv(prefix + "_time.csv", {"t", "step", "step_std", "impulse"}, tm);
+  Eigen::VectorXd w(200);
+  const double wmax = std::min(3.14159 / f.delta(), 10.0 * f.m() * f.omega() + f.omega());
+  for (int i = 0; i < 200; ++i) w(i) = f.omega() * 0.01 * std::pow(wmax / (0.01 * f.omega()), i / 199.0);
+  const Eigen::VectorXcd g = f.frequency_response(w);
+  Eigen::MatrixXd fm(200, 5);
+  for (int i = 0; i < 200; ++i) fm.row(i) << w(i), g(i).real(), g(i).imag(), std::abs(g(i)), std::arg(g(i)) * 180.0 / 3.14159265358979;
+  write_csv(prefix + "_freq.csv", {"w", "re", "im", "mag", "phase_deg"}, fm);
+  std::printf("wrote %s_time.csv and %s_freq.csv\n", prefix.c_str(), prefix.c_str());
+}
+
+int run_fsf(const FitArgs& a, const IdData& d) {
+  auto sets = parse_sets(a.sets);
+  bool unstable = false;
+  const FsfOptions o = fsf_options(sets, &unstable);
+  reject_unknown(sets, "fsf", "T, n, a, b, unstable");
+  Result<FsfModel> r;
+  try {
+    r = fsf(d, o);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+  if (!a.responses.empty()) {
+    check_output_path(a.responses + "_time.csv", {a.data.path}, a.force);
+    check_output_path(a.responses + "_freq.csv", {a.data.path}, a.force);
+  }
+  const int code = finish(r, "fsf", d, a.json);
+  if (!a.responses.empty()) write_fsf_responses(a.responses, r.model);
+  return code;
+}
+
+int run_physical(const FitArgs& a, const IdData& d) {
+  if (a.model_expr.empty()) throw UsageError("--method physical needs --model EXPRESSION (e.g. \"k1/(s^2-k2)\")");
+  std::vector<PhysicalParameter> ps;
+  std::vector<std::string> names;
+  for (const auto& p : a.params) {
+    const auto eq = p.find('=');
+    if (eq == std::string::npos || eq == 0) throw UsageError("--param needs NAME=INITIAL (got '" + p + "')");
+    PhysicalParameter q;
+    q.name = p.substr(0, eq);
+    q.initial = to_double("--param " + q.name, p.substr(eq + 1));
+    ps.push_back(q);
+    names.push_back(q.name);
+  }
+  // The parser reports a syntax error or an undeclared symbol with its column; a --param the
+  // expression does not use is reported as well.
+  std::vector<std::string> symbols;
+  try {
+    PhysicalModel check(a.model_expr, names);
+    symbols = PhysicalModel::symbols(a.model_expr);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(std::string(e.what()) + "; declare every parameter with --param NAME=INITIAL");
+  }
+  for (const auto& n : names) {
+    bool used = false;
+    for (const auto& s : symbols) used = used || n == s;
+    if (!used) throw UsageError(detail::format("--param {}: '{}' does not appear in the model \"{}\"", n, n, a.model_expr));
+  }
+  auto sets = parse_sets(a.sets);
+  PhysicalFitOptions po;
+  consume_sets(sets, [&](const std::string& k, const std::string& v) {
+    if (k == "max_iterations") po.max_iterations = to_int(k, v);
+    else if (k == "tolerance") po.tolerance = to_double(k, v);
+    else if (k.rfind("lower.", 0) == 0 || k.rfind("upper.", 0) == 0 || k.rfind("fix.", 0) == 0) {
+      const auto dot = k.find('.');
+      const std::string name = k.substr(dot + 1);
+      bool found = false;
+      for (auto& q : ps)
+        if (q.name == name) {
+          found = true;
+          if (k[0] == 'l') q.lower = to_double(k, v);
+          else if (k[0] == 'u') q.upper = to_double(k, v);
+          else { q.fixed = true; q.initial = to_double(k, v); }
+        }
+      if (!found) throw UsageError("--set " + k + ": '" + name + "' is not a --param");
+    } else return false;
+    return true;
+  });
+  Result<TransferFunction> r;
+  try {
+    const PhysicalModel model(a.model_expr, names);
+    if (a.via == "raw") {
+      double wa = 0;
+      bool unstable = false;
+      consume_sets(sets, [&](const std::string& k, const std::string& v) {
+        if (k == "a") wa = to_double(k, v);
+        else if (k == "unstable") unstable = to_int(k, v) != 0;
+        else return false;
+        return true;
+      });
+      if (unstable && !(wa > 0)) throw UsageError("the plant is declared unstable: give a window a > 0");
+      reject_unknown(sets, "physical (raw)", "a, unstable, max_iterations, tolerance, lower.NAME, upper.NAME, fix.NAME");
+      r = fit_physical_raw(model, ps, d, wa, po);
+    } else {
+      bool unstable = false;
+      const FsfOptions fo = fsf_options(sets, &unstable);
+      reject_unknown(sets, "physical", "T, n, a, b, unstable, max_iterations, tolerance, lower.NAME, upper.NAME, fix.NAME");
+      const Result<FsfModel> c = fsf(d, fo);
+      r = a.via == "frequency" ? fit_physical_frequency(model, ps, c.model, po) : fit_physical_step(model, ps, c.model, po);
+      for (const auto& w : c.diagnostics.warnings) r.diagnostics.warnings.push_back("fsf: " + w);
+    }
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+  return finish(r, "physical-" + a.via, d, a.json);
+}
+
 int run(const FitArgs& a) {
   check_output_path(a.json, {a.data.path}, a.force);
   if (!a.controller.empty()) return run_closed_loop(a);
@@ -269,6 +406,11 @@ int run(const FitArgs& a) {
       throw UsageError(e.what());
     }
     return finish(r, "srivc", d, a.json);
+  }
+  if (a.method == "fsf" || a.method == "physical") {
+    if (d.nu() != 1) throw UsageError(detail::format("{} needs one input (selected {})", a.method, d.nu()));
+    if (a.via != "fsf" && a.via != "frequency" && a.via != "raw") throw UsageError("--via must be fsf, frequency or raw");
+    return a.method == "fsf" ? run_fsf(a, d) : run_physical(a, d);
   }
   TfOrders orders = all[0];
   if (a.delay && (a.method == "lssvf" || a.method == "ivsvf" || a.method == "rls-svf"))
@@ -315,8 +457,8 @@ int run(const FitArgs& a) {
 void setup_fit(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
   app.add_option("DATA", a->data.path, "CSV/.dat table (header row optional) or .mat file")->required();
-  app.add_option("--method", a->method, "Estimator: srivc, tfest, oe, lssvf, ivsvf or rls-svf")
-      ->check(CLI::IsMember({"lssvf", "ivsvf", "rls-svf", "srivc", "oe", "tfest"}))
+  app.add_option("--method", a->method, "Estimator: srivc, tfest, oe, lssvf, ivsvf, rls-svf, fsf or physical")
+      ->check(CLI::IsMember({"lssvf", "ivsvf", "rls-svf", "srivc", "oe", "tfest", "fsf", "physical"}))
       ->capture_default_str();
   a->data.add_to(app, true);
   app.add_option("--nb", a->nb, "Number of numerator coefficients (default: nf); one per input with several inputs (1,2)")
@@ -329,7 +471,8 @@ void setup_fit(CLI::App& app) {
                  "Method setting KEY=VALUE (repeatable). lssvf/ivsvf: tau (s, 0 = automatic), alpha, transient (s), "
                  "weights=riemann|trapezoidal, fix.NAME=value (e.g. fix.a2=4); ivsvf also max_iterations, tolerance; "
                  "rls-svf: tau, p0, forgetting, alpha, regression_interval, fix.NAME; srivc: max_iterations, tolerance, "
-                 "delay (s), delay_min, delay_max, delay_grid; oe/tfest: the same plus fix.NAME, lower.NAME, upper.NAME");
+                 "delay (s), delay_min, delay_max, delay_grid; oe/tfest: the same plus fix.NAME, lower.NAME, upper.NAME; "
+                 "fsf/physical: T (s), n (odd), a, b, unstable=1; physical also lower.NAME, upper.NAME, fix.NAME");
   app.add_flag("--delay", a->delay,
                "Estimate a (non-integer) input delay (srivc, oe, tfest): grid search over [delay_min, delay_max], then "
                "refinement");
@@ -346,6 +489,12 @@ void setup_fit(CLI::App& app) {
   app.add_option("--u-im", a->u_im, "Input spectrum, imaginary part");
   app.add_option("--y-re", a->y_re, "Output spectrum, real part");
   app.add_option("--y-im", a->y_im, "Output spectrum, imaginary part");
+  app.add_option("--model", a->model_expr, "physical: transfer-function expression in s, e.g. \"k1/(s^2-k2)\"");
+  app.add_option("--param", a->params, "physical: NAME=INITIAL for each parameter of --model (repeatable)");
+  app.add_option("--via", a->via, "physical: fit to the FSF step response (fsf), the FSF frequency response (frequency), "
+                                  "or the raw data (raw)")
+      ->capture_default_str();
+  app.add_option("--responses", a->responses, "fsf: write PREFIX_time.csv (step, std, impulse) and PREFIX_freq.csv");
   app.add_option("--json", a->json, "Write the result (model, parameters, fit) to this JSON file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
   app.callback([a] { g_run = [a] { return run(*a); }; });

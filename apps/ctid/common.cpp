@@ -137,4 +137,21 @@ void print_any(const Result<M>& r, const std::string& method, const IdData& d) {
 void print_result(const Result<TransferFunction>& r, const std::string& method, const IdData& d) { print_any(r, method, d); }
 void print_result(const Result<MisoModel>& r, const std::string& method, const IdData& d) { print_any(r, method, d); }
 
+void print_result(const Result<FsfModel>& r, const std::string& method, const IdData& d) {
+  const FsfModel& f = r.model;
+  std::printf("method: %s   samples: %d   Ts = %g s   T = %g s (N = %d)   n = %d filters   window a = %g\n", method.c_str(),
+              d.size(), f.delta(), f.T(), f.N(), f.n(), f.shift());
+  std::printf("steady-state gain theta0 = %.6g +- %.3g   residual RMS %.4g   condition number %.3g\n", f.theta()(0),
+              r.parameters.std(0), r.diagnostics.scalars.count("residual_rms") ? r.diagnostics.scalars.at("residual_rms") : NAN,
+              r.diagnostics.condition_number);
+  std::printf("compressed step response%s:\n", f.shift() > 0 ? " (of the shifted system G(s + a))" : "");
+  for (int i = 0; i <= 10; ++i) {
+    const double t = f.T() * i / 10.0;
+    const Eigen::VectorXd tv{{t}};
+    std::printf("  t = %8.4g s   y = %10.5g +- %.3g\n", t, f.step_response(tv)(0), f.step_response_std(tv)(0));
+  }
+  std::printf("termination: %s   %.3g s\n", to_string(r.summary.termination), r.summary.seconds);
+  for (const auto& w : r.diagnostics.warnings) std::printf("warning: %s\n", w.c_str());
+}
+
 }  // namespace ctid::cli

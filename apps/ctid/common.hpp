@@ -58,6 +58,7 @@ int to_int(const std::string& key, const std::string& value);
 /// Print a result (model, parameters with std, fit, summary, warnings).
 void print_result(const Result<TransferFunction>& r, const std::string& method, const IdData& data);
 void print_result(const Result<MisoModel>& r, const std::string& method, const IdData& data);
+void print_result(const Result<FsfModel>& r, const std::string& method, const IdData& data);
 
 void setup_fit(CLI::App& app);
 void setup_simulate(CLI::App& app);

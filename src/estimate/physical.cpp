@@ -25,8 +25,11 @@ namespace {
 using ResidualFn = std::function<void(const TransferFunction& g, const std::vector<TransferFunction>* sens,
                                       Eigen::VectorXd& r, Eigen::MatrixXd* J)>;
 
+// target: the data the residuals are measured against (for the fit report).
 Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<PhysicalParameter>& params, double a,
-                             const PhysicalFitOptions& opt, const ResidualFn& residual, int n_data, const char* route) {
+                             const PhysicalFitOptions& opt, const ResidualFn& residual, const Eigen::VectorXd& target,
+                             const char* route) {
+  const int n_data = static_cast<int>(target.size());
   const auto start = std::chrono::steady_clock::now();
   opt.validate();
   const int P = model.n_parameters();
@@ -112,9 +115,11 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
       for (int j = 0; j < p; ++j) res.parameters.covariance(free[i], free[j]) = C(i, j);
     res.parameters.std = res.parameters.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
   }
-  res.fit.n_samples = n_data;
-  res.fit.n_parameters = p;
-  res.fit.mse = 2.0 * lm.cost / n_data;
+  {
+    Eigen::VectorXd r;
+    if (std::isfinite(lm.cost) && evaluate(lm.x, r, nullptr)) res.fit = fit_report_or_inf(target, target + r, p);
+    else res.fit = fit_report_or_inf(target, Eigen::VectorXd::Constant(n_data, NAN), p);
+  }
   res.diagnostics.scalars["shift_a"] = a;
   res.diagnostics.scalars["cost"] = lm.cost;
   res.diagnostics.vectors["cost_history"] = Eigen::Map<Eigen::VectorXd>(history.data(), static_cast<Eigen::Index>(history.size()));
@@ -147,7 +152,7 @@ Result<TransferFunction> fit_physical_step(const PhysicalModel& model, const std
       for (std::size_t j = 0; j < sens->size(); ++j) J->col(static_cast<Eigen::Index>(j)) = step_response((*sens)[j], t);
     }
   };
-  return fit(model, params, fsf.shift(), opt, res, static_cast<int>(t.size()), "step");
+  return fit(model, params, fsf.shift(), opt, res, target, "step");
 }
 
 Result<TransferFunction> fit_physical_frequency(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
@@ -172,7 +177,9 @@ Result<TransferFunction> fit_physical_frequency(const PhysicalModel& model, cons
       }
     }
   };
-  return fit(model, params, fsf.shift(), opt, res, 2 * (m + 1), "frequency");
+  Eigen::VectorXd stacked(2 * (m + 1));
+  stacked << target.real(), target.imag();
+  return fit(model, params, fsf.shift(), opt, res, stacked, "frequency");
 }
 
 namespace {
@@ -223,7 +230,7 @@ Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std:
       for (std::size_t j = 0; j < sens->size(); ++j) J->col(static_cast<Eigen::Index>(j)) = simulate((*sens)[j]);
     }
   };
-  return fit(model, params, a, opt, res, data.size(), "raw");
+  return fit(model, params, a, opt, res, y, "raw");
 }
 
 }  // namespace ctid

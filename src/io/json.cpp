@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include <nlohmann/json.hpp>
 
@@ -133,12 +134,19 @@ void write_model_json(const std::string& path, const LinearModel& m) {
 }
 
 namespace {
+json fsf_json(const FsfModel& f) {
+  return {{"type", "fsf"}, {"delta", f.delta()}, {"N", f.N()}, {"n", f.n()}, {"shift", f.shift()}, {"theta", vec(f.theta())}};
+}
+}  // namespace
+
+namespace {
 template <class M>
 std::string result_json(const Result<M>& r, const std::string& method, int indent) {
   json j;
   j["ctid_version"] = version();
   j["method"] = method;
-  j["model"] = model_json(LinearModel(r.model));
+  if constexpr (std::is_same_v<M, FsfModel>) j["model"] = fsf_json(r.model);
+  else j["model"] = model_json(LinearModel(r.model));
   json params = json::array();
   for (int i = 0; i < r.parameters.size(); ++i)
     params.push_back({{"name", r.parameters.names[i]},
@@ -175,6 +183,12 @@ std::string result_to_json(const Result<MisoModel>& r, const std::string& method
   return result_json(r, method, indent);
 }
 void write_result_json(const std::string& path, const Result<MisoModel>& r, const std::string& method) {
+  write_text_file(path, result_to_json(r, method) + "\n");
+}
+std::string result_to_json(const Result<FsfModel>& r, const std::string& method, int indent) {
+  return result_json(r, method, indent);
+}
+void write_result_json(const std::string& path, const Result<FsfModel>& r, const std::string& method) {
   write_text_file(path, result_to_json(r, method) + "\n");
 }
 

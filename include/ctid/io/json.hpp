@@ -12,6 +12,7 @@
 #include <variant>
 
 #include "ctid/core/types.hpp"
+#include "ctid/model/fsf.hpp"
 #include "ctid/model/miso.hpp"
 #include "ctid/model/state_space.hpp"
 #include "ctid/model/transfer_function.hpp"
@@ -36,5 +37,8 @@ Result<TransferFunction> parse_result_json(const std::string& text, const std::s
 void write_result_json(const std::string& path, const Result<TransferFunction>& result, const std::string& method);
 std::string result_to_json(const Result<MisoModel>& result, const std::string& method, int indent = 2);
 void write_result_json(const std::string& path, const Result<MisoModel>& result, const std::string& method);
+/// FSF results: model {"type": "fsf", "delta", "N", "n", "shift", "theta": [...]} (real parameterisation).
+std::string result_to_json(const Result<FsfModel>& result, const std::string& method, int indent = 2);
+void write_result_json(const std::string& path, const Result<FsfModel>& result, const std::string& method);
 
 }  // namespace ctid
