@@ -4,7 +4,9 @@
 #include <complex>
 #include <cstdlib>
 #include <unistd.h>
+#include <exception>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include <Eigen/Dense>
@@ -40,6 +42,16 @@ inline std::string temp_path(const std::string& name) {
   const auto dir = std::filesystem::temp_directory_path() / ("ctid_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   return (dir / name).string();
+}
+
+/// The message of the exception f throws ("" when it throws none).
+inline std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
 }
 
 inline bool shared_data_available() { return std::filesystem::exists(CTID_SHARED_DATA_DIR); }

@@ -11,18 +11,12 @@
 #include "ctid/estimate/physical.hpp"
 #include "ctid/model/state_space.hpp"
 #include "ctid/simulate/lsim.hpp"
+#include "test_util.hpp"
 
 using namespace ctid;
+using test::error_of;
 
 namespace {
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "";
-}
 
 // Unstable circuit stand-in: 1/(s^2 - 1) under digital PD (SEEDS-SPEC GW.3).
 IdData circuit(double noise_sd, std::uint64_t seed) {

@@ -13,6 +13,7 @@
 #include "test_util.hpp"
 
 using namespace ctid;
+using test::error_of;
 namespace fs = std::filesystem;
 
 namespace {
@@ -20,14 +21,6 @@ std::string write_text(const std::string& name, const std::string& text) {
   const std::string p = test::temp_path(name);
   std::ofstream(p) << text;
   return p;
-}
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "";
 }
 }  // namespace
 
