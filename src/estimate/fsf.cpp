@@ -141,6 +141,98 @@ Result<FsfModel> fsf(const IdData& data, const FsfOptions& o) {
   return r;
 }
 
+Eigen::VectorXcd one_sided_dft(const Eigen::VectorXd& x, int L) {
+  CTID_REQUIRE(L >= 2 && L % 2 == 0 && L >= x.size(), "one_sided_dft: L = {} must be even and >= the length {}", L, x.size());
+  std::vector<double> in(L, 0.0);
+  for (Eigen::Index i = 0; i < x.size(); ++i) in[i] = x(i);
+  std::vector<cd> out;
+  Eigen::FFT<double> fft;
+  fft.fwd(out, in);
+  Eigen::VectorXcd r(L / 2 + 1);
+  for (int k = 0; k <= L / 2; ++k) r(k) = out[k];
+  return r;
+}
+
+Result<FsfModel> fsf_from_spectra(const Eigen::VectorXcd& Uin, const Eigen::VectorXcd& Yin, int L, double Ts,
+                                  const FsfOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
+  o.validate();
+  CTID_REQUIRE_OPTION(o.b == 0.0, "fsf_from_spectra: b must be 0 in the frequency domain (got {})", o.b);
+  CTID_REQUIRE(std::isfinite(Ts) && Ts > 0, "fsf_from_spectra: the sampling period must be > 0 (got {})", Ts);
+  CTID_REQUIRE(L >= 2 && L % 2 == 0, "fsf_from_spectra: the DFT length L must be even (got {})", L);
+  CTID_REQUIRE(Uin.size() == L / 2 + 1 && Yin.size() == L / 2 + 1,
+               "fsf_from_spectra: one-sided spectra of length L/2 + 1 = {} expected (U has {}, Y has {})", L / 2 + 1,
+               Uin.size(), Yin.size());
+  const double Nd = o.T / Ts;
+  const int N = static_cast<int>(std::lround(Nd));
+  CTID_REQUIRE(std::abs(Nd - N) <= 1e-9 * std::max(1.0, Nd), "fsf_from_spectra: T = {} s is not a whole multiple of Ts = {} s",
+               o.T, Ts);
+  CTID_REQUIRE(o.n <= N && N <= L, "fsf_from_spectra: need n <= N <= L (n = {}, N = {}, L = {})", o.n, N, L);
+  Eigen::VectorXcd U = Uin, Y = Yin;
+  if (o.a > 0) {
+    // Window in the time domain: inverse FFT of the padded records, e^{-a t}, FFT (GW 28-29).
+    Eigen::FFT<double> fft;
+    auto window = [&](Eigen::VectorXcd& X) {
+      std::vector<cd> full(L);
+      for (int k = 0; k <= L / 2; ++k) full[k] = X(k);
+      for (int k = 1; k < L / 2; ++k) full[L - k] = std::conj(X(k));
+      std::vector<double> x;
+      fft.inv(x, full);
+      for (int i = 0; i < L; ++i) x[i] *= std::exp(-o.a * i * Ts);
+      std::vector<cd> back;
+      fft.fwd(back, x);
+      for (int k = 0; k <= L / 2; ++k) X(k) = back[k];
+    };
+    window(U);
+    window(Y);
+  }
+  const int m = (o.n - 1) / 2, p = o.n;
+  const FsfModel unit(Ts, N, o.n, Eigen::VectorXd::Zero(o.n));  // only for filter_response
+  internal::StreamingLeastSquares ls(p);
+  std::vector<double> re(p), im(p);
+  for (int i = 0; i <= L / 2; ++i) {
+    const double w = 2.0 * std::numbers::pi * i / (L * Ts);
+    const double weight = (i == 0 || i == L / 2) ? 1.0 : 2.0;
+    // Column for theta_0: H_0 U; Re theta_k: (H_k + H_-k) U; Im theta_k: j (H_k - H_-k) U.
+    const cd c0 = unit.filter_response(0, w) * U(i);
+    re[0] = c0.real();
+    im[0] = c0.imag();
+    for (int k = 1; k <= m; ++k) {
+      const cd hp = unit.filter_response(k, w), hm = unit.filter_response(-k, w);
+      const cd cr = (hp + hm) * U(i), ci = cd(0, 1) * (hp - hm) * U(i);
+      re[2 * k - 1] = cr.real();
+      im[2 * k - 1] = cr.imag();
+      re[2 * k] = ci.real();
+      im[2 * k] = ci.imag();
+    }
+    ls.add(re.data(), Y(i).real(), weight);
+    ls.add(im.data(), Y(i).imag(), weight);
+  }
+  const internal::LinearSolution sol = ls.solve();
+  Result<FsfModel> r;
+  r.model = FsfModel(Ts, N, o.n, sol.theta, sol.covariance, o.a);
+  r.parameters.names.push_back("theta0");
+  for (int k = 1; k <= m; ++k) {
+    r.parameters.names.push_back("re_theta" + std::to_string(k));
+    r.parameters.names.push_back("im_theta" + std::to_string(k));
+  }
+  r.parameters.values = sol.theta;
+  r.parameters.covariance = sol.covariance;
+  r.parameters.std = sol.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  r.parameters.fixed.assign(p, false);
+  r.diagnostics.condition_number = sol.condition;
+  r.diagnostics.scalars["N"] = N;
+  r.diagnostics.scalars["a"] = o.a;
+  if (sol.rank_deficient) {
+    r.summary.termination = Termination::RankDeficient;
+    r.summary.message = "the frequency-domain FSF regressor is rank deficient: the input spectrum does not cover the filter "
+                        "frequencies";
+  }
+  r.summary.iterations = 1;
+  r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
 double fsf_settling_time(const TransferFunction& g, double a, double tol, double t_max) {
   CTID_REQUIRE(std::isfinite(a) && a >= 0, "fsf_settling_time: a must be >= 0 (got {})", a);
   // Poles of G(s + a) are p - a; the envelope of the impulse response decays with the slowest one.

@@ -35,6 +35,18 @@ struct FsfOptions {
 /// FSF model against the windowed output.
 Result<FsfModel> fsf(const IdData& data, const FsfOptions& options);
 
+/// Stage 1 from spectra (GW 24-29, SEEDS-SPEC GW-A4): U and Y are the one-sided DFTs (bins
+/// 0..L/2, L even) of input and output records of M samples at Ts, zero-padded to L >= M + N so
+/// that linear and circular convolution coincide. The window a is applied as inverse FFT ->
+/// e^{-at} -> FFT (the paper's recommendation); b must be 0 (the authors define no frequency-
+/// domain weighting). Solves Y(w_i) = sum_k theta_k Hbar_k(e^{j w_i Ts}) U(w_i) over all bins
+/// (real and imaginary parts, interior bins counted twice for the two-sided sum). Throws
+/// InvalidArgument for inconsistent sizes or L < N.
+Result<FsfModel> fsf_from_spectra(const Eigen::VectorXcd& U, const Eigen::VectorXcd& Y, int L, double Ts,
+                                  const FsfOptions& options);
+/// One-sided DFT (bins 0..L/2) of x zero-padded to length L (L even, L >= x.size()).
+Eigen::VectorXcd one_sided_dft(const Eigen::VectorXd& x, int L);
+
 /// Helper for T: the time after which the impulse response of g (shifted by a: g(s + a))
 /// stays below `tolerance` times its peak (searched up to `t_max`).
 double fsf_settling_time(const class TransferFunction& g, double a = 0.0, double tolerance = 1e-3, double t_max = 1e4);
