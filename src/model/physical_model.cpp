@@ -207,7 +207,9 @@ Ratio eval(const Node& n, const Eigen::VectorXd& theta) {
 }  // namespace
 
 struct PhysicalModel::Compiled {
-  std::unique_ptr<Node> root;
+  std::unique_ptr<Node> root;  // transfer-function expression form
+  // State-space forms: entries (expression form) or a callable; both give values + gradients.
+  std::function<StateSpaceWithGradient(const Eigen::VectorXd&)> ss;
 };
 
 PhysicalModel::PhysicalModel(const std::string& expression, std::vector<std::string> parameters)
@@ -220,6 +222,83 @@ PhysicalModel::PhysicalModel(const std::string& expression, std::vector<std::str
   auto c = std::make_shared<Compiled>();
   c->root = Parser(expr_, &names_, nullptr).parse();
   c_ = c;
+}
+
+namespace {
+// Scalar value and gradient of an expression without s.
+Dual scalar(const Node& root, const std::string& text, const Eigen::VectorXd& theta) {
+  const Ratio r = eval(root, theta);
+  auto deg = [](const DPoly& p) {
+    int d = static_cast<int>(p.size()) - 1;
+    while (d > 0 && p[d].v == 0.0) --d;
+    return d;
+  };
+  CTID_REQUIRE(deg(r.num) == 0 && deg(r.den) == 0, "state-space entry \"{}\": entries must not contain s", text);
+  const Dual n = r.num[0], d = r.den[0];
+  CTID_REQUIRE(d.v != 0.0, "state-space entry \"{}\": division by zero for these parameter values", text);
+  return {n.v / d.v, (n.g * d.v - n.v * d.g) / (d.v * d.v)};
+}
+}  // namespace
+
+PhysicalModel PhysicalModel::from_state_space(const std::vector<std::vector<std::string>>& A,
+                                              const std::vector<std::vector<std::string>>& B,
+                                              const std::vector<std::vector<std::string>>& C,
+                                              const std::vector<std::vector<std::string>>& D, std::vector<std::string> names) {
+  struct Entries {
+    std::vector<std::vector<std::shared_ptr<Node>>> n;
+    std::vector<std::vector<std::string>> text;
+    Eigen::Index rows = 0, cols = 0;
+  };
+  auto parse = [&](const std::vector<std::vector<std::string>>& M, const char* which) {
+    Entries e;
+    e.rows = static_cast<Eigen::Index>(M.size());
+    e.cols = M.empty() ? 0 : static_cast<Eigen::Index>(M[0].size());
+    for (std::size_t i = 0; i < M.size(); ++i) {
+      CTID_REQUIRE(static_cast<Eigen::Index>(M[i].size()) == e.cols, "PhysicalModel: row {} of {} has {} entries ({} expected)",
+                   i + 1, which, M[i].size(), e.cols);
+      e.n.emplace_back();
+      for (const auto& t : M[i]) e.n.back().push_back(std::shared_ptr<Node>(Parser(t, &names, nullptr).parse().release()));
+    }
+    e.text = M;
+    return e;
+  };
+  auto eA = parse(A, "A"), eB = parse(B, "B"), eC = parse(C, "C"), eD = parse(D, "D");
+  CTID_REQUIRE(eA.rows == eA.cols && eA.rows >= 1, "PhysicalModel: A must be square and non-empty (got {}x{})", eA.rows,
+               eA.cols);
+  CTID_REQUIRE(eB.rows == eA.rows && eB.cols == 1, "PhysicalModel: B must be {}x1 (got {}x{})", eA.rows, eB.rows, eB.cols);
+  CTID_REQUIRE(eC.rows == 1 && eC.cols == eA.rows, "PhysicalModel: C must be 1x{} (got {}x{})", eA.rows, eC.rows, eC.cols);
+  CTID_REQUIRE(eD.rows == 1 && eD.cols == 1, "PhysicalModel: D must be 1x1 (got {}x{})", eD.rows, eD.cols);
+  const auto P = static_cast<Eigen::Index>(names.size());
+  auto fn = [eA, eB, eC, eD, P](const Eigen::VectorXd& theta) {
+    auto value = [&](const Entries& e, std::vector<Eigen::MatrixXd>& d) {
+      Eigen::MatrixXd v(e.rows, e.cols);
+      d.assign(static_cast<std::size_t>(P), Eigen::MatrixXd(e.rows, e.cols));
+      for (Eigen::Index i = 0; i < e.rows; ++i)
+        for (Eigen::Index j = 0; j < e.cols; ++j) {
+          const Dual x = scalar(*e.n[i][j], e.text[i][j], theta);
+          v(i, j) = x.v;
+          for (Eigen::Index k = 0; k < P; ++k) d[k](i, j) = x.g(k);
+        }
+      return v;
+    };
+    std::vector<Eigen::MatrixXd> dA, dB, dC, dD;
+    StateSpaceWithGradient out{StateSpace(value(eA, dA), value(eB, dB), value(eC, dC), value(eD, dD)), {}};
+    for (Eigen::Index k = 0; k < P; ++k) out.derivatives.emplace_back(dA[k], dB[k], dC[k], dD[k]);
+    return out;
+  };
+  return from_callable(fn, std::move(names), "state space");
+}
+
+PhysicalModel PhysicalModel::from_callable(std::function<StateSpaceWithGradient(const Eigen::VectorXd&)> model,
+                                           std::vector<std::string> names, std::string description) {
+  CTID_REQUIRE(static_cast<bool>(model), "PhysicalModel: the callable is empty");
+  PhysicalModel m;
+  m.expr_ = std::move(description);
+  m.names_ = std::move(names);
+  auto c = std::make_shared<Compiled>();
+  c->ss = std::move(model);
+  m.c_ = c;
+  return m;
 }
 
 std::vector<std::string> PhysicalModel::symbols(const std::string& expression) {
@@ -271,10 +350,29 @@ void expand(const Node& root, const std::string& expr, const Eigen::VectorXd& th
 }
 }  // namespace
 
+namespace {
+StateSpaceWithGradient checked_state_space(const std::function<StateSpaceWithGradient(const Eigen::VectorXd&)>& f,
+                                           const Eigen::VectorXd& theta) {
+  StateSpaceWithGradient g = f(theta);
+  CTID_REQUIRE(g.model.nu() == 1 && g.model.ny() == 1, "PhysicalModel: the state-space model must be single-input "
+                                                       "single-output (has {} inputs, {} outputs)",
+               g.model.nu(), g.model.ny());
+  CTID_REQUIRE(static_cast<Eigen::Index>(g.derivatives.size()) == theta.size(),
+               "PhysicalModel: {} derivative models for {} parameters", g.derivatives.size(), theta.size());
+  for (const auto& d : g.derivatives)
+    CTID_REQUIRE(d.nx() == g.model.nx() && d.nu() == 1 && d.ny() == 1, "PhysicalModel: a derivative model has the wrong size");
+  return g;
+}
+StateSpace shift_ss(const StateSpace& m, double a) {
+  return StateSpace(m.A() - a * Eigen::MatrixXd::Identity(m.nx(), m.nx()), m.B(), m.C(), m.D());
+}
+}  // namespace
+
 TransferFunction PhysicalModel::shifted(const Eigen::VectorXd& theta, double a) const {
   CTID_REQUIRE(theta.size() == n_parameters(), "PhysicalModel: {} parameter values for {} parameters", theta.size(),
                n_parameters());
   CTID_REQUIRE(theta.allFinite(), "PhysicalModel: parameter values must be finite");
+  if (c_->ss) return shift_ss(checked_state_space(c_->ss, theta).model, a).to_transfer_function();
   Eigen::VectorXd num, den;
   Eigen::MatrixXd dn, dd;
   expand(*c_->root, expr_, theta, a, num, den, dn, dd);
@@ -286,6 +384,24 @@ TransferFunction PhysicalModel::transfer_function(const Eigen::VectorXd& theta) 
 std::vector<TransferFunction> PhysicalModel::sensitivities(const Eigen::VectorXd& theta, double a) const {
   CTID_REQUIRE(theta.size() == n_parameters(), "PhysicalModel: {} parameter values for {} parameters", theta.size(),
                n_parameters());
+  if (c_->ss) {
+    // Sensitivity equations as one linear system per parameter (A already shifted by -aI):
+    // [x; dx] with x' = A x + B u, dx' = dA x + A dx + dB u, dy = dC x + C dx + dD u.
+    const StateSpaceWithGradient g = checked_state_space(c_->ss, theta);
+    const StateSpace m = shift_ss(g.model, a);
+    const Eigen::Index n = m.nx();
+    std::vector<TransferFunction> out;
+    for (const auto& d : g.derivatives) {
+      Eigen::MatrixXd A2 = Eigen::MatrixXd::Zero(2 * n, 2 * n), B2(2 * n, 1), C2(1, 2 * n);
+      A2.topLeftCorner(n, n) = m.A();
+      A2.bottomLeftCorner(n, n) = d.A();
+      A2.bottomRightCorner(n, n) = m.A();
+      B2 << m.B(), d.B();
+      C2 << d.C(), m.C();
+      out.push_back(StateSpace(A2, B2, C2, d.D()).to_transfer_function());
+    }
+    return out;
+  }
   Eigen::VectorXd num, den;
   Eigen::MatrixXd dn, dd;
   expand(*c_->root, expr_, theta, a, num, den, dn, dd);

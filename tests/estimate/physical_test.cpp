@@ -84,6 +84,48 @@ TEST(PhysicalModel, SensitivitiesMatchFiniteDifferences) {
   }
 }
 
+TEST(PhysicalModel, StateSpaceAndCallableFormsMatchTheTransferFunctionForm) {
+  // Mass-spring-damper x'' = (f - d x' - k x)/m written three ways; the shifted transfer functions
+  // and the sensitivities (sensitivity equations for the state-space forms) agree to 1e-9.
+  const PhysicalModel tf("1/(m*s^2 + d*s + k)", {"m", "d", "k"});
+  const PhysicalModel ss = PhysicalModel::from_state_space({{"0", "1"}, {"-k/m", "-d/m"}}, {{"0"}, {"1/m"}}, {{"1", "0"}},
+                                                           {{"0"}}, {"m", "d", "k"});
+  const PhysicalModel cb = PhysicalModel::from_callable(
+      [](const Eigen::VectorXd& p) {
+        const double m = p(0), d = p(1), k = p(2);
+        StateSpaceWithGradient g{StateSpace(Eigen::MatrixXd{{0, 1}, {-k / m, -d / m}}, Eigen::MatrixXd{{0}, {1 / m}},
+                                            Eigen::MatrixXd{{1, 0}}, Eigen::MatrixXd{{0}}),
+                                 {}};
+        const Eigen::MatrixXd Zb = Eigen::MatrixXd::Zero(2, 1);
+        const Eigen::MatrixXd Zc = Eigen::MatrixXd::Zero(1, 2), Zd = Eigen::MatrixXd::Zero(1, 1);
+        g.derivatives.emplace_back(Eigen::MatrixXd{{0, 0}, {k / (m * m), d / (m * m)}}, Eigen::MatrixXd{{0}, {-1 / (m * m)}}, Zc, Zd);
+        g.derivatives.emplace_back(Eigen::MatrixXd{{0, 0}, {0, -1 / m}}, Zb, Zc, Zd);
+        g.derivatives.emplace_back(Eigen::MatrixXd{{0, 0}, {-1 / m, 0}}, Zb, Zc, Zd);
+        return g;
+      },
+      {"m", "d", "k"});
+  const Eigen::VectorXd th{{2.0, 0.6, 3.0}}, w{{0.2, 1.1, 5.0}};
+  for (double a : {0.0, 1.0}) {
+    const Eigen::VectorXcd ref = tf.shifted(th, a).frequency_response(w);
+    const auto sref = tf.sensitivities(th, a);
+    for (const PhysicalModel* m : {&ss, &cb}) {
+      EXPECT_LT((m->shifted(th, a).frequency_response(w) - ref).norm(), 1e-9 * ref.norm()) << a;
+      const auto sens = m->sensitivities(th, a);
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::VectorXcd r = sref[k].frequency_response(w);
+        EXPECT_LT((sens[k].frequency_response(w) - r).norm(), 1e-9 * r.norm()) << k;
+      }
+    }
+  }
+  EXPECT_NE(error_of([] { PhysicalModel::from_state_space({{"s"}}, {{"1"}}, {{"1"}}, {{"0"}}, {}).transfer_function(Eigen::VectorXd(0)); })
+                .find("must not contain s"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { PhysicalModel::from_state_space({{"0", "1"}}, {{"1"}}, {{"1"}}, {{"0"}}, {}); }).find("square"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { PhysicalModel::from_state_space({{"q"}}, {{"1"}}, {{"1"}}, {{"0"}}, {"k"}); }).find("unknown symbol 'q'"),
+            std::string::npos);
+}
+
 TEST(GawthropWang, UnstableCircuitTwoStageReachesThePhysicalParameters) {
   // SEEDS-SPEC GW.3: a = 2, b = 0, T = 8 s, LM from (2, 0). The spec's verified noise-free results:
   // (0.973, 1.040) for n = 11 and (0.987, 1.013) for n = 21 — reproduced here to 1e-3; the issue's
@@ -107,6 +149,14 @@ TEST(GawthropWang, UnstableCircuitTwoStageReachesThePhysicalParameters) {
   }
   const auto raw = fit_physical_raw(m, start, d, 2.0);
   EXPECT_LT((raw.parameters.values.array() - 1.0).abs().maxCoeff(), 1e-6);
+  // The same plant as a state-space structure gives the same two-stage estimate.
+  const PhysicalModel ms = PhysicalModel::from_state_space({{"0", "1"}, {"k2", "0"}}, {{"0"}, {"k1"}}, {{"1", "0"}}, {{"0"}},
+                                                           {"k1", "k2"});
+  const auto c21 = fsf(d, {.T = 8.0, .n = 21, .a = 2.0});
+  EXPECT_LT((fit_physical_step(ms, start, c21.model).parameters.values - fit_physical_step(m, start, c21.model).parameters.values)
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-6);
   // With output noise (sigma = 0.05), ten seeds: mean within 5 % of (1, 1) (spec: 0.971, 1.026).
   Eigen::VectorXd mean = Eigen::VectorXd::Zero(2);
   for (int s = 1; s <= 10; ++s)

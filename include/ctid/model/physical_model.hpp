@@ -7,18 +7,29 @@
 //          primary := number | name | "(" expr ")".  The name `s` is the Laplace variable.
 // The expression is expanded once into N(s; Theta)/D(s; Theta) with coefficients carried
 // as values plus exact gradients with respect to Theta (forward automatic differentiation),
-// so transfer_function() and its parameter derivatives are exact.
+// so transfer_function() and its parameter derivatives are exact. State-space forms (entries
+// that are expressions, or a C++ callable with its derivatives) give the sensitivities through
+// the sensitivity equations d/dt dx/dTheta_k = A dx/dTheta_k + dA/dTheta_k x + dB/dTheta_k u,
+// realised as one linear system per parameter (SISO: input 0 to output 0).
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include <Eigen/Dense>
 
+#include "ctid/model/state_space.hpp"
 #include "ctid/model/transfer_function.hpp"
 
 namespace ctid {
+
+/// A state-space model and its derivatives with respect to each parameter (same sizes).
+struct StateSpaceWithGradient {
+  StateSpace model;
+  std::vector<StateSpace> derivatives;  ///< d(A, B, C, D)/dTheta_k, one per parameter
+};
 
 class PhysicalModel {
  public:
@@ -26,6 +37,16 @@ class PhysicalModel {
   /// Theta). Throws InvalidArgument with the column (1-based) of a syntax error or an unknown
   /// symbol, and for an expression that is not a proper rational function of s.
   PhysicalModel(const std::string& expression, std::vector<std::string> parameters);
+  /// A state-space structure whose entries are expressions of the parameters (no s), given
+  /// row by row, e.g. A = {{"0", "1"}, {"-k/m", "-d/m"}}, B = {{"0"}, {"1/m"}}, C = {{"1", "0"}},
+  /// D = {{"0"}}. Throws InvalidArgument (with the entry and column) for bad entries or sizes.
+  static PhysicalModel from_state_space(const std::vector<std::vector<std::string>>& A,
+                                        const std::vector<std::vector<std::string>>& B,
+                                        const std::vector<std::vector<std::string>>& C,
+                                        const std::vector<std::vector<std::string>>& D, std::vector<std::string> parameters);
+  /// A C++ callable Theta -> state space together with its exact parameter derivatives.
+  static PhysicalModel from_callable(std::function<StateSpaceWithGradient(const Eigen::VectorXd&)> model,
+                                     std::vector<std::string> parameters, std::string description = "callable");
   /// Names of the symbols used in an expression (other than s), in order of appearance;
   /// throws InvalidArgument on a syntax error.
   static std::vector<std::string> symbols(const std::string& expression);
@@ -37,12 +58,14 @@ class PhysicalModel {
   /// G(s; Theta). Throws InvalidArgument when Theta has the wrong size, is not finite, or
   /// makes the denominator vanish.
   TransferFunction transfer_function(const Eigen::VectorXd& theta) const;
-  /// G(s + a; Theta) (the exponentially shifted model of Gawthrop & Wang's unstable case).
+  /// G(s + a; Theta) (the exponentially shifted model of Gawthrop & Wang's unstable case:
+  /// A -> A - aI for state-space forms).
   TransferFunction shifted(const Eigen::VectorXd& theta, double a) const;
   /// dG/dTheta_k(s + a) = (N_k D - N D_k)/D^2, one transfer function per parameter.
   std::vector<TransferFunction> sensitivities(const Eigen::VectorXd& theta, double a = 0.0) const;
 
  private:
+  PhysicalModel() = default;
   struct Compiled;
   std::string expr_;
   std::vector<std::string> names_;
