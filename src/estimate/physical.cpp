@@ -125,6 +125,16 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
   res.diagnostics.vectors["cost_history"] = Eigen::Map<Eigen::VectorXd>(history.data(), static_cast<Eigen::Index>(history.size()));
   res.diagnostics.warnings.push_back(detail::format(
       "{} route: parameter standard deviations assume independent residuals; they are indicative", route));
+  // The window must make G(s + a) stable: a > max Re(poles) of the fitted plant (GW-A2 step 1).
+  const Eigen::VectorXcd poles = res.model.poles();
+  double slowest = -INFINITY;
+  for (Eigen::Index i = 0; i < poles.size(); ++i) slowest = std::max(slowest, poles(i).real());
+  res.diagnostics.scalars["max_pole_real_part"] = slowest;
+  if (poles.size() > 0 && !(a > slowest))
+    res.diagnostics.warnings.push_back(detail::format(
+        "the window a = {} does not exceed the largest real part of the fitted plant's poles ({}): G(s + a) is not "
+        "stable and the compressed response is not meaningful; increase a",
+        a, slowest));
   res.summary.iterations = lm.iterations;
   if (!std::isfinite(lm.cost)) {
     res.summary.termination = Termination::NumericalFailure;

@@ -343,7 +343,7 @@ void expand(const Node& root, const std::string& expr, const Eigen::VectorXd& th
   dden.resize(dd + 1, P);
   auto divide = [&](const Dual& c, double& v, Eigen::MatrixXd& g, int row) {
     v = c.v / lead.v;
-    g.row(row) = ((c.g * lead.v - c.v * lead.g) / (lead.v * lead.v)).transpose();
+    if (g.cols() > 0) g.row(row) = ((c.g * lead.v - c.v * lead.g) / (lead.v * lead.v)).transpose();  // no parameters: no gradient
   };
   for (int i = 0; i <= dn; ++i) divide(r.num[dn - i], num(i), dnum, i);
   for (int i = 0; i <= dd; ++i) divide(r.den[dd - i], den(i), dden, i);

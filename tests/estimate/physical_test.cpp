@@ -149,6 +149,9 @@ TEST(GawthropWang, UnstableCircuitTwoStageReachesThePhysicalParameters) {
   }
   const auto raw = fit_physical_raw(m, start, d, 2.0);
   EXPECT_LT((raw.parameters.values.array() - 1.0).abs().maxCoeff(), 1e-6);
+  EXPECT_NEAR(raw.diagnostics.scalars.at("max_pole_real_part"), 1.0, 1e-6);  // poles +-1 < a = 2: no window warning
+  for (const auto& w : raw.diagnostics.warnings) EXPECT_EQ(w.find("does not exceed"), std::string::npos) << w;
+
   // The same plant as a state-space structure gives the same two-stage estimate.
   const PhysicalModel ms = PhysicalModel::from_state_space({{"0", "1"}, {"k2", "0"}}, {{"0"}, {"k1"}}, {{"1", "0"}}, {{"0"}},
                                                            {"k1", "k2"});
@@ -198,6 +201,11 @@ TEST(GawthropWang, BallAndBeamWithinOnePercentAndBPositiveDegrades) {
   ASSERT_FALSE(c9.diagnostics.warnings.empty());
   const auto r9 = fit_physical_step(m, {{"K", 1.0}}, c9.model);
   EXPECT_GT(std::abs(r9.parameters.value("K") - 2.5), 0.25);  // spec: K ~ 0.57 with b = 0.9
+  // Without a window (a = 0) the double integrator's poles at 0 are not covered: warned about.
+  const auto r_nowin = fit_physical_step(m, {{"K", 1.0}}, fsf(data, {.T = 10.0, .n = 21}).model);
+  bool warned = false;
+  for (const auto& w : r_nowin.diagnostics.warnings) warned = warned || w.find("does not exceed") != std::string::npos;
+  EXPECT_TRUE(warned);
 }
 
 TEST(GawthropWang, BadParameterSets) {
