@@ -255,19 +255,22 @@ FsfOptions fsf_options(std::map<std::string, std::string>& sets, bool* unstable)
 
 void write_fsf_responses(const std::string& prefix, const FsfModel& f) {
   const int K = 501;
-  Eigen::MatrixXd tm(K, 4);
+  Eigen::MatrixXd tm(K, 5);
   for (int i = 0; i < K; ++i) {
     const Eigen::VectorXd t{{f.T() * i / (K - 1)}};
-    tm.row(i) << t(0), f.step_response(t)(0), f.step_response_std(t)(0), f.impulse_response(t)(0);
+    tm.row(i) << t(0), f.step_response(t)(0), f.step_response_std(t)(0), f.impulse_response(t)(0),
+        f.impulse_response_std(t)(0);
   }
-  write_csv(prefix + "_time.csv", {"t", "step", "step_std", "impulse"}, tm);
+  write_csv(prefix + "_time.csv", {"t", "step", "step_std", "impulse", "impulse_std"}, tm);
   Eigen::VectorXd w(200);
   const double wmax = std::min(3.14159 / f.delta(), 10.0 * f.m() * f.omega() + f.omega());
   for (int i = 0; i < 200; ++i) w(i) = f.omega() * 0.01 * std::pow(wmax / (0.01 * f.omega()), i / 199.0);
-  const Eigen::VectorXcd g = f.frequency_response(w);
-  Eigen::MatrixXd fm(200, 5);
-  for (int i = 0; i < 200; ++i) fm.row(i) << w(i), g(i).real(), g(i).imag(), std::abs(g(i)), std::arg(g(i)) * 180.0 / 3.14159265358979;
-  write_csv(prefix + "_freq.csv", {"w", "re", "im", "mag", "phase_deg"}, fm);
+  const Eigen::VectorXcd g = f.frequency_response(w), gs = f.frequency_response_std(w);
+  Eigen::MatrixXd fm(200, 7);
+  for (int i = 0; i < 200; ++i)
+    fm.row(i) << w(i), g(i).real(), g(i).imag(), gs(i).real(), gs(i).imag(), std::abs(g(i)),
+        std::arg(g(i)) * 180.0 / 3.14159265358979;
+  write_csv(prefix + "_freq.csv", {"w", "re", "im", "re_std", "im_std", "mag", "phase_deg"}, fm);
   std::printf("wrote %s_time.csv and %s_freq.csv\n", prefix.c_str(), prefix.c_str());
 }
 
@@ -494,7 +497,9 @@ void setup_fit(CLI::App& app) {
   app.add_option("--via", a->via, "physical: fit to the FSF step response (fsf), the FSF frequency response (frequency), "
                                   "or the raw data (raw)")
       ->capture_default_str();
-  app.add_option("--responses", a->responses, "fsf: write PREFIX_time.csv (step, std, impulse) and PREFIX_freq.csv");
+  app.add_option("--responses", a->responses,
+                 "fsf: write PREFIX_time.csv (step and impulse with standard deviations) and PREFIX_freq.csv (G(jw) with "
+                 "standard deviations of its real and imaginary parts)");
   app.add_option("--json", a->json, "Write the result (model, parameters, fit) to this JSON file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
   app.callback([a] { g_run = [a] { return run(*a); }; });

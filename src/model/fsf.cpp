@@ -76,17 +76,55 @@ Eigen::VectorXd FsfModel::step_response_std(const Eigen::VectorXd& t) const {
   return s;
 }
 
-Eigen::VectorXd FsfModel::impulse_response(const Eigen::VectorXd& t) const {
-  Eigen::VectorXd g = Eigen::VectorXd::Zero(t.size());
+Eigen::RowVectorXd FsfModel::impulse_basis(double t) const {
+  Eigen::RowVectorXd b = Eigen::RowVectorXd::Zero(n_);
+  if (t < 0 || t >= T()) return b;
   const double W = omega();
-  for (Eigen::Index i = 0; i < t.size(); ++i) {
-    if (t(i) < 0 || t(i) >= T()) continue;
-    double v = theta_(0);
-    for (int k = 1; k <= m(); ++k)  // 2 Re[theta_k e^{jkWt}]
-      v += 2.0 * (theta_(2 * k - 1) * std::cos(k * W * t(i)) - theta_(2 * k) * std::sin(k * W * t(i)));
-    g(i) = v / T();
+  b(0) = 1.0 / T();
+  for (int k = 1; k <= m(); ++k) {  // 2 Re[theta_k e^{jkWt}] / T
+    b(2 * k - 1) = 2.0 * std::cos(k * W * t) / T();
+    b(2 * k) = -2.0 * std::sin(k * W * t) / T();
   }
+  return b;
+}
+
+Eigen::VectorXd FsfModel::impulse_response(const Eigen::VectorXd& t) const {
+  Eigen::VectorXd g(t.size());
+  for (Eigen::Index i = 0; i < t.size(); ++i) g(i) = impulse_basis(t(i)).dot(theta_);
   return g;
+}
+
+Eigen::VectorXd FsfModel::impulse_response_std(const Eigen::VectorXd& t) const {
+  Eigen::VectorXd s = Eigen::VectorXd::Constant(t.size(), NAN);
+  if (cov_.size() == 0) return s;
+  for (Eigen::Index i = 0; i < t.size(); ++i) {
+    const Eigen::RowVectorXd b = impulse_basis(t(i));
+    s(i) = std::sqrt(std::max(0.0, (b * cov_ * b.transpose())(0, 0)));
+  }
+  return s;
+}
+
+Eigen::VectorXcd FsfModel::frequency_response_std(const Eigen::VectorXd& w) const {
+  Eigen::VectorXcd s = Eigen::VectorXcd::Constant(w.size(), cd(NAN, NAN));
+  if (cov_.size() == 0) return s;
+  for (Eigen::Index i = 0; i < w.size(); ++i) {
+    // G = theta_0 H_0 + sum_k (Re theta_k (H_k + H_-k) + Im theta_k j (H_k - H_-k)): linear in theta.
+    Eigen::RowVectorXd re(n_), im(n_);
+    const cd h0 = filter_response(0, w(i));
+    re(0) = h0.real();
+    im(0) = h0.imag();
+    for (int k = 1; k <= m(); ++k) {
+      const cd hp = filter_response(k, w(i)), hm = filter_response(-k, w(i));
+      const cd a = hp + hm, b = cd(0, 1) * (hp - hm);
+      re(2 * k - 1) = a.real();
+      im(2 * k - 1) = a.imag();
+      re(2 * k) = b.real();
+      im(2 * k) = b.imag();
+    }
+    s(i) = cd(std::sqrt(std::max(0.0, (re * cov_ * re.transpose())(0, 0))),
+              std::sqrt(std::max(0.0, (im * cov_ * im.transpose())(0, 0))));
+  }
+  return s;
 }
 
 Eigen::VectorXd FsfModel::discrete_impulse_response() const {

@@ -324,7 +324,7 @@ TEST(Cli, GawthropWangFsfAndPhysical) {
   CliRun r = ctid_run("fit " + csv + " --time t --method fsf --set T=8 --set n=21 --set a=2 --responses " + prefix);
   ASSERT_EQ(r.code, 0) << r.err;
   const CsvTable step = read_csv(prefix + "_time.csv");
-  EXPECT_EQ(step.names, (std::vector<std::string>{"t", "step", "step_std", "impulse"}));
+  EXPECT_EQ(step.names, (std::vector<std::string>{"t", "step", "step_std", "impulse", "impulse_std"}));
   // Step response of G(s + 2) = 1/((s+1)(s+3)) reaches 1/3 (spec: within 4-8e-3).
   EXPECT_NEAR(step.values(step.values.rows() - 1, 1), 1.0 / 3.0, 8e-3);
   EXPECT_TRUE(fs::exists(prefix + "_freq.csv"));

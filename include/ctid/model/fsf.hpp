@@ -48,6 +48,13 @@ class FsfModel {
   /// Standard deviation of the step response at t from the parameter covariance (the step
   /// response is linear in theta); empty covariance -> NaN.
   Eigen::VectorXd step_response_std(const Eigen::VectorXd& t) const;
+  /// Standard deviation of the impulse response at t (linear in theta); NaN without covariance.
+  Eigen::VectorXd impulse_response_std(const Eigen::VectorXd& t) const;
+  /// Standard deviations of the real and imaginary parts of Gbar(e^{j w Delta}) at each w,
+  /// returned as std_re + j std_im (both are linear in theta); NaN without covariance.
+  Eigen::VectorXcd frequency_response_std(const Eigen::VectorXd& w) const;
+  /// Row vector b(t) with impulse_response(t) = b(t) . theta.
+  Eigen::RowVectorXd impulse_basis(double t) const;
   /// The discrete model's impulse response g_i = sum_k theta_k e^{j2 pi k i/N}/N, i = 0..N-1.
   Eigen::VectorXd discrete_impulse_response() const;
   /// Output of the discrete model for input u (from rest): y_i = sum_{l<N} g_l u_{i-l}.
