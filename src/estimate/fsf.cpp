@@ -30,6 +30,27 @@ void FsfOptions::validate() const {
                         weights(i));
 }
 
+namespace {
+// Model, named parameters and covariance of an FSF least-squares solution.
+Result<FsfModel> fsf_result(const internal::LinearSolution& sol, double Ts, int N, int n, double a) {
+  Result<FsfModel> r;
+  r.model = FsfModel(Ts, N, n, sol.theta, sol.covariance, a);
+  r.parameters.names.push_back("theta0");
+  for (int k = 1; k <= (n - 1) / 2; ++k) {
+    r.parameters.names.push_back("re_theta" + std::to_string(k));
+    r.parameters.names.push_back("im_theta" + std::to_string(k));
+  }
+  r.parameters.values = sol.theta;
+  r.parameters.covariance = sol.covariance;
+  r.parameters.std = sol.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  r.parameters.fixed.assign(n, false);
+  r.diagnostics.condition_number = sol.condition;
+  r.diagnostics.scalars["N"] = N;
+  r.diagnostics.scalars["a"] = a;
+  return r;
+}
+}  // namespace
+
 Result<FsfModel> fsf(const IdData& data, const FsfOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   o.validate();
@@ -106,23 +127,10 @@ Result<FsfModel> fsf(const IdData& data, const FsfOptions& o) {
     sol = ls.solve();
   }
 
-  Result<FsfModel> r;
-  r.model = FsfModel(Ts, N, o.n, sol.theta, sol.covariance, o.a);
-  r.parameters.names.push_back("theta0");
-  for (int k = 1; k <= m; ++k) {
-    r.parameters.names.push_back("re_theta" + std::to_string(k));
-    r.parameters.names.push_back("im_theta" + std::to_string(k));
-  }
-  r.parameters.values = sol.theta;
-  r.parameters.covariance = sol.covariance;
-  r.parameters.std = sol.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
-  r.parameters.fixed.assign(p, false);
+  Result<FsfModel> r = fsf_result(sol, Ts, N, o.n, o.a);
   r.fit.n_samples = M;
   r.fit.n_parameters = p;
   r.fit.mse = sol.rss / std::max(1.0, double(sol.n_rows));
-  r.diagnostics.condition_number = sol.condition;
-  r.diagnostics.scalars["N"] = N;
-  r.diagnostics.scalars["a"] = o.a;
   r.diagnostics.scalars["b"] = o.b;
   r.diagnostics.scalars["residual_rms"] = std::sqrt(r.fit.mse);
   if (o.b > 0 && M > N)
@@ -209,20 +217,7 @@ Result<FsfModel> fsf_from_spectra(const Eigen::VectorXcd& Uin, const Eigen::Vect
     ls.add(im.data(), Y(i).imag(), weight);
   }
   const internal::LinearSolution sol = ls.solve();
-  Result<FsfModel> r;
-  r.model = FsfModel(Ts, N, o.n, sol.theta, sol.covariance, o.a);
-  r.parameters.names.push_back("theta0");
-  for (int k = 1; k <= m; ++k) {
-    r.parameters.names.push_back("re_theta" + std::to_string(k));
-    r.parameters.names.push_back("im_theta" + std::to_string(k));
-  }
-  r.parameters.values = sol.theta;
-  r.parameters.covariance = sol.covariance;
-  r.parameters.std = sol.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
-  r.parameters.fixed.assign(p, false);
-  r.diagnostics.condition_number = sol.condition;
-  r.diagnostics.scalars["N"] = N;
-  r.diagnostics.scalars["a"] = o.a;
+  Result<FsfModel> r = fsf_result(sol, Ts, N, o.n, o.a);
   if (sol.rank_deficient) {
     r.summary.termination = Termination::RankDeficient;
     r.summary.message = "the frequency-domain FSF regressor is rank deficient: the input spectrum does not cover the filter "
