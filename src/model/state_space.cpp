@@ -54,9 +54,18 @@ bool StateSpace::is_stable() const {
 }
 
 namespace {
+// det(sI - M) from the eigenvalues. Defective (repeated) eigenvalues come back perturbed by
+// O(sqrt(eps)) and not always as exact conjugate pairs; the coefficients are continuous in the
+// roots, so the real part of the expanded product is accurate and the imaginary residue is dropped
+// (Polynomial::from_roots rejects it, rightly, for user-given roots).
 Polynomial char_poly(const Eigen::MatrixXd& M) {
   if (M.rows() == 0) return Polynomial{1.0};
-  return Polynomial::from_roots(Eigen::EigenSolver<Eigen::MatrixXd>(M, false).eigenvalues());
+  const Eigen::VectorXcd r = Eigen::EigenSolver<Eigen::MatrixXd>(M, false).eigenvalues();
+  Eigen::VectorXcd c = Eigen::VectorXcd::Zero(r.size() + 1);
+  c(0) = 1.0;
+  for (Eigen::Index k = 0; k < r.size(); ++k)
+    for (Eigen::Index i = k + 1; i >= 1; --i) c(i) -= r(k) * c(i - 1);
+  return Polynomial(Eigen::VectorXd(c.real()));
 }
 }  // namespace
 
