@@ -65,55 +65,92 @@ Result<FsfModel> fsf(const IdData& data, const FsfOptions& o) {
   const int M = data.size();
   CTID_REQUIRE(N <= M, "fsf: T = {} s ({} samples) is longer than the record ({} samples, {} s)", o.T, N, M, M * Ts);
   CTID_REQUIRE(o.n <= N, "fsf: n = {} filters exceed N = T/Ts = {}", o.n, N);
+  CTID_REQUIRE(o.a * o.T <= 300, "fsf: a*T = {} is too large (a = {}, T = {} s): the window e^(-aT) would leave "
+               "nothing of the record after the first T seconds; choose a <= {}", o.a * o.T, o.a, o.T, 300 / o.T);
   CTID_REQUIRE(o.weights.size() == 0 || o.weights.size() == M, "fsf: {} weights for {} samples", o.weights.size(), M);
   const int m = (o.n - 1) / 2, p = o.n;
   CTID_REQUIRE(M > p, "fsf: {} samples cannot determine {} parameters", M, p);
   const Eigen::VectorXd u = data.u().col(0), y = data.y().col(0);
 
-  // Overlap-save: FFT size F (power of two, about 8N but not much beyond the record), S = F - N + 1
-  // new outputs per block; larger blocks amortise the n/2 + 1 transforms per block over more samples.
-  int F = 1;
-  while (F < 2 * N || (F < 8 * N && F < M + N)) F *= 2;
-  const int S = F - N + 1;
-  Eigen::FFT<double> fft;
-  // Filter spectra: h_k(l) = e^{a l Ts} e^{j 2 pi k l / N} / N, l < N (k = 0..m).
-  std::vector<std::vector<cd>> H(m + 1);
-  {
-    std::vector<cd> h(F);
+  // Regressors by exact FIR summation with shared partial sums (the van Herk / Gil-Werman sliding
+  // window): the record is cut into chunks of N samples; the window (i-N, i] of output i = cN + j is the
+  // suffix (j, N) of chunk c-1 plus the prefix [0, j] of chunk c, so every regressor is a sum of two
+  // partial sums of its own N terms. Nothing is subtracted or carried from chunk to chunk, so the
+  // round-off is that of direct N-term summation (no recursion on the unit circle, GW 2), at O(n) per
+  // sample. With p = i - l, the filter weight e^{a l Ts} W^{k l} / N (W = e^{j 2 pi / N}) factors as
+  // e^{a Ts (i - chunk start)} W^{k i} / N times e^{-a Ts (p - chunk start)} W^{-k p}, all bounded by e^{2aT}.
+  const double aTs = o.a * Ts, cTs = (o.b - o.a) * Ts;
+  std::vector<double> E(N), G0(N), G1(N), C(N);
+  std::vector<double> twr(static_cast<size_t>(m + 1) * N), twi(twr.size());
+  for (int j = 0; j < N; ++j) {
+    E[j] = std::exp(-aTs * j);
+    G0[j] = std::exp(aTs * j);
+    G1[j] = std::exp(aTs * (N + j));
+    C[j] = std::exp(cTs * j);
     for (int k = 0; k <= m; ++k) {
-      std::fill(h.begin(), h.end(), cd(0));
-      for (int l = 0; l < N; ++l)
-        h[l] = std::exp(o.a * l * Ts) * std::exp(cd(0, 2.0 * std::numbers::pi * k * l / N)) / double(N);
-      fft.fwd(H[k], h);
+      const double phi = 2.0 * std::numbers::pi * static_cast<double>((static_cast<long long>(k) * j) % N) / N;
+      twr[static_cast<size_t>(k) * N + j] = std::cos(phi);
+      twi[static_cast<size_t>(k) * N + j] = -std::sin(phi);  // W^{-k j}
     }
   }
-  std::vector<cd> x(F), X(F), Yk(F);
-  std::vector<std::vector<cd>> out(m + 1, std::vector<cd>(F));
-  std::vector<double> row(p);
-  const double t0 = data.t0();
-  // One pass over the record feeding the weighted rows to a least-squares kernel.
+  const size_t K = static_cast<size_t>(m + 1);
+  std::vector<double> xr(K * N), xi(K * N), pre_r(K * N), pre_i(K * N), suf_r(K * (N + 1)), suf_i(K * (N + 1));
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows(N, p);
   auto pass = [&](auto& kernel) {
-    for (int i0 = 0; i0 < M; i0 += S) {
-      // Input segment u[i0 - N + 1 .. i0 + S - 1] (zero before the record and after its end).
-      for (int q = 0; q < F; ++q) {
-        const int idx = i0 - N + 1 + q;
-        x[q] = (idx >= 0 && idx < M) ? cd(u(idx), 0.0) : cd(0.0);
-      }
-      fft.fwd(X, x);
-      for (int k = 0; k <= m; ++k) {
-        for (int q = 0; q < F; ++q) Yk[q] = X[q] * H[k][q];
-        fft.inv(out[k], Yk);
-      }
-      const int count = std::min(S, M - i0);
-      for (int j = 0; j < count; ++j) {
-        const int i = i0 + j, q = N - 1 + j;
-        const double c = std::exp((o.b - o.a) * (data.time(i) - t0));  // e^{(b-a) t_i} <= 1
-        row[0] = c * out[0][q].real();
-        for (int k = 1; k <= m; ++k) {
-          row[2 * k - 1] = c * 2.0 * out[k][q].real();
-          row[2 * k] = -c * 2.0 * out[k][q].imag();
+    std::fill(suf_r.begin(), suf_r.end(), 0.0);  // zero input before the record
+    std::fill(suf_i.begin(), suf_i.end(), 0.0);
+    for (int c0 = 0; c0 < M; c0 += N) {
+      const int len = std::min(N, M - c0);
+      const double cbase = std::exp(cTs * c0) / N;  // e^{(b-a)(t_{c0} - t0)} / N
+      for (size_t k = 0; k < K; ++k) {
+        double* a_r = &xr[k * N];
+        double* a_i = &xi[k * N];
+        const double* wr = &twr[k * N];
+        const double* wi = &twi[k * N];
+        for (int j = 0; j < len; ++j) {
+          const double v = E[j] * u(c0 + j);
+          a_r[j] = v * wr[j];
+          a_i[j] = v * wi[j];
         }
-        kernel.add(row.data(), c * y(i), o.weights.size() ? o.weights(i) : 1.0);
+        double* pr = &pre_r[k * N];
+        double* pi = &pre_i[k * N];
+        double sr = 0, si = 0;
+        for (int j = 0; j < len; ++j) {
+          sr += a_r[j];
+          si += a_i[j];
+          pr[j] = sr;
+          pi[j] = si;
+        }
+        const double* qr = &suf_r[k * (N + 1)];
+        const double* qi = &suf_i[k * (N + 1)];
+        for (int j = 0; j < len; ++j) {
+          const double g1 = cbase * C[j] * G1[j], g0 = cbase * C[j] * G0[j];
+          const double s_r = g1 * qr[j + 1] + g0 * pr[j], s_i = g1 * qi[j + 1] + g0 * pi[j];
+          // out = conj(W^{-k j}) s;  regressors Re(out) (k = 0), 2 Re(out), -2 Im(out)
+          const double o_r = wr[j] * s_r + wi[j] * s_i, o_i = wr[j] * s_i - wi[j] * s_r;
+          if (k == 0) {
+            rows(j, 0) = o_r;
+          } else {
+            rows(j, 2 * k - 1) = 2.0 * o_r;
+            rows(j, 2 * k) = -2.0 * o_i;
+          }
+        }
+      }
+      for (int j = 0; j < len; ++j) {
+        const int i = c0 + j;
+        kernel.add(rows.row(j).data(), cbase * N * C[j] * y(i), o.weights.size() ? o.weights(i) : 1.0);
+      }
+      // Suffix sums of this chunk for the next one (a partial last chunk is never needed again).
+      for (size_t k = 0; k < K; ++k) {
+        double* qr = &suf_r[k * (N + 1)];
+        double* qi = &suf_i[k * (N + 1)];
+        double sr = 0, si = 0;
+        for (int j = len - 1; j >= 0; --j) {
+          sr += xr[k * N + j];
+          si += xi[k * N + j];
+          qr[j] = sr;
+          qi[j] = si;
+        }
       }
     }
   };

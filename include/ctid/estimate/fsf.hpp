@@ -3,7 +3,8 @@
 // weighting b for unstable plants (GW 14-21; SEEDS-SPEC GW-A1, GW-A2).
 //
 // Regressors phi_i = sum_{l<N} f_l u_{i-l} (zero input before the record) are computed by
-// overlap-save FFT convolution — never by the marginally stable recursive form. With a window
+// exact FIR summation from prefix/suffix partial sums of N-sample chunks (O(n) per sample) —
+// never by the marginally stable recursive form. With a window
 // a and weight b the rows are formed as in SEEDS-SPEC GW-A2, never with e^{bt} and e^{-at}
 // separately:  e^{b t_i} y_{a,i} = e^{(b-a) t_i} y_i,
 //              e^{b t_i} phi_{a,i} = e^{(b-a) t_i} sum_{l<N} (f_l e^{a l Delta}) u_{i-l}.
