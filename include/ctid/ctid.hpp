@@ -24,6 +24,7 @@
 #include "ctid/io/mat.hpp"
 #include "ctid/model/fsf.hpp"
 #include "ctid/model/miso.hpp"
+#include "ctid/model/modal.hpp"
 #include "ctid/model/physical_model.hpp"
 #include "ctid/model/state_space.hpp"
 #include "ctid/model/transfer_function.hpp"

@@ -1,0 +1,181 @@
+// El-Shafey (1987) ch. 2 and Theorems 4.1-4.2: see include/ctid/model/modal.hpp.
+#include "ctid/model/modal.hpp"
+
+#include <cmath>
+
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include "ctid/core/check.hpp"
+
+namespace ctid {
+
+namespace {
+bool all_finite(const Eigen::MatrixXd& M) { return M.allFinite(); }
+
+double condition_2(const Eigen::MatrixXd& M) {
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(M);
+  const Eigen::VectorXd s = svd.singularValues();
+  return s(s.size() - 1) > 0 ? s(0) / s(s.size() - 1) : std::numeric_limits<double>::infinity();
+}
+}  // namespace
+
+InputGenerator::InputGenerator(Eigen::MatrixXd A, Eigen::VectorXd c, Eigen::VectorXd x0)
+    : A_(std::move(A)), c_(std::move(c)), x0_(std::move(x0)) {
+  CTID_REQUIRE(A_.rows() == A_.cols() && A_.rows() >= 1, "InputGenerator: A must be square and non-empty (got {}x{})",
+               A_.rows(), A_.cols());
+  CTID_REQUIRE(c_.size() == A_.rows() && x0_.size() == A_.rows(),
+               "InputGenerator: c ({}) and x0 ({}) must have the order of A ({})", c_.size(), x0_.size(), A_.rows());
+  CTID_REQUIRE(all_finite(A_) && all_finite(c_) && all_finite(x0_), "InputGenerator: non-finite entries");
+}
+
+InputGenerator InputGenerator::constant(double level) {
+  return InputGenerator(Eigen::MatrixXd::Zero(1, 1), Eigen::VectorXd::Constant(1, level), Eigen::VectorXd::Ones(1));
+}
+
+InputGenerator InputGenerator::exponential(double sigma, double amplitude) {
+  return InputGenerator(Eigen::MatrixXd::Constant(1, 1, sigma), Eigen::VectorXd::Constant(1, amplitude),
+                        Eigen::VectorXd::Ones(1));
+}
+
+InputGenerator InputGenerator::sinusoid(double w, double a_sin, double a_cos, double sigma) {
+  CTID_REQUIRE(std::isfinite(w) && w > 0, "InputGenerator::sinusoid: the frequency must be > 0 rad/s (got {})", w);
+  Eigen::MatrixXd A(2, 2);
+  A << sigma, w, -w, sigma;
+  return InputGenerator(A, Eigen::Vector2d(a_sin, a_cos), Eigen::Vector2d(0.0, 1.0));
+}
+
+InputGenerator InputGenerator::operator+(const InputGenerator& o) const {
+  if (order() == 0) return o;
+  if (o.order() == 0) return *this;
+  const int n1 = order(), n2 = o.order();
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n1 + n2, n1 + n2);
+  A.topLeftCorner(n1, n1) = A_;
+  A.bottomRightCorner(n2, n2) = o.A_;
+  Eigen::VectorXd c(n1 + n2), x0(n1 + n2);
+  c << c_, o.c_;
+  x0 << x0_, o.x0_;
+  return InputGenerator(A, c, x0);
+}
+
+Eigen::VectorXcd InputGenerator::modes() const { return Eigen::EigenSolver<Eigen::MatrixXd>(A_, false).eigenvalues(); }
+
+Polynomial InputGenerator::characteristic_polynomial() const {
+  return StateSpace(A_, Eigen::MatrixXd::Zero(order(), 1), Eigen::MatrixXd::Zero(1, order()), Eigen::MatrixXd::Zero(1, 1))
+      .to_transfer_function()
+      .den();
+}
+
+Eigen::MatrixXd InputGenerator::basis(const Eigen::VectorXd& t) const {
+  CTID_REQUIRE(order() >= 1, "InputGenerator: empty generator");
+  CTID_REQUIRE(t.allFinite(), "InputGenerator::basis: non-finite time");
+  Eigen::MatrixXd X(t.size(), order());
+  for (Eigen::Index i = 0; i < t.size(); ++i) X.row(i) = (Eigen::MatrixXd(A_ * t(i)).exp() * x0_).transpose();
+  return X;
+}
+
+Eigen::VectorXd InputGenerator::operator()(const Eigen::VectorXd& t) const { return basis(t) * c_; }
+
+ModalParameters modal_parameters(const StateSpace& sys, const Eigen::VectorXd& shifts, int max_order) {
+  CTID_REQUIRE(sys.nu() == 1 && sys.ny() == 1, "modal_parameters: needs a SISO model (got {} inputs, {} outputs)",
+               sys.nu(), sys.ny());
+  const int n = sys.nx();
+  CTID_REQUIRE(n >= 1, "modal_parameters: the model has no states");
+  CTID_REQUIRE(shifts.size() == n, "modal_parameters: {} shifts given for a model of order {} (one per state)",
+               shifts.size(), n);
+  CTID_REQUIRE(max_order >= 0, "modal_parameters: max_order must be >= 0 (got {})", max_order);
+  for (int i = 0; i < n; ++i) {
+    CTID_REQUIRE(std::isfinite(shifts(i)) && shifts(i) != 0, "modal_parameters: shift {} must be finite and non-zero "
+                 "(got {})", i + 1, shifts(i));
+    for (int k = 0; k < i; ++k)
+      CTID_REQUIRE(shifts(i) != shifts(k), "modal_parameters: shifts {} and {} are equal ({} s)", k + 1, i + 1, shifts(i));
+  }
+  ModalParameters r;
+  r.psi.resize(n, n);
+  const Eigen::RowVectorXd c = sys.C().row(0);
+  for (int i = 0; i < n; ++i) r.psi.row(i) = c * Eigen::MatrixXd(-sys.A() * shifts(i)).exp();
+  r.condition = condition_2(r.psi);
+  CTID_REQUIRE(r.condition < 1e13, "modal_parameters: psi is singular (condition {}): the model is unobservable or the "
+               "shifts make two modes indistinguishable; move the shifts", r.condition);
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(r.psi.transpose());
+  r.P.resize(max_order + 1, n);
+  Eigen::RowVectorXd cAj = c;
+  for (int j = 0; j <= max_order; ++j) {
+    r.P.row(j) = -lu.solve(cAj.transpose()).transpose();
+    cAj = cAj * sys.A();
+  }
+  return r;
+}
+
+ModalParameters modal_parameters(const TransferFunction& tf, const Eigen::VectorXd& shifts, int max_order) {
+  return modal_parameters(phase_variable_form(tf), shifts, max_order);
+}
+
+StateSpace phase_variable_form(const TransferFunction& tf) {
+  const int n = tf.order();
+  CTID_REQUIRE(n >= 1, "phase_variable_form: the transfer function has no poles");
+  CTID_REQUIRE(tf.num().degree() < n || tf.num().is_zero(),
+               "phase_variable_form: needs a strictly proper transfer function (numerator degree {} >= {})",
+               tf.num().degree(), n);
+  const double lead = tf.den().leading();
+  // a_k (k = 0..n, a_n = 1) and b_j (j = 0..n-1), ascending powers.
+  Eigen::VectorXd a(n + 1), b = Eigen::VectorXd::Zero(n);
+  for (int k = 0; k <= n; ++k) a(k) = tf.den().coefficient_of_power(k) / lead;
+  for (int j = 0; j < n; ++j) b(j) = tf.num().coefficient_of_power(j) / lead;
+  // ES 2.12: b_j = sum_{k=j+1}^{n} a_k b~_{k-j}, solved from j = n-1 down.
+  Eigen::VectorXd bt(n + 1);
+  bt(0) = 0;
+  for (int m = 1; m <= n; ++m) {
+    double s = b(n - m);
+    for (int k = n - m + 1; k <= n - 1; ++k) s -= a(k) * bt(k - n + m);
+    bt(m) = s;
+  }
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i + 1 < n; ++i) A(i, i + 1) = 1.0;
+  for (int k = 0; k < n; ++k) A(n - 1, k) = -a(k);
+  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(1, n);
+  C(0, 0) = 1.0;
+  return StateSpace(A, bt.tail(n), C, Eigen::MatrixXd::Zero(1, 1));
+}
+
+ModalModel::ModalModel(Eigen::VectorXd shifts, Eigen::MatrixXd P, Eigen::MatrixXd Q)
+    : shifts_(std::move(shifts)), P_(std::move(P)), Q_(std::move(Q)) {
+  CTID_REQUIRE(shifts_.size() >= 1, "ModalModel: needs at least one shift");
+  CTID_REQUIRE(P_.cols() == shifts_.size() && P_.rows() >= 1,
+               "ModalModel: P must have one column per shift ({} columns, {} shifts)", P_.cols(), shifts_.size());
+  CTID_REQUIRE(Q_.rows() == P_.rows() || Q_.size() == 0, "ModalModel: Q has {} rows, P has {}", Q_.rows(), P_.rows());
+  if (Q_.size() == 0) Q_.resize(P_.rows(), 0);
+}
+
+Polynomial ModalModel::characteristic_polynomial() const {
+  const int n = order();
+  CTID_REQUIRE(max_order() >= n, "ModalModel: Theorem 4.1 needs p_0 .. p_{} (have up to p_{})", n, max_order());
+  const Eigen::MatrixXd Pn = P_.topRows(n);
+  const Eigen::VectorXd a = Pn.transpose().colPivHouseholderQr().solve(-P_.row(n).transpose());
+  Eigen::VectorXd c(n + 1);
+  c(0) = 1.0;
+  for (int k = 0; k < n; ++k) c(k + 1) = a(n - 1 - k);
+  return Polynomial(c);
+}
+
+TransferFunction ModalModel::transfer_function(const InputGenerator& g) const {
+  const int n = order();
+  const Polynomial den = characteristic_polynomial();
+  CTID_REQUIRE(Q_.cols() == g.order(), "ModalModel: Q has {} columns but the input generator has order {}", Q_.cols(),
+               g.order());
+  CTID_REQUIRE(g.order() >= n, "ModalModel: Theorem 4.2 needs at least n = {} input modes (the generator has {})", n,
+               g.order());
+  Eigen::VectorXd qt = Q_.row(n).transpose();
+  for (int j = 0; j < n; ++j) qt += den.coefficient_of_power(j) * Q_.row(j).transpose();
+  Eigen::MatrixXd Rb(g.order(), n);
+  Eigen::VectorXd v = g.c();
+  for (int j = 0; j < n; ++j) {
+    Rb.col(j) = v;
+    v = g.A().transpose() * v;
+  }
+  const Eigen::VectorXd b = Rb.colPivHouseholderQr().solve(qt);
+  Eigen::VectorXd num(n);
+  for (int j = 0; j < n; ++j) num(j) = b(n - 1 - j);
+  return TransferFunction(Polynomial(num), den);
+}
+
+}  // namespace ctid
