@@ -293,6 +293,41 @@ Eigen::VectorXd time_grid(double h, int n) {
   return Eigen::VectorXd::LinSpaced(n, 0.0, h * (n - 1));
 }
 
+Eigen::VectorXd lsim(const StateSpace& sys, const InputGenerator& input, const Eigen::VectorXd& t,
+                     const Eigen::VectorXd& x0) {
+  CTID_REQUIRE(sys.nu() == 1 && sys.ny() == 1, "lsim: a generated input needs a SISO model (got {} inputs, {} outputs)",
+               sys.nu(), sys.ny());
+  CTID_REQUIRE(input.order() >= 1, "lsim: empty input generator");
+  CTID_REQUIRE(x0.size() == 0 || x0.size() == sys.nx(), "lsim: x0 has {} entries for {} states", x0.size(), sys.nx());
+  const int n = sys.nx(), nc = input.order();
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n + nc, n + nc);
+  M.topLeftCorner(n, n) = sys.A();
+  M.topRightCorner(n, nc) = sys.B() * input.c().transpose();
+  M.bottomRightCorner(nc, nc) = input.A();
+  Eigen::RowVectorXd Ca(n + nc);
+  Ca << sys.C().row(0), sys.D()(0, 0) * input.c().transpose();
+  Eigen::VectorXd z(n + nc);
+  z << (x0.size() ? x0 : Eigen::VectorXd::Zero(n)), input.x0();
+  Eigen::VectorXd y(t.size());
+  double tp = 0.0, hp = -1.0;
+  Eigen::MatrixXd Phi;
+  for (Eigen::Index i = 0; i < t.size(); ++i) {
+    CTID_REQUIRE(std::isfinite(t(i)) && t(i) >= tp, "lsim: times must be finite, >= 0 and increasing (t[{}] = {})", i,
+                 t(i));
+    const double h = t(i) - tp;
+    if (h > 0) {
+      if (std::abs(h - hp) > 1e-12 * std::max(1.0, h)) {  // uniform grids: one exponential
+        Phi = expm(M * h);
+        hp = h;
+      }
+      z = Phi * z;
+    }
+    tp = t(i);
+    y(i) = Ca.dot(z);
+  }
+  return y;
+}
+
 Eigen::VectorXd step_response(const TransferFunction& tf, const Eigen::VectorXd& t) {
   CTID_REQUIRE(t.size() >= 1 && t(0) >= 0, "step_response: times must start at t >= 0");
   // Prepend t = 0 so the step is applied at time zero.

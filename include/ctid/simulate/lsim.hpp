@@ -14,6 +14,7 @@
 
 #include "ctid/data/iddata.hpp"
 #include "ctid/model/miso.hpp"
+#include "ctid/model/modal.hpp"
 #include "ctid/model/state_space.hpp"
 #include "ctid/model/transfer_function.hpp"
 
@@ -50,6 +51,12 @@ Eigen::VectorXd lsim(const TransferFunction& tf, const Eigen::VectorXd& u, const
 /// Simulate a MISO model: the sum of its channels, channel i driven by input column i.
 /// Throws InvalidArgument when the data do not have one input per channel.
 Eigen::VectorXd lsim(const MisoModel& model, const IdData& data);
+
+/// Exact response of a SISO model to a generated input u = c^T x_c(t) (El-Shafey's input generator):
+/// the matrix exponential of the system augmented with the generator, [x; x_c]' =
+/// [[A, B c^T], [0, A_c]] [x; x_c], x_c(0) = input.x0(), x(0) = x0 (empty: zero). t increasing, >= 0.
+Eigen::VectorXd lsim(const StateSpace& sys, const InputGenerator& input, const Eigen::VectorXd& t,
+                     const Eigen::VectorXd& x0 = {});
 
 /// Unit-step response at the times t (t >= 0, increasing): step applied at t = 0.
 Eigen::VectorXd step_response(const TransferFunction& tf, const Eigen::VectorXd& t);
