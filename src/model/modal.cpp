@@ -157,25 +157,105 @@ Polynomial ModalModel::characteristic_polynomial() const {
   return Polynomial(c);
 }
 
-TransferFunction ModalModel::transfer_function(const InputGenerator& g) const {
-  const int n = order();
-  const Polynomial den = characteristic_polynomial();
-  CTID_REQUIRE(Q_.cols() == g.order(), "ModalModel: Q has {} columns but the input generator has order {}", Q_.cols(),
-               g.order());
-  CTID_REQUIRE(g.order() >= n, "ModalModel: Theorem 4.2 needs at least n = {} input modes (the generator has {})", n,
-               g.order());
-  Eigen::VectorXd qt = Q_.row(n).transpose();
-  for (int j = 0; j < n; ++j) qt += den.coefficient_of_power(j) * Q_.row(j).transpose();
-  Eigen::MatrixXd Rb(g.order(), n);
-  Eigen::VectorXd v = g.c();
-  for (int j = 0; j < n; ++j) {
-    Rb.col(j) = v;
-    v = g.A().transpose() * v;
+TransferFunction ModalModel::transfer_function(const InputGenerator& g) const { return modal_theorems_tf({{*this, g}}); }
+
+namespace {
+// Descending monic polynomial from ascending a_0..a_{n-1}; numerator from ascending b.
+TransferFunction tf_from_ab(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  const Eigen::Index n = a.size();
+  Eigen::VectorXd den(n + 1), num(n);
+  den(0) = 1.0;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    den(k + 1) = a(n - 1 - k);
+    num(k) = b(n - 1 - k);
   }
-  const Eigen::VectorXd b = Rb.colPivHouseholderQr().solve(qt);
-  Eigen::VectorXd num(n);
-  for (int j = 0; j < n; ++j) num(j) = b(n - 1 - j);
-  return TransferFunction(Polynomial(num), den);
+  return TransferFunction(Polynomial(num), Polynomial(den));
+}
+
+int common_order(const std::vector<ModalExperiment>& ex, const char* who) {
+  CTID_REQUIRE(!ex.empty(), "{}: no experiments", who);
+  const int n = ex[0].model.order();
+  for (size_t e = 0; e < ex.size(); ++e) {
+    CTID_REQUIRE(ex[e].model.order() == n, "{}: experiment {} has order {}, experiment 1 has {}", who, e + 1,
+                 ex[e].model.order(), n);
+    CTID_REQUIRE(ex[e].model.Q().cols() == ex[e].input.order(), "{}: experiment {} has {} q columns but its input "
+                 "generator has order {}", who, e + 1, ex[e].model.Q().cols(), ex[e].input.order());
+  }
+  return n;
+}
+
+// [v, A^T v, ..., (A^T)^{n-1} v] (n_c x n).
+Eigen::MatrixXd krylov(const Eigen::MatrixXd& A, Eigen::VectorXd v, int n) {
+  Eigen::MatrixXd K(v.size(), n);
+  for (int j = 0; j < n; ++j) {
+    K.col(j) = v;
+    v = A.transpose() * v;
+  }
+  return K;
+}
+}  // namespace
+
+TransferFunction modal_theorems_tf(const std::vector<ModalExperiment>& ex) {
+  const int n = common_order(ex, "modal_theorems_tf");
+  int rows_a = 0, rows_b = 0;
+  for (size_t e = 0; e < ex.size(); ++e) {
+    CTID_REQUIRE(ex[e].model.max_order() >= n, "modal_theorems_tf: Theorem 4.1 needs p_0 .. p_{} (experiment {} has up "
+                 "to p_{})", n, e + 1, ex[e].model.max_order());
+    rows_a += n;
+    rows_b += ex[e].input.order();
+  }
+  CTID_REQUIRE(rows_b >= n, "modal_theorems_tf: Theorem 4.2 needs at least n = {} input modes in total (have {})", n,
+               rows_b);
+  // Theorem 4.1: P^T a = -p_n for every experiment.
+  Eigen::MatrixXd Aa(rows_a, n);
+  Eigen::VectorXd ba(rows_a);
+  int r = 0;
+  for (const auto& x : ex) {
+    Aa.middleRows(r, n) = x.model.P().topRows(n).transpose();
+    ba.segment(r, n) = -x.model.P().row(n).transpose();
+    r += n;
+  }
+  const Eigen::VectorXd a = Aa.colPivHouseholderQr().solve(ba);
+  // Theorem 4.2: q_n + sum a_j q_j = R_b b.
+  Eigen::MatrixXd Ab(rows_b, n);
+  Eigen::VectorXd bb(rows_b);
+  r = 0;
+  for (const auto& x : ex) {
+    const int nc = x.input.order();
+    Eigen::VectorXd qt = x.model.Q().row(n).transpose();
+    for (int j = 0; j < n; ++j) qt += a(j) * x.model.Q().row(j).transpose();
+    Ab.middleRows(r, nc) = krylov(x.input.A(), x.input.c(), n);
+    bb.segment(r, nc) = qt;
+    r += nc;
+  }
+  return tf_from_ab(a, Ab.colPivHouseholderQr().solve(bb));
+}
+
+TransferFunction modal_output_function_tf(const std::vector<ModalExperiment>& ex) {
+  const int n = common_order(ex, "modal_output_function_tf");
+  int rows = 0;
+  for (const auto& x : ex) rows += x.input.order();
+  CTID_REQUIRE(rows >= 2 * n, "modal_output_function_tf: needs at least 2n = {} input modes in total (have {})", 2 * n,
+               rows);
+  Eigen::MatrixXd R(rows, 2 * n);
+  Eigen::VectorXd rhs(rows);
+  int r = 0;
+  for (const auto& x : ex) {
+    const int nc = x.input.order();
+    const Eigen::VectorXd q0 = x.model.Q().row(0).transpose();
+    // nu = (I + sum_i p_0i e^{-A^T T_i}) c: the input filtered by the output modal parameters (ES 4.5).
+    Eigen::VectorXd nu = x.input.c();
+    for (int i = 0; i < n; ++i)
+      nu += x.model.P()(0, i) * (Eigen::MatrixXd(-x.input.A().transpose() * x.model.shifts()(i)).exp() * x.input.c());
+    R.block(r, 0, nc, n) = krylov(x.input.A(), q0, n);
+    R.block(r, n, nc, n) = -krylov(x.input.A(), nu, n);
+    Eigen::VectorXd v = q0;
+    for (int j = 0; j < n; ++j) v = x.input.A().transpose() * v;
+    rhs.segment(r, nc) = -v;
+    r += nc;
+  }
+  const Eigen::VectorXd theta = R.colPivHouseholderQr().solve(rhs);
+  return tf_from_ab(theta.head(n), theta.tail(n));
 }
 
 }  // namespace ctid

@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include <unsupported/Eigen/MatrixFunctions>
+
 #include "ctid/core/check.hpp"
 
 namespace ctid {
@@ -58,6 +60,29 @@ Eigen::VectorXd modal_filter(const Eigen::VectorXd& y, double Ts, const Eigen::V
     for (Eigen::Index i = std::max<Eigen::Index>(0, L); i < std::min(N, N + L); ++i) out(i) += weights(k) * y(i - L);
   }
   return out;
+}
+
+IdData modal_filter(const IdData& data, const Eigen::VectorXd& shifts, const Eigen::VectorXd& weights, double lead) {
+  CTID_REQUIRE(data.is_uniform(), "modal_filter: needs uniformly sampled data");
+  Eigen::MatrixXd u(data.size(), data.nu()), y(data.size(), data.ny());
+  for (int k = 0; k < data.nu(); ++k) u.col(k) = modal_filter(Eigen::VectorXd(data.u().col(k)), data.ts(), shifts, weights, lead);
+  for (int k = 0; k < data.ny(); ++k) y.col(k) = modal_filter(Eigen::VectorXd(data.y().col(k)), data.ts(), shifts, weights, lead);
+  IdData out(u, y, data.ts(), data.t0());
+  for (int k = 0; k < data.nu(); ++k) out.set_intersample(k, data.intersample(k));
+  out.set_input_names(data.input_names());
+  out.set_output_names(data.output_names());
+  out.set_input_units(data.input_units());
+  out.set_output_units(data.output_units());
+  return out;
+}
+
+InputGenerator modal_filter(const InputGenerator& g, const Eigen::VectorXd& shifts, const Eigen::VectorXd& weights,
+                            double lead) {
+  CTID_REQUIRE(shifts.size() == weights.size(), "modal_filter: {} shifts but {} weights", shifts.size(), weights.size());
+  Eigen::VectorXd c = lead * g.c();
+  for (Eigen::Index k = 0; k < shifts.size(); ++k)
+    c += weights(k) * (Eigen::MatrixXd(-g.A().transpose() * shifts(k)).exp() * g.c());
+  return InputGenerator(g.A(), c, g.x0());
 }
 
 Eigen::VectorXd annihilator(const InputGenerator& g, const Eigen::VectorXd& shifts) {

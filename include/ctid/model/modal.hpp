@@ -11,6 +11,8 @@
 // which contains only the input's modes: with a generated input, y_j(t) = q_j^T x_c(t).
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Dense>
 
 #include "ctid/model/state_space.hpp"
@@ -98,12 +100,30 @@ class ModalModel {
   Polynomial characteristic_polynomial() const;
   /// Theorems 4.1 and 4.2 (ES 4.15-4.31): b from q_n + sum_j a_j q_j = R_b b,
   /// R_b = [c, A^T c, ..., A^{(n-1)T} c] of the input generator (needs generator order >= n, same
-  /// basis as Q). Throws InvalidArgument otherwise.
+  /// basis as Q). Throws InvalidArgument otherwise. Several experiments: see modal_theorems_tf.
   TransferFunction transfer_function(const InputGenerator& input) const;
 
  private:
   Eigen::VectorXd shifts_;
   Eigen::MatrixXd P_, Q_;
 };
+
+/// One experiment's modal quantities with the generator of the input they were estimated on (for
+/// prefiltered pairs: the filtered input, see modal_filter(InputGenerator, ...)).
+struct ModalExperiment {
+  ModalModel model;
+  InputGenerator input;
+};
+
+/// Theorems 4.1 and 4.2 stacked over experiments (ES-C8, e.g. prefiltered pairs of ES-C6): a from all
+/// p_n + sum_j a_j p_j = 0 by least squares, b from all q_n + sum_j a_j q_j = R_b b. Needs max_order >= n
+/// in every experiment and at least n input modes in total. Throws InvalidArgument otherwise.
+TransferFunction modal_theorems_tf(const std::vector<ModalExperiment>& experiments);
+
+/// Output-modal-function route (ES-C7, ES 4.1-4.14): from p_0 and q_0 of each experiment,
+/// nu^T = c^T (I + sum_i p_0i e^{-A T_i}) and q_0^T (A^n + sum a_j A^j) = sum b_j nu^T A^j, stacked:
+/// theta = [a; b] = -(R^T R)^{-1} R^T (A^n)^T q_0. Needs at least 2n input modes in total.
+/// Throws InvalidArgument otherwise.
+TransferFunction modal_output_function_tf(const std::vector<ModalExperiment>& experiments);
 
 }  // namespace ctid

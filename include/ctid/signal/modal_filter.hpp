@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 
+#include "ctid/data/iddata.hpp"
 #include "ctid/model/modal.hpp"
 
 namespace ctid {
@@ -28,6 +29,17 @@ Eigen::VectorXi shift_lags(const Eigen::VectorXd& shifts, double Ts);
 /// the record; the caller keeps to validity windows). Throws InvalidArgument for size mismatches.
 Eigen::VectorXd modal_filter(const Eigen::VectorXd& y, double Ts, const Eigen::VectorXd& shifts,
                              const Eigen::VectorXd& weights, double lead = 1.0);
+
+/// The same filter applied to every input and output column of a uniformly sampled record (the
+/// filtered pair satisfies the same differential equation, ES 3.47). Throws InvalidArgument for
+/// non-uniform data.
+IdData modal_filter(const IdData& data, const Eigen::VectorXd& shifts, const Eigen::VectorXd& weights,
+                    double lead = 1.0);
+
+/// The generated input after the filter: same basis, c' = lead c + sum_k weights_k e^{-A^T T_k} c
+/// (annihilated modes get c' = 0 up to round-off; pass the generator of the modes to keep).
+InputGenerator modal_filter(const InputGenerator& input, const Eigen::VectorXd& shifts, const Eigen::VectorXd& weights,
+                            double lead = 1.0);
 
 /// Annihilating prefilter for the modes of a generator (ES-C6): l = -c^T psi_c^{-1} with psi_c rows
 /// c^T e^{-A T_Li}; one shift per generator state. L applied to any free response of that generator
