@@ -17,6 +17,7 @@
 #include <Eigen/Dense>
 
 #include "ctid/core/types.hpp"
+#include "ctid/data/frequency_data.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/model/modal.hpp"
 #include "ctid/model/transfer_function.hpp"
@@ -121,5 +122,54 @@ struct PronyOptions {
 /// least squares, poles s = ln(z)/T of z^order + p_1 z^{order-1} + ... . Reports cond(R^T R) and a
 /// warning that imaginary parts are only known modulo 2 pi / T (aliasing band (-pi/T, pi/T]).
 PoleEstimate prony(const Eigen::VectorXd& y, double Ts, const PronyOptions& options);
+
+// ---- Nonparametric responses (ES-C10 .. ES-C12) ----------------------------------------------
+
+/// A response estimated on a time grid (seconds) — the same quantities FsfModel::step_response /
+/// impulse_response give at chosen times.
+struct TimeResponse {
+  Eigen::VectorXd t;
+  Eigen::VectorXd value;
+};
+
+/// Frequency response at the harmonics of a periodic input, with the correlations it came from.
+struct HarmonicResponse {
+  FrequencyData response;  ///< w = k w_o, G = H(j k w_o)
+  Eigen::MatrixXd nu;      ///< rows k: [int sin(k w_o tau) u_0, int cos(k w_o tau) u_0] (un-normalised, ES 5.1 ff.)
+  Eigen::MatrixXd q;       ///< rows k: the same correlations of y_0
+};
+
+/// ES-C10 (ES 5.1-5.14): frequency response at harmonics k of a periodic input of period `period`,
+/// from (u_0, y_0) = (u, y) filtered with the output modal parameters p_0 of `model` (transients
+/// annihilated, so one period starting at window_start >= T_n suffices; unstable systems too).
+/// [Re H, Im H] = q^T [[nu_1, nu_2], [-nu_2, nu_1]]^{-1}. u_0 is integrated exactly when the input is
+/// held (Zoh data: square waves), otherwise with `rule`; y_0 with `rule`. Throws InvalidArgument when
+/// the window leaves the record or is off the sample grid, or a harmonic is < 1 or not excited (nu = 0).
+HarmonicResponse modal_frequency_response(const IdData& data, const ModalModel& model, double period,
+                                          const std::vector<int>& harmonics, double window_start,
+                                          Quadrature rule = Quadrature::Simpson);
+
+/// ES-C11 (ES 5.15-5.37): step response g on [0, horizon] from a piecewise-constant input whose levels
+/// change only at multiples of `level_period` T, given output modal parameters p_0 for the shifts
+/// T_i = i T (from modal_estimate on the constant-input windows). For every offset s in [0, T):
+/// y_0(kT + s) = u(k)^T Delta L g(s), u(k) = [u(k) .. u(k-n)], solved by least squares over all periods
+/// k >= n, then extrapolated with g(s + (n+k)T) = q_00 - sum_i p_0i g(s + (n+k-i)T). The initial state
+/// need not be zero. Throws InvalidArgument for shifts that are not i T, a level period off the sample
+/// grid, an input that changes inside a period, or too few distinct level sequences.
+TimeResponse modal_step_response(const IdData& data, const ModalModel& model, double level_period, double horizon);
+
+/// ES-C12 (ES 5.38-5.42): impulse response from a step response g (uniform grid from t = 0) with
+/// negative shifts: h(t) = q_10 - sum_i p_1i g(t - T_i). p_1 and g(T_o) by Fourier functions (2m =
+/// functions) on [0, T_o]; q_10 by ES 5.42.
+struct ImpulseFromStep {
+  TimeResponse impulse;   ///< h on [0, end of g - max |T_i|]
+  Eigen::VectorXd p1;     ///< estimated p_1 for the given shifts
+  double q10 = 0.0;       ///< the constant output-derivative modal function of the step
+  double g_To = 0.0;      ///< the estimated g(T_o)
+};
+/// Throws InvalidArgument for non-negative shifts or shifts off the grid, T_o off the grid or beyond
+/// the step response, fewer functions than n + 1, or a non-uniform grid.
+ImpulseFromStep modal_impulse_from_step(const TimeResponse& step, const Eigen::VectorXd& negative_shifts, double To,
+                                        int functions = 6, Quadrature rule = Quadrature::Simpson);
 
 }  // namespace ctid
