@@ -12,6 +12,7 @@
 #include "ctid/estimate/fsf.hpp"
 #include "ctid/estimate/lssvf.hpp"
 #include "ctid/estimate/modal.hpp"
+#include "ctid/estimate/modal_observer.hpp"
 #include "ctid/estimate/oe.hpp"
 #include "ctid/estimate/order_selection.hpp"
 #include "ctid/estimate/orders.hpp"
