@@ -2,6 +2,7 @@
 // free-response data matrix and Prony (ES-C9). See include/ctid/estimate/modal.hpp.
 #include "ctid/estimate/modal.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <complex>
@@ -170,8 +171,7 @@ Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& inp
       for (int i = s.i0; i <= s.i0 + s.K; i += o.stride) {
         reg(i, r.data());
         if (ivlag > 0) {
-          CTID_REQUIRE(i - lag(0) + ivlag < N, "modal: the instrument y(t - T_1 + iv_shift) at t = {} s is beyond the "
-                       "record", i * Ts);
+          if (i - lag(0) + ivlag >= N) continue;  // the instrument y(t - T_1 + iv_shift) is beyond the record
           reg(i, z.data(), ivlag);
           iv.add(z.data(), r.data(), y(i));
         } else {
@@ -321,6 +321,85 @@ Result<TransferFunction> modal_transfer_function(const IdData& data, const Input
   Eigen::VectorXd t(data.size());
   for (int i = 0; i < data.size(); ++i) t(i) = data.time(i) - data.t0();
   r.fit = fit_report_or_inf(data.y().col(0), lsim(r.model.to_state_space(), input, t), 2 * n);
+  return r;
+}
+
+Result<TransferFunction> modal_fit(const IdData& data, int nb, ModalOptions o, const InputGenerator* input) {
+  const auto t_start = std::chrono::steady_clock::now();
+  o.validate();
+  const int n = static_cast<int>(o.shifts.size());
+  CTID_REQUIRE(nb >= 1 && nb <= n, "modal_fit: nb = {} numerator coefficients must be in [1, n = {}]", nb, n);
+  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "modal_fit: needs one input and one output (got {}, {})", data.nu(),
+               data.ny());
+  if (input) {
+    CTID_REQUIRE(nb == n, "modal_fit: Theorem 4.2 estimates all n = {} numerator coefficients (nb = {})", n, nb);
+    Result<TransferFunction> r = modal_transfer_function(data, *input, o);
+    r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+    return r;
+  }
+  if (o.windows.empty()) {
+    // Automatic windows: Walsh blocks must tile each window (trim to a multiple of N sampling periods);
+    // the Fourier recursion needs one window (the longest).
+    const double Ts = data.ts();
+    for (ModalWindow w : piecewise_constant_windows(data, o.shifts(n - 1), Ts)) {
+      if (o.basis == ModalBasis::Walsh) w.length = std::floor(w.length / Ts / o.functions + 1e-9) * o.functions * Ts;
+      if (w.length > 0) o.windows.push_back(w);
+    }
+    if (o.basis == ModalBasis::Fourier && o.windows.size() > 1) {
+      const auto longest = std::max_element(o.windows.begin(), o.windows.end(),
+                                            [](const ModalWindow& a, const ModalWindow& b) { return a.length < b.length; });
+      o.windows = {*longest};
+    }
+  }
+  CTID_REQUIRE(!o.windows.empty(), "modal_fit: the input never stays constant long enough after a switch (T_n = {} s, "
+               "the largest shift, plus the Walsh blocks): no validity windows", o.shifts(n - 1));
+  if (o.basis != ModalBasis::Discrete) o.max_order = std::max(o.max_order, n);
+  const Result<ModalModel> m = modal_estimate(data, data.u(), o);
+  Polynomial den;
+  if (m.model.max_order() >= n) {
+    den = m.model.characteristic_polynomial();  // Theorem 4.1
+  } else {
+    const double T = o.shifts(0);
+    for (int i = 0; i < n; ++i)
+      CTID_REQUIRE(std::abs(o.shifts(i) - (i + 1) * T) <= 1e-9 * T, "modal_fit: the Discrete route needs uniform shifts "
+                   "T_i = i T (T_{} = {} s, T_1 = {} s); or use the Fourier/Walsh basis", i + 1, o.shifts(i), T);
+    Eigen::VectorXd zc(n + 1);
+    zc << 1.0, m.model.P().row(0).transpose();
+    const Eigen::VectorXcd z = Polynomial(zc).roots();
+    Eigen::VectorXcd e = Eigen::VectorXcd::Zero(n + 1);
+    e(0) = 1.0;
+    for (int k = 0; k < n; ++k) {
+      const std::complex<double> sk = std::log(z(k)) / T;
+      for (int i = k + 1; i >= 1; --i) e(i) -= sk * e(i - 1);
+    }
+    den = Polynomial(Eigen::VectorXd(e.real()));
+  }
+  // Numerator by linear least squares on the exact responses of s^j / A(s) (j < nb) to the data's input.
+  Eigen::MatrixXd X(data.size(), nb);
+  for (int j = 0; j < nb; ++j) {
+    Eigen::VectorXd num = Eigen::VectorXd::Zero(j + 1);
+    num(0) = 1.0;
+    X.col(j) = lsim(TransferFunction(Polynomial(num), den), data, 0);
+  }
+  const internal::LinearSolution sol = least_squares(X, data.y().col(0));
+  Result<TransferFunction> r;
+  Eigen::VectorXd numc(nb);
+  for (int j = 0; j < nb; ++j) numc(j) = sol.theta(nb - 1 - j);
+  r.model = TransferFunction(Polynomial(numc), den);
+  for (int j = 0; j < n; ++j) r.parameters.names.push_back(detail::format("a{}", j));
+  for (int j = 0; j < nb; ++j) r.parameters.names.push_back(detail::format("b{}", j));
+  r.parameters.values.resize(n + nb);
+  for (int j = 0; j < n; ++j) r.parameters.values(j) = den.coefficient_of_power(j);
+  r.parameters.values.tail(nb) = sol.theta;
+  r.parameters.std = Eigen::VectorXd::Constant(n + nb, std::numeric_limits<double>::quiet_NaN());
+  r.parameters.std.tail(nb) = sol.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();  // given A(s)
+  r.parameters.fixed.assign(n + nb, false);
+  r.diagnostics = m.diagnostics;
+  r.diagnostics.scalars["windows"] = static_cast<double>(o.windows.size());
+  r.summary = m.summary;
+  if (!r.model.is_stable()) r.diagnostics.warnings.push_back("the estimated model is unstable");
+  r.fit = fit_report_or_inf(data.y().col(0), lsim(r.model, data, 0), n + nb);
+  r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return r;
 }
 

@@ -465,3 +465,27 @@ TEST(ModalResponses, Tables53And54StepAndImpulseResponsesFromPiecewiseConstantDa
   EXPECT_THROW(modal_impulse_from_step(g, -neg, 192 * Ts), InvalidArgument);
   EXPECT_THROW(modal_step_response(d, m.model, 10 * Ts, 640 * Ts), InvalidArgument);
 }
+
+TEST(ModalFit, PiecewiseConstantInputsGiveTheTransferFunctionByBothRoutes) {
+  // The Ex. 5.2 record (levels +1, +2, -1, -2 each 80 Ts, Ts = pi/320) extended to 4 cycles: (a) Walsh functions
+  // on the constant-input windows with p_0..p_3 and Theorem 4.1, (b) the Discrete route with uniform shifts
+  // i T (poles from p_0). Both with the numerator by least squares given A(s): S3 to 1e-6 on noise-free data.
+  const double Ts = kPi / 320;
+  const int N = 1280;
+  Eigen::VectorXd u(N);
+  const double levels[4] = {1, 2, -1, -2};
+  for (int i = 0; i < N; ++i) u(i) = levels[(i / 80) % 4];
+  const IdData d(u, lsim(kS3, u, time_grid(Ts, N)), Ts);
+  const Eigen::Vector3d shifts(16 * Ts, 32 * Ts, 48 * Ts);
+  for (auto basis : {ModalBasis::Walsh, ModalBasis::Discrete}) {
+    const auto r = modal_fit(d, 2, {.shifts = shifts, .basis = basis, .functions = 8});
+    ASSERT_TRUE(r.usable()) << r.summary.message;
+    EXPECT_LT(max_rel(r.model.den().coefficients(), kS3.den().coefficients()), 1e-6) << static_cast<int>(basis);
+    EXPECT_NEAR(r.model.num().coefficient_of_power(1), 13.0, 1e-5);
+    EXPECT_NEAR(r.model.num().coefficient_of_power(0), 52.0, 1e-5);
+    EXPECT_GT(r.fit.fit_percent, 99.999);
+  }
+  EXPECT_THROW(modal_fit(d, 4, {.shifts = shifts}), InvalidArgument);  // nb > n
+  EXPECT_THROW(modal_fit(d, 2, {.shifts = Eigen::Vector3d(16, 32, 56) * Ts, .basis = ModalBasis::Discrete}),
+               InvalidArgument);  // non-uniform shifts on the Discrete route
+}

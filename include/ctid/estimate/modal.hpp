@@ -76,6 +76,22 @@ Result<ModalModel> modal_estimate(const IdData& data, const InputGenerator& inpu
 Result<TransferFunction> modal_transfer_function(const IdData& data, const InputGenerator& input,
                                                  ModalOptions options);
 
+/// One-call parametric identification by modal functions for the two input types of the thesis.
+///  * input given (a generated input, e.g. sinusoids): p_0..p_n and q_0..q_n on options.windows
+///    (default: [T_n, end]) and Theorems 4.1 and 4.2 (ES-C8); needs >= n input modes and nb == n.
+///  * input == nullptr (a piecewise-constant input): validity windows from every level switch
+///    (piecewise_constant_windows, settle T_n; trimmed to whole Walsh blocks, or the longest one for
+///    Fourier) unless options.windows is set; the input itself is the
+///    basis (one constant mode per window). a by Theorem 4.1 when options.max_order >= n (Walsh
+///    across windows, or Fourier on one window); with the Discrete basis and uniform shifts
+///    T_i = i T, the poles are s_k = ln(z_k)/T from z^n + p_01 z^{n-1} + .. + p_0n = 0 (ES-C1 scalar form).
+///    The numerator (nb coefficients b_0..b_{nb-1}) is linear once A(s) is known: least squares of the
+///    output on the exact responses of s^j/A(s) to the held input, from rest.
+/// fit compares the model's simulated output with the data. Throws InvalidArgument as modal_estimate,
+/// or when nb is outside [1, n], or the shifts are not uniform for the Discrete piecewise route.
+Result<TransferFunction> modal_fit(const IdData& data, int nb, ModalOptions options,
+                                  const InputGenerator* input = nullptr);
+
 /// Characteristic polynomial det(sI - M) by Newton's identities with T_k = trace(M^k) (ES 4.50 with
 /// the index fix of SEEDS-SPEC ES-C9): a_{n-1} = -T_1, a_{n-k} = -(a_{n-k+1} T_1 + ... + a_{n-1} T_{k-1} + T_k)/k.
 Polynomial newton_characteristic_polynomial(const Eigen::MatrixXd& M);
