@@ -370,6 +370,44 @@ int run_physical(const FitArgs& a, const IdData& d) {
   return finish(r, "physical-" + a.via, d, a.json);
 }
 
+// El-Shafey: modal functions (generated input with --set frequencies, or piecewise-constant input).
+int run_modal(const FitArgs& a, const IdData& d0) {
+  if (d0.nu() != 1) throw UsageError(detail::format("modal needs one input (selected {})", d0.nu()));
+  if (a.nf.size() != 1 || a.nb.size() > 1 || a.nk.size() != 1) throw UsageError("modal: one --nb, --nf and --nk value");
+  const int n = a.nf[0], nb = a.nb.empty() ? n : a.nb[0], nk = a.nk[0];
+  if (nk < 0) throw UsageError("--nk must be >= 0");
+  auto sets = parse_sets(a.sets);
+  ModalSettings ms = modal_settings(sets, d0.ts());
+  reject_unknown(sets, "modal", "shifts (samples) or shift_times (s), basis=fourier|walsh|discrete, functions, iv "
+                                "(samples), stride, quadrature, window=START,LENGTH (samples), frequencies=w1,..");
+  if (ms.options.shifts.size() != n)
+    throw UsageError(detail::format("modal needs one shift per pole: --set shifts=S1,..,S{} (samples; got {} for --nf {})",
+                                    n, ms.options.shifts.size(), n));
+  // An input delay of nk samples: fit on the delayed input (zero before the record), report it as io_delay.
+  IdData d = d0;
+  if (nk > 0) {
+    Eigen::MatrixXd u = Eigen::MatrixXd::Zero(d0.size(), 1);
+    for (int i = nk; i < d0.size(); ++i) u(i, 0) = d0.u()(i - nk, 0);
+    d = IdData(u, d0.y(), d0.ts(), d0.t0());
+    d.set_intersample(0, d0.intersample(0));
+  }
+  if (!ms.basis_given) ms.options.basis = ms.frequencies.empty() ? ModalBasis::Walsh : ModalBasis::Fourier;
+  if (!ms.functions_given && ms.options.basis == ModalBasis::Walsh) ms.options.functions = 8;
+  Result<TransferFunction> r;
+  try {
+    if (!ms.frequencies.empty()) {
+      const InputGenerator g = generator_fitted_to_input(ms.frequencies, d);
+      r = modal_fit(d, nb, ms.options, &g);
+    } else {
+      r = modal_fit(d, nb, ms.options);
+    }
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+  if (nk > 0) r.model.set_io_delay(nk * d0.ts());
+  return finish(r, "modal", d0, a.json);
+}
+
 int run(const FitArgs& a) {
   check_output_path(a.json, {a.data.path}, a.force);
   if (!a.controller.empty()) return run_closed_loop(a);
@@ -415,6 +453,7 @@ int run(const FitArgs& a) {
     if (a.via != "fsf" && a.via != "frequency" && a.via != "raw") throw UsageError("--via must be fsf, frequency or raw");
     return a.method == "fsf" ? run_fsf(a, d) : run_physical(a, d);
   }
+  if (a.method == "modal") return run_modal(a, d);
   TfOrders orders = all[0];
   if (a.delay && (a.method == "lssvf" || a.method == "ivsvf" || a.method == "rls-svf"))
     throw UsageError("--delay (delay estimation) needs --method srivc, oe or tfest");
@@ -460,8 +499,8 @@ int run(const FitArgs& a) {
 void setup_fit(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
   app.add_option("DATA", a->data.path, "CSV/.dat table (header row optional) or .mat file")->required();
-  app.add_option("--method", a->method, "Estimator: srivc, tfest, oe, lssvf, ivsvf, rls-svf, fsf or physical")
-      ->check(CLI::IsMember({"lssvf", "ivsvf", "rls-svf", "srivc", "oe", "tfest", "fsf", "physical"}))
+  app.add_option("--method", a->method, "Estimator: srivc, tfest, oe, lssvf, ivsvf, rls-svf, fsf, physical or modal")
+      ->check(CLI::IsMember({"lssvf", "ivsvf", "rls-svf", "srivc", "oe", "tfest", "fsf", "physical", "modal"}))
       ->capture_default_str();
   a->data.add_to(app, true);
   app.add_option("--nb", a->nb, "Number of numerator coefficients (default: nf); one per input with several inputs (1,2)")
@@ -475,7 +514,9 @@ void setup_fit(CLI::App& app) {
                  "weights=riemann|trapezoidal, fix.NAME=value (e.g. fix.a2=4); ivsvf also max_iterations, tolerance; "
                  "rls-svf: tau, p0, forgetting, alpha, regression_interval, fix.NAME; srivc: max_iterations, tolerance, "
                  "delay (s), delay_min, delay_max, delay_grid; oe/tfest: the same plus fix.NAME, lower.NAME, upper.NAME; "
-                 "fsf/physical: T (s), n (odd), a, b, unstable=1; physical also lower.NAME, upper.NAME, fix.NAME");
+                 "fsf/physical: T (s), n (odd), a, b, unstable=1; physical also lower.NAME, upper.NAME, fix.NAME; modal: "
+                 "shifts=S1,..,Sn (samples) or shift_times (s), basis=fourier|walsh|discrete, functions, iv (samples), "
+                 "stride, quadrature=simpson|trapezoid, window=START,LENGTH (samples), frequencies=w1,.. (generated input)");
   app.add_flag("--delay", a->delay,
                "Estimate a (non-integer) input delay (srivc, oe, tfest): grid search over [delay_min, delay_max], then "
                "refinement");

@@ -60,7 +60,20 @@ void print_result(const Result<TransferFunction>& r, const std::string& method, 
 void print_result(const Result<MisoModel>& r, const std::string& method, const IdData& data);
 void print_result(const Result<FsfModel>& r, const std::string& method, const IdData& data);
 
+/// Modal-function settings (El-Shafey) from --set: shifts (samples) or shift_times (s), basis,
+/// functions, iv (samples), stride, quadrature, window=START,LENGTH (samples), frequencies (rad/s).
+struct ModalSettings {
+  ModalOptions options;
+  std::vector<double> frequencies;  ///< a generated input: 0 = constant, w > 0 = sinusoid pair
+  bool basis_given = false, functions_given = false;
+};
+ModalSettings modal_settings(std::map<std::string, std::string>& sets, double Ts);
+/// The generator of the given frequencies with its coefficients c fitted to the measured input.
+InputGenerator generator_fitted_to_input(const std::vector<double>& frequencies, const IdData& d);
+
 void setup_fit(CLI::App& app);
+void setup_poles(CLI::App& app);
+void setup_response(CLI::App& app);
 void setup_simulate(CLI::App& app);
 void setup_validate(CLI::App& app);
 void setup_demo(CLI::App& app);

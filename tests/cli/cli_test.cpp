@@ -60,7 +60,7 @@ std::string good_csv() {
 }  // namespace
 
 TEST(Cli, HelpAndVersion) {
-  for (const char* sub : {"fit", "simulate", "validate", "demo"}) {
+  for (const char* sub : {"fit", "simulate", "validate", "demo", "poles", "response"}) {
     const CliRun r = ctid_run(std::string(sub) + " --help");
     EXPECT_EQ(r.code, 0) << sub;
     EXPECT_NE(r.out.find("--"), std::string::npos) << sub;
@@ -355,5 +355,80 @@ TEST(Cli, GawthropWangFsfAndPhysical) {
     const CliRun b = ctid_run("fit " + csv + " --time t " + c.args);
     EXPECT_EQ(b.code, 2) << c.args;
     EXPECT_NE(b.err.find(c.message), std::string::npos) << c.args << "\n" << b.err;
+  }
+}
+
+namespace {
+// El-Shafey Ex. 5.2 input (levels +1, +2, -1, -2 each 80 samples, Ts = pi/320) repeated 4 times, S3 exact.
+const TransferFunction kS3(Eigen::VectorXd{{13.0, 52.0}}, Eigen::VectorXd{{1.0, 4.0, 30.0, 52.0}});
+constexpr double kTs320 = 3.14159265358979323846 / 320;
+std::string steps_csv() {
+  const int N = 1280;
+  Eigen::VectorXd u(N);
+  const double lv[4] = {1, 2, -1, -2};
+  for (int i = 0; i < N; ++i) u(i) = lv[(i / 80) % 4];
+  Eigen::MatrixXd m(N, 2);
+  m << u, lsim(kS3, u, time_grid(kTs320, N));
+  const std::string p = test::temp_path("steps.csv");
+  write_csv(p, {"u", "y"}, m);
+  return p;
+}
+std::string ts320() { return detail::format("{}", kTs320); }
+}  // namespace
+
+TEST(Cli, ModalFitPolesAndResponses) {
+  const std::string data = steps_csv(), json = test::temp_path("modal.json");
+  fs::remove(json);
+  // fit --method modal: Walsh functions on the constant-input windows, Theorem 4.1, numerator by LS (exact data).
+  CliRun r = ctid_run("fit " + data + " --ts " + ts320() + " --method modal --nf 3 --nb 2 --set shifts=16,32,48 --json " + json);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const LinearModel m = read_model_json(json);
+  const auto& tf = std::get<TransferFunction>(m);
+  EXPECT_LT((tf.den().coefficients() - kS3.den().coefficients()).cwiseAbs().maxCoeff(), 1e-5);
+  EXPECT_NEAR(tf.num().coefficient_of_power(0), 52.0, 1e-4);
+  // response --kind step: the ES-C11 estimate written as CSV equals the true step response.
+  const std::string g = test::temp_path("g.csv");
+  fs::remove(g);
+  r = ctid_run("response " + data + " --ts " + ts320() + " --order 3 --kind step --set period=" +
+               detail::format("{}", 20 * kTs320) + " --set horizon=5 --out " + g);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const CsvTable t = read_csv(g);
+  const Eigen::VectorXd truth = step_response(kS3, t.values.col(0));
+  EXPECT_LT((t.values.col(1) - truth).cwiseAbs().maxCoeff(), 1e-8);
+  // poles: the output of this record after the last switch is not free, so use an S3 free response.
+  const int N = 400;
+  Eigen::MatrixXd fr(N, 1);
+  fr.col(0) = lsim(phase_variable_form(kS3), InputGenerator::constant(0.0), time_grid(kTs320, N), Eigen::Vector3d(1, 0, 0));
+  const std::string free = test::temp_path("free.csv");
+  write_csv(free, {"y"}, fr);
+  r = ctid_run("poles " + free + " --ts " + ts320() + " --order 3 --set shifts=20,40,60");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("s^3 + 4 s^2 + 30 s + 52"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Prony"), std::string::npos);
+}
+
+TEST(Cli, ModalBadInputs) {
+  const std::string data = steps_csv();
+  const std::string base = "fit " + data + " --ts " + ts320() + " --method modal --nf 3 ";
+  struct Case {
+    std::string args, message;
+  };
+  const std::vector<Case> cases = {
+      {base + "--set shifts=16,32", "one shift per pole"},
+      {base + "--set shifts=32,16,48", "increasing"},
+      {base + "--set shifts=16.5,32,48", "whole number of samples"},
+      {base + "--set shift_times=0.1,0.2,0.3", "not a whole multiple of the sampling period"},
+      {base + "--set shifts=16,32,48 --set basis=walsh --set functions=6", "power of two"},
+      {base + "--set shifts=16,32,48 --set basis=fourier --set functions=2 --set window=60,19", "Fourier functions for"},
+      {base + "--set shifts=16,32,48 --set basis=discrete --set window=60,2", "equations"},
+      {base + "--set shifts=16,32,48 --set colour=red", "not a setting of modal"},
+      {"poles " + data + " --ts " + ts320() + " --output y --order 3", "shifts"},
+      {"response " + data + " --ts " + ts320() + " --order 3 --kind step", "period"},
+  };
+  for (const auto& c : cases) {
+    const CliRun r = ctid_run(c.args);
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   }
 }

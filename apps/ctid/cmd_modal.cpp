@@ -1,0 +1,310 @@
+// ctid — El-Shafey's modal-function tools: shared --set parsing, `ctid poles` (free-response data
+// matrix, Theorem 4.3, against Prony) and `ctid response --method modal` (step, impulse, frequency).
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <sstream>
+
+#include "common.hpp"
+
+namespace ctid::cli {
+extern std::function<int()> g_run;
+
+namespace {
+std::vector<double> to_list(const std::string& key, const std::string& value) {
+  std::vector<double> out;
+  std::stringstream ss(value);
+  std::string item;
+  while (std::getline(ss, item, ',')) out.push_back(to_double(key, item));
+  if (out.empty()) throw UsageError("--set " + key + ": give a comma-separated list (got '" + value + "')");
+  return out;
+}
+
+int whole_samples(const std::string& key, double v) {
+  if (!(std::abs(v - std::round(v)) <= 1e-9) || v < 0)
+    throw UsageError(detail::format("--set {}: {} is not a whole number of samples", key, v));
+  return static_cast<int>(std::lround(v));
+}
+}  // namespace
+
+ModalSettings modal_settings(std::map<std::string, std::string>& sets, double Ts) {
+  ModalSettings m;
+  std::vector<double> shifts;
+  bool in_samples = false;
+  consume_sets(sets, [&](const std::string& k, const std::string& v) {
+    if (k == "shifts") {
+      shifts = to_list(k, v);
+      for (double& s : shifts) s = whole_samples(k, s) * Ts;
+      in_samples = true;
+    } else if (k == "shift_times") {
+      if (in_samples) throw UsageError("give either shifts (samples) or shift_times (seconds), not both");
+      shifts = to_list(k, v);
+    } else if (k == "basis") {
+      if (v == "fourier") m.options.basis = ModalBasis::Fourier;
+      else if (v == "walsh") m.options.basis = ModalBasis::Walsh;
+      else if (v == "discrete") m.options.basis = ModalBasis::Discrete;
+      else throw UsageError("--set basis: use fourier, walsh or discrete (got '" + v + "')");
+      m.basis_given = true;
+    } else if (k == "functions") {
+      m.options.functions = to_int(k, v);
+      m.functions_given = true;
+    }
+    else if (k == "iv") m.options.iv_shift = whole_samples(k, to_double(k, v)) * Ts;
+    else if (k == "stride") m.options.stride = to_int(k, v);
+    else if (k == "quadrature") {
+      if (v == "simpson") m.options.quadrature = Quadrature::Simpson;
+      else if (v == "trapezoid") m.options.quadrature = Quadrature::Trapezoid;
+      else throw UsageError("--set quadrature: use simpson or trapezoid (got '" + v + "')");
+    } else if (k == "window") {
+      const auto w = to_list(k, v);
+      if (w.size() != 2) throw UsageError("--set window=START,LENGTH (samples)");
+      m.options.windows = {{whole_samples(k, w[0]) * Ts, whole_samples(k, w[1]) * Ts}};
+    } else if (k == "frequencies") m.frequencies = to_list(k, v);
+    else return false;
+    return true;
+  });
+  m.options.shifts = Eigen::Map<const Eigen::VectorXd>(shifts.data(), static_cast<Eigen::Index>(shifts.size()));
+  return m;
+}
+
+InputGenerator generator_fitted_to_input(const std::vector<double>& frequencies, const IdData& d) {
+  InputGenerator g;
+  for (double w : frequencies) {
+    if (!(w >= 0)) throw UsageError(detail::format("--set frequencies: {} rad/s is not >= 0", w));
+    g = g + (w == 0 ? InputGenerator::constant(1.0) : InputGenerator::sinusoid(w, 1.0, 0.0));
+  }
+  Eigen::VectorXd t(d.size());
+  for (int i = 0; i < d.size(); ++i) t(i) = d.time(i) - d.t0();
+  const Eigen::MatrixXd X = g.basis(t);
+  const Eigen::VectorXd c = X.colPivHouseholderQr().solve(d.u().col(0));  // amplitudes from the measured input
+  return InputGenerator(g.A(), c, g.x0());
+}
+
+namespace {
+
+struct PolesArgs {
+  DataArgs data;
+  int order = 0;
+  std::vector<std::string> sets;
+};
+
+int run_poles(PolesArgs a) {
+  if (a.order < 1) throw UsageError("--order must be >= 1");
+  if (a.data.outputs.empty()) {
+    try {
+      const CsvTable tab = read_csv(a.data.path);
+      std::vector<std::string> rest;
+      for (const auto& n : tab.names)
+        if (n != a.data.time) rest.push_back(n);
+      if (rest.size() != 1) throw UsageError(a.data.path + ": choose the free-response column with --output");
+      a.data.outputs = rest;
+    } catch (const FileError& e) {
+      throw InputError(e.what());
+    }
+  }
+  a.data.inputs = a.data.outputs;  // the response only; no input is used
+  const IdData d = a.data.load(true);
+  const double Ts = d.ts();
+  const Eigen::VectorXd y = d.y().col(0);
+  auto sets = parse_sets(a.sets);
+  FreeResponseOptions o;
+  std::vector<double> shifts, gen;
+  int start = -1, interval = -1, spacing = -1, pairs = -1, p_spacing = -1, p_equations = -1, p_start = 0;
+  consume_sets(sets, [&](const std::string& k, const std::string& v) {
+    if (k == "shifts") shifts = to_list(k, v);
+    else if (k == "start") start = whole_samples(k, to_double(k, v));
+    else if (k == "interval") interval = whole_samples(k, to_double(k, v));
+    else if (k == "spacing") spacing = whole_samples(k, to_double(k, v));
+    else if (k == "pairs") pairs = to_int(k, v);
+    else if (k == "generator") gen = to_list(k, v);
+    else if (k == "quadrature") o.quadrature = v == "trapezoid" ? Quadrature::Trapezoid : Quadrature::Simpson;
+    else if (k == "prony_spacing") p_spacing = whole_samples(k, to_double(k, v));
+    else if (k == "prony_equations") p_equations = to_int(k, v);
+    else if (k == "prony_start") p_start = whole_samples(k, to_double(k, v));
+    else return false;
+    return true;
+  });
+  if (!sets.empty())
+    throw UsageError("--set " + sets.begin()->first + ": not a setting of poles (settings: shifts (samples), start, "
+                     "interval, spacing, pairs, generator (rad/s list), quadrature, prony_spacing, prony_equations, "
+                     "prony_start)");
+  InputGenerator g;
+  for (double w : gen) g = g + (w == 0 ? InputGenerator::constant(1.0) : InputGenerator::sinusoid(w, 1.0));
+  const int n_aug = a.order + g.order();
+  if (shifts.empty()) throw UsageError(detail::format("poles needs --set shifts=S1,..,S{} (samples; one per pole{})", n_aug,
+                                                      g.order() ? " of the system and of the generator" : ""));
+  if (static_cast<int>(shifts.size()) != n_aug)
+    throw UsageError(detail::format("--set shifts has {} values; order {} {} needs {}", shifts.size(), a.order,
+                                    g.order() ? "plus the generator's modes" : "", n_aug));
+  o.shifts.resize(n_aug);
+  int max_shift = 0;
+  for (int i = 0; i < n_aug; ++i) {
+    const int s = whole_samples("shifts", shifts[i]);
+    o.shifts(i) = s * Ts;
+    max_shift = std::max(max_shift, s);
+  }
+  if (interval < 0) interval = std::max(2, whole_samples("shifts", shifts[0]));
+  if (spacing < 0) spacing = interval;
+  if (start < 0) start = max_shift;
+  if (pairs < 0) pairs = (d.size() - 1 - start - interval) / spacing + 1;
+  o.start = start * Ts;
+  o.interval = interval * Ts;
+  o.spacing = spacing * Ts;
+  o.pairs = pairs;
+  if (g.order()) o.generator = g.characteristic_polynomial();
+  PoleEstimate dm;
+  try {
+    dm = free_response_poles(y, Ts, o);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+  auto print = [](const char* title, const PoleEstimate& p) {
+    std::printf("%s\n  characteristic polynomial: %s\n  poles:", title, p.characteristic.to_string("s", 6).c_str());
+    for (auto z : p.poles) std::printf("  %.6g%+.6gj", z.real(), z.imag());
+    std::printf("\n  condition number: %.4g\n", p.condition);
+    for (const auto& w : p.warnings) std::printf("  warning: %s\n", w.c_str());
+  };
+  std::printf("free response: %d samples, Ts = %.6g s, order %d\n", d.size(), Ts, a.order);
+  print("data-matrix method (Theorem 4.3, El-Shafey 1987):", dm);
+  if (g.order()) std::printf("  before deflation by the generator: %s\n", dm.augmented.to_string("s", 6).c_str());
+  if (p_spacing < 0) p_spacing = whole_samples("shifts", shifts[0]);
+  if (p_equations < 0) p_equations = (d.size() - 1 - p_start) / std::max(1, p_spacing) - n_aug + 1;
+  try {
+    const PoleEstimate pr = prony(y, Ts, {.order = n_aug, .spacing = p_spacing, .equations = p_equations, .start = p_start});
+    print(detail::format("Prony (order {}, T = {} samples, {} equations):", n_aug, p_spacing, p_equations).c_str(), pr);
+  } catch (const InvalidArgument& e) {
+    std::printf("Prony: not computed (%s)\n", e.what());
+  }
+  return kOk;
+}
+
+struct ResponseArgs {
+  DataArgs data;
+  std::string method = "modal", kind = "step", out;
+  int order = 0;
+  std::vector<std::string> sets;
+  bool force = false;
+};
+
+int run_response(const ResponseArgs& a) {
+  check_output_path(a.out, {a.data.path}, a.force);
+  if (a.order < 1) throw UsageError("--order must be >= 1");
+  const IdData d = a.data.load(true);
+  if (d.nu() != 1 || d.ny() != 1) throw UsageError("response needs one --input and one --output");
+  const double Ts = d.ts();
+  auto sets = parse_sets(a.sets);
+  double period = 0, horizon = 0, window_start = -1;
+  std::vector<double> harmonics_d;
+  consume_sets(sets, [&](const std::string& k, const std::string& v) {
+    if (k == "period") period = to_double(k, v);
+    else if (k == "horizon") horizon = to_double(k, v);
+    else if (k == "harmonics") harmonics_d = to_list(k, v);
+    else if (k == "window_start") window_start = to_double(k, v);
+    else return false;
+    return true;
+  });
+  ModalSettings ms = modal_settings(sets, Ts);
+  if (!sets.empty())
+    throw UsageError("--set " + sets.begin()->first + ": not a setting of response --method modal (settings: period, "
+                     "horizon, harmonics, window_start, shifts, shift_times, basis, functions, iv, quadrature)");
+  if (!(period > 0)) throw UsageError("response --method modal needs --set period=SECONDS (level period for step/impulse, "
+                                      "input period for frequency)");
+  if (ms.options.shifts.size() == 0) {  // default: shifts i T (step/impulse) or i Ts * period/(n+1) (frequency)
+    ms.options.shifts.resize(a.order);
+    const double base = a.kind == "frequency" ? std::round(period / (a.order + 1) / Ts) * Ts : period;
+    for (int i = 0; i < a.order; ++i) ms.options.shifts(i) = (i + 1) * base;
+  }
+  if (ms.options.shifts.size() != a.order)
+    throw UsageError(detail::format("{} shifts for --order {}", ms.options.shifts.size(), a.order));
+  if (!ms.basis_given) ms.options.basis = ModalBasis::Discrete;
+  const double Tn = ms.options.shifts.maxCoeff();
+  try {
+    // p_0 from the constant-input windows (piecewise-constant input).
+    ModalOptions o = ms.options;
+    o.max_order = 0;
+    if (o.windows.empty()) o.windows = piecewise_constant_windows(d, Tn, Ts);
+    if (o.windows.empty()) throw UsageError("the input never stays constant for longer than T_n: no validity windows");
+    const Result<ModalModel> m = modal_estimate(d, d.u(), o);
+    std::printf("modal parameters p_0:");
+    for (int i = 0; i < a.order; ++i) std::printf(" %.6g", m.model.P()(0, i));
+    std::printf("   (shifts");
+    for (int i = 0; i < a.order; ++i) std::printf(" %.6g", ms.options.shifts(i));
+    std::printf(" s)");
+    std::printf("   (%zu windows, condition %.3g)\n", o.windows.size(), m.diagnostics.condition_number);
+    if (a.kind == "frequency") {
+      std::vector<int> h;
+      for (double x : harmonics_d.empty() ? std::vector<double>{1, 3, 5, 7, 9} : harmonics_d)
+        h.push_back(whole_samples("harmonics", x));
+      const HarmonicResponse r =
+          modal_frequency_response(d, m.model, period, h, window_start >= 0 ? window_start : Tn, ms.options.quadrature);
+      const FrequencyData& f = r.response;
+      Eigen::MatrixXd tab(f.size(), 5);
+      for (int i = 0; i < f.size(); ++i) {
+        const auto G = f.response()(i);
+        tab.row(i) << f.w()(i), G.real(), G.imag(), std::abs(G), std::arg(G) * 180 / 3.14159265358979;
+        std::printf("  w = %-10.5g  H = %.6g %+.6gj   |H| = %.6g  phase = %.4g deg\n", f.w()(i), G.real(), G.imag(),
+                    std::abs(G), tab(i, 4));
+      }
+      if (!a.out.empty()) write_csv(a.out, {"w", "re", "im", "mag", "phase_deg"}, tab);
+    } else {
+      const double hz = horizon > 0 ? horizon : 10 * period * (a.order + 1);
+      TimeResponse g = modal_step_response(d, m.model, period, hz);
+      const char* name = "step";
+      if (a.kind == "impulse") {
+        // Negative shifts -i T and Fourier functions on the first half of the horizon (ES 5.38-5.42).
+        const Eigen::VectorXd neg = -ms.options.shifts;
+        const double To = std::floor((hz - Tn) / 2 / Ts) * Ts;
+        g = modal_impulse_from_step(g, neg, To, std::max(6, 2 * ((a.order + 2) / 2)), ms.options.quadrature).impulse;
+        name = "impulse";
+      }
+      const int K = static_cast<int>(g.t.size());
+      for (int i = 0; i < K; i += std::max(1, K / 20)) std::printf("  t = %-10.5g  %s = %.6g\n", g.t(i), name, g.value(i));
+      if (!a.out.empty()) {
+        Eigen::MatrixXd tab(K, 2);
+        tab << g.t, g.value;
+        write_csv(a.out, {"t", name}, tab);
+      }
+    }
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+  if (!a.out.empty()) std::printf("wrote %s\n", a.out.c_str());
+  return kOk;
+}
+
+}  // namespace
+
+void setup_poles(CLI::App& app) {
+  auto a = std::make_shared<PolesArgs>();
+  app.add_option("DATA", a->data.path, "CSV/.dat table or .mat file holding a free (or generated-input) response")
+      ->required();
+  a->data.add_to(app, true);
+  app.add_option("--order", a->order, "Number of system poles n")->required();
+  app.add_option("--set", a->sets,
+                 "KEY=VALUE: shifts=S1,..,Sn (samples; n + generator modes), start, interval, spacing (samples), pairs, "
+                 "generator=w1,.. (rad/s; 0 = constant) for a forced response, quadrature=simpson|trapezoid, "
+                 "prony_spacing, prony_equations, prony_start");
+  app.callback([a] { g_run = [a] { return run_poles(*a); }; });
+}
+
+void setup_response(CLI::App& app) {
+  auto a = std::make_shared<ResponseArgs>();
+  app.add_option("DATA", a->data.path, "CSV/.dat table or .mat file")->required();
+  app.add_option("--method", a->method, "Estimator of the response: modal (El-Shafey)")
+      ->check(CLI::IsMember({"modal"}))
+      ->capture_default_str();
+  app.add_option("--kind", a->kind, "step, impulse or frequency")
+      ->check(CLI::IsMember({"step", "impulse", "frequency"}))
+      ->capture_default_str();
+  a->data.add_to(app, true);
+  app.add_option("--order", a->order, "System order n")->required();
+  app.add_option("--set", a->sets,
+                 "KEY=VALUE: period (s; level period of a piecewise-constant input, or the input period for "
+                 "frequency), horizon (s), harmonics=1,3,5, window_start (s), shifts (samples), shift_times (s), "
+                 "basis, iv, quadrature");
+  app.add_option("--out", a->out, "Write the response to this CSV file");
+  app.add_flag("--force", a->force, "Overwrite an existing output file");
+  app.callback([a] { g_run = [a] { return run_response(*a); }; });
+}
+
+}  // namespace ctid::cli
