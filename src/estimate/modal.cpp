@@ -197,6 +197,7 @@ Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& inp
     const double To = total * Ts, wo = 2 * std::numbers::pi / To;
     Eigen::MatrixXd RF = Eigen::MatrixXd::Zero(F, p);
     Eigen::VectorXd zF = Eigen::VectorXd::Zero(F), f(F);
+    Eigen::RowVectorXd row(p);
     int offset = 0;
     for (const auto& s : sw) {
       const Eigen::VectorXd wq = quadrature_weights(s.K, Ts, o.quadrature);
@@ -207,7 +208,8 @@ Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& inp
           f(m + h - 1) = std::cos(h * wo * tau);
         }
         f *= wq(k);
-        RF.noalias() += f * reg.row(s.i0 + k);
+        reg(s.i0 + k, row.data());
+        RF.noalias() += f * row;
         zF += f * y(s.i0 + k);
       }
       offset += s.K;
@@ -247,10 +249,12 @@ Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& inp
       Eigen::MatrixXd RB = Eigen::MatrixXd::Zero(NW, p);
       Eigen::VectorXd zB = Eigen::VectorXd::Zero(NW);
       Rdiff[w].resize(NW, p);
+      Eigen::RowVectorXd row(p);
       for (int blk = 0; blk < NW; ++blk) {
         const int first = s.i0 + blk * kb;
         for (int k = 0; k <= kb; ++k) {
-          RB.row(blk) += wq(k) * reg.row(first + k);
+          reg(first + k, row.data());
+          RB.row(blk) += wq(k) * row;
           zB(blk) += wq(k) * y(first + k);
         }
         Rdiff[w].row(blk) = reg.row(first) - reg.row(first + kb);  // R_d^- - R_d^+ (left minus right edges)

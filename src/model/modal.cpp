@@ -69,7 +69,19 @@ Eigen::MatrixXd InputGenerator::basis(const Eigen::VectorXd& t) const {
   CTID_REQUIRE(order() >= 1, "InputGenerator: empty generator");
   CTID_REQUIRE(t.allFinite(), "InputGenerator::basis: non-finite time");
   Eigen::MatrixXd X(t.size(), order());
-  for (Eigen::Index i = 0; i < t.size(); ++i) X.row(i) = (Eigen::MatrixXd(A_ * t(i)).exp() * x0_).transpose();
+  // Uniform grids: steps by Phi = e^{A h}, re-anchored by an exact exponential every 1024 samples so
+  // that round-off cannot accumulate; other grids: one exponential per time.
+  const Eigen::Index N = t.size();
+  const double h = N > 1 ? t(1) - t(0) : 0.0;
+  bool uniform = N > 2 && h > 0;
+  for (Eigen::Index i = 2; uniform && i < N; ++i) uniform = std::abs(t(i) - t(i - 1) - h) <= 1e-12 * std::max(1.0, std::abs(t(i)));
+  const Eigen::MatrixXd Phi = uniform ? Eigen::MatrixXd(Eigen::MatrixXd(A_ * h).exp()) : Eigen::MatrixXd();
+  Eigen::VectorXd x;
+  for (Eigen::Index i = 0; i < N; ++i) {
+    if (!uniform || i % 1024 == 0) x = Eigen::MatrixXd(A_ * t(i)).exp() * x0_;
+    else x = Phi * x;
+    X.row(i) = x.transpose();
+  }
   return X;
 }
 

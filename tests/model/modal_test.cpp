@@ -166,3 +166,18 @@ TEST(ModalParameters, BadInputs) {
                InvalidArgument);
   EXPECT_THROW(InputGenerator::sinusoid(0.0, 1.0), InvalidArgument);
 }
+
+TEST(InputGenerator, BasisOnUniformGridsEqualsTheClosedForm) {
+  // Uniform grids step by e^{A h} with exact re-anchoring every 1024 samples; compare with the closed form.
+  const InputGenerator g = InputGenerator::sinusoid(3.0, 1.0, 0.5, -0.1) + InputGenerator::constant(2.0);
+  const int N = 5000;
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(N, 0.0, (N - 1) * 0.01);
+  const Eigen::MatrixXd X = g.basis(t);
+  for (int i = 0; i < N; i += 7) {
+    EXPECT_NEAR(X(i, 0), std::exp(-0.1 * t(i)) * std::sin(3 * t(i)), 1e-12);
+    EXPECT_NEAR(X(i, 1), std::exp(-0.1 * t(i)) * std::cos(3 * t(i)), 1e-12);
+    EXPECT_NEAR(X(i, 2), 1.0, 1e-12);
+  }
+  EXPECT_NEAR(g(t)(100), X(100, 0) + 0.5 * X(100, 1) + 2.0, 1e-14);
+  EXPECT_EQ(g.characteristic_polynomial().degree(), 3);
+}
