@@ -122,6 +122,33 @@ ModalParameters modal_parameters(const TransferFunction& tf, const Eigen::Vector
   return modal_parameters(phase_variable_form(tf), shifts, max_order);
 }
 
+ShiftChoice choose_modal_shifts(const TransferFunction& prior, double Ts, double max_shift) {
+  const StateSpace pv = phase_variable_form(prior);
+  const int n = pv.nx();
+  CTID_REQUIRE(std::isfinite(Ts) && Ts > 0, "choose_modal_shifts: Ts must be > 0 (got {})", Ts);
+  const int kmax = static_cast<int>(std::floor(max_shift / (n * Ts) + 1e-9));
+  CTID_REQUIRE(kmax >= 1, "choose_modal_shifts: max_shift = {} s is shorter than n Ts = {} s", max_shift, n * Ts);
+  ShiftChoice c;
+  c.spacings.resize(kmax);
+  c.conditions.resize(kmax);
+  const Eigen::RowVectorXd cr = pv.C().row(0);
+  Eigen::MatrixXd psi(n, n);
+  int best = -1;
+  for (int k = 1; k <= kmax; ++k) {
+    const double d = k * Ts;
+    const Eigen::MatrixXd E = Eigen::MatrixXd(-pv.A() * d).exp();  // e^{-A i d} = E^i
+    Eigen::RowVectorXd row = cr;
+    for (int i = 0; i < n; ++i) psi.row(i) = row = row * E;
+    c.spacings(k - 1) = d;
+    c.conditions(k - 1) = condition_2(psi);
+    if (std::isfinite(c.conditions(k - 1)) && (best < 0 || c.conditions(k - 1) < c.conditions(best))) best = k - 1;
+  }
+  CTID_REQUIRE(best >= 0, "choose_modal_shifts: psi is singular for every spacing up to {} s", max_shift / n);
+  c.condition = c.conditions(best);
+  c.shifts = Eigen::VectorXd::LinSpaced(n, 1, n) * c.spacings(best);
+  return c;
+}
+
 StateSpace phase_variable_form(const TransferFunction& tf) {
   const int n = tf.order();
   CTID_REQUIRE(n >= 1, "phase_variable_form: the transfer function has no poles");

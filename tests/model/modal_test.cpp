@@ -181,3 +181,15 @@ TEST(InputGenerator, BasisOnUniformGridsEqualsTheClosedForm) {
   EXPECT_NEAR(g(t)(100), X(100, 0) + 0.5 * X(100, 1) + 2.0, 1e-14);
   EXPECT_EQ(g.characteristic_polynomial().degree(), 3);
 }
+
+TEST(ModalParameters, ShiftHelperMinimisesTheConditionOfPsi) {
+  // S3 sampled at pi/420 with shifts up to 3 x 120 Ts: the chosen spacing's cond(psi) is the minimum of the
+  // scanned curve and no larger than that of the thesis' choice 40 Ts (cond 132.7, printed by the example).
+  const double Ts = kPi / 420;
+  const ShiftChoice c = choose_modal_shifts(kS3, Ts, 360 * Ts);
+  EXPECT_EQ(c.spacings.size(), 120);
+  EXPECT_DOUBLE_EQ(c.condition, c.conditions.minCoeff());
+  EXPECT_LE(c.condition, modal_parameters(kS3, Eigen::Vector3d(40 * Ts, 80 * Ts, 120 * Ts), 0).condition + 1e-9);
+  EXPECT_GT(c.conditions(0), 100 * c.condition);  // one-sample spacing: psi nearly singular
+  EXPECT_THROW(choose_modal_shifts(kS3, Ts, 2 * Ts), InvalidArgument);
+}

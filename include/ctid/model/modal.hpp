@@ -72,6 +72,21 @@ ModalParameters modal_parameters(const StateSpace& sys, const Eigen::VectorXd& s
 /// Same for a strictly proper transfer function (through its phase-variable form).
 ModalParameters modal_parameters(const TransferFunction& tf, const Eigen::VectorXd& shifts, int max_order);
 
+/// Result of choose_modal_shifts: the chosen uniform shifts and the conditioning curve.
+struct ShiftChoice {
+  Eigen::VectorXd shifts;      ///< T_i = i * spacing, i = 1..n
+  double condition = 0.0;      ///< cond(psi) at the chosen spacing
+  Eigen::VectorXd spacings;    ///< every candidate spacing (seconds)
+  Eigen::VectorXd conditions;  ///< cond(psi) at each candidate (inf where psi is singular)
+};
+
+/// Helper for choosing modal time shifts (ES tunables: "affects conditioning of psi"): uniform shifts
+/// T_i = i * spacing with spacing a multiple of Ts up to max_shift / n, picking the spacing that
+/// minimises cond(psi) for a prior model (a first estimate, e.g. from srivc or prony). Short spacings
+/// make psi nearly singular (the shifted outputs are nearly equal); spacings near 2 pi / (mode
+/// frequency differences) alias modes. Throws InvalidArgument for Ts <= 0 or max_shift < n Ts.
+ShiftChoice choose_modal_shifts(const TransferFunction& prior, double Ts, double max_shift);
+
 /// Phase-variable (observable canonical) form of ES 2.11: A companion with ones on the
 /// super-diagonal and last row [-a_0 ... -a_{n-1}], c = e_1, b = the Markov parameters b~
 /// (b~_k = k-th coefficient of H(s) = sum b~_k s^{-k}); the state is x~_1 = y,
