@@ -415,9 +415,10 @@ TEST(ModalResponses, Tables51And52FrequencyResponseFromASquareWave) {
     EXPECT_NEAR(h.nu(k, 1), table(k, 1), 1e-4) << "harmonic " << 2 * k + 1;
     EXPECT_NEAR(h.q(k, 0), table(k, 2), 1e-4) << "harmonic " << 2 * k + 1;
     EXPECT_NEAR(h.q(k, 1), table(k, 3), 1e-4) << "harmonic " << 2 * k + 1;
-    // Table 5.2: H(jk) against the true frequency response (Simpson on y_0 at 840 samples per period).
+    // Table 5.2: H(jk) against the true frequency response (Simpson on y_0 at 840 samples per period:
+    // measured relative error <= 5.9e-7).
     const std::complex<double> truth = kS3(std::complex<double>(0, 2 * k + 1));
-    EXPECT_LT(std::abs(h.response.response()(k) - truth), 2e-4) << "harmonic " << 2 * k + 1;
+    EXPECT_LT(std::abs(h.response.response()(k) - truth), 2e-6 * std::abs(truth)) << "harmonic " << 2 * k + 1;
   }
   // Table 5.2 follows from Table 5.1 by ES 5.14 (algebraic consistency from the published 4-digit numbers, ~1 %).
   const double nu1 = -0.9008, nu2 = 0.3559, q1 = -0.4778, q2 = 0.8423;  // k = 3, published
