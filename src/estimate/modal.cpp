@@ -359,6 +359,18 @@ Result<TransferFunction> modal_fit(const IdData& data, int nb, ModalOptions o, c
                "the largest shift, plus the Walsh blocks): no validity windows", o.shifts(n - 1));
   if (o.basis != ModalBasis::Discrete) o.max_order = std::max(o.max_order, n);
   const Result<ModalModel> m = modal_estimate(data, data.u(), o);
+  Result<TransferFunction> r;
+  r.diagnostics = m.diagnostics;
+  r.diagnostics.scalars["windows"] = static_cast<double>(o.windows.size());
+  r.summary = m.summary;
+  auto failed = [&](const std::string& why) {
+    r.summary.termination = Termination::RankDeficient;
+    r.summary.message = why;
+    r.fit = fit_report_or_inf(data.y().col(0), Eigen::VectorXd::Constant(data.size(), NAN), n + nb);
+    r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+    return r;
+  };
+  if (m.summary.termination == Termination::RankDeficient) return failed(m.summary.message);
   Polynomial den;
   if (m.model.max_order() >= n) {
     den = m.model.characteristic_polynomial();  // Theorem 4.1
@@ -370,6 +382,9 @@ Result<TransferFunction> modal_fit(const IdData& data, int nb, ModalOptions o, c
     Eigen::VectorXd zc(n + 1);
     zc << 1.0, m.model.P().row(0).transpose();
     const Eigen::VectorXcd z = Polynomial(zc).roots();
+    for (int k = 0; k < n; ++k)
+      if (!(std::abs(z(k)) > 1e-300))
+        return failed("a root of z^n + p_01 z^(n-1) + .. + p_0n is at z = 0: no finite pole (p_0n = 0)");
     Eigen::VectorXcd e = Eigen::VectorXcd::Zero(n + 1);
     e(0) = 1.0;
     for (int k = 0; k < n; ++k) {
@@ -386,7 +401,6 @@ Result<TransferFunction> modal_fit(const IdData& data, int nb, ModalOptions o, c
     X.col(j) = lsim(TransferFunction(Polynomial(num), den), data, 0);
   }
   const internal::LinearSolution sol = least_squares(X, data.y().col(0));
-  Result<TransferFunction> r;
   Eigen::VectorXd numc(nb);
   for (int j = 0; j < nb; ++j) numc(j) = sol.theta(nb - 1 - j);
   r.model = TransferFunction(Polynomial(numc), den);
@@ -398,9 +412,6 @@ Result<TransferFunction> modal_fit(const IdData& data, int nb, ModalOptions o, c
   r.parameters.std = Eigen::VectorXd::Constant(n + nb, std::numeric_limits<double>::quiet_NaN());
   r.parameters.std.tail(nb) = sol.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();  // given A(s)
   r.parameters.fixed.assign(n + nb, false);
-  r.diagnostics = m.diagnostics;
-  r.diagnostics.scalars["windows"] = static_cast<double>(o.windows.size());
-  r.summary = m.summary;
   if (!r.model.is_stable()) r.diagnostics.warnings.push_back("the estimated model is unstable");
   r.fit = fit_report_or_inf(data.y().col(0), lsim(r.model, data, 0), n + nb);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();

@@ -405,6 +405,14 @@ TEST(Cli, ModalFitPolesAndResponses) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("s^3 + 4 s^2 + 30 s + 52"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("Prony"), std::string::npos);
+  // A record without output excitation: the modal regression is singular -> not usable (exit 1), named.
+  Eigen::MatrixXd zero(400, 2);
+  zero << Eigen::VectorXd::LinSpaced(400, -1, 1).array().sign().matrix(), Eigen::VectorXd::Zero(400);
+  const std::string z = test::temp_path("zero.csv");
+  write_csv(z, {"u", "y"}, zero);
+  r = ctid_run("fit " + z + " --ts " + ts320() + " --method modal --nf 3 --set shifts=16,32,48 --set basis=discrete");
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("rank deficient"), std::string::npos) << r.err;
 }
 
 TEST(Cli, ModalBadInputs) {

@@ -95,3 +95,18 @@ TEST(Lsim, BadInputsAreReported) {
   EXPECT_THROW(lsim(kFirst, Eigen::VectorXd::Ones(10), tb), InvalidArgument);
   EXPECT_THROW(discretize(Eigen::MatrixXd{{-1.0}}, Eigen::MatrixXd{{1.0}}, 0.0), InvalidArgument);
 }
+
+TEST(Lsim, GeneratedInputIsSimulatedExactly) {
+  // 1/(s + 2) driven by sin 3t from rest: y = (3 e^{-2t} + 2 sin 3t - 3 cos 3t)/13 (closed form).
+  const StateSpace ss = TransferFunction(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 2.0}}).to_state_space();
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(301, 0.0, 6.0);
+  const Eigen::VectorXd y = lsim(ss, InputGenerator::sinusoid(3.0, 1.0), t);
+  for (Eigen::Index i = 0; i < t.size(); ++i)
+    EXPECT_NEAR(y(i), (3 * std::exp(-2 * t(i)) + 2 * std::sin(3 * t(i)) - 3 * std::cos(3 * t(i))) / 13, 1e-12);
+  // Irregular times and an initial state: x(0) = 1 adds e^{-2t}.
+  const Eigen::VectorXd ti{{0.0, 0.1, 0.35, 1.2, 2.0}};
+  const Eigen::VectorXd yi = lsim(ss, InputGenerator::constant(0.0), ti, Eigen::VectorXd::Ones(1));
+  for (Eigen::Index i = 0; i < ti.size(); ++i)
+    EXPECT_NEAR(yi(i), std::exp(-2 * ti(i)) * (ss.C() * Eigen::VectorXd::Ones(1))(0), 1e-12);
+  EXPECT_THROW(lsim(ss, InputGenerator::constant(1.0), Eigen::Vector2d(1.0, 0.5)), InvalidArgument);
+}
