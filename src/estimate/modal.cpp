@@ -1,5 +1,5 @@
 // El-Shafey (1987): modal-parameter estimation (ES-C3, C4, C5), Theorems 4.1/4.2 (ES-C8), poles from a
-// free-response data matrix and Prony (ES-C9). See include/ctid/estimate/modal.hpp.
+// free-response data matrix and Prony (ES-C9), nonparametric responses (ES-C10, C11, C12) and modal_fit.
 #include "ctid/estimate/modal.hpp"
 
 #include <algorithm>
@@ -48,6 +48,33 @@ struct Regressor {
     Eigen::RowVectorXd r(p());
     (*this)(i, r.data());
     return r;
+  }
+};
+
+// Fourier modulating functions f = [sin(w tau) .. sin(m w tau), cos(w tau) .. cos(m w tau)] (ES 3.11 ff.):
+// D f = Omega f with Omega = [[0, Omega'], [-Omega', 0]], Omega' = diag(w, 2w, .., m w) (ES 3.25, missing
+// in the OCR), and f(0) = f(T_o) = [0 .. 0, 1 .. 1].
+struct FourierFunctions {
+  int m;
+  double w;
+  void operator()(double tau, Eigen::VectorXd& f) const {
+    for (int h = 1; h <= m; ++h) {
+      f(h - 1) = std::sin(h * w * tau);
+      f(m + h - 1) = std::cos(h * w * tau);
+    }
+  }
+  Eigen::MatrixXd omega() const {
+    Eigen::MatrixXd Om = Eigen::MatrixXd::Zero(2 * m, 2 * m);
+    for (int h = 1; h <= m; ++h) {
+      Om(h - 1, m + h - 1) = h * w;
+      Om(m + h - 1, h - 1) = -h * w;
+    }
+    return Om;
+  }
+  Eigen::VectorXd at_zero() const {
+    Eigen::VectorXd f0 = Eigen::VectorXd::Zero(2 * m);
+    f0.tail(m).setOnes();
+    return f0;
   }
 };
 
@@ -194,7 +221,7 @@ Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& inp
                  F, p + (J > 0 ? 1 : 0), n, nc, J > 0 ? " + c" : "");
     int total = 0;
     for (const auto& s : sw) total += s.K;
-    const double To = total * Ts, wo = 2 * std::numbers::pi / To;
+    const FourierFunctions ff{m, 2 * std::numbers::pi / (total * Ts)};
     Eigen::MatrixXd RF = Eigen::MatrixXd::Zero(F, p);
     Eigen::VectorXd zF = Eigen::VectorXd::Zero(F), f(F);
     Eigen::RowVectorXd row(p);
@@ -202,11 +229,7 @@ Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& inp
     for (const auto& s : sw) {
       const Eigen::VectorXd wq = quadrature_weights(s.K, Ts, o.quadrature);
       for (int k = 0; k <= s.K; ++k) {
-        const double tau = (offset + k) * Ts;
-        for (int h = 1; h <= m; ++h) {
-          f(h - 1) = std::sin(h * wo * tau);
-          f(m + h - 1) = std::cos(h * wo * tau);
-        }
+        ff((offset + k) * Ts, f);
         f *= wq(k);
         reg(s.i0 + k, row.data());
         RF.noalias() += f * row;
@@ -215,15 +238,8 @@ Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& inp
       offset += s.K;
     }
     store(0, least_squares(RF, zF));  // R_F theta' = z_F, theta = -theta'
-    // D f = Omega f, Omega = [[0, Omega'], [-Omega', 0]], Omega' = diag(wo, 2 wo, .., m wo) (ES 3.25);
-    // f(0) = f(T_o) = [0 .. 0, 1 .. 1].
-    Eigen::MatrixXd Om = Eigen::MatrixXd::Zero(F, F);
-    for (int h = 1; h <= m; ++h) {
-      Om(h - 1, m + h - 1) = h * wo;
-      Om(m + h - 1, h - 1) = -h * wo;
-    }
-    Eigen::VectorXd f0 = Eigen::VectorXd::Zero(F);
-    f0.tail(m).setOnes();
+    const Eigen::MatrixXd Om = ff.omega();
+    const Eigen::VectorXd f0 = ff.at_zero();
     Eigen::MatrixXd Aj(F, p + 1);
     Aj << -RF, -f0;
     Eigen::VectorXd zhat = zF;
@@ -611,6 +627,15 @@ HarmonicResponse modal_frequency_response(const IdData& data, const ModalModel& 
   return r;
 }
 
+Eigen::MatrixXd modal_delta_l(const Eigen::RowVectorXd& p0) {
+  const int n = static_cast<int>(p0.size());
+  Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n + 1, n + 1), D = Eigen::MatrixXd::Identity(n + 1, n + 1);
+  for (int c = 0; c <= n; ++c)
+    for (int r = c; r <= n; ++r) L(r, c) = r == c ? 1.0 : p0(r - c - 1);
+  for (int r = 1; r <= n; ++r) D(r, r - 1) = -1.0;
+  return D * L;
+}
+
 TimeResponse modal_step_response(const IdData& data, const ModalModel& model, double level_period, double horizon) {
   CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "modal_step_response: needs one input and one output (got {}, {})",
                data.nu(), data.ny());
@@ -640,12 +665,7 @@ TimeResponse modal_step_response(const IdData& data, const ModalModel& model, do
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(U);
   CTID_REQUIRE(qr.rank() == n + 1, "modal_step_response: the input level sequences [u(k) .. u(k-{})] span only {} of {} "
                "dimensions; use more distinct levels", n, qr.rank(), n + 1);
-  // Delta L: Delta lower bidiagonal (1, -1), L lower-triangular Toeplitz with first column [1, p_01 .. p_0n].
-  Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n + 1, n + 1), D = Eigen::MatrixXd::Identity(n + 1, n + 1);
-  for (int c = 0; c <= n; ++c)
-    for (int r = c; r <= n; ++r) L(r, c) = r == c ? 1.0 : p0(r - c - 1);
-  for (int r = 1; r <= n; ++r) D(r, r - 1) = -1.0;
-  const Eigen::MatrixXd DL = D * L;  // lower triangular, unit diagonal
+  const Eigen::MatrixXd DL = modal_delta_l(p0.transpose());  // lower triangular, unit diagonal
   const int steps = static_cast<int>(std::floor(horizon / Ts + 1e-9));
   const int blocks = std::max(n + 1, steps / m + 1);  // g(s + i T), i = 0..blocks-1
   Eigen::MatrixXd G(m, blocks);
@@ -701,29 +721,21 @@ ImpulseFromStep modal_impulse_from_step(const TimeResponse& step, const Eigen::V
                "needs the step response up to {} s (it ends at {} s)", To, L.maxCoeff() * h, (K + L.maxCoeff()) * h,
                (S - 1) * h);
   const int m = functions / 2;
-  const double wo = 2 * std::numbers::pi / To;
+  const FourierFunctions ff{m, 2 * std::numbers::pi / To};
   const Eigen::VectorXd wq = quadrature_weights(K, h, rule);
   const Eigen::VectorXd& g = step.value;
   Eigen::MatrixXd R = Eigen::MatrixXd::Zero(functions, n);
   Eigen::VectorXd zg = Eigen::VectorXd::Zero(functions), f(functions), ints = Eigen::VectorXd::Zero(n);
   for (int k = 0; k <= K; ++k) {
-    for (int j = 1; j <= m; ++j) {
-      f(j - 1) = std::sin(j * wo * k * h);
-      f(m + j - 1) = std::cos(j * wo * k * h);
-    }
+    ff(k * h, f);
     for (int i = 0; i < n; ++i) {
       R.col(i) += wq(k) * g(k + L(i)) * f;
       ints(i) += wq(k) * g(k + L(i));
     }
     zg += wq(k) * g(k) * f;
   }
-  Eigen::MatrixXd Om = Eigen::MatrixXd::Zero(functions, functions);
-  for (int j = 1; j <= m; ++j) {
-    Om(j - 1, m + j - 1) = j * wo;
-    Om(m + j - 1, j - 1) = -j * wo;
-  }
-  Eigen::VectorXd f0 = Eigen::VectorXd::Zero(functions);
-  f0.tail(m).setOnes();
+  const Eigen::MatrixXd Om = ff.omega();
+  const Eigen::VectorXd f0 = ff.at_zero();
   // -int g Df + g(T_o) f(T_o) - g(0) f(0) + sum_i p_1i int g(t - T_i) f = q_10 int f = 0.
   Eigen::MatrixXd A(functions, n + 1);
   A << R, f0;

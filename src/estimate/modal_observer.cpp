@@ -95,10 +95,7 @@ DeadbeatObserver DeadbeatObserver::from_step_response(const ModalModel& model, c
   o.Ts_ = Ts;
   o.P_ = model.P().topRows(n);
   const Eigen::RowVectorXd p0 = o.P_.row(0);
-  Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n + 1, n + 1);
-  for (int c = 0; c <= n; ++c)
-    for (int r = c; r <= n; ++r) L(r, c) = r == c ? 1.0 : p0(r - c - 1);
-  const Eigen::MatrixXd DL = delta(n) * L;
+  const Eigen::MatrixXd DL = modal_delta_l(p0);
   const Eigen::PartialPivLU<Eigen::MatrixXd> lu(delta(n).transpose() * gamma(p0));
   std::vector<Eigen::VectorXd> r(m);
   for (int off = 0; off < m; ++off) {

@@ -6,6 +6,11 @@
 //   ES-C8  a and b by Theorems 4.1 and 4.2 (ES 4.15-4.31)
 //   ES-C9  poles from a free-response data matrix, Newton's identities (ES 4.37-4.63, index fix of
 //          ES 4.50), augmentation and deflation for generated inputs; Prony's method as the baseline.
+//   ES-C10 frequency response at the harmonics of a periodic input (ES 5.1-5.14)
+//   ES-C11 step response from piecewise-constant inputs with extrapolation (ES 5.15-5.37)
+//   ES-C12 impulse response from the step response with negative shifts (ES 5.38-5.42)
+// Prefiltered pairs (ES-C6) use signal/modal_filter.hpp; the output-modal-function route (ES-C7) and
+// the stacked theorems are in model/modal.hpp; the observer (ES-C13, C14) in estimate/modal_observer.hpp.
 //
 // Data are uniformly sampled (Ts); the record starts at rest unless the validity windows exclude its
 // start; samples before the record count as zero. Times are seconds from the first sample.
@@ -164,6 +169,11 @@ struct HarmonicResponse {
 HarmonicResponse modal_frequency_response(const IdData& data, const ModalModel& model, double period,
                                           const std::vector<int>& harmonics, double window_start,
                                           Quadrature rule = Quadrature::Simpson);
+
+/// Delta L of ES 5.27-5.29 ((n+1) x (n+1), unit lower triangular): Delta lower bidiagonal (1 on the
+/// diagonal, -1 below), L lower-triangular Toeplitz with first column [1, p_01 .. p_0n]; with shifts
+/// T_i = i T, y_0(kT + s) = [u(k) .. u(k-n)] Delta L [g(s) .. g(s + nT)]^T.
+Eigen::MatrixXd modal_delta_l(const Eigen::RowVectorXd& p0);
 
 /// ES-C11 (ES 5.15-5.37): step response g on [0, horizon] from a piecewise-constant input whose levels
 /// change only at multiples of `level_period` T, given output modal parameters p_0 for the shifts
