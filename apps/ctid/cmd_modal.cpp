@@ -85,6 +85,7 @@ namespace {
 struct PolesArgs {
   DataArgs data;
   int order = 0;
+  std::vector<double> generator;
   std::vector<std::string> sets;
 };
 
@@ -108,7 +109,7 @@ int run_poles(PolesArgs a) {
   const Eigen::VectorXd y = d.y().col(0);
   auto sets = parse_sets(a.sets);
   FreeResponseOptions o;
-  std::vector<double> shifts, gen;
+  std::vector<double> shifts, gen = a.generator;
   int start = -1, interval = -1, spacing = -1, pairs = -1, p_spacing = -1, p_equations = -1, p_start = 0;
   consume_sets(sets, [&](const std::string& k, const std::string& v) {
     if (k == "shifts") shifts = to_list(k, v);
@@ -280,9 +281,13 @@ void setup_poles(CLI::App& app) {
       ->required();
   a->data.add_to(app, true);
   app.add_option("--order", a->order, "Number of system poles n")->required();
+  app.add_option("--generator", a->generator,
+                 "A response forced by a known generated input: its frequencies w1,.. (rad/s; 0 = constant); the "
+                 "augmented estimate is deflated by them")
+      ->delimiter(',');
   app.add_option("--set", a->sets,
                  "KEY=VALUE: shifts=S1,..,Sn (samples; n + generator modes), start, interval, spacing (samples), pairs, "
-                 "generator=w1,.. (rad/s; 0 = constant) for a forced response, quadrature=simpson|trapezoid, "
+                 "generator=w1,.. (same as --generator), quadrature=simpson|trapezoid, "
                  "prony_spacing, prony_equations, prony_start");
   app.callback([a] { g_run = [a] { return run_poles(*a); }; });
 }

@@ -405,6 +405,14 @@ TEST(Cli, ModalFitPolesAndResponses) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("s^3 + 4 s^2 + 30 s + 52"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("Prony"), std::string::npos);
+  // A response forced by sin 4t (ES Ex. 4.7): order 3 + 2 generator modes, deflated by s^2 + 16.
+  Eigen::MatrixXd forced(600, 1);
+  forced.col(0) = lsim(kS3.to_state_space(), InputGenerator::sinusoid(4.0, 1.0), time_grid(kTs320, 600));
+  const std::string fp = test::temp_path("forced.csv");
+  write_csv(fp, {"y"}, forced);
+  r = ctid_run("poles " + fp + " --ts " + ts320() + " --order 3 --generator 4 --set shifts=30,60,90,120,150");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("s^3 + 4 s^2 + 30 s + 52"), std::string::npos) << r.out;
   // A record without output excitation: the modal regression is singular -> not usable (exit 1), named.
   Eigen::MatrixXd zero(400, 2);
   zero << Eigen::VectorXd::LinSpaced(400, -1, 1).array().sign().matrix(), Eigen::VectorXd::Zero(400);
