@@ -1,0 +1,192 @@
+// FROLS / ERR structure detection for polynomial NARX models (Billings & Li 1999, BL 28-32;
+// SEEDS-SPEC BL-D1, BL-D6). See include/ctid/estimate/frols.hpp.
+//
+// With p_m the candidate columns, w_s the orthogonalised selected columns and g_s = w_s^T y / w_s^T w_s,
+// the orthogonal part of an unselected candidate m after s selections has
+//     w_m^T y = p_m^T y - sum_s (p_m^T w_s) g_s,   w_m^T w_m = p_m^T p_m - sum_s (p_m^T w_s)^2 / (w_s^T w_s),
+// so ERR_m = (w_m^T y)^2 / (w_m^T w_m y^T y) needs only the inner products c_sm = p_m^T w_s: one pass over
+// freshly generated candidate blocks per selected term.
+#include "ctid/estimate/frols.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "ctid/core/check.hpp"
+#include "ctid/validate/metrics.hpp"
+
+namespace ctid {
+
+void FrolsOptions::validate() const {
+  CTID_REQUIRE_OPTION(max_terms >= 1, "frols: max_terms must be >= 1 (got {})", max_terms);
+  CTID_REQUIRE_OPTION(std::isfinite(err_tolerance) && err_tolerance >= 0 && err_tolerance < 1,
+                      "frols: err_tolerance must be in [0, 1) (got {})", err_tolerance);
+  CTID_REQUIRE_OPTION(block_rows >= 16, "frols: block_rows must be >= 16 (got {})", block_rows);
+}
+
+namespace {
+// Candidate columns for rows [k0, k0 + rows) into the columns of B.
+void candidate_block(const std::vector<NarxTerm>& cand, const Eigen::VectorXd& y, const Eigen::VectorXd& u,
+                     Eigen::Index k0, Eigen::Index rows, Eigen::MatrixXd& B) {
+  for (size_t m = 0; m < cand.size(); ++m) {
+    auto col = B.col(static_cast<Eigen::Index>(m)).head(rows);
+    col.setOnes();
+    for (const auto& f : cand[m].factors) {
+      const Eigen::VectorXd& x = f.signal == NarxSignal::Output ? y : u;
+      col.array() *= x.segment(k0 - f.lag, rows).array();
+    }
+  }
+}
+
+double criterion_value(InformationCriterion c, double mse, int n, int k) {
+  switch (c) {
+    case InformationCriterion::Aic: return aic(mse, n, k);
+    case InformationCriterion::Aicc: return aicc(mse, n, k);
+    case InformationCriterion::Bic: return bic(mse, n, k);
+    case InformationCriterion::Fpe: return fpe(mse, n, k);
+    case InformationCriterion::None: break;
+  }
+  return 0.0;
+}
+}  // namespace
+
+Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& cand, const FrolsOptions& o) {
+  const auto t_start = std::chrono::steady_clock::now();
+  o.validate();
+  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "frols: needs one input and one output (got {}, {})", data.nu(),
+               data.ny());
+  CTID_REQUIRE(data.is_uniform(), "frols: needs uniformly sampled data");
+  CTID_REQUIRE(!cand.empty(), "frols: no candidate terms");
+  int L = 0;
+  for (const auto& t : cand) {
+    CTID_REQUIRE(!t.has_noise(), "frols: candidate {} is a noise term (use narmax)", t.name());
+    L = std::max(L, t.max_lag());
+  }
+  const Eigen::VectorXd y = data.y().col(0), u = data.u().col(0);
+  const Eigen::Index N = y.size(), Ne = N - L;
+  const int M = static_cast<int>(cand.size());
+  CTID_REQUIRE(Ne > M, "frols: {} candidate terms but only {} usable rows ({} samples minus the largest lag {}); reduce "
+               "the lags or the degree", M, Ne, N, L);
+  const Eigen::VectorXd yt = y.tail(Ne);
+  const double yy = yt.squaredNorm();
+  CTID_REQUIRE(yy > 0, "frols: the output is identically zero");
+  const int K = std::min(o.max_terms, M);
+  const Eigen::Index BR = std::min<Eigen::Index>(o.block_rows, Ne);
+  Eigen::MatrixXd B(BR, M);
+
+  // Pass 0: p_m^T y and p_m^T p_m.
+  Eigen::VectorXd py = Eigen::VectorXd::Zero(M), pp = Eigen::VectorXd::Zero(M);
+  for (Eigen::Index r0 = 0; r0 < Ne; r0 += BR) {
+    const Eigen::Index rows = std::min(BR, Ne - r0);
+    candidate_block(cand, y, u, L + r0, rows, B);
+    py.noalias() += B.topRows(rows).transpose() * yt.segment(r0, rows);
+    pp += B.topRows(rows).colwise().squaredNorm().transpose();
+  }
+
+  std::vector<int> sel;
+  std::vector<double> err, g, ww;
+  Eigen::MatrixXd C(K, M);   // C(s, m) = p_m^T w_s
+  Eigen::MatrixXd W(Ne, K);  // orthogonal columns of the selected terms
+  std::vector<bool> used(M, false);
+  Eigen::VectorXd crit(K);
+  double err_sum = 0;
+  for (int s = 0; s < K; ++s) {
+    int best = -1;
+    double best_err = -1;
+    for (int m = 0; m < M; ++m) {
+      if (used[m] || !(pp(m) > 0)) continue;
+      double num = py(m), den = pp(m);
+      for (int r = 0; r < s; ++r) {
+        num -= C(r, m) * g[r];
+        den -= C(r, m) * C(r, m) / ww[r];
+      }
+      if (!(den > 1e-10 * pp(m))) continue;  // (numerically) in the span of the selected terms
+      const double e = num * num / (den * yy);
+      if (e > best_err) {
+        best_err = e;
+        best = m;
+      }
+    }
+    if (best < 0) break;
+    // w_s = p_best - sum_r (c_r,best / ww_r) w_r, then c_s,m = p_m^T w_s for every candidate.
+    Eigen::VectorXd p(Ne);
+    for (Eigen::Index r0 = 0; r0 < Ne; r0 += BR) {
+      const Eigen::Index rows = std::min(BR, Ne - r0);
+      Eigen::MatrixXd one(rows, 1);
+      candidate_block({cand[best]}, y, u, L + r0, rows, one);
+      p.segment(r0, rows) = one.col(0);
+    }
+    for (int r = 0; r < s; ++r) p -= (C(r, best) / ww[r]) * W.col(r);
+    W.col(s) = p;
+    const double w2 = p.squaredNorm();
+    for (Eigen::Index r0 = 0; r0 < Ne; r0 += BR) {
+      const Eigen::Index rows = std::min(BR, Ne - r0);
+      candidate_block(cand, y, u, L + r0, rows, B);
+      if (r0 == 0) C.row(s).setZero();
+      C.row(s).noalias() += (B.topRows(rows).transpose() * W.col(s).segment(r0, rows)).transpose();
+    }
+    used[best] = true;
+    sel.push_back(best);
+    ww.push_back(w2);
+    g.push_back(W.col(s).dot(yt) / w2);
+    err.push_back(g.back() * g.back() * w2 / yy);
+    err_sum += err.back();
+    const double mse_k = std::max(0.0, yy * (1 - err_sum)) / static_cast<double>(Ne);
+    crit(s) = criterion_value(o.criterion, mse_k, static_cast<int>(Ne), s + 1);
+    if (o.criterion == InformationCriterion::None && 1 - err_sum <= o.err_tolerance) break;
+  }
+  CTID_REQUIRE(!sel.empty(), "frols: every candidate column is zero");
+  int k = static_cast<int>(sel.size());
+  if (o.criterion != InformationCriterion::None) {
+    Eigen::Index best;
+    crit.head(k).minCoeff(&best);
+    k = static_cast<int>(best) + 1;
+  }
+  // theta from A theta = g, A unit upper triangular with A(r, s) = c_r,sel(s) / ww_r.
+  Eigen::MatrixXd A = Eigen::MatrixXd::Identity(k, k);
+  for (int s = 0; s < k; ++s)
+    for (int r = 0; r < s; ++r) A(r, s) = C(r, sel[s]) / ww[r];
+  Eigen::VectorXd gv(k), winv(k);
+  for (int s = 0; s < k; ++s) {
+    gv(s) = g[s];
+    winv(s) = 1.0 / ww[s];
+  }
+  const auto Atri = A.triangularView<Eigen::UnitUpper>();
+  const Eigen::VectorXd theta = Atri.solve(gv);
+  double esr = 1;
+  for (int s = 0; s < k; ++s) esr -= err[s];
+  const double sigma2 = std::max(0.0, yy * esr) / static_cast<double>(std::max<Eigen::Index>(1, Ne - k));
+  const Eigen::MatrixXd Ainv = Atri.solve(Eigen::MatrixXd::Identity(k, k));
+  const Eigen::MatrixXd cov = sigma2 * Ainv * winv.asDiagonal() * Ainv.transpose();
+
+  std::vector<NarxTerm> terms;
+  Result<NarxModel> res;
+  for (int s = 0; s < k; ++s) {
+    terms.push_back(cand[sel[s]]);
+    res.parameters.names.push_back(cand[sel[s]].name());
+  }
+  res.model = NarxModel(terms, theta, data.ts());
+  res.parameters.values = theta;
+  res.parameters.covariance = cov;
+  res.parameters.std = cov.diagonal().cwiseMax(0.0).cwiseSqrt();
+  res.parameters.fixed.assign(k, false);
+  res.diagnostics.vectors["err"] = 100.0 * Eigen::Map<const Eigen::VectorXd>(err.data(), k);
+  if (o.criterion != InformationCriterion::None)
+    res.diagnostics.vectors["criterion"] = crit.head(static_cast<Eigen::Index>(sel.size()));
+  res.diagnostics.scalars["esr"] = esr;
+  res.diagnostics.scalars["candidates"] = M;
+  res.diagnostics.condition_number = Ainv.norm() * A.norm();
+  bool escaped = false;
+  const Eigen::VectorXd ys = res.model.simulate(u, y.head(L), &escaped);
+  if (escaped) {
+    res.fit = fit_report_or_inf(y, Eigen::VectorXd::Constant(N, NAN), k);
+    res.diagnostics.warnings.push_back("the free-run simulation of the selected model escapes (blows up)");
+  } else {
+    res.fit = fit_report_or_inf(y.tail(Ne), ys.tail(Ne), k);
+  }
+  res.summary.iterations = static_cast<int>(sel.size());
+  res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return res;
+}
+
+}  // namespace ctid
