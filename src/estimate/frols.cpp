@@ -8,6 +8,7 @@
 // freshly generated candidate blocks per selected term.
 #include "ctid/estimate/frols.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -37,6 +38,72 @@ void candidate_block(const std::vector<NarxTerm>& cand, const Eigen::VectorXd& y
     }
   }
 }
+
+// Inner products of every candidate with a vector w, without forming the candidate columns: a candidate
+// is prefix * x_a * x_b (x_0 = 1, x_1.. the distinct lagged signals), so for each distinct prefix the
+// (V+1) x (V+1) matrix Z = (X o (w o prefix))^T X holds all of them — a small matrix product per row block.
+class CandidateProducts {
+ public:
+  CandidateProducts(const std::vector<NarxTerm>& cand) {
+    auto var = [&](const NarxFactor& f) {
+      for (size_t i = 0; i < vars_.size(); ++i)
+        if (vars_[i] == f) return static_cast<int>(i) + 1;
+      vars_.push_back(f);
+      return static_cast<int>(vars_.size());
+    };
+    for (const auto& t : cand) {
+      Item it;
+      const int d = t.degree();
+      std::vector<int> prefix;
+      for (int i = 0; i + 2 < d; ++i) prefix.push_back(var(t.factors[i]));
+      it.a = d >= 2 ? var(t.factors[d - 2]) : 0;
+      it.b = d >= 1 ? var(t.factors[d - 1]) : 0;
+      auto g = std::find(prefixes_.begin(), prefixes_.end(), prefix);
+      it.group = static_cast<int>(g - prefixes_.begin());
+      if (g == prefixes_.end()) prefixes_.push_back(prefix);
+      items_.push_back(it);
+    }
+  }
+
+  // c_m = sum_k p_m(k) w(k) over rows k = L .. L + Ne - 1 (w indexed from 0); squared: sum_k p_m(k)^2 w(k).
+  Eigen::VectorXd dot(const Eigen::VectorXd& y, const Eigen::VectorXd& u, Eigen::Index L, const Eigen::VectorXd& w,
+                      Eigen::Index block, bool squared = false) const {
+    const Eigen::Index Ne = w.size(), V = static_cast<Eigen::Index>(vars_.size()) + 1;
+    std::vector<Eigen::MatrixXd> Z(prefixes_.size(), Eigen::MatrixXd::Zero(V, V));
+    Eigen::MatrixXd X(block, V), Vw(block, V);
+    Eigen::VectorXd om(block);
+    for (Eigen::Index r0 = 0; r0 < Ne; r0 += block) {
+      const Eigen::Index rows = std::min(block, Ne - r0);
+      X.col(0).head(rows).setOnes();
+      for (size_t i = 0; i < vars_.size(); ++i) {
+        const Eigen::VectorXd& x = vars_[i].signal == NarxSignal::Output ? y : u;
+        X.col(static_cast<Eigen::Index>(i) + 1).head(rows) = x.segment(L + r0 - vars_[i].lag, rows);
+      }
+      if (squared) X.topRows(rows) = X.topRows(rows).array().square().matrix();
+      for (size_t g = 0; g < prefixes_.size(); ++g) {
+        om.head(rows) = w.segment(r0, rows);
+        for (int v : prefixes_[g]) om.head(rows).array() *= X.col(v).head(rows).array();
+        Vw.topRows(rows) = om.head(rows).asDiagonal() * X.topRows(rows);
+        // X^T diag(om) X is symmetric: the lower triangle is enough.
+        Z[g].triangularView<Eigen::Lower>() += Vw.topRows(rows).transpose() * X.topRows(rows);
+      }
+    }
+    Eigen::VectorXd c(static_cast<Eigen::Index>(items_.size()));
+    for (size_t m = 0; m < items_.size(); ++m) {
+      const Item& it = items_[m];
+      c(static_cast<Eigen::Index>(m)) = Z[it.group](std::max(it.a, it.b), std::min(it.a, it.b));
+    }
+    return c;
+  }
+
+ private:
+  struct Item {
+    int group = 0, a = 0, b = 0;
+  };
+  std::vector<NarxFactor> vars_;
+  std::vector<std::vector<int>> prefixes_;
+  std::vector<Item> items_;
+};
 
 double criterion_value(InformationCriterion c, double mse, int n, int k) {
   switch (c) {
@@ -72,16 +139,11 @@ Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& cand, c
   CTID_REQUIRE(yy > 0, "frols: the output is identically zero");
   const int K = std::min(o.max_terms, M);
   const Eigen::Index BR = std::min<Eigen::Index>(o.block_rows, Ne);
-  Eigen::MatrixXd B(BR, M);
 
   // Pass 0: p_m^T y and p_m^T p_m.
-  Eigen::VectorXd py = Eigen::VectorXd::Zero(M), pp = Eigen::VectorXd::Zero(M);
-  for (Eigen::Index r0 = 0; r0 < Ne; r0 += BR) {
-    const Eigen::Index rows = std::min(BR, Ne - r0);
-    candidate_block(cand, y, u, L + r0, rows, B);
-    py.noalias() += B.topRows(rows).transpose() * yt.segment(r0, rows);
-    pp += B.topRows(rows).colwise().squaredNorm().transpose();
-  }
+  const CandidateProducts products(cand);
+  const Eigen::VectorXd py = products.dot(y, u, L, yt, BR);
+  const Eigen::VectorXd pp = products.dot(y, u, L, Eigen::VectorXd::Ones(Ne), BR, true);
 
   std::vector<int> sel;
   std::vector<double> err, g, ww;
@@ -119,12 +181,7 @@ Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& cand, c
     for (int r = 0; r < s; ++r) p -= (C(r, best) / ww[r]) * W.col(r);
     W.col(s) = p;
     const double w2 = p.squaredNorm();
-    for (Eigen::Index r0 = 0; r0 < Ne; r0 += BR) {
-      const Eigen::Index rows = std::min(BR, Ne - r0);
-      candidate_block(cand, y, u, L + r0, rows, B);
-      if (r0 == 0) C.row(s).setZero();
-      C.row(s).noalias() += (B.topRows(rows).transpose() * W.col(s).segment(r0, rows)).transpose();
-    }
+    C.row(s) = products.dot(y, u, L, W.col(s), BR).transpose();
     used[best] = true;
     sel.push_back(best);
     ww.push_back(w2);

@@ -68,7 +68,12 @@ TEST(NarxModel, SimulationPredictionAndEscape) {
 TEST(Frols, FindsTheTrueStructureOnNoiseFreeData) {
   // 15 candidates (degree 2, lags 2/2, constant); the ERR pass must pick exactly the 6 true terms (the
   // residual after them is zero: ESR < 1e-20) with the coefficients to 1e-10.
+  // Degree 3 (34 candidates) exercises the grouping of the cubic candidates' inner products by prefix.
   const IdData d = record(2000, 0.0, 1);
+  for (int degree : {3, 2}) {
+    const auto r3 = frols(d, narx_candidates(degree, 2, 2), {.max_terms = 10, .err_tolerance = 1e-14});
+    EXPECT_EQ(names(r3.model), names(truth())) << "degree " << degree;
+  }
   const auto r = frols(d, narx_candidates(2, 2, 2), {.max_terms = 10, .err_tolerance = 1e-14});
   ASSERT_TRUE(r.usable()) << r.summary.message;
   EXPECT_EQ(names(r.model), names(truth()));
