@@ -27,14 +27,21 @@ void FrolsOptions::validate() const {
 
 namespace {
 // Candidate columns for rows [k0, k0 + rows) into the columns of B.
-void candidate_block(const std::vector<NarxTerm>& cand, const Eigen::VectorXd& y, const Eigen::VectorXd& u,
-                     Eigen::Index k0, Eigen::Index rows, Eigen::MatrixXd& B) {
+// The three signals a candidate can refer to (e: residuals of the previous NARMAX iteration).
+struct Signals {
+  const Eigen::VectorXd& y;
+  const Eigen::VectorXd& u;
+  const Eigen::VectorXd& e;
+  const Eigen::VectorXd& of(NarxSignal s) const { return s == NarxSignal::Output ? y : s == NarxSignal::Input ? u : e; }
+};
+
+void candidate_block(const std::vector<NarxTerm>& cand, const Signals& sig, Eigen::Index k0, Eigen::Index rows,
+                     Eigen::MatrixXd& B) {
   for (size_t m = 0; m < cand.size(); ++m) {
     auto col = B.col(static_cast<Eigen::Index>(m)).head(rows);
     col.setOnes();
     for (const auto& f : cand[m].factors) {
-      const Eigen::VectorXd& x = f.signal == NarxSignal::Output ? y : u;
-      col.array() *= x.segment(k0 - f.lag, rows).array();
+      col.array() *= sig.of(f.signal).segment(k0 - f.lag, rows).array();
     }
   }
 }
@@ -66,8 +73,8 @@ class CandidateProducts {
   }
 
   // c_m = sum_k p_m(k) w(k) over rows k = L .. L + Ne - 1 (w indexed from 0); squared: sum_k p_m(k)^2 w(k).
-  Eigen::VectorXd dot(const Eigen::VectorXd& y, const Eigen::VectorXd& u, Eigen::Index L, const Eigen::VectorXd& w,
-                      Eigen::Index block, bool squared = false) const {
+  Eigen::VectorXd dot(const Signals& sig, Eigen::Index L, const Eigen::VectorXd& w, Eigen::Index block,
+                      bool squared = false) const {
     const Eigen::Index Ne = w.size(), V = static_cast<Eigen::Index>(vars_.size()) + 1;
     std::vector<Eigen::MatrixXd> Z(prefixes_.size(), Eigen::MatrixXd::Zero(V, V));
     Eigen::MatrixXd X(block, V), Vw(block, V);
@@ -76,8 +83,7 @@ class CandidateProducts {
       const Eigen::Index rows = std::min(block, Ne - r0);
       X.col(0).head(rows).setOnes();
       for (size_t i = 0; i < vars_.size(); ++i) {
-        const Eigen::VectorXd& x = vars_[i].signal == NarxSignal::Output ? y : u;
-        X.col(static_cast<Eigen::Index>(i) + 1).head(rows) = x.segment(L + r0 - vars_[i].lag, rows);
+        X.col(static_cast<Eigen::Index>(i) + 1).head(rows) = sig.of(vars_[i].signal).segment(L + r0 - vars_[i].lag, rows);
       }
       if (squared) X.topRows(rows) = X.topRows(rows).array().square().matrix();
       for (size_t g = 0; g < prefixes_.size(); ++g) {
@@ -117,19 +123,14 @@ double criterion_value(InformationCriterion c, double mse, int n, int k) {
 }
 }  // namespace
 
-Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& cand, const FrolsOptions& o) {
+namespace {
+// FROLS on given signals (e may be all zero when no candidate is a noise term).
+Result<NarxModel> frols_signals(const Signals& sig, double Ts, const std::vector<NarxTerm>& cand, const FrolsOptions& o) {
   const auto t_start = std::chrono::steady_clock::now();
-  o.validate();
-  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "frols: needs one input and one output (got {}, {})", data.nu(),
-               data.ny());
-  CTID_REQUIRE(data.is_uniform(), "frols: needs uniformly sampled data");
-  CTID_REQUIRE(!cand.empty(), "frols: no candidate terms");
   int L = 0;
-  for (const auto& t : cand) {
-    CTID_REQUIRE(!t.has_noise(), "frols: candidate {} is a noise term (use narmax)", t.name());
-    L = std::max(L, t.max_lag());
-  }
-  const Eigen::VectorXd y = data.y().col(0), u = data.u().col(0);
+  for (const auto& t : cand) L = std::max(L, t.max_lag());
+  const Eigen::VectorXd& y = sig.y;
+  const Eigen::VectorXd& u = sig.u;
   const Eigen::Index N = y.size(), Ne = N - L;
   const int M = static_cast<int>(cand.size());
   CTID_REQUIRE(Ne > M, "frols: {} candidate terms but only {} usable rows ({} samples minus the largest lag {}); reduce "
@@ -142,8 +143,8 @@ Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& cand, c
 
   // Pass 0: p_m^T y and p_m^T p_m.
   const CandidateProducts products(cand);
-  const Eigen::VectorXd py = products.dot(y, u, L, yt, BR);
-  const Eigen::VectorXd pp = products.dot(y, u, L, Eigen::VectorXd::Ones(Ne), BR, true);
+  const Eigen::VectorXd py = products.dot(sig, L, yt, BR);
+  const Eigen::VectorXd pp = products.dot(sig, L, Eigen::VectorXd::Ones(Ne), BR, true);
 
   std::vector<int> sel;
   std::vector<double> err, g, ww;
@@ -175,13 +176,13 @@ Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& cand, c
     for (Eigen::Index r0 = 0; r0 < Ne; r0 += BR) {
       const Eigen::Index rows = std::min(BR, Ne - r0);
       Eigen::MatrixXd one(rows, 1);
-      candidate_block({cand[best]}, y, u, L + r0, rows, one);
+      candidate_block({cand[best]}, sig, L + r0, rows, one);
       p.segment(r0, rows) = one.col(0);
     }
     for (int r = 0; r < s; ++r) p -= (C(r, best) / ww[r]) * W.col(r);
     W.col(s) = p;
     const double w2 = p.squaredNorm();
-    C.row(s) = products.dot(y, u, L, W.col(s), BR).transpose();
+    C.row(s) = products.dot(sig, L, W.col(s), BR).transpose();
     used[best] = true;
     sel.push_back(best);
     ww.push_back(w2);
@@ -222,7 +223,7 @@ Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& cand, c
     terms.push_back(cand[sel[s]]);
     res.parameters.names.push_back(cand[sel[s]].name());
   }
-  res.model = NarxModel(terms, theta, data.ts());
+  res.model = NarxModel(terms, theta, Ts);
   res.parameters.values = theta;
   res.parameters.covariance = cov;
   res.parameters.std = cov.diagonal().cwiseMax(0.0).cwiseSqrt();
@@ -234,7 +235,7 @@ Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& cand, c
   res.diagnostics.scalars["candidates"] = M;
   res.diagnostics.condition_number = Ainv.norm() * A.norm();
   bool escaped = false;
-  const Eigen::VectorXd ys = res.model.simulate(u, y.head(L), &escaped);
+  const Eigen::VectorXd ys = res.model.process().simulate(u, y.head(L), &escaped);
   if (escaped) {
     res.fit = fit_report_or_inf(y, Eigen::VectorXd::Constant(N, NAN), k);
     res.diagnostics.warnings.push_back("the free-run simulation of the selected model escapes (blows up)");
@@ -244,6 +245,96 @@ Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& cand, c
   res.summary.iterations = static_cast<int>(sel.size());
   res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return res;
+}
+
+void check_siso(const IdData& data, const char* who) {
+  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "{}: needs one input and one output (got {}, {})", who, data.nu(),
+               data.ny());
+  CTID_REQUIRE(data.is_uniform(), "{}: needs uniformly sampled data", who);
+}
+}  // namespace
+
+Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& cand, const FrolsOptions& o) {
+  o.validate();
+  check_siso(data, "frols");
+  CTID_REQUIRE(!cand.empty(), "frols: no candidate terms");
+  for (const auto& t : cand) CTID_REQUIRE(!t.has_noise(), "frols: candidate {} is a noise term (use narmax)", t.name());
+  const Eigen::VectorXd y = data.y().col(0), u = data.u().col(0), e = Eigen::VectorXd::Zero(y.size());
+  return frols_signals({y, u, e}, data.ts(), cand, o);
+}
+
+void NarmaxOptions::validate() const {
+  frols.validate();
+  CTID_REQUIRE_OPTION(max_noise_terms >= 0, "narmax: max_noise_terms must be >= 0 (got {})", max_noise_terms);
+  CTID_REQUIRE_OPTION(iterations >= 1, "narmax: iterations must be >= 1 (got {})", iterations);
+  CTID_REQUIRE_OPTION(std::isfinite(tolerance) && tolerance >= 0, "narmax: tolerance must be >= 0 (got {})", tolerance);
+  for (const auto& t : noise_candidates)
+    CTID_REQUIRE_OPTION(t.has_noise(), "narmax: noise candidate {} has no e(k-i) factor", t.name());
+}
+
+Result<NarxModel> narmax(const IdData& data, const std::vector<NarxTerm>& process, const NarmaxOptions& o) {
+  const auto t_start = std::chrono::steady_clock::now();
+  o.validate();
+  check_siso(data, "narmax");
+  for (const auto& t : process) CTID_REQUIRE(!t.has_noise(), "narmax: process candidate {} is a noise term", t.name());
+  const Eigen::VectorXd y = data.y().col(0), u = data.u().col(0);
+  // Iteration 0: NARX; then residual-driven selection over process and noise candidates (extended LS).
+  Result<NarxModel> r = frols(data, process, o.frols);
+  std::vector<NarxTerm> all = process;
+  all.insert(all.end(), o.noise_candidates.begin(), o.noise_candidates.end());
+  FrolsOptions fo = o.frols;
+  fo.max_terms = o.frols.max_terms + o.max_noise_terms;
+  int it = 0;
+  double change = std::numeric_limits<double>::infinity();
+  // Residuals of the pseudo-linear regression: e_next(k) = y(k) - phi(k; e)^T theta with the noise regressors
+  // built from the previous residuals (not the recursive predictor, which diverges when an intermediate noise
+  // model is not invertible).
+  Eigen::VectorXd e = Eigen::VectorXd::Zero(y.size());
+  auto residuals = [&](const NarxModel& m) {
+    const Eigen::Index L = m.max_lag(), Ne = y.size() - L;
+    Eigen::VectorXd next = Eigen::VectorXd::Zero(y.size());
+    Eigen::MatrixXd col(Ne, 1);
+    next.tail(Ne) = y.tail(Ne);
+    for (size_t i = 0; i < m.terms().size(); ++i) {
+      candidate_block({m.terms()[i]}, {y, u, e}, L, Ne, col);
+      next.tail(Ne) -= m.coefficients()(static_cast<Eigen::Index>(i)) * col.col(0);
+    }
+    return next;
+  };
+  for (; it < o.iterations && !o.noise_candidates.empty(); ++it) {
+    e = residuals(r.model);
+    Result<NarxModel> next = frols_signals({y, u, e}, data.ts(), all, fo);
+    // Convergence: the same process terms with coefficients within tolerance (relative); noise terms may
+    // trade places among themselves.
+    change = std::numeric_limits<double>::infinity();
+    const NarxModel a = r.model.process(), b = next.model.process();
+    if (a.terms().size() == b.terms().size()) {
+      double d = 0, scale = 0;
+      bool same = true;
+      for (size_t i = 0; i < b.terms().size() && same; ++i) {
+        const auto hit = std::find(a.terms().begin(), a.terms().end(), b.terms()[i]);
+        same = hit != a.terms().end();
+        if (!same) break;
+        const double ca = a.coefficients()(hit - a.terms().begin()), cb = b.coefficients()(static_cast<Eigen::Index>(i));
+        d = std::max(d, std::abs(cb - ca));
+        scale = std::max(scale, std::abs(cb));
+      }
+      if (same) change = d / std::max(scale, 1e-300);
+    }
+    r = std::move(next);
+    if (change <= o.tolerance) {
+      ++it;
+      break;
+    }
+  }
+  r.diagnostics.scalars["narmax_iterations"] = it;
+  r.diagnostics.scalars["relative_change"] = change;
+  if (!o.noise_candidates.empty() && change > o.tolerance)
+    r.diagnostics.warnings.push_back(detail::format(
+        "narmax: the extended least-squares iterations did not settle in {} iterations (last relative change {})", it,
+        change));
+  r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return r;
 }
 
 }  // namespace ctid

@@ -39,4 +39,23 @@ struct FrolsOptions {
 /// Throws InvalidArgument for a multi-channel record, noise terms, or as many candidates as rows.
 Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& candidates, const FrolsOptions& options = {});
 
+struct NarmaxOptions {
+  FrolsOptions frols;                      ///< process-term selection (max_terms counts process terms)
+  /// e(k-1..5), e(k-i)e(k-j), e(k-i)y(k-j) and e(k-i)u(k-j) (i <= 5, j <= 2) by default.
+  std::vector<NarxTerm> noise_candidates = narx_noise_candidates(5, 2, 2);
+  int max_noise_terms = 5;                 ///< noise terms allowed on top of frols.max_terms
+  int iterations = 20;                     ///< extended least-squares iterations
+  double tolerance = 1e-3;                 ///< stop when the process terms repeat and their coefficients change less (relative)
+  void validate() const;
+};
+
+/// NARMAX (BL-D1): NARX selection by FROLS, then iterations in which the residuals e(k) = y(k) - phi(k)^T theta
+/// of the current model (noise regressors from the previous residuals: pseudo-linear regression) feed the
+/// noise candidates and FROLS selects process and noise terms together (extended least squares), until the
+/// terms repeat and the coefficients settle. The noise terms absorb coloured
+/// equation errors (e.g. output measurement noise) so that the process coefficients are not biased;
+/// model.process() drops them for simulation. diagnostics.scalars: "narmax_iterations", "relative_change".
+Result<NarxModel> narmax(const IdData& data, const std::vector<NarxTerm>& process_candidates,
+                         const NarmaxOptions& options = {});
+
 }  // namespace ctid
