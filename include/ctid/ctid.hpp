@@ -10,6 +10,7 @@
 #include "ctid/data/input_design.hpp"
 #include "ctid/estimate/frequency.hpp"
 #include "ctid/estimate/frols.hpp"
+#include "ctid/estimate/gfrf.hpp"
 #include "ctid/estimate/fsf.hpp"
 #include "ctid/estimate/lssvf.hpp"
 #include "ctid/estimate/modal.hpp"
