@@ -30,6 +30,7 @@
 #include "ctid/model/miso.hpp"
 #include "ctid/model/modal.hpp"
 #include "ctid/model/narx.hpp"
+#include "ctid/model/nde.hpp"
 #include "ctid/model/physical_model.hpp"
 #include "ctid/model/state_space.hpp"
 #include "ctid/model/transfer_function.hpp"

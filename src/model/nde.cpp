@@ -1,0 +1,246 @@
+// Polynomial NDE models of Billings & Li (1999), eqs 1-6 (SEEDS-SPEC BL-D3, clean convention): terms,
+// harmonic probing H_1 and H_2, and simulation by adaptive Dormand-Prince 5(4). See include/ctid/model/nde.hpp.
+#include "ctid/model/nde.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "ctid/core/check.hpp"
+
+namespace ctid {
+
+namespace {
+std::string factor_name(const NdeFactor& f) {
+  const char* v = f.input ? "u" : "y";
+  if (f.derivative == 0) return v;
+  if (f.derivative == 1) return std::string("D") + v;
+  return "D^" + std::to_string(f.derivative) + v;
+}
+}  // namespace
+
+std::string NdeTerm::name() const {
+  std::string s;
+  for (size_t i = 0; i < factors.size();) {
+    size_t j = i;
+    while (j < factors.size() && factors[j] == factors[i]) ++j;
+    if (!s.empty()) s += "*";
+    s += factor_name(factors[i]);
+    if (j - i > 1) s += "^" + std::to_string(j - i);
+    i = j;
+  }
+  return s.empty() ? "1" : s;
+}
+
+NdeTerm NdeTerm::parse(const std::string& text) {
+  NdeTerm t;
+  size_t i = 0;
+  auto fail = [&](const char* what) {
+    throw InvalidArgument(detail::format("NDE term \"{}\": {} at position {}", text, what, i + 1));
+  };
+  auto number = [&]() {
+    const size_t start = i;
+    while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ++i;
+    if (i == start) fail("expected a number");
+    return std::stoi(text.substr(start, i - start));
+  };
+  while (true) {
+    NdeFactor f;
+    if (i < text.size() && text[i] == 'D') {
+      ++i;
+      if (i < text.size() && text[i] == '^') ++i;
+      f.derivative = (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ? number() : 1;
+    }
+    if (i >= text.size() || (text[i] != 'y' && text[i] != 'u')) fail("expected y or u");
+    f.input = text[i] == 'u';
+    ++i;
+    int power = 1;
+    if (i < text.size() && text[i] == '^') {
+      ++i;
+      power = number();
+      if (power < 1) fail("a power must be >= 1");
+    }
+    for (int k = 0; k < power; ++k) t.factors.push_back(f);
+    if (i == text.size()) break;
+    if (text[i] != '*') fail("expected \"*\"");
+    ++i;
+  }
+  std::sort(t.factors.begin(), t.factors.end());
+  return t;
+}
+
+NdeModel::NdeModel(std::vector<NdeTerm> terms, Eigen::VectorXd coefficients)
+    : terms_(std::move(terms)), c_(std::move(coefficients)) {
+  CTID_REQUIRE(static_cast<Eigen::Index>(terms_.size()) == c_.size(), "NdeModel: {} terms but {} coefficients",
+               terms_.size(), c_.size());
+  CTID_REQUIRE(c_.allFinite(), "NdeModel: non-finite coefficients");
+  for (auto& t : terms_) {
+    CTID_REQUIRE(!t.factors.empty(), "NdeModel: a constant term is not supported");
+    std::sort(t.factors.begin(), t.factors.end());
+    for (const auto& f : t.factors)
+      CTID_REQUIRE(f.derivative >= 0, "NdeModel: negative derivative order in {}", t.name());
+  }
+  for (size_t i = 0; i < terms_.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      CTID_REQUIRE(!(terms_[i] == terms_[j]), "NdeModel: term {} appears twice", terms_[i].name());
+}
+
+double NdeModel::coefficient(const std::string& name) const {
+  const NdeTerm t = NdeTerm::parse(name);
+  for (size_t i = 0; i < terms_.size(); ++i)
+    if (terms_[i] == t) return c_(static_cast<Eigen::Index>(i));
+  return 0.0;
+}
+
+NdeModel NdeModel::normalized() const {
+  const double cy = coefficient("y");
+  CTID_REQUIRE(cy != 0.0, "NdeModel::normalized: the model has no y term");
+  return NdeModel(terms_, c_ / cy);
+}
+
+namespace {
+Polynomial linear_part(const std::vector<NdeTerm>& terms, const Eigen::VectorXd& c, bool input, double sign) {
+  int L = 0;
+  for (const auto& t : terms)
+    if (t.degree() == 1 && t.factors[0].input == input) L = std::max(L, t.factors[0].derivative);
+  Eigen::VectorXd p = Eigen::VectorXd::Zero(L + 1);  // descending
+  for (size_t i = 0; i < terms.size(); ++i)
+    if (terms[i].degree() == 1 && terms[i].factors[0].input == input)
+      p(L - terms[i].factors[0].derivative) += sign * c(static_cast<Eigen::Index>(i));
+  return Polynomial(p);
+}
+}  // namespace
+
+Polynomial NdeModel::a() const { return linear_part(terms_, c_, false, 1.0); }
+Polynomial NdeModel::b() const { return linear_part(terms_, c_, true, -1.0); }
+
+std::complex<double> NdeModel::h1(std::complex<double> s) const { return b()(s) / a()(s); }
+
+std::complex<double> NdeModel::h2(std::complex<double> s1, std::complex<double> s2) const {
+  const std::complex<double> H1[2] = {h1(s1), h1(s2)}, S[2] = {s1, s2};
+  // Each factor x contributes, on the probing exponential e^{s t}, X(s) = s^l H_1(s) (y) or s^l (u).
+  auto X = [&](const NdeFactor& f, int k) { return std::pow(S[k], f.derivative) * (f.input ? 1.0 : H1[k]); };
+  std::complex<double> rhs = 0.0;
+  for (size_t i = 0; i < terms_.size(); ++i) {
+    if (terms_[i].degree() != 2) continue;
+    const auto& f = terms_[i].factors;
+    rhs -= c_(static_cast<Eigen::Index>(i)) * (X(f[0], 0) * X(f[1], 1) + X(f[0], 1) * X(f[1], 0));
+  }
+  return rhs / (2.0 * a()(s1 + s2));
+}
+
+std::string NdeModel::to_string(int precision) const {
+  std::ostringstream s;
+  s.precision(precision);
+  for (size_t i = 0; i < terms_.size(); ++i) {
+    const double c = c_(static_cast<Eigen::Index>(i));
+    if (i == 0) s << (c < 0 ? "-" : "");
+    else s << (c < 0 ? " - " : " + ");
+    if (std::abs(c) != 1.0) s << std::abs(c) << " ";
+    s << terms_[i].name();
+  }
+  s << " = 0";
+  return s.str();
+}
+
+NdeSimulation NdeModel::simulate(const Eigen::VectorXd& u, const Eigen::VectorXd& t, Intersample intersample,
+                                 const Eigen::VectorXd& x0, double rtol) const {
+  CTID_REQUIRE(u.size() == t.size() && t.size() >= 1, "NdeModel::simulate: {} inputs for {} times", u.size(), t.size());
+  CTID_REQUIRE(u.allFinite() && t.allFinite(), "NdeModel::simulate: non-finite input or time");
+  CTID_REQUIRE(std::isfinite(rtol) && rtol > 0 && rtol < 1, "NdeModel::simulate: rtol must be in (0, 1) (got {})", rtol);
+  // Explicit form: the highest derivative L of y appears once, in a linear term.
+  int L = 0;
+  for (const auto& term : terms_)
+    for (const auto& f : term.factors) {
+      CTID_REQUIRE(!(f.input && f.derivative > 0), "NdeModel::simulate: term {} differentiates the input; a held or "
+                   "linearly interpolated input has no such derivative", term.name());
+      if (!f.input) L = std::max(L, f.derivative);
+    }
+  CTID_REQUIRE(L >= 1, "NdeModel::simulate: no derivative of y: the model is algebraic");
+  int top = -1;
+  for (size_t i = 0; i < terms_.size(); ++i)
+    for (const auto& f : terms_[i].factors)
+      if (!f.input && f.derivative == L) {
+        CTID_REQUIRE(terms_[i].degree() == 1 && top < 0, "NdeModel::simulate: D^{}y must appear only once and "
+                     "linearly (term {}); the model is implicit in its highest derivative", L, terms_[i].name());
+        top = static_cast<int>(i);
+      }
+  CTID_REQUIRE(x0.size() == 0 || x0.size() == L, "NdeModel::simulate: x0 has {} entries, the model has {} states",
+               x0.size(), L);
+  for (Eigen::Index k = 1; k < t.size(); ++k)
+    CTID_REQUIRE(t(k) > t(k - 1), "NdeModel::simulate: times must increase (t[{}] = {}, t[{}] = {})", k - 1, t(k - 1), k,
+                 t(k));
+  const double ctop = c_(top);
+  auto f = [&](const Eigen::VectorXd& x, double uu, Eigen::VectorXd& dx) {
+    double s = 0;
+    for (size_t i = 0; i < terms_.size(); ++i) {
+      if (static_cast<int>(i) == top) continue;
+      double v = c_(static_cast<Eigen::Index>(i));
+      for (const auto& fa : terms_[i].factors) v *= fa.input ? uu : x(fa.derivative);
+      s += v;
+    }
+    dx.head(L - 1) = x.tail(L - 1);
+    dx(L - 1) = -s / ctop;
+  };
+  // Dormand-Prince 5(4) coefficients.
+  static const double c2 = 1. / 5, c3 = 3. / 10, c4 = 4. / 5, c5 = 8. / 9;
+  static const double a21 = 1. / 5, a31 = 3. / 40, a32 = 9. / 40, a41 = 44. / 45, a42 = -56. / 15, a43 = 32. / 9,
+                      a51 = 19372. / 6561, a52 = -25360. / 2187, a53 = 64448. / 6561, a54 = -212. / 729,
+                      a61 = 9017. / 3168, a62 = -355. / 33, a63 = 46732. / 5247, a64 = 49. / 176, a65 = -5103. / 18656,
+                      b1 = 35. / 384, b3 = 500. / 1113, b4 = 125. / 192, b5 = -2187. / 6784, b6 = 11. / 84,
+                      e1 = 71. / 57600, e3 = -71. / 16695, e4 = 71. / 1920, e5 = -17253. / 339200, e6 = 22. / 525,
+                      e7 = -1. / 40;
+  NdeSimulation out;
+  out.y = Eigen::VectorXd::Constant(t.size(), std::numeric_limits<double>::quiet_NaN());
+  Eigen::VectorXd x = x0.size() ? x0 : Eigen::VectorXd::Zero(L);
+  Eigen::VectorXd k1(L), k2(L), k3(L), k4(L), k5(L), k6(L), k7(L), xt(L), xn(L);
+  out.y(0) = x(0);
+  const double atol = 1e-12;
+  double h = (t.size() > 1 ? t(1) - t(0) : 1.0) / 4;
+  for (Eigen::Index k = 0; k + 1 < t.size(); ++k) {
+    const double ta = t(k), tb = t(k + 1);
+    const double ua = u(k), ub = intersample == Intersample::Zoh ? u(k) : u(k + 1);
+    auto uin = [&](double tt) { return ua + (ub - ua) * (tt - ta) / (tb - ta); };
+    double tt = ta;
+    h = std::min(h, tb - ta);
+    f(x, uin(tt), k1);
+    int steps = 0;
+    while (tt < tb) {
+      if (tt + h > tb) h = tb - tt;
+      xt = x + h * a21 * k1;
+      f(xt, uin(tt + c2 * h), k2);
+      xt = x + h * (a31 * k1 + a32 * k2);
+      f(xt, uin(tt + c3 * h), k3);
+      xt = x + h * (a41 * k1 + a42 * k2 + a43 * k3);
+      f(xt, uin(tt + c4 * h), k4);
+      xt = x + h * (a51 * k1 + a52 * k2 + a53 * k3 + a54 * k4);
+      f(xt, uin(tt + c5 * h), k5);
+      xt = x + h * (a61 * k1 + a62 * k2 + a63 * k3 + a64 * k4 + a65 * k5);
+      f(xt, uin(tt + h), k6);
+      xn = x + h * (b1 * k1 + b3 * k3 + b4 * k4 + b5 * k5 + b6 * k6);
+      f(xn, uin(tt + h), k7);
+      const Eigen::VectorXd errv = h * (e1 * k1 + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * k7);
+      double err = 0;
+      for (Eigen::Index i = 0; i < L; ++i)
+        err = std::max(err, std::abs(errv(i)) / (atol + rtol * std::max(std::abs(x(i)), std::abs(xn(i)))));
+      if (!std::isfinite(err) || !xn.allFinite() || xn.cwiseAbs().maxCoeff() > 1e12 || ++steps > 1000000 ||
+          h < 1e-14 * std::max(1.0, std::abs(tt))) {
+        out.termination = Termination::NumericalFailure;
+        out.message = detail::format("the solution escapes at t = {} s (|x| = {}): the model is unstable for this input",
+                                     tt, xn.cwiseAbs().maxCoeff());
+        return out;
+      }
+      if (err <= 1.0) {
+        tt += h;
+        x = xn;
+        k1 = k7;  // first same as last
+      }
+      h *= std::clamp(0.9 * std::pow(std::max(err, 1e-10), -0.2), 0.2, 5.0);
+    }
+    out.y(k + 1) = x(0);
+  }
+  return out;
+}
+
+}  // namespace ctid
