@@ -11,6 +11,7 @@
 #include "ctid/estimate/frequency.hpp"
 #include "ctid/estimate/frols.hpp"
 #include "ctid/estimate/gfrf.hpp"
+#include "ctid/estimate/kia.hpp"
 #include "ctid/estimate/fsf.hpp"
 #include "ctid/estimate/lssvf.hpp"
 #include "ctid/estimate/modal.hpp"

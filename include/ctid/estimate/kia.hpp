@@ -1,0 +1,77 @@
+// ctid — the Kernel Invariance Algorithm of Billings & Li (1999): continuous-time NDE coefficients from
+// the GFRFs of an identified NARX model, order by order, by linear least squares on kernel values at
+// chosen s-points, with generalised least squares (GLS) whitening and ERR term selection.
+//   linear stage     BL 15-25 (SEEDS-SPEC BL-D4): H_1(s) A(s) = B(s), A(s) = 1 + sum alpha_l s^l
+//   quadratic stage  BL 26-27 (BL-D5): 2 A(s_1+s_2) H_2(s_1,s_2) = - sum gamma (probing expression)
+//   ERR selection    BL 28-32 (BL-D6): forward orthogonal selection on the stacked real system; the
+//                    over-parameterise -> converge -> prune -> re-estimate workflow; ERR-chosen filter order.
+// Kernel invariance: H_n^{NDE}(s_1..s_n) = H_n^{NARX}(e^{s_1 T}..e^{s_n T}), divided by prod Z(s_i) for data
+// sampled with a held input (narx_gfrf_ct). Points on the real and imaginary axes (the reading of the
+// paper that reproduces its tables; SEEDS-SPEC BL.3).
+#pragma once
+
+#include <complex>
+#include <vector>
+
+#include "ctid/core/types.hpp"
+#include "ctid/model/narx.hpp"
+#include "ctid/model/nde.hpp"
+
+namespace ctid {
+
+enum class KiaRegion {
+  Axes,           ///< half of the points on the positive real axis, half on the positive imaginary axis
+  RealAxis,
+  ImaginaryAxis,
+  Complex         ///< s = t_1 + j t_2 with t_1, t_2 in (0, max]
+};
+
+struct KiaPointOptions {
+  KiaRegion region = KiaRegion::Axes;
+  int count = 500;        ///< points (linear stage) or point pairs (quadratic stage)
+  double max = 500.0;     ///< rad/s
+  bool grid = false;      ///< evenly spaced instead of uniformly random
+  unsigned seed = 1;
+};
+
+/// The s-points of a region; for pairs call twice with different seeds (as kia_quadratic does).
+/// Throws InvalidArgument for count < 1 or max <= 0.
+std::vector<std::complex<double>> kia_points(const KiaPointOptions& options);
+
+struct KiaLinearOptions {
+  int y_order = 2;             ///< candidates D^1 y .. D^{y_order} y (y itself has coefficient 1)
+  int u_order = 0;             ///< candidates u .. D^{u_order} u
+  KiaPointOptions points;      ///< default: 500 points on both axes in (0, 500] rad/s (the paper's)
+  int gls_order = 10;          ///< filter order G; 0: plain least squares; -1: the smallest G <= 12 whose filter
+                               ///< regression explains >= 99.99 % (sum of ERR) of the residual
+  int max_iterations = 100;
+  double tolerance = 1e-8;     ///< relative change of the coefficients between GLS iterations
+  double err_threshold = 0.0;  ///< % : > 0 prunes terms with a smaller ERR after convergence, then re-estimates
+  bool zoh = true;             ///< divide the NARX kernel by the hold factor Z(s) (data sampled with a held input)
+  void validate() const;
+};
+
+/// Linear stage: returns the linear NDE y + sum alpha_l D^l y - sum beta_l D^l u = 0 (normalised).
+/// parameters: the implicit-form coefficients of the retained candidate terms (names "Dy", "D^2y", "u", ...);
+/// diagnostics.vectors "err" (ERR % of each parameter at convergence, forward selection), "first_iteration"
+/// (plain least squares); scalars "gls_iterations", "gls_order", "err_sum". Throws InvalidArgument for a
+/// NARX model without linear input terms.
+Result<NdeModel> kia_linear(const NarxModel& narx, const KiaLinearOptions& options = {});
+
+struct KiaQuadraticOptions {
+  std::vector<NdeTerm> candidates;  ///< degree-2 terms, e.g. y^2, y*Dy, Dy^2, y*u
+  KiaPointOptions points{.count = 70, .max = 220.0};  ///< point pairs (the paper: 35 real + 35 imaginary in (0, 220))
+  int gls_order = 3;                ///< filter F(s_1 + s_2) order; 0: plain least squares
+  int max_iterations = 100;
+  double tolerance = 1e-8;
+  double err_threshold = 0.0;       ///< % : prune below it after convergence, then re-estimate
+  bool zoh = true;
+  void validate() const;
+};
+
+/// Quadratic stage with the linear part fixed: returns linear + retained quadratic terms (normalised), with
+/// parameters, "err" and "first_iteration" for the quadratic coefficients. Throws InvalidArgument for
+/// candidates that are not of degree 2 or an empty candidate list.
+Result<NdeModel> kia_quadratic(const NarxModel& narx, const NdeModel& linear, const KiaQuadraticOptions& options);
+
+}  // namespace ctid

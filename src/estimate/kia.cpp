@@ -1,0 +1,318 @@
+// Kernel Invariance Algorithm (Billings & Li 1999, eqs 15-32; SEEDS-SPEC BL-D4, BL-D5, BL-D6).
+// See include/ctid/estimate/kia.hpp.
+#include "ctid/estimate/kia.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <random>
+
+#include "ctid/core/check.hpp"
+#include "ctid/estimate/gfrf.hpp"
+
+namespace ctid {
+
+namespace {
+using cd = std::complex<double>;
+
+// Least squares on the real stacking [Re; Im] with unit-norm column scaling (powers of s span decades).
+Eigen::VectorXd solve_stacked(const Eigen::MatrixXcd& P, const Eigen::VectorXcd& z) {
+  const Eigen::Index n = P.rows(), p = P.cols();
+  Eigen::MatrixXd A(2 * n, p);
+  Eigen::VectorXd b(2 * n);
+  A << P.real(), P.imag();
+  b << z.real(), z.imag();
+  Eigen::VectorXd scale = A.colwise().norm().transpose();
+  for (Eigen::Index j = 0; j < p; ++j)
+    if (!(scale(j) > 0)) scale(j) = 1.0;
+  const Eigen::VectorXd x = (A * scale.cwiseInverse().asDiagonal()).colPivHouseholderQr().solve(b);
+  return x.cwiseQuotient(scale);
+}
+
+// ERR (% of b^T b, uncentred) of every column by forward orthogonal selection (BL 28-32), aligned with the columns.
+Eigen::VectorXd forward_err(const Eigen::MatrixXcd& P, const Eigen::VectorXcd& z) {
+  const Eigen::Index n = P.rows(), p = P.cols();
+  Eigen::MatrixXd W(2 * n, p);
+  Eigen::VectorXd b(2 * n);
+  W << P.real(), P.imag();
+  b << z.real(), z.imag();
+  const double bb = b.squaredNorm();
+  Eigen::VectorXd err = Eigen::VectorXd::Zero(p);
+  std::vector<bool> used(p, false);
+  for (Eigen::Index step = 0; step < p; ++step) {
+    Eigen::Index best = -1;
+    double best_err = -1;
+    for (Eigen::Index j = 0; j < p; ++j) {
+      if (used[j]) continue;
+      const double ww = W.col(j).squaredNorm();
+      const double e = ww > 0 ? std::pow(W.col(j).dot(b), 2) / (ww * bb) : 0.0;
+      if (e > best_err) {
+        best_err = e;
+        best = j;
+      }
+    }
+    used[best] = true;
+    err(best) = 100.0 * best_err;
+    const Eigen::VectorXd w = W.col(best);
+    const double ww = w.squaredNorm();
+    if (ww > 0)
+      for (Eigen::Index j = 0; j < p; ++j)
+        if (!used[j]) W.col(j) -= (w.dot(W.col(j)) / ww) * w;  // modified Gram-Schmidt
+  }
+  return err;
+}
+
+struct Gls {
+  Eigen::VectorXd theta, first, err;
+  int iterations = 0, order = 0;
+  bool converged = true;
+};
+
+// GLS (BL 20-25): LS, then F(v) = 1 + sum f_k (v/vmax)^k fitted to the residual, both sides filtered, repeated.
+Gls gls(const Eigen::MatrixXcd& P, const Eigen::VectorXcd& z, const Eigen::VectorXcd& v, int G, int max_iterations,
+        double tol) {
+  Gls r;
+  r.first = r.theta = solve_stacked(P, z);
+  const double vmax = v.cwiseAbs().maxCoeff();
+  const Eigen::VectorXcd vs = v / vmax;
+  auto filter_regressors = [&](const Eigen::VectorXcd& E, int g) {
+    Eigen::MatrixXcd R(E.size(), g);
+    Eigen::VectorXcd pw = vs;
+    for (int k = 0; k < g; ++k) {
+      R.col(k) = -pw.cwiseProduct(E);
+      pw = pw.cwiseProduct(vs);
+    }
+    return R;
+  };
+  if (G < 0) {  // ERR-chosen filter order (BL-D6): the smallest order explaining >= 99.99 % of the residual
+    const Eigen::VectorXcd E = z - P * r.theta.cast<cd>();
+    G = 12;
+    for (int g = 1; g <= 12; ++g)
+      if (forward_err(filter_regressors(E, g), E).sum() >= 99.99) {
+        G = g;
+        break;
+      }
+  }
+  r.order = G;
+  Eigen::VectorXcd F = Eigen::VectorXcd::Ones(z.size());
+  if (G > 0) {
+    r.converged = false;
+    for (r.iterations = 1; r.iterations <= max_iterations; ++r.iterations) {
+      const Eigen::VectorXcd E = z - P * r.theta.cast<cd>();
+      const Eigen::VectorXd f = solve_stacked(filter_regressors(E, G), E);
+      F.setOnes();
+      Eigen::VectorXcd pw = vs;
+      for (int k = 0; k < G; ++k) {
+        F += f(k) * pw;
+        pw = pw.cwiseProduct(vs);
+      }
+      const Eigen::VectorXd next = solve_stacked(F.asDiagonal() * P, F.cwiseProduct(z));
+      const double change = (next - r.theta).cwiseQuotient(next.cwiseAbs().cwiseMax(1e-300)).cwiseAbs().maxCoeff();
+      r.theta = next;
+      if (change <= tol) {
+        r.converged = true;
+        break;
+      }
+    }
+    r.iterations = std::min(r.iterations, max_iterations);
+  }
+  r.err = forward_err(F.asDiagonal() * P, F.cwiseProduct(z));
+  return r;
+}
+
+void check_points(const KiaPointOptions& p) {
+  CTID_REQUIRE(p.count >= 1, "kia: the number of points must be >= 1 (got {})", p.count);
+  CTID_REQUIRE(std::isfinite(p.max) && p.max > 0, "kia: the point range must be > 0 rad/s (got {})", p.max);
+}
+}  // namespace
+
+std::vector<std::complex<double>> kia_points(const KiaPointOptions& o) {
+  check_points(o);
+  std::mt19937_64 rng(o.seed);
+  std::uniform_real_distribution<double> U(0.0, o.max);
+  const int n = o.count;
+  auto value = [&](int i, int count) { return o.grid ? o.max * (i + 1) / count : std::max(U(rng), 1e-9 * o.max); };
+  std::vector<cd> s;
+  s.reserve(n);
+  switch (o.region) {
+    case KiaRegion::Axes: {
+      const int nr = n / 2, ni = n - nr;
+      for (int i = 0; i < nr; ++i) s.emplace_back(value(i, nr), 0.0);
+      for (int i = 0; i < ni; ++i) s.emplace_back(0.0, value(i, ni));
+      break;
+    }
+    case KiaRegion::RealAxis:
+      for (int i = 0; i < n; ++i) s.emplace_back(value(i, n), 0.0);
+      break;
+    case KiaRegion::ImaginaryAxis:
+      for (int i = 0; i < n; ++i) s.emplace_back(0.0, value(i, n));
+      break;
+    case KiaRegion::Complex:
+      for (int i = 0; i < n; ++i) {
+        const double re = value(i, n), im = o.grid ? o.max * (n - i) / n : U(rng);
+        s.emplace_back(re, im);
+      }
+      break;
+  }
+  return s;
+}
+
+void KiaLinearOptions::validate() const {
+  CTID_REQUIRE_OPTION(y_order >= 1, "kia_linear: y_order must be >= 1 (got {})", y_order);
+  CTID_REQUIRE_OPTION(u_order >= 0, "kia_linear: u_order must be >= 0 (got {})", u_order);
+  CTID_REQUIRE_OPTION(gls_order >= -1 && gls_order <= 20, "kia_linear: gls_order must be in [-1, 20] (got {})", gls_order);
+  CTID_REQUIRE_OPTION(max_iterations >= 1, "kia_linear: max_iterations must be >= 1 (got {})", max_iterations);
+  CTID_REQUIRE_OPTION(std::isfinite(err_threshold) && err_threshold >= 0 && err_threshold < 100,
+                      "kia_linear: err_threshold must be in [0, 100) % (got {})", err_threshold);
+  CTID_REQUIRE_OPTION(points.count >= y_order + u_order + 1, "kia_linear: {} points for {} coefficients", points.count,
+                      y_order + u_order + 1);
+}
+
+void KiaQuadraticOptions::validate() const {
+  CTID_REQUIRE_OPTION(!candidates.empty(), "kia_quadratic: no candidate terms");
+  for (const auto& t : candidates)
+    CTID_REQUIRE_OPTION(t.degree() == 2, "kia_quadratic: candidate {} is not of degree 2", t.name());
+  CTID_REQUIRE_OPTION(gls_order >= -1 && gls_order <= 20, "kia_quadratic: gls_order must be in [-1, 20] (got {})",
+                      gls_order);
+  CTID_REQUIRE_OPTION(max_iterations >= 1, "kia_quadratic: max_iterations must be >= 1 (got {})", max_iterations);
+  CTID_REQUIRE_OPTION(std::isfinite(err_threshold) && err_threshold >= 0 && err_threshold < 100,
+                      "kia_quadratic: err_threshold must be in [0, 100) % (got {})", err_threshold);
+  CTID_REQUIRE_OPTION(points.count >= static_cast<int>(candidates.size()), "kia_quadratic: {} point pairs for {} "
+                      "coefficients", points.count, candidates.size());
+}
+
+namespace {
+// Run GLS on a candidate set, prune by ERR and re-run; returns the fit and the retained column indices.
+Gls fit_and_prune(const Eigen::MatrixXcd& P, const Eigen::VectorXcd& z, const Eigen::VectorXcd& v, int G, int iters,
+                  double tol, double threshold, std::vector<int>& keep) {
+  keep.resize(P.cols());
+  for (Eigen::Index j = 0; j < P.cols(); ++j) keep[j] = static_cast<int>(j);
+  Gls r = gls(P, z, v, G, iters, tol);
+  if (threshold > 0) {
+    std::vector<int> kept;
+    for (Eigen::Index j = 0; j < P.cols(); ++j)
+      if (r.err(j) >= threshold) kept.push_back(static_cast<int>(j));
+    if (!kept.empty() && kept.size() < keep.size()) {
+      Eigen::MatrixXcd Pk(P.rows(), static_cast<Eigen::Index>(kept.size()));
+      for (size_t j = 0; j < kept.size(); ++j) Pk.col(static_cast<Eigen::Index>(j)) = P.col(kept[j]);
+      keep = kept;
+      r = gls(Pk, z, v, G, iters, tol);
+    }
+  }
+  return r;
+}
+
+template <class R>
+void fill_parameters(R& res, const std::vector<std::string>& names, const Eigen::VectorXd& values,
+                     const Eigen::VectorXd& first, const Gls& g) {
+  res.parameters.names = names;
+  res.parameters.values = values;
+  res.parameters.std = Eigen::VectorXd::Constant(values.size(), std::numeric_limits<double>::quiet_NaN());
+  res.parameters.fixed.assign(values.size(), false);
+  res.diagnostics.vectors["err"] = g.err;
+  res.diagnostics.vectors["first_iteration"] = first;
+  res.diagnostics.scalars["gls_iterations"] = g.iterations;
+  res.diagnostics.scalars["gls_order"] = g.order;
+  res.diagnostics.scalars["err_sum"] = g.err.sum();
+  res.summary.iterations = g.iterations;
+  if (g.order > 0) {
+    res.summary.termination = g.converged ? Termination::Converged : Termination::MaxIterations;
+    if (!g.converged) res.summary.message = "the GLS iterations did not converge; the last iterate is returned";
+  }
+}
+}  // namespace
+
+Result<NdeModel> kia_linear(const NarxModel& narx, const KiaLinearOptions& o) {
+  const auto t_start = std::chrono::steady_clock::now();
+  o.validate();
+  const std::vector<cd> s = kia_points(o.points);
+  const Eigen::Index n = static_cast<Eigen::Index>(s.size());
+  Eigen::VectorXcd z(n), v(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    z(i) = narx_gfrf_ct(narx, {s[i]}, o.zoh);
+    v(i) = s[i];
+  }
+  CTID_REQUIRE(z.allFinite() && z.cwiseAbs().maxCoeff() > 0, "kia_linear: the NARX model has no linear input-output "
+               "kernel (H_1 = 0 or not finite at the points)");
+  // Columns: u-terms s^l (beta_l), then y-terms -s^l H_1 (alpha_l); H_1 (1 + sum alpha s^l) = sum beta s^l.
+  std::vector<NdeTerm> terms;
+  std::vector<double> sign;
+  const int p = o.u_order + 1 + o.y_order;
+  Eigen::MatrixXcd P(n, p);
+  for (int l = 0; l <= o.u_order; ++l) {
+    for (Eigen::Index i = 0; i < n; ++i) P(i, l) = std::pow(s[i], l);
+    terms.push_back({{{true, l}}});
+    sign.push_back(-1.0);  // implicit form: - beta_l D^l u
+  }
+  for (int l = 1; l <= o.y_order; ++l) {
+    for (Eigen::Index i = 0; i < n; ++i) P(i, o.u_order + l) = -std::pow(s[i], l) * z(i);
+    terms.push_back({{{false, l}}});
+    sign.push_back(1.0);
+  }
+  std::vector<int> keep;
+  const Gls g = fit_and_prune(P, z, v, o.gls_order, o.max_iterations, o.tolerance, o.err_threshold, keep);
+  std::vector<NdeTerm> model_terms = {{{{false, 0}}}};
+  std::vector<double> c = {1.0};
+  std::vector<std::string> names;
+  Eigen::VectorXd values(keep.size()), first(keep.size());
+  for (size_t j = 0; j < keep.size(); ++j) {
+    const Eigen::Index k = static_cast<Eigen::Index>(j);
+    values(k) = sign[keep[j]] * g.theta(k);
+    first(k) = sign[keep[j]] * g.first(k);
+    model_terms.push_back(terms[keep[j]]);
+    c.push_back(values(k));
+    names.push_back(terms[keep[j]].name());
+  }
+  Result<NdeModel> res;
+  res.model = NdeModel(model_terms, Eigen::Map<const Eigen::VectorXd>(c.data(), static_cast<Eigen::Index>(c.size())));
+  fill_parameters(res, names, values, first, g);
+  res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return res;
+}
+
+Result<NdeModel> kia_quadratic(const NarxModel& narx, const NdeModel& linear_in, const KiaQuadraticOptions& o) {
+  const auto t_start = std::chrono::steady_clock::now();
+  o.validate();
+  const NdeModel linear = linear_in.normalized();
+  for (const auto& t : linear.terms())
+    CTID_REQUIRE(t.degree() == 1, "kia_quadratic: the linear model has a nonlinear term {}", t.name());
+  KiaPointOptions second = o.points;
+  second.seed = o.points.seed + 7919;
+  const std::vector<cd> s1 = kia_points(o.points), s2 = kia_points(second);
+  const Eigen::Index n = static_cast<Eigen::Index>(s1.size());
+  const Polynomial A = linear.a();
+  Eigen::VectorXcd z(n), v(n);
+  const int p = static_cast<int>(o.candidates.size());
+  Eigen::MatrixXcd P(n, p);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const cd S[2] = {s1[i], s2[i]}, H1[2] = {linear.h1(s1[i]), linear.h1(s2[i])};
+    z(i) = 2.0 * A(S[0] + S[1]) * narx_gfrf_ct(narx, {S[0], S[1]}, o.zoh);
+    v(i) = S[0] + S[1];
+    auto X = [&](const NdeFactor& f, int k) { return std::pow(S[k], f.derivative) * (f.input ? 1.0 : H1[k]); };
+    for (int j = 0; j < p; ++j) {
+      const auto& f = o.candidates[j].factors;
+      P(i, j) = -(X(f[0], 0) * X(f[1], 1) + X(f[0], 1) * X(f[1], 0));
+    }
+  }
+  CTID_REQUIRE(z.allFinite(), "kia_quadratic: the NARX second-order kernel is not finite at the points");
+  std::vector<int> keep;
+  const Gls g = fit_and_prune(P, z, v, o.gls_order, o.max_iterations, o.tolerance, o.err_threshold, keep);
+  std::vector<NdeTerm> terms = linear.terms();
+  std::vector<double> c(linear.coefficients().data(), linear.coefficients().data() + linear.coefficients().size());
+  std::vector<std::string> names;
+  Eigen::VectorXd values(keep.size()), first(keep.size());
+  for (size_t j = 0; j < keep.size(); ++j) {
+    const Eigen::Index k = static_cast<Eigen::Index>(j);
+    values(k) = g.theta(k);
+    first(k) = g.first(k);
+    terms.push_back(o.candidates[keep[j]]);
+    c.push_back(values(k));
+    names.push_back(o.candidates[keep[j]].name());
+  }
+  Result<NdeModel> res;
+  res.model = NdeModel(terms, Eigen::Map<const Eigen::VectorXd>(c.data(), static_cast<Eigen::Index>(c.size())));
+  fill_parameters(res, names, values, first, g);
+  res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return res;
+}
+
+}  // namespace ctid
