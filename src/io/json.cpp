@@ -137,7 +137,77 @@ namespace {
 json fsf_json(const FsfModel& f) {
   return {{"type", "fsf"}, {"delta", f.delta()}, {"N", f.N()}, {"n", f.n()}, {"shift", f.shift()}, {"theta", vec(f.theta())}};
 }
+
+template <class Terms>
+json terms_json(const Terms& terms, const Eigen::VectorXd& c) {
+  json t = json::array();
+  for (size_t i = 0; i < terms.size(); ++i) t.push_back({{"name", terms[i].name()}, {"value", num(c(static_cast<Eigen::Index>(i)))}});
+  return t;
+}
+json narx_json(const NarxModel& m) { return {{"type", "narx"}, {"ts", m.ts()}, {"terms", terms_json(m.terms(), m.coefficients())}}; }
+json nde_json(const NdeModel& m0) {
+  const NdeModel m = m0.coefficient("y") != 0.0 ? m0.normalized() : m0;
+  return {{"type", "nde"}, {"terms", terms_json(m.terms(), m.coefficients())}};
+}
+
+// The model object of a bare model or an envelope, of the given type.
+const json& typed_model(const json& j, const char* type, const Reader& rd) {
+  const json& m = j.contains("model") ? j.at("model") : j;
+  const json& t = rd.member(m, "type", "the model");
+  if (!t.is_string() || t.get<std::string>() != type)
+    rd.fail(detail::format("the model type is {}, expected \"{}\"", t.dump(), type));
+  return m;
+}
+
+template <class Term>
+std::pair<std::vector<Term>, Eigen::VectorXd> read_terms(const json& m, const Reader& rd) {
+  const json& ts = rd.member(m, "terms", "the model");
+  if (!ts.is_array()) rd.fail("\"terms\" must be an array of {name, value}");
+  std::vector<Term> terms;
+  Eigen::VectorXd c(static_cast<Eigen::Index>(ts.size()));
+  for (std::size_t i = 0; i < ts.size(); ++i) {
+    const json& t = ts[i];
+    if (!t.is_object() || !t.contains("name") || !t.contains("value") || !t.at("name").is_string() ||
+        !t.at("value").is_number())
+      rd.fail(detail::format("terms[{}] must be {{\"name\": string, \"value\": number}}", i));
+    try {
+      terms.push_back(Term::parse(t.at("name").get<std::string>()));
+    } catch (const InvalidArgument& e) {
+      rd.fail(detail::format("terms[{}]: {}", i, e.what()));
+    }
+    c(static_cast<Eigen::Index>(i)) = t.at("value").get<double>();
+  }
+  return {terms, c};
+}
 }  // namespace
+
+NarxModel parse_narx_json(const std::string& text, const std::string& source) {
+  const Reader rd{source};
+  const json j = parse_text(text, rd);
+  const json& m = typed_model(j, "narx", rd);
+  auto [terms, c] = read_terms<NarxTerm>(m, rd);
+  const json& ts = rd.member(m, "ts", "the model");
+  if (!ts.is_number()) rd.fail("\"ts\" must be a number (seconds)");
+  try {
+    return NarxModel(terms, c, ts.get<double>());
+  } catch (const InvalidArgument& e) {
+    rd.fail(std::string("invalid NARX model: ") + e.what());
+  }
+}
+
+NdeModel parse_nde_json(const std::string& text, const std::string& source) {
+  const Reader rd{source};
+  const json j = parse_text(text, rd);
+  auto [terms, c] = read_terms<NdeTerm>(typed_model(j, "nde", rd), rd);
+  try {
+    return NdeModel(terms, c);
+  } catch (const InvalidArgument& e) {
+    rd.fail(std::string("invalid NDE model: ") + e.what());
+  }
+}
+
+NarxModel read_narx_json(const std::string& path) { return parse_narx_json(read_text_file(path), path); }
+NdeModel read_nde_json(const std::string& path) { return parse_nde_json(read_text_file(path), path); }
 
 namespace {
 template <class M>
@@ -146,6 +216,8 @@ std::string result_json(const Result<M>& r, const std::string& method, int inden
   j["ctid_version"] = version();
   j["method"] = method;
   if constexpr (std::is_same_v<M, FsfModel>) j["model"] = fsf_json(r.model);
+  else if constexpr (std::is_same_v<M, NarxModel>) j["model"] = narx_json(r.model);
+  else if constexpr (std::is_same_v<M, NdeModel>) j["model"] = nde_json(r.model);
   else j["model"] = model_json(LinearModel(r.model));
   json params = json::array();
   for (int i = 0; i < r.parameters.size(); ++i)
@@ -189,6 +261,19 @@ std::string result_to_json(const Result<FsfModel>& r, const std::string& method,
   return result_json(r, method, indent);
 }
 void write_result_json(const std::string& path, const Result<FsfModel>& r, const std::string& method) {
+  write_text_file(path, result_to_json(r, method) + "\n");
+}
+
+std::string result_to_json(const Result<NarxModel>& r, const std::string& method, int indent) {
+  return result_json(r, method, indent);
+}
+void write_result_json(const std::string& path, const Result<NarxModel>& r, const std::string& method) {
+  write_text_file(path, result_to_json(r, method) + "\n");
+}
+std::string result_to_json(const Result<NdeModel>& r, const std::string& method, int indent) {
+  return result_json(r, method, indent);
+}
+void write_result_json(const std::string& path, const Result<NdeModel>& r, const std::string& method) {
   write_text_file(path, result_to_json(r, method) + "\n");
 }
 

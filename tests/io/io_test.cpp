@@ -171,3 +171,32 @@ TEST(RealData, DaisyHairDryerReads) {
   EXPECT_NEAR(d.u().mean(), 5.0, 0.05);
   EXPECT_NEAR(d.y().mean(), 4.89, 0.01);
 }
+
+TEST(Json, NarxAndNdeModelsRoundTripAndBadFilesAreNamed) {
+  Result<NarxModel> r;
+  r.model = NarxModel({NarxTerm::parse("y(k-1)"), NarxTerm::parse("y(k-1)*u(k-2)"), NarxTerm::parse("e(k-1)")},
+                      Eigen::Vector3d(0.5, -0.25, 0.1), 0.01);
+  r.parameters.names = {"y(k-1)", "y(k-1)*u(k-2)", "e(k-1)"};
+  r.parameters.values = r.model.coefficients();
+  const NarxModel back = parse_narx_json(result_to_json(r, "narx"));
+  EXPECT_EQ(back.terms(), r.model.terms());
+  EXPECT_EQ(back.coefficients(), r.model.coefficients());
+  EXPECT_EQ(back.ts(), 0.01);
+  // NDE: written normalised (y coefficient +1), read back.
+  Result<NdeModel> n;
+  n.model = NdeModel({NdeTerm::parse("y"), NdeTerm::parse("D^2y"), NdeTerm::parse("u"), NdeTerm::parse("y*Dy")},
+                     Eigen::Vector4d(2.0, 2e-4, -2.0, -0.012));
+  const NdeModel nb = parse_nde_json(result_to_json(n, "kia"));
+  EXPECT_DOUBLE_EQ(nb.coefficient("y"), 1.0);
+  EXPECT_DOUBLE_EQ(nb.coefficient("y*Dy"), -0.006);
+  // Unknown term names and wrong types are reported with the file name and the position.
+  try {
+    parse_narx_json(R"J({"type": "narx", "ts": 1, "terms": [{"name": "y(k-1)*x(k-2)", "value": 1}]})J", "m.json");
+    FAIL() << "no error";
+  } catch (const FileError& e) {
+    EXPECT_NE(std::string(e.what()).find("m.json: terms[0]"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("position 8"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(parse_nde_json(R"J({"type": "narx", "ts": 1, "terms": []})J"), FileError);
+  EXPECT_THROW(parse_narx_json(R"J({"type": "narx", "terms": []})J"), FileError);  // no ts
+}

@@ -14,6 +14,8 @@
 #include "ctid/core/types.hpp"
 #include "ctid/model/fsf.hpp"
 #include "ctid/model/miso.hpp"
+#include "ctid/model/narx.hpp"
+#include "ctid/model/nde.hpp"
 #include "ctid/model/state_space.hpp"
 #include "ctid/model/transfer_function.hpp"
 
@@ -40,5 +42,19 @@ void write_result_json(const std::string& path, const Result<MisoModel>& result,
 /// FSF results: model {"type": "fsf", "delta", "N", "n", "shift", "theta": [...]} (real parameterisation).
 std::string result_to_json(const Result<FsfModel>& result, const std::string& method, int indent = 2);
 void write_result_json(const std::string& path, const Result<FsfModel>& result, const std::string& method);
+
+/// NARX/NARMAX models: {"type": "narx", "ts": s, "terms": [{"name": "y(k-1)*u(k-2)", "value": c}, ...]}.
+/// NDE models: {"type": "nde", "terms": [{"name": "D^2y", "value": 1e-4}, {"name": "y*Dy", ...}]}, written
+/// normalised so that the coefficient of y is +1 when the model has a y term (DESIGN.md §8).
+std::string result_to_json(const Result<NarxModel>& result, const std::string& method, int indent = 2);
+void write_result_json(const std::string& path, const Result<NarxModel>& result, const std::string& method);
+std::string result_to_json(const Result<NdeModel>& result, const std::string& method, int indent = 2);
+void write_result_json(const std::string& path, const Result<NdeModel>& result, const std::string& method);
+/// Read a NARX (or NDE) model from a bare model object or a result envelope. Throws FileError naming the
+/// file and the problem (wrong type, a malformed or unknown term name with its position, a missing member).
+NarxModel read_narx_json(const std::string& path);
+NdeModel read_nde_json(const std::string& path);
+NarxModel parse_narx_json(const std::string& text, const std::string& source = "<json>");
+NdeModel parse_nde_json(const std::string& text, const std::string& source = "<json>");
 
 }  // namespace ctid
