@@ -22,7 +22,7 @@ struct FitArgs {
   std::string model_expr, via = "fsf", responses;
   std::vector<std::string> params;
   std::string w = "w", re = "re", im = "im", u_re, u_im, y_re, y_im;
-  std::string json;
+  std::string json, narx;
   bool force = false;
 };
 
@@ -454,6 +454,7 @@ int run(const FitArgs& a) {
     return a.method == "fsf" ? run_fsf(a, d) : run_physical(a, d);
   }
   if (a.method == "modal") return run_modal(a, d);
+  if (a.method == "narx" || a.method == "kia") return run_narx_or_kia(a.method, d, a.sets, a.narx, a.json);
   TfOrders orders = all[0];
   if (a.delay && (a.method == "lssvf" || a.method == "ivsvf" || a.method == "rls-svf"))
     throw UsageError("--delay (delay estimation) needs --method srivc, oe or tfest");
@@ -499,8 +500,9 @@ int run(const FitArgs& a) {
 void setup_fit(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
   app.add_option("DATA", a->data.path, "CSV/.dat table (header row optional) or .mat file")->required();
-  app.add_option("--method", a->method, "Estimator: srivc, tfest, oe, lssvf, ivsvf, rls-svf, fsf, physical or modal")
-      ->check(CLI::IsMember({"lssvf", "ivsvf", "rls-svf", "srivc", "oe", "tfest", "fsf", "physical", "modal"}))
+  app.add_option("--method", a->method,
+                 "Estimator: srivc, tfest, oe, lssvf, ivsvf, rls-svf, fsf, physical, modal, narx or kia")
+      ->check(CLI::IsMember({"lssvf", "ivsvf", "rls-svf", "srivc", "oe", "tfest", "fsf", "physical", "modal", "narx", "kia"}))
       ->capture_default_str();
   a->data.add_to(app, true);
   app.add_option("--nb", a->nb, "Number of numerator coefficients (default: nf); one per input with several inputs (1,2)")
@@ -516,7 +518,11 @@ void setup_fit(CLI::App& app) {
                  "delay (s), delay_min, delay_max, delay_grid; oe/tfest: the same plus fix.NAME, lower.NAME, upper.NAME; "
                  "fsf/physical: T (s), n (odd), a, b, unstable=1; physical also lower.NAME, upper.NAME, fix.NAME; modal: "
                  "shifts=S1,..,Sn (samples) or shift_times (s), basis=fourier|walsh|discrete, functions, iv (samples), "
-                 "stride, quadrature=simpson|trapezoid, window=START,LENGTH (samples), frequencies=w1,.. (generated input)");
+                 "stride, quadrature=simpson|trapezoid, window=START,LENGTH (samples), frequencies=w1,.. (generated input); "
+                 "narx: degree, ylag, ulag, umin, constant, max_terms, err_tolerance, criterion=none|aic|aicc|bic|fpe, "
+                 "noise_terms (NARMAX e lags), noise_max; kia: the narx settings or --narx FILE, y_order, u_order, points, "
+                 "max (rad/s), seed, gls_order, err_threshold (%), zoh, quadratic=y^2,y*Dy, qpoints, qmax, qgls_order, "
+                 "qerr_threshold");
   app.add_flag("--delay", a->delay,
                "Estimate a (non-integer) input delay (srivc, oe, tfest): grid search over [delay_min, delay_max], then "
                "refinement");
@@ -541,6 +547,7 @@ void setup_fit(CLI::App& app) {
   app.add_option("--responses", a->responses,
                  "fsf: write PREFIX_time.csv (step and impulse with standard deviations) and PREFIX_freq.csv (G(jw) with "
                  "standard deviations of its real and imaginary parts)");
+  app.add_option("--narx", a->narx, "kia: the NARX model JSON to reconstruct from (otherwise a NARX model is fitted first)");
   app.add_option("--json", a->json, "Write the result (model, parameters, fit) to this JSON file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
   app.callback([a] { g_run = [a] { return run(*a); }; });

@@ -71,7 +71,12 @@ ModalSettings modal_settings(std::map<std::string, std::string>& sets, double Ts
 /// The generator of the given frequencies with its coefficients c fitted to the measured input.
 InputGenerator generator_fitted_to_input(const std::vector<double>& frequencies, const IdData& d);
 
+/// Billings & Li: fit --method narx | kia (cmd_nonlinear.cpp).
+int run_narx_or_kia(const std::string& method, const IdData& d, const std::vector<std::string>& sets,
+                    const std::string& narx_file, const std::string& json);
+
 void setup_fit(CLI::App& app);
+void setup_gfrf(CLI::App& app);
 void setup_poles(CLI::App& app);
 void setup_response(CLI::App& app);
 void setup_simulate(CLI::App& app);

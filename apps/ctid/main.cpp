@@ -1,4 +1,4 @@
-// ctid — command-line tool. Subcommands: fit, simulate, validate, order, poles, response, demo (DESIGN.md §8).
+// ctid — command-line tool. Subcommands: fit, simulate, validate, order, poles, response, gfrf, demo (DESIGN.md §8).
 // Exit codes: 0 ok, 1 estimate not usable, 2 usage, 3 input file error; one line on stderr.
 #include <cstdio>
 #include <functional>
@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   setup_order(*app.add_subcommand("order", "Rank model structures [nb nf nk] by YIC, RT2, AIC or BIC (SRIVC fits)"));
   setup_poles(*app.add_subcommand("poles", "Poles from a free response: data-matrix method (El-Shafey) against Prony"));
   setup_response(*app.add_subcommand("response", "Nonparametric step, impulse or frequency response (modal functions)"));
+  setup_gfrf(*app.add_subcommand("gfrf", "Generalised frequency response functions of a NARX or NDE model file"));
   setup_demo(*app.add_subcommand("demo", "Identify a bundled real data set and print the model"));
   try {
     app.parse(argc, argv);

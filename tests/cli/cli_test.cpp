@@ -60,7 +60,7 @@ std::string good_csv() {
 }  // namespace
 
 TEST(Cli, HelpAndVersion) {
-  for (const char* sub : {"fit", "simulate", "validate", "demo", "poles", "response"}) {
+  for (const char* sub : {"fit", "simulate", "validate", "demo", "poles", "response", "gfrf"}) {
     const CliRun r = ctid_run(std::string(sub) + " --help");
     EXPECT_EQ(r.code, 0) << sub;
     EXPECT_NE(r.out.find("--"), std::string::npos) << sub;
@@ -447,4 +447,46 @@ TEST(Cli, ModalBadInputs) {
     EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << "\n" << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   }
+}
+
+TEST(Cli, NarxKiaAndGfrf) {
+  // Billings & Li system (33), +-1 input held at 400 Hz, 1000 samples, noise-free, simulated by the NDE integrator.
+  std::vector<NdeTerm> t;
+  for (const char* s : {"y", "Dy", "D^2y", "u", "y^2", "y*Dy"}) t.push_back(NdeTerm::parse(s));
+  const NdeModel truth(t, (Eigen::VectorXd(6) << 1, 0.002, 1e-4, -1, 0.1, -0.006).finished());
+  const int N = 1000;
+  Eigen::VectorXd u(N);
+  for (int i = 0; i < N; ++i) u(i) = ((i * 7919 + i / 3) % 5) < 2 ? 1.0 : -1.0;  // deterministic +-1 sequence
+  Eigen::MatrixXd m(N, 2);
+  m << u, truth.simulate(u, time_grid(0.0025, N), Intersample::Zoh, {}, 1e-11).y;
+  const std::string data = test::temp_path("bl.csv"), narx = test::temp_path("narx.json"), nde = test::temp_path("nde.json"),
+                    csv = test::temp_path("h2.csv");
+  write_csv(data, {"u", "y"}, m);
+  for (const auto& f : {narx, nde, csv}) fs::remove(f);
+  CliRun r = ctid_run("fit " + data + " --ts 0.0025 --method narx --set ylag=6 --set ulag=6 --json " + narx);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("ERR"), std::string::npos);
+  EXPECT_TRUE(read_narx_json(narx).terms().size() >= 5);
+  r = ctid_run("fit " + data + " --ts 0.0025 --method kia --narx " + narx + " --set quadratic=y^2,y*Dy --json " + nde);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const NdeModel got = read_nde_json(nde);
+  for (const char* s : {"Dy", "D^2y", "u", "y^2", "y*Dy"})
+    EXPECT_NEAR(got.coefficient(s), truth.coefficient(s), 0.05 * std::abs(truth.coefficient(s))) << s;
+  r = ctid_run("gfrf " + nde + " --order 2 --w 10,50 --out " + csv);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(read_csv(csv).values.rows(), 4);
+  // Bad input.
+  r = ctid_run("fit " + data + " --ts 0.0025 --method narx --set ylag=0");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("ylag"), std::string::npos) << r.err;
+  Eigen::MatrixXd small = m.topRows(100);
+  const std::string sd = test::temp_path("small.csv");
+  write_csv(sd, {"u", "y"}, small);
+  r = ctid_run("fit " + sd + " --ts 0.0025 --method narx --set degree=2 --set ylag=16 --set ulag=16");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("candidate terms but only"), std::string::npos) << r.err;
+  const std::string bad = write("bad_narx.json", R"J({"type": "narx", "ts": 0.0025, "terms": [{"name": "y(k-1)*w(k-2)", "value": 1}]})J");
+  r = ctid_run("fit " + data + " --ts 0.0025 --method kia --narx " + bad);
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("terms[0]"), std::string::npos) << r.err;
 }

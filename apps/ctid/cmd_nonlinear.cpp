@@ -1,0 +1,256 @@
+// ctid — Billings & Li: `ctid fit --method narx|kia` and `ctid gfrf` (NARX/NARMAX by FROLS, the Kernel
+// Invariance Algorithm, generalised frequency response functions).
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <sstream>
+
+#include "common.hpp"
+
+namespace ctid::cli {
+extern std::function<int()> g_run;
+
+namespace {
+std::vector<std::string> split(const std::string& v) {
+  std::vector<std::string> out;
+  std::stringstream ss(v);
+  std::string item;
+  while (std::getline(ss, item, ',')) out.push_back(item);
+  return out;
+}
+
+InformationCriterion criterion_of(const std::string& v) {
+  if (v == "none") return InformationCriterion::None;
+  if (v == "aic") return InformationCriterion::Aic;
+  if (v == "aicc") return InformationCriterion::Aicc;
+  if (v == "bic") return InformationCriterion::Bic;
+  if (v == "fpe") return InformationCriterion::Fpe;
+  throw UsageError("--set criterion: use none, aic, aicc, bic or fpe (got '" + v + "')");
+}
+
+void print_narx(const Result<NarxModel>& r) {
+  std::printf("selected terms (in order of selection) with their error reduction ratio:\n");
+  const Eigen::VectorXd& err = r.diagnostics.vectors.at("err");
+  for (int i = 0; i < r.parameters.size(); ++i)
+    std::printf("  %-22s %14.6g +- %-11.3g ERR %8.4f %%\n", r.parameters.names[i].c_str(), r.parameters.values(i),
+                r.parameters.std(i), i < err.size() ? err(i) : NAN);
+  std::printf("1 - sum(ERR) = %.3g   free-run fit %.2f %%\n", r.diagnostics.scalars.at("esr"), r.fit.fit_percent);
+}
+}  // namespace
+
+// Consumes the NARX settings; noise_terms > 0 selects NARMAX.
+Result<NarxModel> run_narx(const IdData& d, std::map<std::string, std::string>& sets) {
+  int degree = 2, ylag = 2, ulag = 2, umin = 1, elag = 0, noise_max = 5;
+  bool constant = true;
+  FrolsOptions fo{.criterion = InformationCriterion::Aic};
+  consume_sets(sets, [&](const std::string& k, const std::string& v) {
+    if (k == "degree") degree = to_int(k, v);
+    else if (k == "ylag") ylag = to_int(k, v);
+    else if (k == "ulag") ulag = to_int(k, v);
+    else if (k == "umin") umin = to_int(k, v);
+    else if (k == "constant") constant = to_int(k, v) != 0;
+    else if (k == "max_terms") fo.max_terms = to_int(k, v);
+    else if (k == "err_tolerance") fo.err_tolerance = to_double(k, v);
+    else if (k == "criterion") fo.criterion = criterion_of(v);
+    else if (k == "noise_terms") elag = to_int(k, v);
+    else if (k == "noise_max") noise_max = to_int(k, v);
+    else return false;
+    return true;
+  });
+  if (ylag < 1) throw UsageError(detail::format("--set ylag={}: a NARX model needs past outputs (ylag >= 1)", ylag));
+  if (elag < 0) throw UsageError("--set noise_terms must be >= 0");
+  try {
+    const std::vector<NarxTerm> cand = narx_candidates(degree, ylag, ulag, constant, umin);
+    std::printf("candidates: %zu (degree %d, ylag %d, ulag %d)\n", cand.size(), degree, ylag, ulag);
+    if (elag == 0) return frols(d, cand, fo);
+    return narmax(d, cand, {.frols = fo, .noise_candidates = narx_noise_candidates(elag, 2, 2), .max_noise_terms = noise_max});
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+}
+
+int run_narx_or_kia(const std::string& method, const IdData& d, const std::vector<std::string>& set_list,
+                    const std::string& narx_file, const std::string& json) {
+  if (d.nu() != 1 || d.ny() != 1) throw UsageError(method + " needs one --input and one --output");
+  auto sets = parse_sets(set_list);
+  if (method == "narx") {
+    const Result<NarxModel> r = run_narx(d, sets);
+    if (!sets.empty())
+      throw UsageError("--set " + sets.begin()->first + ": not a setting of narx (settings: degree, ylag, ulag, umin, "
+                       "constant, max_terms, err_tolerance, criterion, noise_terms, noise_max)");
+    print_narx(r);
+    if (!json.empty()) {
+      write_result_json(json, r, "narx");
+      std::printf("wrote %s\n", json.c_str());
+    }
+    return r.usable() ? kOk : kNotUsable;
+  }
+  // kia: the NARX model from --narx, or identified here.
+  KiaLinearOptions lo;
+  KiaQuadraticOptions qo;
+  lo.zoh = qo.zoh = d.intersample(0) == Intersample::Zoh;
+  consume_sets(sets, [&](const std::string& k, const std::string& v) {
+    if (k == "y_order") lo.y_order = to_int(k, v);
+    else if (k == "u_order") lo.u_order = to_int(k, v);
+    else if (k == "points") lo.points.count = to_int(k, v);
+    else if (k == "max") lo.points.max = to_double(k, v);
+    else if (k == "seed") lo.points.seed = qo.points.seed = static_cast<unsigned>(to_int(k, v));
+    else if (k == "gls_order") lo.gls_order = to_int(k, v);
+    else if (k == "err_threshold") lo.err_threshold = to_double(k, v);
+    else if (k == "zoh") lo.zoh = qo.zoh = to_int(k, v) != 0;
+    else if (k == "quadratic") {
+      try {
+        for (const auto& t : split(v)) qo.candidates.push_back(NdeTerm::parse(t));
+      } catch (const InvalidArgument& e) {
+        throw UsageError(std::string("--set quadratic: ") + e.what());
+      }
+    } else if (k == "qpoints") qo.points.count = to_int(k, v);
+    else if (k == "qmax") qo.points.max = to_double(k, v);
+    else if (k == "qgls_order") qo.gls_order = to_int(k, v);
+    else if (k == "qerr_threshold") qo.err_threshold = to_double(k, v);
+    else return false;
+    return true;
+  });
+  NarxModel narx;
+  if (!narx_file.empty()) {
+    try {
+      narx = read_narx_json(narx_file).process();
+    } catch (const FileError& e) {
+      throw InputError(e.what());
+    }
+    if (std::abs(narx.ts() - d.ts()) > 1e-9 * d.ts())
+      throw UsageError(detail::format("{} was identified at Ts = {} s, the data have {} s", narx_file, narx.ts(), d.ts()));
+  } else {
+    const Result<NarxModel> r = run_narx(d, sets);
+    print_narx(r);
+    narx = r.model.process();
+  }
+  if (!sets.empty())
+    throw UsageError("--set " + sets.begin()->first + ": not a setting of kia (settings: y_order, u_order, points, max, "
+                     "seed, gls_order, err_threshold, zoh, quadratic=y^2,y*Dy, qpoints, qmax, qgls_order, "
+                     "qerr_threshold, and the narx settings)");
+  Result<NdeModel> r;
+  try {
+    r = kia_linear(narx, lo);
+    if (!qo.candidates.empty()) {
+      const Result<NdeModel> lin = r;
+      r = kia_quadratic(narx, lin.model, qo);
+      r.parameters.names.insert(r.parameters.names.begin(), lin.parameters.names.begin(), lin.parameters.names.end());
+      Eigen::VectorXd v(lin.parameters.size() + r.parameters.values.size());
+      v << lin.parameters.values, r.parameters.values;
+      r.parameters.values = v;
+      r.parameters.std = Eigen::VectorXd::Constant(v.size(), NAN);
+      r.parameters.fixed.assign(v.size(), false);
+      Eigen::VectorXd e(v.size());
+      e << lin.diagnostics.vectors.at("err"), r.diagnostics.vectors.at("err");
+      r.diagnostics.vectors["err"] = e;
+    }
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+  // Validation: simulate the NDE on the record's input.
+  Eigen::VectorXd t(d.size());
+  for (int i = 0; i < d.size(); ++i) t(i) = d.time(i) - d.t0();
+  const NdeSimulation sim = r.model.simulate(d.u().col(0), t, d.intersample(0));
+  if (!sim.ok()) {
+    r.summary.termination = sim.termination;
+    r.summary.message = "the NDE simulation failed: " + sim.message;
+    r.fit = fit_report_or_inf(d.y().col(0), Eigen::VectorXd::Constant(d.size(), NAN), r.parameters.size());
+  } else {
+    r.fit = fit_report_or_inf(d.y().col(0), sim.y, r.parameters.size());
+  }
+  std::printf("NDE: %s\n", r.model.to_string(5).c_str());
+  const Eigen::VectorXd& err = r.diagnostics.vectors.at("err");
+  for (int i = 0; i < r.parameters.size(); ++i)
+    std::printf("  %-10s %14.6g   ERR %8.4f %%\n", r.parameters.names[i].c_str(), r.parameters.values(i), err(i));
+  std::printf("simulated output fit: %.2f %%   (hold factor %s)\n", r.fit.fit_percent, lo.zoh ? "on" : "off");
+  if (!json.empty()) {
+    write_result_json(json, r, "kia");
+    std::printf("wrote %s\n", json.c_str());
+  }
+  if (!r.usable()) {
+    std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", r.summary.message.c_str());
+    return kNotUsable;
+  }
+  return kOk;
+}
+
+namespace {
+struct GfrfArgs {
+  std::string model, out;
+  int order = 1;
+  std::vector<double> w;
+  bool real = false, no_zoh = false, force = false;
+};
+
+int run_gfrf(const GfrfArgs& a) {
+  check_output_path(a.out, {a.model}, a.force);
+  if (a.order < 1 || a.order > 3) throw UsageError(detail::format("--order must be 1, 2 or 3 (got {})", a.order));
+  if (a.w.empty()) throw UsageError("give the frequencies with --w w1,w2,.. (rad/s)");
+  std::function<Complex(const std::vector<Complex>&)> kernel;
+  std::string kind;
+  try {
+    const NarxModel m = read_narx_json(a.model).process();
+    kernel = [m, zoh = !a.no_zoh](const std::vector<Complex>& s) { return narx_gfrf_ct(m, s, zoh); };
+    kind = "narx";
+  } catch (const FileError& narx_error) {
+    try {
+      const NdeModel m = read_nde_json(a.model);
+      if (a.order > 2) throw UsageError("NDE kernels are available to order 2 (harmonic probing)");
+      kernel = [m](const std::vector<Complex>& s) { return s.size() == 1 ? m.h1(s[0]) : m.h2(s[0], s[1]); };
+      kind = "nde";
+    } catch (const FileError&) {
+      throw InputError(std::string(narx_error.what()) + " (and it is not an NDE model either)");
+    }
+  }
+  std::vector<Complex> pts;
+  for (double w : a.w) pts.push_back(a.real ? Complex(w, 0) : Complex(0, w));
+  const int P = static_cast<int>(pts.size());
+  int rows = 1;
+  for (int i = 0; i < a.order; ++i) rows *= P;
+  Eigen::MatrixXd tab(rows, 2 * a.order + 3);
+  std::vector<std::string> names;
+  for (int i = 1; i <= a.order; ++i) {
+    names.push_back("s" + std::to_string(i) + "_re");
+    names.push_back("s" + std::to_string(i) + "_im");
+  }
+  names.insert(names.end(), {"re", "im", "mag"});
+  std::vector<int> idx(a.order, 0);
+  for (int r = 0; r < rows; ++r) {
+    std::vector<Complex> s;
+    for (int i = 0; i < a.order; ++i) {
+      s.push_back(pts[idx[i]]);
+      tab(r, 2 * i) = pts[idx[i]].real();
+      tab(r, 2 * i + 1) = pts[idx[i]].imag();
+    }
+    const Complex h = kernel(s);
+    tab(r, 2 * a.order) = h.real();
+    tab(r, 2 * a.order + 1) = h.imag();
+    tab(r, 2 * a.order + 2) = std::abs(h);
+    for (int i = a.order - 1; i >= 0 && ++idx[i] == P; --i) idx[i] = 0;
+  }
+  std::printf("%s model, H_%d at %d point%s%s\n", kind.c_str(), a.order, rows, rows == 1 ? "" : "s",
+              kind == "narx" && !a.no_zoh ? " (divided by the hold factor Z(s))" : "");
+  for (int r = 0; r < std::min(rows, 10); ++r)
+    std::printf("  H = %.6g %+.6gj\n", tab(r, 2 * a.order), tab(r, 2 * a.order + 1));
+  if (!a.out.empty()) {
+    write_csv(a.out, names, tab);
+    std::printf("wrote %s\n", a.out.c_str());
+  }
+  return kOk;
+}
+}  // namespace
+
+void setup_gfrf(CLI::App& app) {
+  auto a = std::make_shared<GfrfArgs>();
+  app.add_option("MODEL", a->model, "NARX or NDE model JSON (result of fit --method narx or kia)")->required();
+  app.add_option("--order", a->order, "Kernel order n (1..3; NDE: 1..2)")->capture_default_str();
+  app.add_option("--w", a->w, "Frequencies (rad/s); order n evaluates every n-tuple")->delimiter(',');
+  app.add_flag("--real", a->real, "Use s = w on the real axis instead of s = j w");
+  app.add_flag("--no-zoh", a->no_zoh, "NARX: do not divide by the hold factor Z(s) (data not sampled with a held input)");
+  app.add_option("--out", a->out, "Write the kernel values to this CSV file");
+  app.add_flag("--force", a->force, "Overwrite an existing output file");
+  app.callback([a] { g_run = [a] { return run_gfrf(*a); }; });
+}
+
+}  // namespace ctid::cli
