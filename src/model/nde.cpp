@@ -130,6 +130,32 @@ std::complex<double> NdeModel::h2(std::complex<double> s1, std::complex<double> 
   return rhs / (2.0 * a()(s1 + s2));
 }
 
+std::complex<double> NdeModel::h3(std::complex<double> s1, std::complex<double> s2, std::complex<double> s3) const {
+  using cd = std::complex<double>;
+  const cd S[3] = {s1, s2, s3}, H1[3] = {h1(s1), h1(s2), h1(s3)};
+  // First-order component of a factor on e^{s_k t}; second-order component on e^{(s_j+s_k) t}.
+  auto X1 = [&](const NdeFactor& f, int k) { return std::pow(S[k], f.derivative) * (f.input ? 1.0 : H1[k]); };
+  auto X2 = [&](const NdeFactor& f, int j, int k) {
+    return f.input ? cd(0.0) : std::pow(S[j] + S[k], f.derivative) * 2.0 * h2(S[j], S[k]);
+  };
+  cd rhs = 0.0;
+  for (size_t t = 0; t < terms_.size(); ++t) {
+    const auto& f = terms_[t].factors;
+    const double c = c_(static_cast<Eigen::Index>(t));
+    if (f.size() == 2) {
+      for (int i = 0; i < 3; ++i) {
+        const int j = (i + 1) % 3, k = (i + 2) % 3;
+        rhs -= c * (X1(f[0], i) * X2(f[1], j, k) + X2(f[0], j, k) * X1(f[1], i));
+      }
+    } else if (f.size() == 3) {
+      int p[3] = {0, 1, 2};
+      do rhs -= c * X1(f[0], p[0]) * X1(f[1], p[1]) * X1(f[2], p[2]);
+      while (std::next_permutation(p, p + 3));
+    }
+  }
+  return rhs / (6.0 * a()(s1 + s2 + s3));
+}
+
 std::string NdeModel::to_string(int precision) const {
   std::ostringstream s;
   s.precision(precision);

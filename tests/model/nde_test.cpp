@@ -73,3 +73,28 @@ TEST(NdeModel, LinearSimulationIsExactAndEscapesAreReported) {
   const NdeModel implicit({NdeTerm::parse("y"), NdeTerm::parse("y*D^2y"), NdeTerm::parse("u")}, Eigen::Vector3d(1, 1, -1));
   EXPECT_THROW(implicit.simulate(u, t), InvalidArgument);
 }
+
+TEST(NdeModel, HarmonicProbingH3AgreesWithAThreeToneSimulation) {
+  // BL (33) plus 0.05 y^3: H_3 gets the cubic term and the quadratic terms' products with H_2. Tones at 4, 6 and
+  // 7 Hz (amplitude A = 0.005): the only third-order combination at 17 Hz is 4 + 6 + 7, whose cosine amplitude is
+  // (3/2) A^3 H_3; lower orders have no 17 Hz component, higher ones are O(A^4). 5 kHz, linear interpolation.
+  std::vector<NdeTerm> t;
+  for (const char* s : {"y", "Dy", "D^2y", "u", "y^2", "y*Dy", "y^3"}) t.push_back(NdeTerm::parse(s));
+  const NdeModel m(t, (Eigen::VectorXd(7) << 1, 0.002, 1e-4, -1, 0.1, -0.006, 0.05).finished());
+  EXPECT_NEAR((NdeModel({NdeTerm::parse("y"), NdeTerm::parse("u"), NdeTerm::parse("y^3")}, Eigen::Vector3d(1, -1, 0.2))
+                   .h3(1.0, 2.0, 3.0)).real(), -0.2, 1e-15);  // y = u - 0.2 y^3: H_3 = -0.2
+  const double A = 0.005, pi2 = 2 * std::numbers::pi, Ts = 2e-4;
+  const double w[3] = {pi2 * 4, pi2 * 6, pi2 * 7};
+  const int N = 15001;
+  const Eigen::VectorXd tt = Eigen::VectorXd::LinSpaced(N, 0.0, (N - 1) * Ts);
+  const Eigen::VectorXd u = A * ((w[0] * tt).array().cos() + (w[1] * tt).array().cos() + (w[2] * tt).array().cos());
+  const NdeSimulation r = m.simulate(u, tt, Intersample::Foh, {}, 1e-11);
+  ASSERT_TRUE(r.ok()) << r.message;
+  const double ws = w[0] + w[1] + w[2];
+  std::complex<double> c = 0.0;
+  const int K = 5000;
+  for (int i = N - K; i < N; ++i) c += r.y(i) * std::exp(std::complex<double>(0, -ws * tt(i)));
+  c *= 2.0 / K;
+  const std::complex<double> h3 = m.h3({0, w[0]}, {0, w[1]}, {0, w[2]});
+  EXPECT_LT(std::abs(c - 1.5 * A * A * A * h3), 0.01 * std::abs(1.5 * A * A * A * h3));
+}

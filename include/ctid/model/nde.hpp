@@ -64,6 +64,11 @@ class NdeModel {
   /// Symmetric H_2(s_1, s_2) by harmonic probing of the quadratic terms (SEEDS-SPEC BL-D3):
   /// 2 A(s_1+s_2) H_2 = - sum over y-y, y-u and u-u products of their probing expressions.
   std::complex<double> h2(std::complex<double> s1, std::complex<double> s2) const;
+  /// Symmetric H_3(s_1, s_2, s_3) by harmonic probing with three exponentials: the coefficient of
+  /// e^{(s_1+s_2+s_3)t} gives 6 A(s_1+s_2+s_3) H_3 = - sum over quadratic terms of their first x second
+  /// order products (second-order components (s_j+s_k)^l 2 H_2(s_j, s_k) of y) - sum over cubic terms of
+  /// the six orderings of first-order products. Terms of degree > 3 do not enter.
+  std::complex<double> h3(std::complex<double> s1, std::complex<double> s2, std::complex<double> s3) const;
   /// "y + 0.002 Dy + 0.0001 D^2y - u + 0.1 y^2 - 0.006 y*Dy = 0".
   std::string to_string(int precision = 4) const;
 
