@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <cmath>
 #include <random>
 
@@ -46,10 +47,15 @@ Eigen::VectorXd forward_err(const Eigen::MatrixXcd& P, const Eigen::VectorXcd& z
       if (used[j]) continue;
       const double ww = W.col(j).squaredNorm();
       const double e = ww > 0 ? std::pow(W.col(j).dot(b), 2) / (ww * bb) : 0.0;
-      if (e > best_err) {
+      if (std::isfinite(e) && e > best_err) {
         best_err = e;
         best = j;
       }
+    }
+    if (best < 0) {  // non-finite columns: no ERR for the rest
+      for (Eigen::Index j = 0; j < p; ++j)
+        if (!used[j]) err(j) = std::numeric_limits<double>::quiet_NaN();
+      break;
     }
     used[best] = true;
     err(best) = 100.0 * best_err;
@@ -295,6 +301,7 @@ Result<NdeModel> kia_quadratic(const NarxModel& narx, const NdeModel& linear_in,
     }
   }
   CTID_REQUIRE(z.allFinite(), "kia_quadratic: the NARX second-order kernel is not finite at the points");
+  CTID_REQUIRE(P.allFinite(), "kia_quadratic: the linear model's H_1 is not finite at the points (a pole on an axis?)");
   std::vector<int> keep;
   const Gls g = fit_and_prune(P, z, v, o.gls_order, o.max_iterations, o.tolerance, o.err_threshold, keep);
   std::vector<NdeTerm> terms = linear.terms();
@@ -362,6 +369,7 @@ Result<NdeModel> kia_cubic(const NarxModel& narx, const NdeModel& model_in, cons
     }
   }
   CTID_REQUIRE(z.allFinite(), "kia_cubic: the NARX third-order kernel is not finite at the points");
+  CTID_REQUIRE(P.allFinite(), "kia_cubic: the model's kernels are not finite at the points (a pole on an axis?)");
   std::vector<int> keep;
   const Gls g = fit_and_prune(P, z, v, o.gls_order, o.max_iterations, o.tolerance, o.err_threshold, keep);
   std::vector<NdeTerm> terms = model.terms();
