@@ -226,6 +226,27 @@ void fill_parameters(R& res, const std::vector<std::string>& names, const Eigen:
     if (!g.converged) res.summary.message = "the GLS iterations did not converge; the last iterate is returned";
   }
 }
+// The model plus the retained candidates with their estimated coefficients (quadratic and cubic stages).
+Result<NdeModel> extended(const NdeModel& base, const std::vector<NdeTerm>& candidates, const std::vector<int>& keep,
+                          const Gls& g, std::chrono::steady_clock::time_point t_start) {
+  std::vector<NdeTerm> terms = base.terms();
+  std::vector<double> c(base.coefficients().data(), base.coefficients().data() + base.coefficients().size());
+  std::vector<std::string> names;
+  Eigen::VectorXd values(keep.size()), first(keep.size());
+  for (size_t j = 0; j < keep.size(); ++j) {
+    const Eigen::Index k = static_cast<Eigen::Index>(j);
+    values(k) = g.theta(k);
+    first(k) = g.first(k);
+    terms.push_back(candidates[keep[j]]);
+    c.push_back(values(k));
+    names.push_back(candidates[keep[j]].name());
+  }
+  Result<NdeModel> res;
+  res.model = NdeModel(terms, Eigen::Map<const Eigen::VectorXd>(c.data(), static_cast<Eigen::Index>(c.size())));
+  fill_parameters(res, names, values, first, g);
+  res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return res;
+}
 }  // namespace
 
 Result<NdeModel> kia_linear(const NarxModel& narx, const KiaLinearOptions& o) {
@@ -304,23 +325,7 @@ Result<NdeModel> kia_quadratic(const NarxModel& narx, const NdeModel& linear_in,
   CTID_REQUIRE(P.allFinite(), "kia_quadratic: the linear model's H_1 is not finite at the points (a pole on an axis?)");
   std::vector<int> keep;
   const Gls g = fit_and_prune(P, z, v, o.gls_order, o.max_iterations, o.tolerance, o.err_threshold, keep);
-  std::vector<NdeTerm> terms = linear.terms();
-  std::vector<double> c(linear.coefficients().data(), linear.coefficients().data() + linear.coefficients().size());
-  std::vector<std::string> names;
-  Eigen::VectorXd values(keep.size()), first(keep.size());
-  for (size_t j = 0; j < keep.size(); ++j) {
-    const Eigen::Index k = static_cast<Eigen::Index>(j);
-    values(k) = g.theta(k);
-    first(k) = g.first(k);
-    terms.push_back(o.candidates[keep[j]]);
-    c.push_back(values(k));
-    names.push_back(o.candidates[keep[j]].name());
-  }
-  Result<NdeModel> res;
-  res.model = NdeModel(terms, Eigen::Map<const Eigen::VectorXd>(c.data(), static_cast<Eigen::Index>(c.size())));
-  fill_parameters(res, names, values, first, g);
-  res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-  return res;
+  return extended(linear, o.candidates, keep, g, t_start);
 }
 
 void KiaCubicOptions::validate() const {
@@ -372,23 +377,7 @@ Result<NdeModel> kia_cubic(const NarxModel& narx, const NdeModel& model_in, cons
   CTID_REQUIRE(P.allFinite(), "kia_cubic: the model's kernels are not finite at the points (a pole on an axis?)");
   std::vector<int> keep;
   const Gls g = fit_and_prune(P, z, v, o.gls_order, o.max_iterations, o.tolerance, o.err_threshold, keep);
-  std::vector<NdeTerm> terms = model.terms();
-  std::vector<double> c(model.coefficients().data(), model.coefficients().data() + model.coefficients().size());
-  std::vector<std::string> names;
-  Eigen::VectorXd values(keep.size()), first(keep.size());
-  for (size_t j = 0; j < keep.size(); ++j) {
-    const Eigen::Index k = static_cast<Eigen::Index>(j);
-    values(k) = g.theta(k);
-    first(k) = g.first(k);
-    terms.push_back(o.candidates[keep[j]]);
-    c.push_back(values(k));
-    names.push_back(o.candidates[keep[j]].name());
-  }
-  Result<NdeModel> res;
-  res.model = NdeModel(terms, Eigen::Map<const Eigen::VectorXd>(c.data(), static_cast<Eigen::Index>(c.size())));
-  fill_parameters(res, names, values, first, g);
-  res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-  return res;
+  return extended(model, o.candidates, keep, g, t_start);
 }
 
 }  // namespace ctid

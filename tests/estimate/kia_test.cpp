@@ -10,6 +10,7 @@
 
 #include "ctid/core/error.hpp"
 #include "ctid/data/input_design.hpp"
+#include "ctid/io/json.hpp"
 #include "ctid/estimate/frols.hpp"
 #include "ctid/estimate/kia.hpp"
 #include "ctid/io/load.hpp"
@@ -18,19 +19,8 @@
 using namespace ctid;
 
 namespace {
-NarxModel bl34() {
-  const std::vector<std::string> n = {
-      "y(k-1)",  "y(k-8)",  "y(k-2)",          "u(k-2)",  "u(k-3)",  "u(k-5)",          "y(k-3)",         "u(k-4)",
-      "y(k-3)*y(k-8)", "y(k-9)", "u(k-7)", "u(k-1)",  "y(k-12)", "u(k-6)", "y(k-7)*y(k-9)", "y(k-1)*y(k-2)",
-      "u(k-8)",  "u(k-9)",  "y(k-13)",         "u(k-10)", "y(k-10)*y(k-11)", "u(k-11)", "y(k-11)", "y(k-5)",
-      "y(k-10)", "y(k-7)*y(k-15)", "y(k-9)*y(k-14)", "u(k-12)", "y(k-16)", "y(k-2)*y(k-8)"};
-  const std::vector<double> c = {0.22099,  -0.28266, 0.00073,  0.11415,  0.13593, 0.16375, 0.09909,  0.13737,
-                                 0.02375,  0.08582,  0.13896,  0.04719,  -0.34567, 0.11822, -0.0840,  0.13378,
-                                 0.09797,  0.08407,  -0.06159, 0.07489,  -0.09918, 0.03417, -0.09156, 0.1092,
-                                 0.08644,  0.10144,  -0.10199, 0.01344,  -0.02788, -0.09730};
-  std::vector<NarxTerm> t;
-  for (const auto& s : n) t.push_back(NarxTerm::parse(s));
-  return NarxModel(t, Eigen::Map<const Eigen::VectorXd>(c.data(), static_cast<Eigen::Index>(c.size())), 0.0025);
+NarxModel bl34() {  // Billings & Li (1999) model (34) as printed (SEEDS-SPEC BL.3)
+  return read_narx_json(std::string(CTID_EXAMPLES_DATA_DIR) + "/bl34_narx.json");
 }
 
 double value(const Result<NdeModel>& r, const std::string& name) { return r.parameters.value(name); }
