@@ -21,6 +21,10 @@ constexpr int kInputFile = 3;
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+/// The computation ran but its result cannot be used (e.g. a simulation that escapes): exit 1.
+struct NotUsable : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 /// A problem with an input file or its contents: exit 3.
 struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;

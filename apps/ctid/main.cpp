@@ -39,6 +39,9 @@ int main(int argc, char** argv) {
   } catch (const UsageError& e) {
     std::fprintf(stderr, "ctid: %s\n", e.what());
     return kUsage;
+  } catch (const NotUsable& e) {
+    std::fprintf(stderr, "ctid: %s\n", e.what());
+    return kNotUsable;
   } catch (const InputError& e) {
     std::fprintf(stderr, "ctid: %s\n", e.what());
     return kInputFile;

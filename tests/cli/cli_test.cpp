@@ -475,6 +475,23 @@ TEST(Cli, NarxKiaAndGfrf) {
   r = ctid_run("gfrf " + nde + " --order 2 --w 10,50 --out " + csv);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(read_csv(csv).values.rows(), 4);
+  // simulate: the NDE and NARX files reproduce the record (time axis from --ts); an escaping NDE is exit 1.
+  const std::string sim = test::temp_path("nde_sim.csv");
+  fs::remove(sim);
+  r = ctid_run("simulate " + nde + " " + data + " --ts 0.0025 --input u --out " + sim);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Eigen::VectorXd ysim = read_csv(sim).values.col(2);
+  EXPECT_LT((ysim - m.col(1)).norm() / m.col(1).norm(), 0.02);
+  fs::remove(sim);
+  r = ctid_run("simulate " + narx + " " + data + " --ts 0.0025 --input u --out " + sim);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string escaping =
+      write("escape.json", R"J({"type": "nde", "terms": [{"name": "Dy", "value": 1}, {"name": "y^2", "value": -1}, {"name": "u", "value": 5}]})J");  // Dy = y^2 - 5u, mean(u) < 0
+  fs::remove(sim);
+  r = ctid_run("simulate " + escaping + " " + data + " --ts 0.0025 --input u --out " + sim);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("escapes"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(sim));  // no partial output
   // Bad input.
   r = ctid_run("fit " + data + " --ts 0.0025 --method narx --set ylag=0");
   EXPECT_EQ(r.code, 2);
