@@ -200,15 +200,18 @@ Eigen::VectorXd NarxModel::predict(const Eigen::VectorXd& u, const Eigen::Vector
     e(k) = y(k) - p1(k);
   }
   if (steps == 1) return p1;
-  Eigen::VectorXd out = y, w(N);
+  // For each k: measured data up to k - steps, then `steps` model iterations (future noise = 0). The
+  // iterated entries of w and ez are restored afterwards, so each prediction costs O(steps * terms).
+  Eigen::VectorXd out = y, w = y, ez = e;
   for (Eigen::Index k = L; k < N; ++k) {
-    // Start from measured data up to k - steps, then iterate the model `steps` times (future noise = 0).
     const Eigen::Index k0 = std::max(L, k - steps + 1);
-    w = y;
-    Eigen::VectorXd ez = e;
     for (Eigen::Index j = k0; j <= k; ++j) ez(j) = 0.0;
     for (Eigen::Index j = k0; j <= k; ++j) w(j) = evaluate(terms_, theta_, u, w, &ez, j);
     out(k) = w(k);
+    for (Eigen::Index j = k0; j <= k; ++j) {
+      w(j) = y(j);
+      ez(j) = e(j);
+    }
   }
   return out;
 }

@@ -15,8 +15,8 @@ namespace {
 std::string factor_name(const NdeFactor& f) {
   const char* v = f.input ? "u" : "y";
   if (f.derivative == 0) return v;
-  if (f.derivative == 1) return std::string("D") + v;
-  return "D^" + std::to_string(f.derivative) + v;
+  if (f.derivative == 1) return detail::format("D{}", v);
+  return detail::format("D^{}{}", f.derivative, v);
 }
 }  // namespace
 
@@ -27,7 +27,7 @@ std::string NdeTerm::name() const {
     while (j < factors.size() && factors[j] == factors[i]) ++j;
     if (!s.empty()) s += "*";
     s += factor_name(factors[i]);
-    if (j - i > 1) s += "^" + std::to_string(j - i);
+    if (j - i > 1) s += detail::format("^{}", j - i);
     i = j;
   }
   return s.empty() ? "1" : s;
@@ -220,7 +220,7 @@ NdeSimulation NdeModel::simulate(const Eigen::VectorXd& u, const Eigen::VectorXd
   NdeSimulation out;
   out.y = Eigen::VectorXd::Constant(t.size(), std::numeric_limits<double>::quiet_NaN());
   Eigen::VectorXd x = x0.size() ? x0 : Eigen::VectorXd::Zero(L);
-  Eigen::VectorXd k1(L), k2(L), k3(L), k4(L), k5(L), k6(L), k7(L), xt(L), xn(L);
+  Eigen::VectorXd k1(L), k2(L), k3(L), k4(L), k5(L), k6(L), k7(L), xt(L), xn(L), errv(L);
   out.y(0) = x(0);
   const double atol = 1e-12;
   double h = (t.size() > 1 ? t(1) - t(0) : 1.0) / 4;
@@ -246,7 +246,7 @@ NdeSimulation NdeModel::simulate(const Eigen::VectorXd& u, const Eigen::VectorXd
       f(xt, uin(tt + h), k6);
       xn = x + h * (b1 * k1 + b3 * k3 + b4 * k4 + b5 * k5 + b6 * k6);
       f(xn, uin(tt + h), k7);
-      const Eigen::VectorXd errv = h * (e1 * k1 + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * k7);
+      errv = h * (e1 * k1 + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * k7);
       double err = 0;
       for (Eigen::Index i = 0; i < L; ++i)
         err = std::max(err, std::abs(errv(i)) / (atol + rtol * std::max(std::abs(x(i)), std::abs(xn(i)))));
