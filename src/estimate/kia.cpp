@@ -237,7 +237,7 @@ void fill_parameters(R& res, const std::vector<std::string>& names, const Eigen:
     if (!g.converged) res.summary.message = "the GLS iterations did not converge; the last iterate is returned";
   }
 }
-// The model plus the retained candidates with their estimated coefficients (quadratic and cubic stages).
+// The model plus the retained candidates with their estimated coefficients (linear, quadratic and cubic stages).
 Result<NdeModel> extended(const NdeModel& base, const std::vector<NdeTerm>& candidates, const std::vector<int>& keep,
                           const Gls& g, std::chrono::steady_clock::time_point t_start) {
   std::vector<NdeTerm> terms = base.terms();
@@ -272,40 +272,22 @@ Result<NdeModel> kia_linear(const NarxModel& narx, const KiaLinearOptions& o) {
   }
   CTID_REQUIRE(z.allFinite() && z.cwiseAbs().maxCoeff() > 0, "kia_linear: the NARX model has no linear input-output "
                "kernel (H_1 = 0 or not finite at the points)");
-  // Columns: u-terms s^l (beta_l), then y-terms -s^l H_1 (alpha_l); H_1 (1 + sum alpha s^l) = sum beta s^l.
+  // H_1 (1 + sum alpha_l s^l) = sum beta_l s^l with the implicit-form coefficients as unknowns: u-terms
+  // (coefficient -beta_l) have columns -s^l, y-terms (alpha_l) -s^l H_1.
   std::vector<NdeTerm> terms;
-  std::vector<double> sign;
   const int p = o.u_order + 1 + o.y_order;
   Eigen::MatrixXcd P(n, p);
   for (int l = 0; l <= o.u_order; ++l) {
-    for (Eigen::Index i = 0; i < n; ++i) P(i, l) = std::pow(s[i], l);
+    for (Eigen::Index i = 0; i < n; ++i) P(i, l) = -std::pow(s[i], l);
     terms.push_back({{{true, l}}});
-    sign.push_back(-1.0);  // implicit form: - beta_l D^l u
   }
   for (int l = 1; l <= o.y_order; ++l) {
     for (Eigen::Index i = 0; i < n; ++i) P(i, o.u_order + l) = -std::pow(s[i], l) * z(i);
     terms.push_back({{{false, l}}});
-    sign.push_back(1.0);
   }
   std::vector<int> keep;
   const Gls g = fit_and_prune(P, z, v, o.gls_order, o.max_iterations, o.tolerance, o.err_threshold, keep);
-  std::vector<NdeTerm> model_terms = {{{{false, 0}}}};
-  std::vector<double> c = {1.0};
-  std::vector<std::string> names;
-  Eigen::VectorXd values(keep.size()), first(keep.size());
-  for (size_t j = 0; j < keep.size(); ++j) {
-    const Eigen::Index k = static_cast<Eigen::Index>(j);
-    values(k) = sign[keep[j]] * g.theta(k);
-    first(k) = sign[keep[j]] * g.first(k);
-    model_terms.push_back(terms[keep[j]]);
-    c.push_back(values(k));
-    names.push_back(terms[keep[j]].name());
-  }
-  Result<NdeModel> res;
-  res.model = NdeModel(model_terms, Eigen::Map<const Eigen::VectorXd>(c.data(), static_cast<Eigen::Index>(c.size())));
-  fill_parameters(res, names, values, first, g);
-  res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-  return res;
+  return extended(NdeModel({{{{false, 0}}}}, Eigen::VectorXd::Ones(1)), terms, keep, g, t_start);
 }
 
 Result<NdeModel> kia_quadratic(const NarxModel& narx, const NdeModel& linear_in, const KiaQuadraticOptions& o) {
