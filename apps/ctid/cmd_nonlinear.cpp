@@ -2,6 +2,7 @@
 // Invariance Algorithm, generalised frequency response functions).
 #include <cmath>
 #include <cstdio>
+#include <algorithm>
 #include <functional>
 #include <sstream>
 
@@ -88,6 +89,7 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
   // kia: the NARX model from --narx, or identified here.
   KiaLinearOptions lo;
   KiaQuadraticOptions qo;
+  bool refine = true;
   lo.zoh = qo.zoh = d.intersample(0) == Intersample::Zoh;
   consume_sets(sets, [&](const std::string& k, const std::string& v) {
     if (k == "y_order") lo.y_order = to_int(k, v);
@@ -98,6 +100,7 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
     else if (k == "gls_order") lo.gls_order = to_int(k, v);
     else if (k == "err_threshold") lo.err_threshold = to_double(k, v);
     else if (k == "zoh") lo.zoh = qo.zoh = to_int(k, v) != 0;
+    else if (k == "refine") refine = to_int(k, v) != 0;
     else if (k == "quadratic") {
       try {
         for (const auto& t : split(v)) qo.candidates.push_back(NdeTerm::parse(t));
@@ -127,7 +130,7 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
   }
   if (!sets.empty())
     throw UsageError("--set " + sets.begin()->first + ": not a setting of kia (settings: y_order, u_order, points, max, "
-                     "seed, gls_order, err_threshold, zoh, quadratic=y^2,y*Dy, qpoints, qmax, qgls_order, "
+                     "seed, gls_order, err_threshold, zoh, refine, quadratic=y^2,y*Dy, qpoints, qmax, qgls_order, "
                      "qerr_threshold, and the narx settings)");
   Result<NdeModel> r;
   try {
@@ -164,6 +167,22 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
   for (int i = 0; i < r.parameters.size(); ++i)
     std::printf("  %-10s %14.6g   ERR %8.4f %%\n", r.parameters.names[i].c_str(), r.parameters.values(i), err(i));
   std::printf("simulated output fit: %.2f %%   (hold factor %s)\n", r.fit.fit_percent, lo.zoh ? "on" : "off");
+  if (refine) {
+    // Output-error refinement of the coefficients (nde_oe): consistent under output noise.
+    const Result<NdeModel> oe = nde_oe(d, r.model);
+    if (oe.usable()) {
+      std::printf("refined by output error (%d iterations): %s\n", oe.summary.iterations, oe.model.to_string(5).c_str());
+      for (int i = 0; i < oe.parameters.size(); ++i)
+        std::printf("  %-10s %14.6g +- %.3g%s\n", oe.parameters.names[i].c_str(), oe.parameters.values(i),
+                    oe.parameters.std(i), oe.parameters.fixed[static_cast<size_t>(i)] ? "  (reference)" : "");
+      for (const auto& w : oe.diagnostics.warnings) std::printf("  note: %s\n", w.c_str());
+      std::printf("simulated output fit: %.2f %%\n", oe.fit.fit_percent);
+      r = oe;
+    } else {
+      std::fprintf(stderr, "ctid: warning: the output-error refinement failed (%s); keeping the KIA model\n",
+                   oe.summary.message.c_str());
+    }
+  }
   if (!json.empty()) {
     write_result_json(json, r, "kia");
     std::printf("wrote %s\n", json.c_str());
@@ -177,16 +196,17 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
 
 namespace {
 struct GfrfArgs {
-  std::string model, out;
+  std::string model, out, points;
   int order = 1;
   std::vector<double> w;
   bool real = false, no_zoh = false, force = false;
 };
 
 int run_gfrf(const GfrfArgs& a) {
-  check_output_path(a.out, {a.model}, a.force);
+  check_output_path(a.out, {a.model, a.points}, a.force);
   if (a.order < 1 || a.order > 3) throw UsageError(detail::format("--order must be 1, 2 or 3 (got {})", a.order));
-  if (a.w.empty()) throw UsageError("give the frequencies with --w w1,w2,.. (rad/s)");
+  if (a.w.empty() == a.points.empty())
+    throw UsageError("give either the frequencies with --w w1,w2,.. (rad/s) or the points with --points FILE");
   std::function<Complex(const std::vector<Complex>&)> kernel;
   std::string kind;
   try {
@@ -196,38 +216,68 @@ int run_gfrf(const GfrfArgs& a) {
   } catch (const FileError& narx_error) {
     try {
       const NdeModel m = read_nde_json(a.model);
-      if (a.order > 2) throw UsageError("NDE kernels are available to order 2 (harmonic probing)");
-      kernel = [m](const std::vector<Complex>& s) { return s.size() == 1 ? m.h1(s[0]) : m.h2(s[0], s[1]); };
+      kernel = [m](const std::vector<Complex>& s) {
+        return s.size() == 1 ? m.h1(s[0]) : s.size() == 2 ? m.h2(s[0], s[1]) : m.h3(s[0], s[1], s[2]);
+      };
       kind = "nde";
     } catch (const FileError&) {
       throw InputError(std::string(narx_error.what()) + " (and it is not an NDE model either)");
     }
   }
-  std::vector<Complex> pts;
-  for (double w : a.w) pts.push_back(a.real ? Complex(w, 0) : Complex(0, w));
-  const int P = static_cast<int>(pts.size());
-  int rows = 1;
-  for (int i = 0; i < a.order; ++i) rows *= P;
-  Eigen::MatrixXd tab(rows, 2 * a.order + 3);
   std::vector<std::string> names;
   for (int i = 1; i <= a.order; ++i) {
     names.push_back("s" + std::to_string(i) + "_re");
     names.push_back("s" + std::to_string(i) + "_im");
   }
-  names.insert(names.end(), {"re", "im", "mag"});
-  std::vector<int> idx(a.order, 0);
-  for (int r = 0; r < rows; ++r) {
-    std::vector<Complex> s;
-    for (int i = 0; i < a.order; ++i) {
-      s.push_back(pts[idx[i]]);
-      tab(r, 2 * i) = pts[idx[i]].real();
-      tab(r, 2 * i + 1) = pts[idx[i]].imag();
+  // The evaluation points: one n-tuple per row.
+  std::vector<std::vector<Complex>> tuples;
+  if (!a.points.empty()) {
+    CsvTable in;
+    try {
+      in = read_csv(a.points);
+    } catch (const FileError& e) {
+      throw InputError(e.what());
     }
-    const Complex h = kernel(s);
+    std::vector<int> col;
+    for (const auto& n : names) {
+      const auto it = std::find(in.names.begin(), in.names.end(), n);
+      if (it == in.names.end())
+        throw InputError(detail::format("{}: no column '{}' (H_{} needs the columns s1_re, s1_im .. s{}_im)", a.points,
+                                        n, a.order, a.order));
+      col.push_back(static_cast<int>(it - in.names.begin()));
+    }
+    for (Eigen::Index r = 0; r < in.values.rows(); ++r) {
+      std::vector<Complex> s;
+      for (int i = 0; i < a.order; ++i) s.emplace_back(in.values(r, col[2 * i]), in.values(r, col[2 * i + 1]));
+      tuples.push_back(s);
+    }
+    if (tuples.empty()) throw InputError(a.points + ": no points");
+  } else {  // every n-tuple of the frequencies
+    std::vector<Complex> pts;
+    for (double w : a.w) pts.push_back(a.real ? Complex(w, 0) : Complex(0, w));
+    const int P = static_cast<int>(pts.size());
+    int rows = 1;
+    for (int i = 0; i < a.order; ++i) rows *= P;
+    std::vector<int> idx(a.order, 0);
+    for (int r = 0; r < rows; ++r) {
+      std::vector<Complex> s;
+      for (int i = 0; i < a.order; ++i) s.push_back(pts[idx[i]]);
+      tuples.push_back(s);
+      for (int i = a.order - 1; i >= 0 && ++idx[i] == P; --i) idx[i] = 0;
+    }
+  }
+  const int rows = static_cast<int>(tuples.size());
+  Eigen::MatrixXd tab(rows, 2 * a.order + 3);
+  names.insert(names.end(), {"re", "im", "mag"});
+  for (int r = 0; r < rows; ++r) {
+    for (int i = 0; i < a.order; ++i) {
+      tab(r, 2 * i) = tuples[r][i].real();
+      tab(r, 2 * i + 1) = tuples[r][i].imag();
+    }
+    const Complex h = kernel(tuples[r]);
     tab(r, 2 * a.order) = h.real();
     tab(r, 2 * a.order + 1) = h.imag();
     tab(r, 2 * a.order + 2) = std::abs(h);
-    for (int i = a.order - 1; i >= 0 && ++idx[i] == P; --i) idx[i] = 0;
   }
   std::printf("%s model, H_%d at %d point%s%s\n", kind.c_str(), a.order, rows, rows == 1 ? "" : "s",
               kind == "narx" && !a.no_zoh ? " (divided by the hold factor Z(s))" : "");
@@ -244,8 +294,10 @@ int run_gfrf(const GfrfArgs& a) {
 void setup_gfrf(CLI::App& app) {
   auto a = std::make_shared<GfrfArgs>();
   app.add_option("MODEL", a->model, "NARX or NDE model JSON (result of fit --method narx or kia)")->required();
-  app.add_option("--order", a->order, "Kernel order n (1..3; NDE: 1..2)")->capture_default_str();
+  app.add_option("--order", a->order, "Kernel order n (1..3)")->capture_default_str();
   app.add_option("--w", a->w, "Frequencies (rad/s); order n evaluates every n-tuple")->delimiter(',');
+  app.add_option("--points", a->points, "CSV of complex points, one n-tuple per row: columns s1_re, s1_im, .., sn_im "
+                 "(the layout of --out)");
   app.add_flag("--real", a->real, "Use s = w on the real axis instead of s = j w");
   app.add_flag("--no-zoh", a->no_zoh, "NARX: do not divide by the hold factor Z(s) (data not sampled with a held input)");
   app.add_option("--out", a->out, "Write the kernel values to this CSV file");

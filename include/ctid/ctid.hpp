@@ -12,6 +12,7 @@
 #include "ctid/estimate/frols.hpp"
 #include "ctid/estimate/gfrf.hpp"
 #include "ctid/estimate/kia.hpp"
+#include "ctid/estimate/nde_oe.hpp"
 #include "ctid/estimate/fsf.hpp"
 #include "ctid/estimate/lssvf.hpp"
 #include "ctid/estimate/modal.hpp"

@@ -467,14 +467,42 @@ TEST(Cli, NarxKiaAndGfrf) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("ERR"), std::string::npos);
   EXPECT_TRUE(read_narx_json(narx).terms().size() >= 5);
+  // KIA alone (refine=0): within 5 % of the truth; with the default output-error refinement: within 0.1 %.
+  r = ctid_run("fit " + data + " --ts 0.0025 --method kia --narx " + narx + " --set quadratic=y^2,y*Dy --set refine=0 --json " + nde);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.find("refined"), std::string::npos);
+  for (const char* s : {"Dy", "D^2y", "u", "y^2", "y*Dy"})
+    EXPECT_NEAR(read_nde_json(nde).coefficient(s), truth.coefficient(s), 0.05 * std::abs(truth.coefficient(s))) << s;
+  fs::remove(nde);
   r = ctid_run("fit " + data + " --ts 0.0025 --method kia --narx " + narx + " --set quadratic=y^2,y*Dy --json " + nde);
   ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("refined by output error"), std::string::npos) << r.out;
   const NdeModel got = read_nde_json(nde);
   for (const char* s : {"Dy", "D^2y", "u", "y^2", "y*Dy"})
-    EXPECT_NEAR(got.coefficient(s), truth.coefficient(s), 0.05 * std::abs(truth.coefficient(s))) << s;
+    EXPECT_NEAR(got.coefficient(s), truth.coefficient(s), 1e-3 * std::abs(truth.coefficient(s))) << s;
   r = ctid_run("gfrf " + nde + " --order 2 --w 10,50 --out " + csv);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(read_csv(csv).values.rows(), 4);
+  const CsvTable h2 = read_csv(csv);
+  ASSERT_EQ(h2.values.rows(), 4);
+  EXPECT_NEAR(h2.values(1, 4), got.h2({0, 10}, {0, 50}).real(), 1e-12 * std::abs(got.h2({0, 10}, {0, 50})));
+  // --points: arbitrary complex pairs from a CSV (here the layout of the file just written, one row per pair).
+  const std::string pts = write("points.csv", "s1_re,s1_im,s2_re,s2_im\n3,40,-1,7\n0,10,0,50\n");
+  const std::string csv2 = test::temp_path("h2_points.csv");
+  fs::remove(csv2);
+  r = ctid_run("gfrf " + nde + " --order 2 --points " + pts + " --out " + csv2);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const CsvTable hp = read_csv(csv2);
+  ASSERT_EQ(hp.values.rows(), 2);
+  const auto h = got.h2({3, 40}, {-1, 7});
+  EXPECT_NEAR(hp.values(0, 4), h.real(), 1e-12 * std::abs(h));
+  EXPECT_NEAR(hp.values(0, 5), h.imag(), 1e-12 * std::abs(h));
+  EXPECT_NEAR(hp.values(1, 6), h2.values(1, 6), 1e-12 * h2.values(1, 6));
+  r = ctid_run("gfrf " + nde + " --order 3 --points " + pts);
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("no column 's3_re'"), std::string::npos) << r.err;
+  r = ctid_run("gfrf " + nde + " --order 2 --points " + pts + " --w 10");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("either"), std::string::npos) << r.err;
   // simulate: the NDE and NARX files reproduce the record (time axis from --ts); an escaping NDE is exit 1.
   const std::string sim = test::temp_path("nde_sim.csv");
   fs::remove(sim);

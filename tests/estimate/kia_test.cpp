@@ -13,6 +13,7 @@
 #include "ctid/io/json.hpp"
 #include "ctid/estimate/frols.hpp"
 #include "ctid/estimate/kia.hpp"
+#include "ctid/estimate/nde_oe.hpp"
 #include "ctid/io/load.hpp"
 #include "ctid/simulate/lsim.hpp"
 
@@ -109,8 +110,9 @@ NdeModel bl33() {
   return NdeModel(t, (Eigen::VectorXd(6) << 1, 0.002, 1e-4, -1, 0.1, -0.006).finished());
 }
 
-// Relative errors of the reconstructed Dy, D^2y, u, y^2, y*Dy for one record.
-Eigen::VectorXd end_to_end(unsigned seed, double snr_db) {
+// Relative errors of the reconstructed Dy, D^2y, u, y^2, y*Dy for one record: row 0 KIA, row 1 KIA refined by
+// output error (nde_oe on the same record).
+Eigen::MatrixXd end_to_end(unsigned seed, double snr_db) {
   const int N = 1000;
   const double T = 0.0025;
   std::mt19937 rng(seed);
@@ -126,9 +128,15 @@ Eigen::VectorXd end_to_end(unsigned seed, double snr_db) {
   const NarxModel narx = (snr_db > 0 ? narmax(d, cand, {.frols = fo}) : frols(d, cand, fo)).model.process();
   const auto lin = kia_linear(narx, {.y_order = 2, .u_order = 0});  // hold factor on: the data were held
   const auto q = kia_quadratic(narx, lin.model, {.candidates = {NdeTerm::parse("y^2"), NdeTerm::parse("y*Dy")}});
-  Eigen::VectorXd e(5);
+  const auto refined = nde_oe(d, q.model);
+  EXPECT_TRUE(refined.usable()) << refined.summary.message;
+  const NdeModel kia = q.model.normalized();
+  Eigen::MatrixXd e(2, 5);
   int i = 0;
-  for (const char* s : {"Dy", "D^2y", "u", "y^2", "y*Dy"}) e(i++) = std::abs(q.model.coefficient(s) / truth.coefficient(s) - 1);
+  for (const char* s : {"Dy", "D^2y", "u", "y^2", "y*Dy"}) {
+    e(0, i) = std::abs(kia.coefficient(s) / truth.coefficient(s) - 1);
+    e(1, i++) = std::abs(refined.model.coefficient(s) / truth.coefficient(s) - 1);
+  }
   return e;
 }
 }  // namespace
@@ -136,12 +144,20 @@ Eigen::VectorXd end_to_end(unsigned seed, double snr_db) {
 TEST(Kia, EndToEndFromSimulatedData) {
   // Noise-free: NARX (FROLS, degree 2, lags 1..6, AIC) -> KIA with the hold factor: every coefficient within 1 %
   // (issue 6 target; measured <= 0.55 % on this seed).
-  const Eigen::VectorXd clean = end_to_end(11, 0.0);
-  EXPECT_LT(clean.maxCoeff(), 0.01) << clean.transpose();
-  // 20 dB output noise, NARMAX, 8 seeds. Measured upper medians (5th of 8): Dy 5.5 %, D^2y 0.5 %, u 1.8 %,
-  // y*Dy 2.2 %, y^2 21.5 % (range 2-48 %): the small y^2 effect is the weak spot (issue 6 asks for 10 %).
+  // Output-error refinement of that model: within 0.1 %.
+  const Eigen::MatrixXd clean = end_to_end(11, 0.0);
+  EXPECT_LT(clean.row(0).maxCoeff(), 0.01) << clean;
+  EXPECT_LT(clean.row(1).maxCoeff(), 0.001) << clean;
+  // 20 dB output noise, NARMAX, 8 seeds. KIA alone, measured upper medians (5th of 8): Dy 5.5 %, D^2y 0.5 %,
+  // u 1.8 %, y*Dy 2.2 %, y^2 21.5 % (range 2-48 %): the small y^2 effect is the weak spot of the equation-error
+  // chain. Refined by output error (nde_oe): measured worst over the 8 seeds 2.8 % (y^2; its standard error is
+  // 0.9-1.9 %), so every coefficient of every seed must be within 10 % (issue 6 target).
   Eigen::MatrixXd E(8, 5);
-  for (int s = 0; s < 8; ++s) E.row(s) = end_to_end(static_cast<unsigned>(s + 1), 20.0).transpose();
+  for (int s = 0; s < 8; ++s) {
+    const Eigen::MatrixXd e = end_to_end(static_cast<unsigned>(s + 1), 20.0);
+    E.row(s) = e.row(0);
+    EXPECT_LT(e.row(1).maxCoeff(), 0.10) << "seed " << s + 1 << ": " << e.row(1);
+  }
   for (int c = 0; c < 5; ++c) {
     std::vector<double> v(E.col(c).data(), E.col(c).data() + 8);
     std::nth_element(v.begin(), v.begin() + 4, v.end());
@@ -175,8 +191,10 @@ TEST(Kia, SilverboxRealData) {
   // 3, lags 1..3 (AIC, at most 10 terms) on 20000 samples of the multisine part (means removed), free-run on the
   // "arrow (full)" test [100, 40575): measured 3.67 mV RMS (references in the README: SysIdentPy NARX 4.15 mV,
   // SUBNET 5.79 mV). KIA (linear + y^2 + y^3; the generator is a hold followed by a reconstruction filter, so no
-  // hold factor; points up to 1000 rad/s) gives m y'' + d y' + k y + k3 y^3 = u with free-run RMS 21.7 mV: a
-  // stable, interpretable continuous-time equation, but 6x less accurate than the NARX model it came from.
+  // hold factor; points up to 1000 rad/s) gives m y'' + d y' + k y + k3 y^3 = u: free-run RMS 21.7 mV with the input
+  // held between samples, 7.4 mV with it interpolated linearly (closer to the filtered generator output). Refined by
+  // output error (nde_oe, linear interpolation, 5000 training samples): measured 0.95 mV, better than the NARX model
+  // and both references.
   const std::string path = std::string(CTID_SHARED_DATA_DIR) + "/silverbox/SNLS80mV.csv";
   if (!std::ifstream(path)) GTEST_SKIP() << path << " not available";
   const IdData all = load_iddata(path, {.inputs = {"V1"}, .outputs = {"V2"}, .ts = 1.0 / 610.3515625});
@@ -189,16 +207,28 @@ TEST(Kia, SilverboxRealData) {
   bool escaped = false;
   const Eigen::VectorXd yn = narx.model.simulate(ua, ya.head(narx.model.max_lag()), &escaped);
   ASSERT_FALSE(escaped);
-  const double rms_narx = std::sqrt((yn - ya).tail(40425).squaredNorm() / 40425);
-  EXPECT_LT(rms_narx, 4.5e-3);
+  auto rms = [&](const Eigen::VectorXd& yhat) { return std::sqrt((yhat - ya).tail(40425).squaredNorm() / 40425); };
+  EXPECT_LT(rms(yn), 4.5e-3);
   const auto lin = kia_linear(narx.model, {.y_order = 2, .u_order = 0, .points = {.max = 1000}, .zoh = false});
   const auto q = kia_quadratic(narx.model, lin.model, {.candidates = {NdeTerm::parse("y^2")}, .zoh = false});
   const auto c = kia_cubic(narx.model, q.model, {.candidates = {NdeTerm::parse("y^3")}, .zoh = false});
   EXPECT_GT(c.model.coefficient("y^3"), 0.0);  // a hardening spring
   const Eigen::VectorXd x0 = (Eigen::VectorXd(2) << ya(0), (ya(1) - ya(0)) / all.ts()).finished();
-  const NdeSimulation sim = c.model.simulate(ua, time_grid(all.ts(), 40475), Intersample::Zoh, x0);
+  const Eigen::VectorXd t = time_grid(all.ts(), 40475);
+  const NdeSimulation held = c.model.simulate(ua, t, Intersample::Zoh, x0);
+  ASSERT_TRUE(held.ok()) << held.message;
+  EXPECT_LT(rms(held.y), 25e-3);
+  const NdeSimulation linear = c.model.simulate(ua, t, Intersample::Foh, x0);
+  ASSERT_TRUE(linear.ok()) << linear.message;
+  EXPECT_LT(rms(linear.y), 9e-3);
+  IdData short_train(u.segment(40650, 5000), y.segment(40650, 5000), all.ts());
+  short_train.set_intersample(Intersample::Foh);
+  const auto refined = nde_oe(short_train, c.model);
+  ASSERT_TRUE(refined.usable()) << refined.summary.message;
+  EXPECT_GT(refined.model.coefficient("y^3"), 0.0);
+  const NdeSimulation sim = refined.model.simulate(ua, t, Intersample::Foh, x0);
   ASSERT_TRUE(sim.ok()) << sim.message;
-  EXPECT_LT(std::sqrt((sim.y - ya).tail(40425).squaredNorm() / 40425), 25e-3);
+  EXPECT_LT(rms(sim.y), 1.5e-3);
 }
 
 TEST(Kia, ErrChoosesTheGlsFilterOrder) {

@@ -1,0 +1,42 @@
+// ctid — output-error refinement of a nonlinear differential-equation (NDE) model: the coefficients of a
+// given term structure (e.g. the one the Kernel Invariance Algorithm selected, Billings & Li 1999) and
+// the initial state are adjusted to minimise the simulation error
+//     V(theta) = sum_k (y(t_k) - yhat(t_k; theta))^2,   yhat = NdeModel::simulate (adaptive Dormand-Prince),
+// by Levenberg-Marquardt with a forward-difference Jacobian (Ljung 1999, ch. 7: the prediction-error
+// estimate for white output noise, consistent where equation-error estimates such as the NARX/KIA chain
+// are biased by noise). It plays the role of MATLAB's `pem`/`nlgreyest` refinement after an initial
+// estimate. Covariance sigma^2 (J^T J)^{-1} of the free parameters.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "ctid/core/types.hpp"
+#include "ctid/data/iddata.hpp"
+#include "ctid/model/nde.hpp"
+
+namespace ctid {
+
+struct NdeOeOptions {
+  int max_iterations = 50;
+  double tolerance = 1e-9;             ///< relative cost decrease or parameter change that stops the search
+  bool estimate_initial_state = true;  ///< estimate [y, Dy, .., D^{L-1}y] at the first sample; false: from rest
+  std::vector<std::string> fixed;      ///< term names whose coefficients are held (the reference term always is)
+  double rtol = 1e-10;                 ///< relative tolerance of the simulations (the Jacobian steps are 1e-6)
+  void validate() const;
+};
+
+/// Refine the coefficients of `initial` on SISO data (input held or linear between samples as the data's
+/// intersample says; BandLimited is treated as linear). The reference term — y, or the highest derivative
+/// of y when y is absent — keeps its coefficient; the returned model is scaled so that y has coefficient
+/// +1 when present. When the starting model's simulation escapes, its nonlinear (degree >= 2) coefficients
+/// are shrunk by halves (down to 0) until it does not; the factor is diagnostics.scalars "start_scale"
+/// (1: none) and a warning says so. parameters: every term's coefficient (reference and `fixed` ones
+/// flagged fixed, with zero variance), then "y(0)", "Dy(0)", .. when estimated. diagnostics: vector "x0"
+/// (initial state), scalars "noise_variance", "start_scale". Termination Converged / MaxIterations, or
+/// NumericalFailure (fit infinite) when no shrunk start can be simulated.
+/// Throws InvalidArgument for data that are not SISO, fewer samples than free parameters, a model that
+/// NdeModel::simulate rejects, unknown names in `fixed`; InvalidOptions for bad options.
+Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOeOptions& options = {});
+
+}  // namespace ctid

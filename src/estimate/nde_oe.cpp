@@ -1,0 +1,181 @@
+// Output-error refinement of an NDE model (see include/ctid/estimate/nde_oe.hpp; Ljung 1999 ch. 7).
+#include "ctid/estimate/nde_oe.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "ctid/core/check.hpp"
+#include "ctid/validate/metrics.hpp"
+#include "internal/levenberg_marquardt.hpp"
+
+namespace ctid {
+
+void NdeOeOptions::validate() const {
+  CTID_REQUIRE_OPTION(max_iterations >= 1, "nde_oe: max_iterations must be >= 1 (got {})", max_iterations);
+  CTID_REQUIRE_OPTION(std::isfinite(tolerance) && tolerance > 0 && tolerance < 1,
+                      "nde_oe: tolerance must be in (0, 1) (got {})", tolerance);
+  CTID_REQUIRE_OPTION(std::isfinite(rtol) && rtol >= 1e-13 && rtol <= 1e-6,
+                      "nde_oe: rtol must be in [1e-13, 1e-6] (got {}); the Jacobian needs accurate simulations", rtol);
+}
+
+Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOeOptions& opt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  opt.validate();
+  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "nde_oe: needs SISO data (got {} inputs, {} outputs)", data.nu(),
+               data.ny());
+  const auto& terms = initial.terms();
+  const int m = static_cast<int>(terms.size());
+  // Order of the model (number of states) and the reference term.
+  int L = 0;
+  for (const auto& term : terms)
+    for (const auto& f : term.factors)
+      if (!f.input) L = std::max(L, f.derivative);
+  int ref = -1, top = -1;
+  for (int i = 0; i < m; ++i) {
+    const auto& f = terms[static_cast<size_t>(i)].factors;
+    if (f.size() == 1 && !f[0].input && f[0].derivative == 0) ref = i;
+    if (f.size() == 1 && !f[0].input && f[0].derivative == L) top = i;
+  }
+  if (ref < 0) ref = top;
+  CTID_REQUIRE(ref >= 0, "nde_oe: the model {} has neither y nor a linear highest derivative of y", initial.to_string());
+  std::vector<bool> fixed(static_cast<size_t>(m), false);
+  fixed[static_cast<size_t>(ref)] = true;
+  for (const auto& name : opt.fixed) {
+    int hit = -1;
+    for (int i = 0; i < m; ++i)
+      if (terms[static_cast<size_t>(i)].name() == name) hit = i;
+    CTID_REQUIRE(hit >= 0, "nde_oe: fixed term '{}' is not a term of {}", name, initial.to_string());
+    fixed[static_cast<size_t>(hit)] = true;
+  }
+  const Eigen::VectorXd c_init = initial.coefficients() / initial.coefficients()(ref);
+  std::vector<int> free;
+  for (int i = 0; i < m; ++i)
+    if (!fixed[static_cast<size_t>(i)]) free.push_back(i);
+  const int pc = static_cast<int>(free.size());
+  const int nx = opt.estimate_initial_state ? L : 0;
+  const int p = pc + nx;
+  const int N = data.size();
+  CTID_REQUIRE(N > p, "nde_oe: {} samples for {} free parameters", N, p);
+
+  const Eigen::VectorXd u = data.u().col(0), y = data.y().col(0);
+  Eigen::VectorXd t(N);
+  for (int k = 0; k < N; ++k) t(k) = data.time(k) - data.t0();
+  const Intersample hold = data.intersample(0) == Intersample::Zoh ? Intersample::Zoh : Intersample::Foh;
+  // Typical size of each state at the start, for the difference steps: |y|_max / dt^k.
+  const double dt = N > 1 ? t(1) - t(0) : 1.0;
+  const double ymax = std::max(y.cwiseAbs().maxCoeff(), 1e-300);
+
+  auto coefficients = [&](const Eigen::VectorXd& x) {
+    Eigen::VectorXd c = c_init;
+    for (int j = 0; j < pc; ++j) c(free[static_cast<size_t>(j)]) = x(j);
+    return c;
+  };
+  auto simulate = [&](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
+    const NdeModel model(terms, coefficients(x));
+    const NdeSimulation s = model.simulate(u, t, hold, nx ? Eigen::VectorXd(x.tail(nx)) : Eigen::VectorXd(), opt.rtol);
+    out = s.y;
+    return s.ok();
+  };
+
+  // Start: the given coefficients, y(0) measured and its derivatives 0 (differences of noisy samples are
+  // worse); when that simulation escapes, the free nonlinear coefficients are halved until it does not.
+  Eigen::VectorXd x0 = Eigen::VectorXd::Zero(p);
+  if (nx) x0(pc) = y(0);
+  double start_scale = 1.0;
+  Eigen::VectorXd ys;
+  for (int shrink = 0;; ++shrink) {
+    start_scale = shrink > 30 ? 0.0 : std::ldexp(1.0, -shrink);
+    for (int j = 0; j < pc; ++j) {
+      const int i = free[static_cast<size_t>(j)];
+      x0(j) = c_init(i) * (terms[static_cast<size_t>(i)].degree() >= 2 ? start_scale : 1.0);
+    }
+    if (simulate(x0, ys) || start_scale == 0.0) break;
+  }
+
+  Eigen::VectorXd h(p);
+  for (int j = 0; j < p; ++j)
+    h(j) = 1e-6 * (j < pc ? std::max(std::abs(x0(j)), 1e-8 * c_init.cwiseAbs().maxCoeff())
+                          : std::max(std::abs(x0(j)), ymax / std::pow(dt, j - pc)));
+  auto evaluate = [&](const Eigen::VectorXd& x, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
+    Eigen::VectorXd yx;
+    if (!simulate(x, yx)) return false;
+    r = y - yx;
+    if (J) {
+      J->resize(N, p);
+      Eigen::VectorXd xp = x, yp;
+      for (int j = 0; j < p; ++j) {
+        xp(j) = x(j) + h(j);
+        if (!simulate(xp, yp)) return false;
+        J->col(j) = (yx - yp) / h(j);  // d r / d x_j
+        xp(j) = x(j);
+      }
+    }
+    return true;
+  };
+  internal::LmOptions lmo;
+  lmo.max_iterations = opt.max_iterations;
+  lmo.ftol = opt.tolerance;
+  lmo.xtol = opt.tolerance;
+  const Eigen::VectorXd lo = Eigen::VectorXd::Constant(p, -INFINITY), hi = Eigen::VectorXd::Constant(p, INFINITY);
+  const internal::LmResult lm = internal::levenberg_marquardt(evaluate, x0, lo, hi, lmo);
+
+  Result<NdeModel> r;
+  const Eigen::VectorXd c = coefficients(lm.x);
+  r.model = NdeModel(terms, c);
+  const int np = m + nx;
+  r.parameters.names.resize(static_cast<size_t>(np));
+  r.parameters.values.resize(np);
+  r.parameters.fixed.assign(static_cast<size_t>(np), false);
+  for (int i = 0; i < m; ++i) {
+    r.parameters.names[static_cast<size_t>(i)] = terms[static_cast<size_t>(i)].name();
+    r.parameters.values(i) = c(i);
+    r.parameters.fixed[static_cast<size_t>(i)] = fixed[static_cast<size_t>(i)];
+  }
+  for (int k = 0; k < nx; ++k) {
+    r.parameters.names[static_cast<size_t>(m + k)] =
+        k == 0 ? "y(0)" : (k == 1 ? "Dy(0)" : "D^" + std::to_string(k) + "y(0)");
+    r.parameters.values(m + k) = lm.x(pc + k);
+  }
+  std::vector<int> slot(free);
+  for (int k = 0; k < nx; ++k) slot.push_back(m + k);
+  const double sigma2 = 2.0 * lm.cost / std::max(1, N - p);
+  r.parameters.covariance = Eigen::MatrixXd::Zero(np, np);
+  r.parameters.std = Eigen::VectorXd::Zero(np);
+  if (lm.jtj.rows() == p && std::isfinite(sigma2)) {
+    const Eigen::MatrixXd C = sigma2 * lm.jtj.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
+    for (int i = 0; i < p; ++i)
+      for (int j = 0; j < p; ++j)
+        r.parameters.covariance(slot[static_cast<size_t>(i)], slot[static_cast<size_t>(j)]) = C(i, j);
+    r.parameters.std = r.parameters.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+    const Eigen::VectorXd dg = lm.jtj.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
+                                   dg.asDiagonal() * lm.jtj * dg.asDiagonal(), Eigen::EigenvaluesOnly)
+                                   .eigenvalues();
+    r.diagnostics.condition_number = ev(0) > 0 ? std::sqrt(ev(p - 1) / ev(0)) : INFINITY;
+  }
+  r.diagnostics.vectors["x0"] = nx ? Eigen::VectorXd(lm.x.tail(nx)) : Eigen::VectorXd::Zero(L);
+  r.diagnostics.scalars["noise_variance"] = sigma2;
+  r.diagnostics.scalars["start_scale"] = start_scale;
+  if (start_scale < 1.0)
+    r.diagnostics.warnings.push_back(detail::format(
+        "the starting model escapes on these data; the search started with its nonlinear coefficients times {}",
+        start_scale));
+  r.summary.iterations = lm.iterations;
+  Eigen::VectorXd yfit;
+  if (!std::isfinite(lm.cost) || !simulate(lm.x, yfit)) {
+    r.summary.termination = Termination::NumericalFailure;
+    r.summary.message = "the model cannot be simulated on these data, even with its nonlinear terms removed";
+    yfit = Eigen::VectorXd::Constant(N, NAN);
+  } else if (lm.converged) {
+    r.summary.termination = Termination::Converged;
+  } else {
+    r.summary.termination = Termination::MaxIterations;
+    r.summary.message = lm.message;
+  }
+  r.fit = fit_report_or_inf(y, yfit, p);
+  r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+}  // namespace ctid

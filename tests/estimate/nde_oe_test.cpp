@@ -1,0 +1,110 @@
+// Output-error refinement of NDE models (estimate/nde_oe.hpp). The data are simulations of known equations
+// (Billings & Li (33) and a Duffing equation) by the adaptive NDE integrator at rtol 1e-11; noise-free records
+// must give the generating coefficients back to the integration accuracy.
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "ctid/core/error.hpp"
+#include "ctid/estimate/nde_oe.hpp"
+#include "ctid/simulate/lsim.hpp"
+
+using namespace ctid;
+
+namespace {
+NdeModel model(std::initializer_list<const char*> names, std::initializer_list<double> values) {
+  std::vector<NdeTerm> t;
+  for (const char* s : names) t.push_back(NdeTerm::parse(s));
+  Eigen::VectorXd c(static_cast<Eigen::Index>(values.size()));
+  int i = 0;
+  for (double v : values) c(i++) = v;
+  return NdeModel(t, c);
+}
+
+NdeModel bl33(double ydy = -0.006, double u = -1.0) {
+  return model({"y", "Dy", "D^2y", "u", "y^2", "y*Dy"}, {1, 0.002, 1e-4, u, 0.1, ydy});
+}
+
+// +-1 random input held per sample at 400 Hz, the response from the state x0.
+IdData record(const NdeModel& m, int n, const Eigen::VectorXd& x0 = {}) {
+  std::mt19937 rng(5);
+  std::bernoulli_distribution coin(0.5);
+  Eigen::VectorXd u(n);
+  for (int i = 0; i < n; ++i) u(i) = coin(rng) ? 1.0 : -1.0;
+  const NdeSimulation s = m.simulate(u, time_grid(0.0025, n), Intersample::Zoh, x0, 1e-11);
+  EXPECT_TRUE(s.ok());
+  return IdData(u, s.y, 0.0025);
+}
+}  // namespace
+
+TEST(NdeOe, RecoversCoefficientsAndInitialStateFromAPerturbedStart) {
+  const NdeModel truth = bl33();
+  const Eigen::Vector2d x0(0.3, -20.0);
+  const IdData d = record(truth, 600, x0);
+  Eigen::VectorXd c = truth.coefficients();
+  c.tail(5) *= 1.15;  // every free coefficient 15 % off
+  const auto r = nde_oe(d, NdeModel(truth.terms(), c * 2.0));  // a scaled start: y's coefficient is normalised back to 1
+  ASSERT_TRUE(r.usable()) << r.summary.message;
+  EXPECT_EQ(r.summary.termination, Termination::Converged);
+  for (const char* s : {"Dy", "D^2y", "u", "y^2", "y*Dy"})
+    EXPECT_NEAR(r.model.coefficient(s), truth.coefficient(s), 1e-5 * std::abs(truth.coefficient(s))) << s;
+  EXPECT_DOUBLE_EQ(r.model.coefficient("y"), 1.0);
+  EXPECT_NEAR(r.parameters.value("y(0)"), 0.3, 1e-6);
+  EXPECT_NEAR(r.parameters.value("Dy(0)"), -20.0, 1e-3);
+  EXPECT_TRUE(r.parameters.fixed[static_cast<size_t>(r.parameters.index("y"))]);
+  EXPECT_EQ(r.parameters.std(r.parameters.index("y")), 0.0);
+  EXPECT_GT(r.fit.fit_percent, 99.99);
+  EXPECT_DOUBLE_EQ(r.diagnostics.scalars.at("start_scale"), 1.0);
+  EXPECT_TRUE(r.diagnostics.warnings.empty());
+}
+
+TEST(NdeOe, StartThatEscapesIsShrunkTowardsItsLinearPart) {
+  // y*Dy ten times too large makes the damping 0.002 - 0.06 y negative above y = 0.033: the start escapes, so the
+  // nonlinear coefficients are halved until it simulates, and the search still reaches the truth.
+  const NdeModel truth = bl33();
+  const IdData d = record(truth, 800);
+  const NdeSimulation bad = bl33(-0.06).simulate(d.u().col(0), time_grid(0.0025, 800));
+  ASSERT_FALSE(bad.ok());
+  const auto r = nde_oe(d, bl33(-0.06), {.estimate_initial_state = false});
+  ASSERT_TRUE(r.usable()) << r.summary.message;
+  EXPECT_LT(r.diagnostics.scalars.at("start_scale"), 1.0);
+  ASSERT_EQ(r.diagnostics.warnings.size(), 1u);
+  EXPECT_NEAR(r.model.coefficient("y*Dy"), -0.006, 1e-4 * 0.006);
+  EXPECT_NEAR(r.model.coefficient("y^2"), 0.1, 1e-4 * 0.1);
+}
+
+TEST(NdeOe, FixedTermsAreHeld) {
+  const NdeModel truth = bl33();
+  const IdData d = record(truth, 600);
+  const auto r = nde_oe(d, bl33(-0.006, -1.1), {.estimate_initial_state = false, .fixed = {"u"}});
+  ASSERT_TRUE(r.usable());
+  EXPECT_DOUBLE_EQ(r.model.coefficient("u"), -1.1);
+  EXPECT_EQ(r.parameters.std(r.parameters.index("u")), 0.0);
+  EXPECT_EQ(r.parameters.size(), 6);  // no initial-state parameters
+  // With the gain held wrong the fit cannot be exact.
+  EXPECT_LT(r.fit.fit_percent, 99.0);
+}
+
+TEST(NdeOe, ModelWithoutYIsNormalisedByItsHighestDerivative) {
+  // An integrating Duffing-like plant D^2y + 2 Dy + 0.5 Dy^3 = u (no y term): D^2y is the reference.
+  const NdeModel truth = model({"Dy", "D^2y", "u", "Dy^3"}, {2.0, 1.0, -1.0, 0.5});
+  const IdData d = record(truth, 1000);
+  const auto r = nde_oe(d, model({"Dy", "D^2y", "u", "Dy^3"}, {1.6, 1.0, -0.9, 0.6}), {.estimate_initial_state = false});
+  ASSERT_TRUE(r.usable()) << r.summary.message;
+  EXPECT_DOUBLE_EQ(r.model.coefficient("D^2y"), 1.0);
+  EXPECT_NEAR(r.model.coefficient("Dy"), 2.0, 1e-5);
+  EXPECT_NEAR(r.model.coefficient("Dy^3"), 0.5, 1e-5);
+}
+
+TEST(NdeOe, BadInputIsRejected) {
+  const IdData d = record(bl33(), 200);
+  EXPECT_THROW(nde_oe(d, bl33(), {.fixed = {"y^3"}}), InvalidArgument);
+  EXPECT_THROW(nde_oe(d, bl33(), {.max_iterations = 0}), InvalidOptions);
+  EXPECT_THROW(nde_oe(d, bl33(), {.rtol = 1e-3}), InvalidOptions);
+  const IdData mimo(Eigen::MatrixXd::Zero(200, 2), d.y(), 0.0025);
+  EXPECT_THROW(nde_oe(mimo, bl33()), InvalidArgument);
+  const IdData tiny(d.u().topRows(5), d.y().topRows(5), 0.0025);
+  EXPECT_THROW(nde_oe(tiny, bl33()), InvalidArgument);  // 5 samples for 7 free parameters
+  // D^2y inside a product: not an explicit equation.
+  EXPECT_THROW(nde_oe(d, model({"y", "Dy", "D^2y", "u", "y*D^2y"}, {1, 0.002, 1e-4, -1, 0.1})), InvalidArgument);
+}
