@@ -8,6 +8,7 @@
 #include "ctid/core/check.hpp"
 #include "ctid/validate/metrics.hpp"
 #include "internal/levenberg_marquardt.hpp"
+#include "internal/ode.hpp"
 
 namespace ctid {
 
@@ -62,9 +63,6 @@ Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOe
   Eigen::VectorXd t(N);
   for (int k = 0; k < N; ++k) t(k) = data.time(k) - data.t0();
   const Intersample hold = data.intersample(0) == Intersample::Zoh ? Intersample::Zoh : Intersample::Foh;
-  // Typical size of each state at the start, for the difference steps: |y|_max / dt^k.
-  const double dt = N > 1 ? t(1) - t(0) : 1.0;
-  const double ymax = std::max(y.cwiseAbs().maxCoeff(), 1e-300);
 
   auto coefficients = [&](const Eigen::VectorXd& x) {
     Eigen::VectorXd c = c_init;
@@ -93,24 +91,70 @@ Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOe
     if (simulate(x0, ys) || start_scale == 0.0) break;
   }
 
-  Eigen::VectorXd h(p);
-  for (int j = 0; j < p; ++j)
-    h(j) = 1e-6 * (j < pc ? std::max(std::abs(x0(j)), 1e-8 * c_init.cwiseAbs().maxCoeff())
-                          : std::max(std::abs(x0(j)), ymax / std::pow(dt, j - pc)));
+  // Forward sensitivities (DESIGN.md §6: analytic, not differences). With x = [y, Dy, .., D^{L-1}y] and the
+  // explicit form D^L y = f_L(x, u) = -(1/c_top) sum_{i != top} c_i phi_i(x, u), the sensitivity S_j = dx/dtheta_j
+  // obeys S_j' = [S_j(1..L-1); grad_x f_L . S_j + df_L/dtheta_j], with df_L/dc_i = -phi_i/c_top (i != top),
+  // df_L/dc_top = -f_L/c_top, 0 for the initial state, and S_j(0) = e_k for theta_j = D^k y(0).
+  const Eigen::Index nz = L + static_cast<Eigen::Index>(L) * p;
+  Eigen::VectorXd phi(m), grad(L);
+  auto sensitivities = [&](const Eigen::VectorXd& x, Eigen::VectorXd& yhat, Eigen::MatrixXd& S) {
+    const Eigen::VectorXd c = coefficients(x);
+    const double ctop = c(top);
+    internal::OdeRhs rhs = [&](const Eigen::VectorXd& z, double uu, Eigen::VectorXd& dz) {
+      grad.setZero();
+      double sum = 0;
+      for (int i = 0; i < m; ++i) {
+        if (i == top) continue;
+        const auto& fs = terms[static_cast<size_t>(i)].factors;
+        double v = 1;
+        for (const auto& fa : fs) v *= fa.input ? uu : z(fa.derivative);
+        phi(i) = v;
+        sum += c(i) * v;
+        for (size_t q = 0; q < fs.size(); ++q) {  // d phi_i / d x_k by the product rule
+          if (fs[q].input) continue;
+          double others = c(i);
+          for (size_t r2 = 0; r2 < fs.size(); ++r2)
+            if (r2 != q) others *= fs[r2].input ? uu : z(fs[r2].derivative);
+          grad(fs[q].derivative) += others;
+        }
+      }
+      const double fl = -sum / ctop;
+      grad /= -ctop;
+      dz.head(L - 1) = z.segment(1, L - 1);
+      dz(L - 1) = fl;
+      for (int j = 0; j < p; ++j) {
+        const Eigen::Index o = L + static_cast<Eigen::Index>(L) * j;
+        dz.segment(o, L - 1) = z.segment(o + 1, L - 1);
+        double b = 0;
+        if (j < pc) {
+          const int i = free[static_cast<size_t>(j)];
+          b = i == top ? -fl / ctop : -phi(i) / ctop;
+        }
+        dz(o + L - 1) = grad.dot(z.segment(o, L)) + b;
+      }
+    };
+    Eigen::VectorXd z0 = Eigen::VectorXd::Zero(nz);
+    if (nx) z0.head(L) = x.tail(nx);
+    for (int k = 0; k < nx; ++k) z0(L + static_cast<Eigen::Index>(L) * (pc + k) + k) = 1.0;
+    yhat.resize(N);
+    S.resize(N, p);
+    return internal::dopri45(rhs, z0, u, t, hold == Intersample::Zoh, opt.rtol, 1e-12, L,
+                             [&](Eigen::Index k, const Eigen::VectorXd& z) {
+                               yhat(k) = z(0);
+                               for (int j = 0; j < p; ++j) S(k, j) = z(L + static_cast<Eigen::Index>(L) * j);
+                             })
+        .ok;
+  };
   auto evaluate = [&](const Eigen::VectorXd& x, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
     Eigen::VectorXd yx;
-    if (!simulate(x, yx)) return false;
-    r = y - yx;
-    if (J) {
-      J->resize(N, p);
-      Eigen::VectorXd xp = x, yp;
-      for (int j = 0; j < p; ++j) {
-        xp(j) = x(j) + h(j);
-        if (!simulate(xp, yp)) return false;
-        J->col(j) = (yx - yp) / h(j);  // d r / d x_j
-        xp(j) = x(j);
-      }
+    if (!J) {
+      if (!simulate(x, yx)) return false;
+      r = y - yx;
+      return true;
     }
+    if (!sensitivities(x, yx, *J)) return false;
+    r = y - yx;
+    *J = -*J;
     return true;
   };
   internal::LmOptions lmo;

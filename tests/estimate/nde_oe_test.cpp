@@ -58,6 +58,45 @@ TEST(NdeOe, RecoversCoefficientsAndInitialStateFromAPerturbedStart) {
   EXPECT_TRUE(r.diagnostics.warnings.empty());
 }
 
+TEST(NdeOe, SensitivitiesAgreeWithFiniteDifferences) {
+  // The reported covariance sigma^2 (J^T J)^{-1} uses the integrated sensitivities J; recomputed
+  // here with J by central differences of NdeModel::simulate (steps 1e-5 relative, simulations at rtol 1e-12,
+  // difference error ~1e-7) they must agree to 0.1 %.
+  const NdeModel truth = bl33();
+  IdData d = record(truth, 500, Eigen::Vector2d(0.1, 5.0));
+  Eigen::VectorXd noisy = d.y().col(0);
+  std::mt19937 rng(9);
+  std::normal_distribution<double> e(0.0, 0.01);
+  for (auto& v : noisy) v += e(rng);
+  d = IdData(d.u(), noisy, 0.0025);
+  const auto r = nde_oe(d, truth);
+  ASSERT_TRUE(r.usable());
+  const int m = 6, p = 7;  // free: Dy, D^2y, u, y^2, y*Dy, y(0), Dy(0)
+  const std::vector<int> slot{1, 2, 3, 4, 5, 6, 7};
+  auto sim = [&](const Eigen::VectorXd& theta) {
+    Eigen::VectorXd c = r.model.coefficients();
+    c.tail(m - 1) = theta.head(m - 1);
+    return NdeModel(truth.terms(), c).simulate(d.u().col(0), time_grid(0.0025, 500), Intersample::Zoh, theta.tail(2), 1e-12).y;
+  };
+  Eigen::VectorXd theta(p);
+  for (int j = 0; j < p; ++j) theta(j) = r.parameters.values(slot[static_cast<size_t>(j)]);
+  Eigen::MatrixXd J(500, p);
+  for (int j = 0; j < p; ++j) {
+    const double h = 1e-5 * std::abs(theta(j));
+    Eigen::VectorXd a = theta, b = theta;
+    a(j) += h;
+    b(j) -= h;
+    J.col(j) = (sim(a) - sim(b)) / (2 * h);
+  }
+  const double sigma2 = r.diagnostics.scalars.at("noise_variance");
+  const Eigen::MatrixXd C = sigma2 * (J.transpose() * J).inverse();
+  for (int i = 0; i < p; ++i)
+    for (int j = 0; j < p; ++j)  // covariances, not just variances: a column with the wrong sign changes only these
+      EXPECT_NEAR(r.parameters.covariance(slot[static_cast<size_t>(i)], slot[static_cast<size_t>(j)]), C(i, j),
+                  1e-3 * std::sqrt(C(i, i) * C(j, j)))
+          << r.parameters.names[slot[static_cast<size_t>(i)]] << ", " << r.parameters.names[slot[static_cast<size_t>(j)]];
+}
+
 TEST(NdeOe, StartThatEscapesIsShrunkTowardsItsLinearPart) {
   // y*Dy ten times too large makes the damping 0.002 - 0.06 y negative above y = 0.033: the start escapes, so the
   // nonlinear coefficients are halved until it simulates, and the search still reaches the truth.

@@ -2,9 +2,9 @@
 // given term structure (e.g. the one the Kernel Invariance Algorithm selected, Billings & Li 1999) and
 // the initial state are adjusted to minimise the simulation error
 //     V(theta) = sum_k (y(t_k) - yhat(t_k; theta))^2,   yhat = NdeModel::simulate (adaptive Dormand-Prince),
-// by Levenberg-Marquardt with a forward-difference Jacobian (Ljung 1999, ch. 7: the prediction-error
-// estimate for white output noise, consistent where equation-error estimates such as the NARX/KIA chain
-// are biased by noise). It plays the role of MATLAB's `pem`/`nlgreyest` refinement after an initial
+// by Levenberg-Marquardt with exact forward sensitivities integrated alongside the state (Ljung 1999,
+// ch. 7: the prediction-error estimate for white output noise, consistent where equation-error estimates
+// such as the NARX/KIA chain are biased by noise). It plays the role of MATLAB's `pem`/`nlgreyest` refinement after an initial
 // estimate. Covariance sigma^2 (J^T J)^{-1} of the free parameters.
 #pragma once
 
@@ -22,7 +22,7 @@ struct NdeOeOptions {
   double tolerance = 1e-9;             ///< relative cost decrease or parameter change that stops the search
   bool estimate_initial_state = true;  ///< estimate [y, Dy, .., D^{L-1}y] at the first sample; false: from rest
   std::vector<std::string> fixed;      ///< term names whose coefficients are held (the reference term always is)
-  double rtol = 1e-10;                 ///< relative tolerance of the simulations (the Jacobian steps are 1e-6)
+  double rtol = 1e-10;                 ///< relative tolerance of the simulations
   void validate() const;
 };
 
