@@ -14,6 +14,7 @@
 #include <limits>
 
 #include "ctid/core/check.hpp"
+#include "ctid/core/progress.hpp"
 #include "ctid/validate/metrics.hpp"
 
 namespace ctid {
@@ -153,7 +154,12 @@ Result<NarxModel> frols_signals(const Signals& sig, double Ts, const std::vector
   std::vector<bool> used(M, false);
   Eigen::VectorXd crit(K);
   double err_sum = 0;
+  bool interrupted = false;
   for (int s = 0; s < K; ++s) {
+    if (s > 0 && !report_progress("frols", s, 1 - err_sum)) {
+      interrupted = true;
+      break;
+    }
     int best = -1;
     double best_err = -1;
     for (int m = 0; m < M; ++m) {
@@ -243,6 +249,10 @@ Result<NarxModel> frols_signals(const Signals& sig, double Ts, const std::vector
     res.fit = fit_report_or_inf(y.tail(Ne), ys.tail(Ne), k);
   }
   res.summary.iterations = static_cast<int>(sel.size());
+  if (interrupted) {
+    res.summary.termination = Termination::Interrupted;
+    res.summary.message = detail::format("interrupted after selecting {} terms", sel.size());
+  }
   res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return res;
 }
@@ -302,6 +312,12 @@ Result<NarxModel> narmax(const IdData& data, const std::vector<NarxTerm>& proces
     return next;
   };
   for (; it < o.iterations && !o.noise_candidates.empty(); ++it) {
+    if (r.summary.termination == Termination::Interrupted) break;
+    if (!report_progress("narmax", it + 1, NAN)) {
+      r.summary.termination = Termination::Interrupted;
+      r.summary.message = detail::format("interrupted after {} extended least-squares iterations", it);
+      break;
+    }
     e = residuals(r.model);
     Result<NarxModel> next = frols_signals({y, u, e}, data.ts(), all, fo);
     // Convergence: the same process terms with coefficients within tolerance (relative); noise terms may

@@ -125,6 +125,9 @@ Result<TransferFunction> refine(const IdData& data, const TfOrders& o, const Tra
   if (!std::isfinite(lm.cost)) {
     r.summary.termination = Termination::Unstable;
     r.summary.message = "the starting model is unstable or cannot be simulated; give a stable initial model";
+  } else if (lm.interrupted) {
+    r.summary.termination = Termination::Interrupted;
+    r.summary.message = lm.message;
   } else if (lm.converged) {
     r.summary.termination = Termination::Converged;
   } else {

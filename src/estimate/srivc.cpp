@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "ctid/core/check.hpp"
+#include "ctid/core/progress.hpp"
 #include "ctid/estimate/lssvf.hpp"
 #include "ctid/signal/prefilter.hpp"
 #include "ctid/simulate/lsim.hpp"
@@ -58,6 +59,7 @@ struct SrivcRun {
   int iterations = 0;
   bool converged = false;
   bool rank_deficient = false;
+  bool interrupted = false;
 };
 
 double relative_change(const Eigen::VectorXd& next, const Eigen::VectorXd& prev) {
@@ -166,6 +168,10 @@ SrivcRun srivc_fixed_delay(const IdData& d, const TfOrders& o, double delay, Eig
   SrivcRun run;
   run.theta = theta;
   for (int it = 1; it <= max_iterations; ++it) {
+    if (!report_progress("srivc", it, NAN)) {
+      run.interrupted = true;
+      return run;
+    }
     SrivcRun step = srivc_detail::iv_step(y, t, ch, o.nf, run.theta);
     step.iterations = it;
     if (step.rank_deficient) {
@@ -303,6 +309,10 @@ Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const
                   detail::format("the instrumental-variable matrix is singular (condition {}); the input does not excite {} "
                                  "parameters",
                                  run.sol.condition, p));
+  if (run.interrupted) {
+    r.summary.termination = Termination::Interrupted;
+    r.summary.message = detail::format("interrupted after {} iterations", run.iterations);
+  }
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "ctid/core/check.hpp"
+#include "ctid/core/progress.hpp"
 
 namespace ctid::internal {
 
@@ -23,6 +24,11 @@ LmResult levenberg_marquardt(const LmEvaluate& evaluate, Eigen::VectorXd x, cons
   double lambda = o.lambda0;
   Eigen::VectorXd rt;
   for (int it = 1; it <= o.max_iterations; ++it) {
+    if (!report_progress("levenberg_marquardt", it, cost)) {
+      res.interrupted = true;
+      res.message = detail::format("interrupted after {} iterations", it - 1);
+      break;
+    }
     res.iterations = it;
     const Eigen::MatrixXd A = J.transpose() * J;
     const Eigen::VectorXd g = J.transpose() * r;  // gradient of the cost

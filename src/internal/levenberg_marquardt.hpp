@@ -23,6 +23,7 @@ struct LmResult {
   Eigen::MatrixXd jtj;              // J^T J at x
   int iterations = 0;
   bool converged = false;
+  bool interrupted = false;         // the progress callback (core/progress.hpp) asked to stop
   std::string message;
 };
 
