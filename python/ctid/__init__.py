@@ -1,0 +1,238 @@
+"""ctid — continuous-time system identification.
+
+The C++ library (module ``ctid._ctid``) with keyword arguments: every estimator takes the data, the
+structure, and the fields of its C++ options struct as keyword arguments with the same names, e.g.
+``ctid.srivc(data, nb=2, nf=2, max_iterations=50)``. Results carry ``.model``, ``.parameters``
+(names, values, std, covariance), ``.fit``, ``.summary`` and ``.diagnostics``; ``repr(result)`` is a
+brief report. Bad input raises ``ctid.InvalidArgument`` / ``ctid.InvalidOptions`` (ValueErrors) or
+``ctid.FileError`` (an OSError); an estimator that does not succeed returns a result whose
+``summary.termination`` says why and ``usable()`` is False. Ctrl-C stops a long estimation: the
+result comes back with termination ``"interrupted"``.
+"""
+import numpy as _np
+
+from . import _ctid
+from ._ctid import (  # noqa: F401  (re-exported)
+    CorrelationTest, FileError, FsfModel, IdData, InputGenerator, InvalidArgument, InvalidOptions, NarxModel, NarxTerm,
+    ModalWindow, NdeModel, NdeSimulation, NdeTerm, NonlinearCorrelationTests, PhysicalModel, TransferFunction,
+    add_noise_snr,
+    fit_percent, input_residual_crosscorrelation, load, narx_candidates, narx_noise_candidates,
+    nonlinear_correlation_tests, prbs, read_narx_json, read_nde_json, residual_autocorrelation, time_grid,
+)
+
+__version__ = _ctid.__version__
+
+
+def _options(cls, who, kwargs):
+    """An options struct of type cls from keyword arguments (nested structs from dicts, enums from names)."""
+    o = cls()
+    for key, value in kwargs.items():
+        if key.startswith("_") or not hasattr(o, key):
+            known = sorted(k for k in dir(o) if not k.startswith("_"))
+            raise TypeError(f"{who}: unknown option '{key}' (options: {', '.join(known)})")
+        current = getattr(o, key)
+        if isinstance(value, dict) and type(current).__module__.startswith("ctid"):  # a nested options struct
+            value = _options(type(current), f"{who}.{key}", value)
+        elif isinstance(value, str) and hasattr(type(current), "__members__"):
+            members = {name.lower(): m for name, m in type(current).__members__.items()}
+            if value.lower() not in members:
+                raise ValueError(f"{who}: option '{key}' must be one of {', '.join(members)} (got '{value}')")
+            value = members[value.lower()]
+        setattr(o, key, value)
+    return o
+
+
+def _terms(cls, terms):
+    """Terms from names (parsed here so that a bad name raises InvalidArgument naming the position)."""
+    return [t if isinstance(t, cls) else cls(t) for t in terms]
+
+
+def _columns(a, name):
+    a = _np.asarray(a, dtype=float)
+    if a.ndim == 1:
+        a = a.reshape(-1, 1)
+    if a.ndim != 2:
+        raise InvalidArgument(f"IdData.from_arrays: {name} must be 1-D or (n_samples, n_channels) (got shape {a.shape})")
+    return a
+
+
+def _from_arrays(cls, u, y, ts=None, t=None, t0=0.0, input_names=None, output_names=None, intersample=None):
+    """A record from arrays shaped (n_samples,) or (n_samples, n_channels): uniform with ts (and t0), or at the
+    strictly increasing times t. u may be None or empty for a time series."""
+    y = _columns(y, "y")
+    u = _np.zeros((y.shape[0], 0)) if u is None else _columns(u, "u")
+    if (ts is None) == (t is None):
+        raise InvalidArgument("IdData.from_arrays: give either ts (uniform sampling) or t (sample times)")
+    d = IdData(u, y, float(ts), float(t0)) if t is None else IdData(u, y, _np.asarray(t, dtype=float).ravel())
+    if input_names is not None:
+        d.input_names = list(input_names)
+    if output_names is not None:
+        d.output_names = list(output_names)
+    if intersample is not None:
+        d.intersample = intersample
+    return d
+
+
+def _from_pandas(cls, frame, inputs, outputs, ts=None, time=None, intersample=None):
+    """A record from the columns of a pandas DataFrame (time: a column of sample times, or ts)."""
+    t = None if time is None else frame[time].to_numpy(dtype=float)
+    return _from_arrays(cls, frame[list(inputs)].to_numpy(dtype=float) if inputs else None,
+                        frame[list(outputs)].to_numpy(dtype=float), ts=ts, t=t,
+                        input_names=inputs, output_names=outputs, intersample=intersample)
+
+
+IdData.from_arrays = classmethod(_from_arrays)
+IdData.from_pandas = classmethod(_from_pandas)
+
+
+def _report(result):
+    """Brief text report of a result (what repr() shows)."""
+    s = result.summary
+    lines = [f"{type(result.model).__name__}: {result.model!r}",
+             f"termination: {s.termination}" + (f" ({s.message})" if s.message else "")
+             + f", {s.iterations} iteration(s), {s.seconds:.3g} s, usable: {result.usable()}"]
+    p = result.parameters
+    if len(p):
+        lines.append(f"{'parameter':<16}{'value':>14}{'std':>12}")
+        for i, name in enumerate(p.names):
+            sd = "fixed" if p.fixed and p.fixed[i] else f"{p.std[i]:.4g}" if len(p.std) else "-"
+            lines.append(f"{name:<16}{p.values[i]:>14.6g}{sd:>12}")
+    f = result.fit
+    lines.append(f"fit: {f.fit_percent:.2f} %  (mse {f.mse:.4g}, aic {f.aic:.4g}, {f.n_samples} samples)")
+    lines += [f"warning: {w}" for w in result.diagnostics.warnings]
+    return "\n".join(lines)
+
+
+for _cls in (_ctid.TransferFunctionResult, _ctid.FsfResult, _ctid.NarxResult, _ctid.NdeResult):
+    _cls.__repr__ = _report
+    _cls.report = _report
+
+
+# ---- estimators with keyword options (names as in C++) ----
+
+def lssvf(data, nb, nf, nk=0, **options):
+    """Johansson (1986): least squares on state-variable-filtered signals (options: LssvfOptions)."""
+    return _ctid.lssvf(data, nb, nf, nk, _options(_ctid.LssvfOptions, "lssvf", options))
+
+
+def ivsvf(data, nb, nf, nk=0, **options):
+    """Johansson's regression with instrumental variables (options: IvsvfOptions; svf=dict(...))."""
+    return _ctid.ivsvf(data, nb, nf, nk, _options(_ctid.IvsvfOptions, "ivsvf", options))
+
+
+def srivc(data, nb, nf, nk=0, **options):
+    """Simplified refined instrumental variables for continuous-time models (options: SrivcOptions)."""
+    return _ctid.srivc(data, nb, nf, nk, _options(_ctid.SrivcOptions, "srivc", options))
+
+
+def oe(data, nb, nf, nk=0, **options):
+    """Continuous-time output error by Levenberg-Marquardt (options: OeOptions)."""
+    return _ctid.oe(data, nb, nf, nk, _options(_ctid.OeOptions, "oe", options))
+
+
+def tfest(data, nb, nf, nk=0, **options):
+    """SRIVC start, then output-error refinement (options: OeOptions)."""
+    return _ctid.tfest(data, nb, nf, nk, _options(_ctid.OeOptions, "tfest", options))
+
+
+def fsf(data, **options):
+    """Gawthrop & Wang (2005) frequency-sampling-filter model (options: FsfOptions; T is required)."""
+    return _ctid.fsf(data, _options(_ctid.FsfOptions, "fsf", options))
+
+
+def frols(data, candidates, **options):
+    """Polynomial NARX structure selection by FROLS/ERR (options: FrolsOptions; criterion='aic', ...)."""
+    return _ctid.frols(data, _terms(NarxTerm, candidates), _options(_ctid.FrolsOptions, "frols", options))
+
+
+def narmax(data, candidates, **options):
+    """NARMAX by FROLS and extended least squares (options: NarmaxOptions; frols=dict(...))."""
+    if "noise_candidates" in options:
+        options["noise_candidates"] = _terms(NarxTerm, options["noise_candidates"])
+    return _ctid.narmax(data, _terms(NarxTerm, candidates), _options(_ctid.NarmaxOptions, "narmax", options))
+
+
+def kia_linear(narx, **options):
+    """Kernel Invariance Algorithm, linear stage (options: KiaLinearOptions; points=dict(...))."""
+    return _ctid.kia_linear(narx, _options(_ctid.KiaLinearOptions, "kia_linear", options))
+
+
+def kia_quadratic(narx, linear, **options):
+    """Kernel Invariance Algorithm, quadratic stage (options: KiaQuadraticOptions; candidates=['y^2', ...])."""
+    if "candidates" in options:
+        options["candidates"] = _terms(NdeTerm, options["candidates"])
+    return _ctid.kia_quadratic(narx, linear, _options(_ctid.KiaQuadraticOptions, "kia_quadratic", options))
+
+
+def kia_cubic(narx, model, **options):
+    """Kernel Invariance Algorithm, cubic stage (options: KiaCubicOptions; candidates=['y^3', ...])."""
+    if "candidates" in options:
+        options["candidates"] = _terms(NdeTerm, options["candidates"])
+    return _ctid.kia_cubic(narx, model, _options(_ctid.KiaCubicOptions, "kia_cubic", options))
+
+
+def nde_oe(data, initial, **options):
+    """Output-error refinement of an NDE model's coefficients and initial state (options: NdeOeOptions)."""
+    return _ctid.nde_oe(data, initial, _options(_ctid.NdeOeOptions, "nde_oe", options))
+
+
+def modal_fit(data, nb, input=None, **options):
+    """El-Shafey (1987) modal-function identification (options: ModalOptions; shifts= is required; input: an
+    InputGenerator for a generated input, None for a piecewise-constant one)."""
+    if "windows" in options:
+        options["windows"] = [w if isinstance(w, ModalWindow) else ModalWindow(*w) for w in options["windows"]]
+    return _ctid.modal_fit(data, nb, _options(_ctid.ModalOptions, "modal_fit", options), input)
+
+
+def free_response_poles(y, ts, **options):
+    """Poles from a free-response data matrix, El-Shafey Theorem 4.3 (options: FreeResponseOptions)."""
+    return _ctid.free_response_poles(_np.asarray(y, dtype=float), ts,
+                                     _options(_ctid.FreeResponseOptions, "free_response_poles", options))
+
+
+def fit_physical_step(model, parameters, compressed, **options):
+    """Gawthrop & Wang stage 2 against the FSF step response. parameters: {"name": initial} or
+    {"name": {"initial": .., "lower": .., "upper": .., "fixed": ..}} (options: PhysicalFitOptions)."""
+    return _ctid.fit_physical_step(model, parameters, getattr(compressed, "model", compressed),
+                                   _options(_ctid.PhysicalFitOptions, "fit_physical_step", options))
+
+
+def fit_physical_frequency(model, parameters, compressed, **options):
+    """Gawthrop & Wang stage 2 against the FSF frequency samples (GW 30)."""
+    return _ctid.fit_physical_frequency(model, parameters, getattr(compressed, "model", compressed),
+                                        _options(_ctid.PhysicalFitOptions, "fit_physical_frequency", options))
+
+
+def fit_physical_raw(model, parameters, data, a=0.0, **options):
+    """Physical parameters by output error on the raw record (exponentially windowed when a > 0)."""
+    return _ctid.fit_physical_raw(model, parameters, data, a,
+                                  _options(_ctid.PhysicalFitOptions, "fit_physical_raw", options))
+
+
+def rls_svf(nb, nf, **options):
+    """Johansson (1986) recursive least squares on filtered signals: an RlsSvf to feed with update() or run()
+    (options: RlsSvfOptions: tau, forgetting, alpha, fixed, ...)."""
+    return _ctid.RlsSvf(nb, nf, _options(_ctid.RlsSvfOptions, "rls_svf", options))
+
+
+# ---- simulation of any model on a record ----
+
+def simulate(model, data, **kwargs):
+    """Simulated output of a model (or result) driven by the input of `data` (first output channel's
+    shape): TransferFunction exactly from rest with the data's intersample; FsfModel by its discrete
+    convolution; NarxModel free-run from the first measured outputs; NdeModel from y(0) at rest (x0= to
+    override)."""
+    model = getattr(model, "model", model)
+    u = data.u[:, 0]
+    t = data.times - data.t0
+    if isinstance(model, TransferFunction):
+        return model.simulate(u, t, data.intersample[0])
+    if isinstance(model, FsfModel):
+        return model.simulate(u)
+    if isinstance(model, NarxModel):
+        p = model.process()
+        return p.simulate(u, data.y[: p.max_lag, 0])
+    if isinstance(model, NdeModel):
+        s = model.simulate(u, t, kwargs.get("intersample", data.intersample[0]), kwargs.get("x0", _np.zeros(0)))
+        return s.y
+    raise InvalidArgument(f"simulate: no simulation for a {type(model).__name__}")

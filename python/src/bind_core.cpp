@@ -1,0 +1,138 @@
+// ctid Python module — data, results, linear models, simulation and validation.
+#include "common.hpp"
+
+namespace ctid::python {
+
+namespace {
+Eigen::VectorXd lsim_tf(const TransferFunction& g, const Eigen::VectorXd& u, const Eigen::VectorXd& t,
+                        const std::string& intersample) {
+  return lsim(g, u, t, intersample_from_string(intersample));
+}
+}  // namespace
+
+void bind_core(py::module_& m) {
+  py::class_<ParameterSet>(m, "ParameterSet", "Estimated parameters: names, values, std, covariance, fixed.")
+      .def_readonly("names", &ParameterSet::names)
+      .def_readonly("values", &ParameterSet::values)
+      .def_readonly("std", &ParameterSet::std)
+      .def_readonly("covariance", &ParameterSet::covariance)
+      .def_readonly("fixed", &ParameterSet::fixed)
+      .def("__len__", &ParameterSet::size)
+      .def("__getitem__", &ParameterSet::value, py::arg("name"), "Value of a parameter by name.");
+
+  py::class_<FitReport>(m, "FitReport", "Quality of fit of the simulated output (see validate/metrics.hpp).")
+      .def_readonly("fit_percent", &FitReport::fit_percent)
+      .def_readonly("nrmse", &FitReport::nrmse)
+      .def_readonly("mse", &FitReport::mse)
+      .def_readonly("fpe", &FitReport::fpe)
+      .def_readonly("aic", &FitReport::aic)
+      .def_readonly("aicc", &FitReport::aicc)
+      .def_readonly("bic", &FitReport::bic)
+      .def_readonly("n_samples", &FitReport::n_samples)
+      .def_readonly("n_parameters", &FitReport::n_parameters);
+
+  py::class_<Summary>(m, "Summary", "How the run ended.")
+      .def_property_readonly("termination", [](const Summary& s) { return std::string(to_string(s.termination)); })
+      .def_readonly("message", &Summary::message)
+      .def_readonly("iterations", &Summary::iterations)
+      .def_readonly("seconds", &Summary::seconds)
+      .def("succeeded", &Summary::succeeded);
+
+  py::class_<Diagnostics>(m, "Diagnostics", "Numerical diagnostics: condition number, warnings, method-specific numbers.")
+      .def_readonly("condition_number", &Diagnostics::condition_number)
+      .def_readonly("warnings", &Diagnostics::warnings)
+      .def_readonly("scalars", &Diagnostics::scalars)
+      .def_readonly("vectors", &Diagnostics::vectors);
+
+  py::class_<IdData>(m, "IdData", "Sampled input/output record (columns = channels).")
+      .def(py::init<Eigen::MatrixXd, Eigen::MatrixXd, double, double>(), py::arg("u"), py::arg("y"), py::arg("ts"),
+           py::arg("t0") = 0.0)
+      .def(py::init<Eigen::MatrixXd, Eigen::MatrixXd, Eigen::VectorXd>(), py::arg("u"), py::arg("y"), py::arg("t"))
+      .def_property_readonly("u", &IdData::u)
+      .def_property_readonly("y", &IdData::y)
+      .def_property_readonly("ts", &IdData::ts)
+      .def_property_readonly("t0", &IdData::t0)
+      .def_property_readonly("times", &IdData::times)
+      .def_property_readonly("is_uniform", &IdData::is_uniform)
+      .def_property_readonly("nu", &IdData::nu)
+      .def_property_readonly("ny", &IdData::ny)
+      .def("__len__", &IdData::size)
+      .def_property("input_names", &IdData::input_names, &IdData::set_input_names)
+      .def_property("output_names", &IdData::output_names, &IdData::set_output_names)
+      .def_property(
+          "intersample",
+          [](const IdData& d) {
+            std::vector<std::string> v;
+            for (int i = 0; i < d.nu(); ++i) v.emplace_back(to_string(d.intersample(i)));
+            return v;
+          },
+          [](IdData& d, const std::string& s) { d.set_intersample(intersample_from_string(s)); },
+          "Per input: 'zoh', 'foh' or 'bandlimited' (set: one value for all inputs).")
+      .def("slice", &IdData::slice, py::arg("begin"), py::arg("end"), "Samples [begin, end).")
+      .def("split", py::overload_cast<double>(&IdData::split, py::const_), py::arg("fraction"),
+           "(estimation, validation) at a fraction of the samples.");
+
+  m.def(
+      "load",
+      [](const std::string& path, std::vector<std::string> inputs, std::vector<std::string> outputs,
+         const std::string& time, double ts, const std::string& intersample) {
+        DataSpec spec;
+        spec.inputs = std::move(inputs);
+        spec.outputs = std::move(outputs);
+        spec.time = time;
+        spec.ts = ts;
+        spec.intersample = intersample_from_string(intersample);
+        return load_iddata(path, spec);
+      },
+      py::arg("path"), py::arg("inputs"), py::arg("outputs"), py::arg("time") = "", py::arg("ts") = 0.0,
+      py::arg("intersample") = "zoh", "Load a CSV or .mat record by column / variable names.");
+
+  py::class_<TransferFunction>(m, "TransferFunction", "G(s) = e^{-s delay} B(s)/A(s), descending powers of s.")
+      .def(py::init<const Eigen::VectorXd&, const Eigen::VectorXd&, double>(), py::arg("num"), py::arg("den"),
+           py::arg("delay") = 0.0)
+      .def_property_readonly("num", [](const TransferFunction& g) { return g.num().coefficients(); })
+      .def_property_readonly("den", [](const TransferFunction& g) { return g.den().coefficients(); })
+      .def_property_readonly("delay", &TransferFunction::io_delay)
+      .def_property_readonly("order", &TransferFunction::order)
+      .def("poles", &TransferFunction::poles)
+      .def("zeros", &TransferFunction::zeros)
+      .def("dc_gain", &TransferFunction::dc_gain)
+      .def("is_stable", &TransferFunction::is_stable)
+      .def("freqresp", &TransferFunction::frequency_response, py::arg("w"), "G(jw) at the angular frequencies w (rad/s).")
+      .def("step", [](const TransferFunction& g, const Eigen::VectorXd& t) { return step_response(g, t); }, py::arg("t"))
+      .def("impulse", [](const TransferFunction& g, const Eigen::VectorXd& t) { return impulse_response(g, t); },
+           py::arg("t"))
+      .def("simulate", &lsim_tf, py::arg("u"), py::arg("t"), py::arg("intersample") = "zoh",
+           "Exact simulation from rest of the input u at the times t.")
+      .def("__call__", &TransferFunction::operator(), py::arg("s"))
+      .def("__repr__", [](const TransferFunction& g) { return g.to_string(6); });
+  bind_result<TransferFunction>(m, "TransferFunctionResult");
+
+  m.def("time_grid", &time_grid, py::arg("ts"), py::arg("n"));
+  m.def("prbs", [](int n, int register_length, int clock_period) {
+          return prbs(n, {.register_length = register_length, .clock_period = clock_period});
+        }, py::arg("n"), py::arg("register_length") = 10, py::arg("clock_period") = 1, "PRBS of +-1.");
+  m.def("add_noise_snr", &add_noise_snr, py::arg("x"), py::arg("snr_db"), py::arg("seed"),
+        "x plus white Gaussian noise at the given signal-to-noise ratio (dB, power of x - mean).");
+  m.def("fit_percent", &fit_percent, py::arg("y"), py::arg("yhat"), "100 (1 - ||y - yhat|| / ||y - mean(y)||).");
+
+  py::class_<CorrelationTest>(m, "CorrelationTest")
+      .def_readonly("lags", &CorrelationTest::lags)
+      .def_readonly("values", &CorrelationTest::values)
+      .def_readonly("bound", &CorrelationTest::bound)
+      .def_readonly("n_outside", &CorrelationTest::n_outside)
+      .def("passed", &CorrelationTest::passed);
+  m.def("residual_autocorrelation", &residual_autocorrelation, py::arg("e"), py::arg("max_lag") = 25);
+  m.def("input_residual_crosscorrelation", &input_residual_crosscorrelation, py::arg("u"), py::arg("e"),
+        py::arg("max_lag") = 25);
+  py::class_<NonlinearCorrelationTests>(m, "NonlinearCorrelationTests")
+      .def_readonly("ee", &NonlinearCorrelationTests::ee)
+      .def_readonly("ue", &NonlinearCorrelationTests::ue)
+      .def_readonly("e_eu", &NonlinearCorrelationTests::e_eu)
+      .def_readonly("u2_e", &NonlinearCorrelationTests::u2_e)
+      .def_readonly("u2_e2", &NonlinearCorrelationTests::u2_e2)
+      .def("passed", &NonlinearCorrelationTests::passed);
+  m.def("nonlinear_correlation_tests", &nonlinear_correlation_tests, py::arg("u"), py::arg("e"), py::arg("max_lag") = 20);
+}
+
+}  // namespace ctid::python

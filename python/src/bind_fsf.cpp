@@ -1,0 +1,36 @@
+// ctid Python module — Gawthrop & Wang (2005) frequency-sampling filters: the compressed model and its
+// step, impulse and frequency responses with standard deviations.
+#include "common.hpp"
+
+namespace ctid::python {
+
+void bind_fsf(py::module_& m) {
+  py::class_<FsfOptions>(m, "FsfOptions")
+      .def(py::init<>())
+      .def_readwrite("T", &FsfOptions::T)
+      .def_readwrite("n", &FsfOptions::n)
+      .def_readwrite("a", &FsfOptions::a)
+      .def_readwrite("b", &FsfOptions::b)
+      .def_readwrite("weights", &FsfOptions::weights);
+  py::class_<FsfModel>(m, "FsfModel", "Frequency-sampling-filter model (GW 2005): N samples per window, n filters.")
+      .def_property_readonly("delta", &FsfModel::delta)
+      .def_property_readonly("N", &FsfModel::N)
+      .def_property_readonly("n", &FsfModel::n)
+      .def_property_readonly("T", &FsfModel::T)
+      .def_property_readonly("theta", &FsfModel::theta)
+      .def_property_readonly("covariance", &FsfModel::covariance)
+      .def("freqresp", &FsfModel::frequency_response, py::arg("w"))
+      .def("freqresp_std", &FsfModel::frequency_response_std, py::arg("w"), "std of the real and imaginary parts (re + j im).")
+      .def("step", &FsfModel::step_response, py::arg("t"))
+      .def("step_std", &FsfModel::step_response_std, py::arg("t"))
+      .def("impulse", &FsfModel::impulse_response, py::arg("t"))
+      .def("impulse_std", &FsfModel::impulse_response_std, py::arg("t"))
+      .def("simulate", &FsfModel::simulate, py::arg("u"), "Discrete FSF model output for u (from rest).");
+  bind_result<FsfModel>(m, "FsfResult");
+  m.def(
+      "fsf",
+      [](const IdData& d, const FsfOptions& o) { return interruptible([&] { return fsf(d, o); }); },
+      py::arg("data"), py::arg("options"), "Stage 1 of Gawthrop & Wang: the FSF model by least squares.");
+}
+
+}  // namespace ctid::python

@@ -1,0 +1,166 @@
+// ctid Python module — Billings & Li (1999): polynomial NARX/NARMAX by FROLS, GFRFs, NDE models, the Kernel
+// Invariance Algorithm and the output-error refinement of NDE models. Terms convert from their names
+// ("y(k-1)*u(k-2)", "y*Dy").
+#include "common.hpp"
+
+namespace ctid::python {
+
+namespace {
+template <class Term>
+std::vector<std::string> names(const std::vector<Term>& terms) {
+  std::vector<std::string> v;
+  for (const auto& t : terms) v.push_back(t.name());
+  return v;
+}
+}  // namespace
+
+void bind_nonlinear(py::module_& m) {
+  py::class_<NarxTerm>(m, "NarxTerm")
+      .def(py::init([](const std::string& s) { return NarxTerm::parse(s); }), py::arg("name"))
+      .def_property_readonly("name", &NarxTerm::name)
+      .def_property_readonly("degree", &NarxTerm::degree)
+      .def("__repr__", &NarxTerm::name);
+  py::implicitly_convertible<std::string, NarxTerm>();
+  m.def("narx_candidates", [](int degree, int ylag, int ulag, bool constant, int umin) {
+          return names(narx_candidates(degree, ylag, ulag, constant, umin));
+        }, py::arg("degree"), py::arg("ylag"), py::arg("ulag"), py::arg("constant") = true, py::arg("umin") = 1,
+        "Names of every monomial up to `degree` in y(k-1..ylag), u(k-umin..ulag) (and 1).");
+  m.def("narx_noise_candidates", [](int elag, int degree, int cross_lag) {
+          return names(narx_noise_candidates(elag, degree, cross_lag));
+        }, py::arg("elag"), py::arg("degree") = 1, py::arg("cross_lag") = 0);
+
+  py::class_<NarxModel>(m, "NarxModel", "Polynomial NARX(MAX) model y(k) = sum theta_m term_m(k).")
+      .def(py::init<std::vector<NarxTerm>, Eigen::VectorXd, double>(), py::arg("terms"), py::arg("coefficients"),
+           py::arg("ts"))
+      .def_property_readonly("terms", [](const NarxModel& n) { return names(n.terms()); })
+      .def_property_readonly("coefficients", &NarxModel::coefficients)
+      .def_property_readonly("ts", &NarxModel::ts)
+      .def_property_readonly("max_lag", &NarxModel::max_lag)
+      .def("process", &NarxModel::process, "The model without its noise terms.")
+      .def("simulate", [](const NarxModel& n, const Eigen::VectorXd& u, const Eigen::VectorXd& y0) {
+             return n.simulate(u, y0);
+           }, py::arg("u"), py::arg("y0") = Eigen::VectorXd(), "Free run (NaN from an escape on).")
+      .def("predict", &NarxModel::predict, py::arg("u"), py::arg("y"), py::arg("steps") = 1)
+      .def("gfrf", [](const NarxModel& n, const std::vector<std::complex<double>>& s, bool zoh) {
+             return narx_gfrf_ct(n.process(), s, zoh);
+           }, py::arg("s"), py::arg("zoh") = true,
+           "Continuous-time symmetric H_n(s_1..s_n) = H_n^NARX(e^{s_i T}) / prod Z(s_i) (zoh: held input).")
+      .def("gfrf_discrete", [](const NarxModel& n, const std::vector<std::complex<double>>& z) {
+             return narx_gfrf(n.process(), z);
+           }, py::arg("z"))
+      .def("__repr__", [](const NarxModel& n) { return n.to_string(6); });
+  bind_result<NarxModel>(m, "NarxResult");
+  m.def("read_narx_json", &read_narx_json, py::arg("path"));
+
+  py::enum_<InformationCriterion>(m, "InformationCriterion")
+      .value("None", InformationCriterion::None)
+      .value("Aic", InformationCriterion::Aic)
+      .value("Aicc", InformationCriterion::Aicc)
+      .value("Bic", InformationCriterion::Bic)
+      .value("Fpe", InformationCriterion::Fpe);
+  py::class_<FrolsOptions>(m, "FrolsOptions")
+      .def(py::init<>())
+      .def_readwrite("max_terms", &FrolsOptions::max_terms)
+      .def_readwrite("err_tolerance", &FrolsOptions::err_tolerance)
+      .def_readwrite("criterion", &FrolsOptions::criterion)
+      .def_readwrite("block_rows", &FrolsOptions::block_rows);
+  py::class_<NarmaxOptions>(m, "NarmaxOptions")
+      .def(py::init<>())
+      .def_readwrite("frols", &NarmaxOptions::frols)
+      .def_readwrite("noise_candidates", &NarmaxOptions::noise_candidates)
+      .def_readwrite("max_noise_terms", &NarmaxOptions::max_noise_terms)
+      .def_readwrite("iterations", &NarmaxOptions::iterations)
+      .def_readwrite("tolerance", &NarmaxOptions::tolerance);
+  m.def("frols", [](const IdData& d, const std::vector<NarxTerm>& c, const FrolsOptions& o) {
+          return interruptible([&] { return frols(d, c, o); });
+        }, py::arg("data"), py::arg("candidates"), py::arg("options") = FrolsOptions{});
+  m.def("narmax", [](const IdData& d, const std::vector<NarxTerm>& c, const NarmaxOptions& o) {
+          return interruptible([&] { return narmax(d, c, o); });
+        }, py::arg("data"), py::arg("candidates"), py::arg("options") = NarmaxOptions{});
+
+  py::class_<NdeTerm>(m, "NdeTerm")
+      .def(py::init([](const std::string& s) { return NdeTerm::parse(s); }), py::arg("name"))
+      .def_property_readonly("name", &NdeTerm::name)
+      .def_property_readonly("degree", &NdeTerm::degree)
+      .def("__repr__", &NdeTerm::name);
+  py::implicitly_convertible<std::string, NdeTerm>();
+  py::class_<NdeSimulation>(m, "NdeSimulation")
+      .def_readonly("y", &NdeSimulation::y)
+      .def_property_readonly("termination", [](const NdeSimulation& s) { return std::string(to_string(s.termination)); })
+      .def_readonly("message", &NdeSimulation::message)
+      .def("ok", &NdeSimulation::ok);
+  py::class_<NdeModel>(m, "NdeModel", "Polynomial nonlinear differential equation sum c_m prod D^l x = 0.")
+      .def(py::init<std::vector<NdeTerm>, Eigen::VectorXd>(), py::arg("terms"), py::arg("coefficients"))
+      .def_property_readonly("terms", [](const NdeModel& n) { return names(n.terms()); })
+      .def_property_readonly("coefficients", &NdeModel::coefficients)
+      .def("coefficient", &NdeModel::coefficient, py::arg("name"))
+      .def("normalized", &NdeModel::normalized)
+      .def("h1", &NdeModel::h1, py::arg("s"))
+      .def("h2", &NdeModel::h2, py::arg("s1"), py::arg("s2"))
+      .def("h3", &NdeModel::h3, py::arg("s1"), py::arg("s2"), py::arg("s3"))
+      .def("simulate", [](const NdeModel& n, const Eigen::VectorXd& u, const Eigen::VectorXd& t,
+                          const std::string& intersample, const Eigen::VectorXd& x0, double rtol) {
+             return n.simulate(u, t, intersample_from_string(intersample), x0, rtol);
+           }, py::arg("u"), py::arg("t"), py::arg("intersample") = "zoh", py::arg("x0") = Eigen::VectorXd(),
+           py::arg("rtol") = 1e-9)
+      .def("__repr__", [](const NdeModel& n) { return n.to_string(6); });
+  bind_result<NdeModel>(m, "NdeResult");
+  m.def("read_nde_json", &read_nde_json, py::arg("path"));
+
+  py::enum_<KiaRegion>(m, "KiaRegion")
+      .value("Axes", KiaRegion::Axes)
+      .value("RealAxis", KiaRegion::RealAxis)
+      .value("ImaginaryAxis", KiaRegion::ImaginaryAxis)
+      .value("Complex", KiaRegion::Complex);
+  py::class_<KiaPointOptions>(m, "KiaPointOptions")
+      .def(py::init<>())
+      .def_readwrite("region", &KiaPointOptions::region)
+      .def_readwrite("count", &KiaPointOptions::count)
+      .def_readwrite("max", &KiaPointOptions::max)
+      .def_readwrite("grid", &KiaPointOptions::grid)
+      .def_readwrite("seed", &KiaPointOptions::seed);
+  py::class_<KiaLinearOptions>(m, "KiaLinearOptions")
+      .def(py::init<>())
+      .def_readwrite("y_order", &KiaLinearOptions::y_order)
+      .def_readwrite("u_order", &KiaLinearOptions::u_order)
+      .def_readwrite("points", &KiaLinearOptions::points)
+      .def_readwrite("gls_order", &KiaLinearOptions::gls_order)
+      .def_readwrite("max_iterations", &KiaLinearOptions::max_iterations)
+      .def_readwrite("tolerance", &KiaLinearOptions::tolerance)
+      .def_readwrite("err_threshold", &KiaLinearOptions::err_threshold)
+      .def_readwrite("zoh", &KiaLinearOptions::zoh);
+  py::class_<KiaQuadraticOptions>(m, "KiaQuadraticOptions")
+      .def(py::init<>())
+      .def_readwrite("candidates", &KiaQuadraticOptions::candidates)
+      .def_readwrite("points", &KiaQuadraticOptions::points)
+      .def_readwrite("gls_order", &KiaQuadraticOptions::gls_order)
+      .def_readwrite("max_iterations", &KiaQuadraticOptions::max_iterations)
+      .def_readwrite("tolerance", &KiaQuadraticOptions::tolerance)
+      .def_readwrite("err_threshold", &KiaQuadraticOptions::err_threshold)
+      .def_readwrite("zoh", &KiaQuadraticOptions::zoh);
+  py::class_<KiaCubicOptions>(m, "KiaCubicOptions")
+      .def(py::init<>())
+      .def_readwrite("candidates", &KiaCubicOptions::candidates)
+      .def_readwrite("points", &KiaCubicOptions::points)
+      .def_readwrite("gls_order", &KiaCubicOptions::gls_order)
+      .def_readwrite("max_iterations", &KiaCubicOptions::max_iterations)
+      .def_readwrite("tolerance", &KiaCubicOptions::tolerance)
+      .def_readwrite("err_threshold", &KiaCubicOptions::err_threshold)
+      .def_readwrite("zoh", &KiaCubicOptions::zoh);
+  m.def("kia_linear", &kia_linear, py::arg("narx"), py::arg("options") = KiaLinearOptions{});
+  m.def("kia_quadratic", &kia_quadratic, py::arg("narx"), py::arg("linear"), py::arg("options"));
+  m.def("kia_cubic", &kia_cubic, py::arg("narx"), py::arg("model"), py::arg("options"));
+
+  py::class_<NdeOeOptions>(m, "NdeOeOptions")
+      .def(py::init<>())
+      .def_readwrite("max_iterations", &NdeOeOptions::max_iterations)
+      .def_readwrite("tolerance", &NdeOeOptions::tolerance)
+      .def_readwrite("estimate_initial_state", &NdeOeOptions::estimate_initial_state)
+      .def_readwrite("fixed", &NdeOeOptions::fixed)
+      .def_readwrite("rtol", &NdeOeOptions::rtol);
+  m.def("nde_oe", [](const IdData& d, const NdeModel& initial, const NdeOeOptions& o) {
+          return interruptible([&] { return nde_oe(d, initial, o); });
+        }, py::arg("data"), py::arg("initial"), py::arg("options") = NdeOeOptions{});
+}
+
+}  // namespace ctid::python

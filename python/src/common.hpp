@@ -1,0 +1,56 @@
+// ctid Python module — shared helpers of the binding files (one file per area: adding a method's binding is
+// a change to one bind_*.cpp file plus its keyword wrapper in ctid/__init__.py).
+#pragma once
+
+#include <pybind11/complex.h>
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "ctid/ctid.hpp"
+
+namespace py = pybind11;
+
+namespace ctid::python {
+
+/// Runs f() with the GIL released. Ctrl-C is noticed at the estimator's next progress report (the
+/// callback takes the GIL and checks for signals) and ends the run with Termination::Interrupted; the
+/// best iterate is returned and the KeyboardInterrupt is consumed (the result says what happened).
+template <class F>
+auto interruptible(F&& f) {
+  bool stop = false;
+  ProgressScope scope([&stop](const ProgressEvent&) {
+    if (stop) return false;
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) {
+      PyErr_Clear();
+      stop = true;
+    }
+    return !stop;
+  });
+  py::gil_scoped_release release;
+  return f();
+}
+
+/// Binds Result<Model> as a Python class `name` (model, parameters, fit, summary, diagnostics, usable()).
+template <class Model>
+void bind_result(py::module_& m, const char* name) {
+  using R = Result<Model>;
+  py::class_<R>(m, name)
+      .def_readonly("model", &R::model)
+      .def_readonly("parameters", &R::parameters)
+      .def_readonly("fit", &R::fit)
+      .def_readonly("summary", &R::summary)
+      .def_readonly("diagnostics", &R::diagnostics)
+      .def("usable", &R::usable, "Whether the estimate can be trusted (succeeded, finite parameters).");
+}
+
+void bind_core(py::module_& m);
+void bind_linear(py::module_& m);
+void bind_fsf(py::module_& m);
+void bind_nonlinear(py::module_& m);
+void bind_modal(py::module_& m);
+void bind_physical(py::module_& m);
+
+}  // namespace ctid::python

@@ -1,0 +1,46 @@
+import numpy as np
+import pytest
+
+import ctid
+
+
+def test_from_arrays_shapes_names_and_times():
+    u = np.arange(10.0)
+    y = np.column_stack([np.sin(u), np.cos(u)])
+    d = ctid.IdData.from_arrays(u, y, ts=0.5, t0=1.0, input_names=["v"], output_names=["a", "b"], intersample="foh")
+    assert len(d) == 10 and d.nu == 1 and d.ny == 2
+    assert d.u.shape == (10, 1) and d.y.shape == (10, 2)
+    np.testing.assert_array_equal(d.y, y)
+    assert d.ts == 0.5 and d.times[-1] == pytest.approx(5.5)
+    assert d.input_names == ["v"] and d.output_names == ["a", "b"] and d.intersample == ["foh"]
+    irregular = ctid.IdData.from_arrays(u, y[:, 0], t=np.cumsum(np.linspace(0.1, 0.2, 10)))
+    assert not irregular.is_uniform
+    est, val = d.split(0.7)
+    assert len(est) == 7 and len(val) == 3
+
+
+def test_bad_input_raises_value_errors_naming_the_problem():
+    with pytest.raises(ctid.InvalidArgument, match="999"):
+        ctid.IdData.from_arrays(np.zeros(1000), np.zeros(999), ts=0.1)
+    with pytest.raises(ValueError, match="NaN|non-finite|Inf"):
+        ctid.IdData.from_arrays(np.zeros(5), np.array([0, 1, np.nan, 2, 3.0]), ts=0.1)
+    with pytest.raises(ctid.InvalidArgument, match="either ts"):
+        ctid.IdData.from_arrays(np.zeros(5), np.zeros(5))
+    with pytest.raises(ctid.InvalidArgument, match="shape"):
+        ctid.IdData.from_arrays(np.zeros((5, 1, 1)), np.zeros(5), ts=1.0)
+    with pytest.raises(ctid.FileError):
+        ctid.load("/nonexistent/file.csv", inputs=["u"], outputs=["y"], ts=1.0)
+    assert issubclass(ctid.InvalidOptions, ValueError) and issubclass(ctid.FileError, OSError)
+
+
+def test_load_bundled_dryer(tmp_path):
+    from conftest import EXAMPLES_DATA
+    d = ctid.load(str(EXAMPLES_DATA / "dryer.dat"), inputs=["1"], outputs=["2"], ts=0.08)
+    assert len(d) == 1000 and d.ts == 0.08
+
+
+def test_from_pandas_when_available():
+    pd = pytest.importorskip("pandas")
+    frame = pd.DataFrame({"t": np.arange(5) * 0.1, "u": np.ones(5), "y": np.arange(5.0)})
+    d = ctid.IdData.from_pandas(frame, inputs=["u"], outputs=["y"], time="t")
+    assert d.input_names == ["u"] and len(d) == 5

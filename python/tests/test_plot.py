@@ -1,0 +1,30 @@
+import numpy as np
+import pytest
+
+matplotlib = pytest.importorskip("matplotlib")
+matplotlib.use("Agg")
+
+import ctid  # noqa: E402
+import ctid.plot  # noqa: E402
+
+
+def test_plots_draw_and_return_axes(plant, tmp_path):
+    import matplotlib.pyplot as plt
+    g, d = plant
+    r = ctid.srivc(d, 1, 2)
+    f = ctid.fsf(d, T=20.0, n=31)
+    ax = ctid.plot.compare(d, r, f, labels=["srivc", "fsf"])
+    assert len(ax.lines) == 3 and "fit" in ax.get_legend().get_texts()[1].get_text()
+    axes = ctid.plot.residuals(d, r)
+    assert "outside" in axes[0].get_title()
+    axes = ctid.plot.bode(r)
+    assert len(axes[0].lines) == 1 and len(axes[0].collections) == 1  # the confidence band
+    axes = ctid.plot.bode(f)
+    assert len(axes[0].collections) == 1
+    ax = ctid.plot.step(f)
+    y = ax.lines[0].get_ydata()
+    assert y[-1] == pytest.approx(1.0, abs=0.05)
+    ctid.plot.impulse(r)
+    plt.savefig(tmp_path / "last.png")
+    assert (tmp_path / "last.png").stat().st_size > 1000
+    plt.close("all")
