@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <type_traits>
 
 #include "common.hpp"
 
@@ -22,7 +23,7 @@ struct FitArgs {
   std::string model_expr, via = "fsf", responses;
   std::vector<std::string> params;
   std::string w = "w", re = "re", im = "im", u_re, u_im, y_re, y_im;
-  std::string json, narx;
+  std::string json, narx, report;
   bool force = false;
 };
 
@@ -43,13 +44,18 @@ void apply_svf_sets(std::map<std::string, std::string>& s, LssvfOptions& o) {
   });
 }
 
-// Print, write the JSON file if asked, and map usability to the exit code.
+// Print, write the JSON file and the HTML report if asked, and map usability to the exit code.
 template <class M>
-int finish(const Result<M>& r, const std::string& method, const IdData& d, const std::string& json) {
+int finish(const Result<M>& r, const std::string& method, const IdData& d, const FitArgs& a) {
   print_result(r, method, d);
-  if (!json.empty()) {
-    write_result_json(json, r, method);
-    std::printf("wrote %s\n", json.c_str());
+  if (!a.json.empty()) {
+    write_result_json(a.json, r, method);
+    std::printf("wrote %s\n", a.json.c_str());
+  }
+  if constexpr (std::is_same_v<M, MisoModel>) {
+    if (!a.report.empty()) std::fprintf(stderr, "ctid: warning: --report is not available for multi-input models\n");
+  } else {
+    write_report(a.report, d, r, method, a.sets, a.data.path);
   }
   if (!r.usable()) {
     std::fprintf(stderr, "ctid: the estimate is not usable: %s\n",
@@ -169,7 +175,7 @@ int run_closed_loop(const FitArgs& a) {
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }
-  return finish(r2, "clsrivc", d, a.json);
+  return finish(r2, "clsrivc", d, a);
 }
 
 // Frequency-response data: columns w, re, im (G) or the spectra U and Y.
@@ -289,7 +295,7 @@ int run_fsf(const FitArgs& a, const IdData& d) {
     check_output_path(a.responses + "_time.csv", {a.data.path}, a.force);
     check_output_path(a.responses + "_freq.csv", {a.data.path}, a.force);
   }
-  const int code = finish(r, "fsf", d, a.json);
+  const int code = finish(r, "fsf", d, a);
   if (!a.responses.empty()) write_fsf_responses(a.responses, r.model);
   return code;
 }
@@ -367,7 +373,7 @@ int run_physical(const FitArgs& a, const IdData& d) {
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }
-  return finish(r, "physical-" + a.via, d, a.json);
+  return finish(r, "physical-" + a.via, d, a);
 }
 
 // El-Shafey: modal functions (generated input with --set frequencies, or piecewise-constant input).
@@ -405,12 +411,14 @@ int run_modal(const FitArgs& a, const IdData& d0) {
     throw UsageError(e.what());
   }
   if (nk > 0) r.model.set_io_delay(nk * d0.ts());
-  return finish(r, "modal", d0, a.json);
+  return finish(r, "modal", d0, a);
 }
 
 int run(const FitArgs& a) {
   check_output_path(a.json, {a.data.path}, a.force);
+  check_output_path(a.report, {a.data.path, a.json}, a.force);
   if (!a.controller.empty()) return run_closed_loop(a);
+  if (a.frequency && !a.report.empty()) throw UsageError("--report needs time-domain data (not --frequency)");
   if (a.frequency) return run_frequency(a);
   const IdData d = a.data.load(true);
   if (d.ny() != 1) throw UsageError(detail::format("{} estimates single-output models (selected {} outputs)", a.method, d.ny()));
@@ -446,7 +454,7 @@ int run(const FitArgs& a) {
     } catch (const InvalidArgument& e) {
       throw UsageError(e.what());
     }
-    return finish(r, "srivc", d, a.json);
+    return finish(r, "srivc", d, a);
   }
   if (a.method == "fsf" || a.method == "physical") {
     if (d.nu() != 1) throw UsageError(detail::format("{} needs one input (selected {})", a.method, d.nu()));
@@ -454,7 +462,7 @@ int run(const FitArgs& a) {
     return a.method == "fsf" ? run_fsf(a, d) : run_physical(a, d);
   }
   if (a.method == "modal") return run_modal(a, d);
-  if (a.method == "narx" || a.method == "kia") return run_narx_or_kia(a.method, d, a.sets, a.narx, a.json);
+  if (a.method == "narx" || a.method == "kia") return run_narx_or_kia(a.method, d, a.sets, a.narx, a.json, a.report);
   TfOrders orders = all[0];
   if (a.delay && (a.method == "lssvf" || a.method == "ivsvf" || a.method == "rls-svf"))
     throw UsageError("--delay (delay estimation) needs --method srivc, oe or tfest");
@@ -492,7 +500,7 @@ int run(const FitArgs& a) {
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }
-  return finish(r, a.method, d, a.json);
+  return finish(r, a.method, d, a);
 }
 
 }  // namespace
@@ -549,6 +557,7 @@ void setup_fit(CLI::App& app) {
                  "standard deviations of its real and imaginary parts)");
   app.add_option("--narx", a->narx, "kia: the NARX model JSON to reconstruct from (otherwise a NARX model is fitted first)");
   app.add_option("--json", a->json, "Write the result (model, parameters, fit) to this JSON file");
+  app.add_option("--report", a->report, "Write a self-contained HTML report (plots, tests, parameters) to this file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
   app.callback([a] { g_run = [a] { return run(*a); }; });
 }

@@ -71,7 +71,8 @@ Result<NarxModel> run_narx(const IdData& d, std::map<std::string, std::string>& 
 }
 
 int run_narx_or_kia(const std::string& method, const IdData& d, const std::vector<std::string>& set_list,
-                    const std::string& narx_file, const std::string& json) {
+                    const std::string& narx_file, const std::string& json,
+                    const std::string& report) {
   if (d.nu() != 1 || d.ny() != 1) throw UsageError(method + " needs one --input and one --output");
   auto sets = parse_sets(set_list);
   if (method == "narx") {
@@ -84,6 +85,7 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
       write_result_json(json, r, "narx");
       std::printf("wrote %s\n", json.c_str());
     }
+    write_report(report, d, r, "narx", set_list, "");
     return r.usable() ? kOk : kNotUsable;
   }
   // kia: the NARX model from --narx, or identified here.
@@ -187,6 +189,7 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
     write_result_json(json, r, "kia");
     std::printf("wrote %s\n", json.c_str());
   }
+  write_report(report, d, r, refine ? "kia+oe" : "kia", set_list, narx_file);
   if (!r.usable()) {
     std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", r.summary.message.c_str());
     return kNotUsable;

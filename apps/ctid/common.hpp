@@ -64,6 +64,35 @@ void print_result(const Result<TransferFunction>& r, const std::string& method, 
 void print_result(const Result<MisoModel>& r, const std::string& method, const IdData& data);
 void print_result(const Result<FsfModel>& r, const std::string& method, const IdData& data);
 
+/// --report: write the HTML report of r on d (nothing when path is empty). `sets` are shown as the method
+/// settings. A report that cannot be made (e.g. multi-channel data) is a UsageError; a write failure an
+/// InputError.
+template <class M>
+void write_report(const std::string& path, const IdData& d, const Result<M>& r, const std::string& method,
+                  const std::vector<std::string>& sets, const std::string& source) {
+  if (path.empty()) return;
+  ReportOptions o;
+  o.method = method;
+  o.title = "ctid " + method + " fit";
+  o.data_source = source;
+  for (const auto& s : sets) {
+    const auto eq = s.find('=');
+    o.settings.emplace_back(s.substr(0, eq), eq == std::string::npos ? "" : s.substr(eq + 1));
+  }
+  std::string html;
+  try {
+    html = html_report(d, r, o);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(std::string("--report: ") + e.what());
+  }
+  try {
+    write_text_file(path, html);
+  } catch (const FileError& e) {
+    throw InputError(e.what());
+  }
+  std::printf("wrote %s\n", path.c_str());
+}
+
 /// Modal-function settings (El-Shafey) from --set: shifts (samples) or shift_times (s), basis,
 /// functions, iv (samples), stride, quadrature, window=START,LENGTH (samples), frequencies (rad/s).
 struct ModalSettings {
@@ -77,7 +106,8 @@ InputGenerator generator_fitted_to_input(const std::vector<double>& frequencies,
 
 /// Billings & Li: fit --method narx | kia (cmd_nonlinear.cpp).
 int run_narx_or_kia(const std::string& method, const IdData& d, const std::vector<std::string>& sets,
-                    const std::string& narx_file, const std::string& json);
+                    const std::string& narx_file, const std::string& json,
+                    const std::string& report);
 
 void setup_fit(CLI::App& app);
 void setup_gfrf(CLI::App& app);
@@ -87,5 +117,6 @@ void setup_simulate(CLI::App& app);
 void setup_validate(CLI::App& app);
 void setup_demo(CLI::App& app);
 void setup_order(CLI::App& app);
+void setup_report(CLI::App& app);
 
 }  // namespace ctid::cli

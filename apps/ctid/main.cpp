@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   setup_poles(*app.add_subcommand("poles", "Poles from a free response: data-matrix method (El-Shafey) against Prony"));
   setup_response(*app.add_subcommand("response", "Nonparametric step, impulse or frequency response (modal functions)"));
   setup_gfrf(*app.add_subcommand("gfrf", "Generalised frequency response functions of a NARX or NDE model file"));
+  setup_report(*app.add_subcommand("report", "Self-contained HTML report of a result file on a record"));
   setup_demo(*app.add_subcommand("demo", "Identify a bundled real data set and print the model"));
   try {
     app.parse(argc, argv);

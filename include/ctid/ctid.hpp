@@ -26,6 +26,7 @@
 #include "ctid/estimate/srivc.hpp"
 #include "ctid/io/csv.hpp"
 #include "ctid/io/file.hpp"
+#include "ctid/io/report.hpp"
 #include "ctid/io/json.hpp"
 #include "ctid/io/load.hpp"
 #include "ctid/io/mat.hpp"

@@ -16,7 +16,7 @@ from ._ctid import (  # noqa: F401  (re-exported)
     CorrelationTest, FileError, FsfModel, IdData, InputGenerator, InvalidArgument, InvalidOptions, NarxModel, NarxTerm,
     ModalWindow, NdeModel, NdeSimulation, NdeTerm, NonlinearCorrelationTests, PhysicalModel, TransferFunction,
     add_noise_snr,
-    fit_percent, input_residual_crosscorrelation, load, narx_candidates, narx_noise_candidates,
+    fit_percent, html_report, input_residual_crosscorrelation, load, narx_candidates, narx_noise_candidates,
     nonlinear_correlation_tests, prbs, read_narx_json, read_nde_json, residual_autocorrelation, time_grid,
 )
 

@@ -107,6 +107,7 @@ void bind_core(py::module_& m) {
       .def("__call__", &TransferFunction::operator(), py::arg("s"))
       .def("__repr__", [](const TransferFunction& g) { return g.to_string(6); });
   bind_result<TransferFunction>(m, "TransferFunctionResult");
+  def_report<TransferFunction>(m);
 
   m.def("time_grid", &time_grid, py::arg("ts"), py::arg("n"));
   m.def("prbs", [](int n, int register_length, int clock_period) {

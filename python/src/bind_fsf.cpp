@@ -27,6 +27,7 @@ void bind_fsf(py::module_& m) {
       .def("impulse_std", &FsfModel::impulse_response_std, py::arg("t"))
       .def("simulate", &FsfModel::simulate, py::arg("u"), "Discrete FSF model output for u (from rest).");
   bind_result<FsfModel>(m, "FsfResult");
+  def_report<FsfModel>(m);
   m.def(
       "fsf",
       [](const IdData& d, const FsfOptions& o) { return interruptible([&] { return fsf(d, o); }); },

@@ -50,6 +50,7 @@ void bind_nonlinear(py::module_& m) {
            }, py::arg("z"))
       .def("__repr__", [](const NarxModel& n) { return n.to_string(6); });
   bind_result<NarxModel>(m, "NarxResult");
+  def_report<NarxModel>(m);
   m.def("read_narx_json", &read_narx_json, py::arg("path"));
 
   py::enum_<InformationCriterion>(m, "InformationCriterion")
@@ -105,6 +106,7 @@ void bind_nonlinear(py::module_& m) {
            py::arg("rtol") = 1e-9)
       .def("__repr__", [](const NdeModel& n) { return n.to_string(6); });
   bind_result<NdeModel>(m, "NdeResult");
+  def_report<NdeModel>(m);
   m.def("read_nde_json", &read_nde_json, py::arg("path"));
 
   py::enum_<KiaRegion>(m, "KiaRegion")

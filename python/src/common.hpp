@@ -46,6 +46,25 @@ void bind_result(py::module_& m, const char* name) {
       .def("usable", &R::usable, "Whether the estimate can be trusted (succeeded, finite parameters).");
 }
 
+/// ctid.html_report(data, result, path, method="", title="", settings={}) for Result<Model>: writes the
+/// self-contained HTML report (io/report.hpp).
+template <class Model>
+void def_report(py::module_& m) {
+  m.def(
+      "html_report",
+      [](const IdData& d, const Result<Model>& r, const std::string& path, const std::string& method,
+         const std::string& title, const std::map<std::string, std::string>& settings) {
+        ReportOptions o;
+        o.method = method;
+        o.title = title;
+        o.settings.assign(settings.begin(), settings.end());
+        write_text_file(path, html_report(d, r, o));
+      },
+      py::arg("data"), py::arg("result"), py::arg("path"), py::arg("method") = "", py::arg("title") = "",
+      py::arg("settings") = std::map<std::string, std::string>{},
+      "Write the self-contained HTML report of a result on a record (plots, residual tests, parameters).");
+}
+
 void bind_core(py::module_& m);
 void bind_linear(py::module_& m);
 void bind_fsf(py::module_& m);

@@ -28,3 +28,14 @@ def test_plots_draw_and_return_axes(plant, tmp_path):
     plt.savefig(tmp_path / "last.png")
     assert (tmp_path / "last.png").stat().st_size > 1000
     plt.close("all")
+
+
+def test_html_report_from_python(plant, tmp_path):
+    _, d = plant
+    r = ctid.srivc(d, 1, 2)
+    path = tmp_path / "r.html"
+    ctid.html_report(d, r, str(path), method="srivc", settings={"nb": "1", "nf": "2"})
+    text = path.read_text()
+    assert "Residual tests" in text and "srivc" in text and text.count('class="plot"') == 9
+    with pytest.raises(ctid.FileError):
+        ctid.html_report(d, r, str(tmp_path / "missing" / "r.html"))

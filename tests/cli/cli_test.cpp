@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sys/wait.h>
 
 #include <gtest/gtest.h>
@@ -534,4 +535,103 @@ TEST(Cli, NarxKiaAndGfrf) {
   r = ctid_run("fit " + data + " --ts 0.0025 --method kia --narx " + bad);
   EXPECT_EQ(r.code, 3);
   EXPECT_NE(r.err.find("terms[0]"), std::string::npos) << r.err;
+}
+
+namespace {
+// Runs headless Chromium on a report: the page's self-check line ("plots=N drawn=M errors=E") from the DOM
+// after load, the console messages on stderr, and a screenshot. Empty when Chromium is not installed.
+struct BrowserRun {
+  std::string selfcheck, log;
+};
+std::optional<BrowserRun> open_in_browser(const std::string& html, const std::string& png) {
+  if (std::system("command -v chromium >/dev/null 2>&1") != 0) return std::nullopt;
+  const std::string flags = "timeout 120 chromium --headless --no-sandbox --disable-gpu --hide-scrollbars "
+                            "--enable-logging=stderr --v=0 --virtual-time-budget=10000 --window-size=1100,5000 ";
+  const std::string dom = test::temp_path("dom.html"), log = test::temp_path("chromium.log");
+  std::system((flags + "--dump-dom " + html + " >" + dom + " 2>" + log).c_str());
+  std::system((flags + "--screenshot=" + png + " " + html + " >/dev/null 2>&1").c_str());
+  std::ifstream d(dom), l(log);
+  const std::string text((std::istreambuf_iterator<char>(d)), {});
+  BrowserRun r;
+  r.log.assign(std::istreambuf_iterator<char>(l), {});
+  const auto at = text.find("id=\"ctid-selfcheck\">");
+  if (at != std::string::npos) r.selfcheck = text.substr(at + 20, text.find('<', at + 20) - at - 20);
+  return r;
+}
+}  // namespace
+
+TEST(Cli, ReportsOpenInABrowserWithEveryPlotDrawn) {
+  // One report per model type: SRIVC and FSF on the bundled hair dryer, NARX and KIA (+ output-error refinement)
+  // on the Billings & Li system (33). Each must load with no console error and every plot drawn (canvas with
+  // painted pixels); the screenshots go to the build tree (docs/images holds copies).
+  const std::string dryer = std::string(CTID_EXAMPLES_DATA_DIR) + "/dryer.dat";
+  const std::string base = " --ts 0.08 --input 1 --output 2 --detrend mean ";
+  std::vector<NdeTerm> t;
+  for (const char* s : {"y", "Dy", "D^2y", "u", "y^2", "y*Dy"}) t.push_back(NdeTerm::parse(s));
+  const NdeModel truth(t, (Eigen::VectorXd(6) << 1, 0.002, 1e-4, -1, 0.1, -0.006).finished());
+  const int N = 1000;
+  Eigen::VectorXd u(N);
+  for (int i = 0; i < N; ++i) u(i) = ((i * 7919 + i / 3) % 5) < 2 ? 1.0 : -1.0;
+  Eigen::MatrixXd m(N, 2);
+  m << u, truth.simulate(u, time_grid(0.0025, N), Intersample::Zoh, {}, 1e-11).y;
+  const std::string bl = test::temp_path("bl_report.csv");
+  write_csv(bl, {"u", "y"}, m);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"srivc", "fit " + dryer + base + "--method srivc --nb 2 --nf 2 --nk 2"},
+      {"fsf", "fit " + dryer + base + "--method fsf --set T=4 --set n=21"},
+      {"narx", "fit " + bl + " --ts 0.0025 --method narx --set ylag=6 --set ulag=6"},
+      {"kia", "fit " + bl + " --ts 0.0025 --method kia --set ylag=6 --set ulag=6 --set quadratic=y^2,y*Dy"},
+  };
+  for (const auto& [name, args] : cases) {
+    const std::string html = test::temp_path("report_" + name + ".html");
+    fs::remove(html);
+    const CliRun r = ctid_run(args + " --report " + html);
+    ASSERT_EQ(r.code, 0) << name << ": " << r.err;
+    std::ifstream f(html);
+    const std::string text((std::istreambuf_iterator<char>(f)), {});
+    EXPECT_NE(text.find("Residual tests"), std::string::npos) << name;
+    EXPECT_NE(text.find("Parameters"), std::string::npos) << name;
+    for (const char* ref : {"src=\"http", "href=\"http", "url(http"}) EXPECT_EQ(text.find(ref), std::string::npos) << name;
+    EXPECT_TRUE(report_has_plot_library());
+    const std::string png = std::string(CTID_TEST_OUTPUT_DIR) + "/report_" + name + ".png";
+    const auto b = open_in_browser(html, png);
+    if (!b) GTEST_SKIP() << "chromium is not installed (scripts/install-deps.sh installs it)";
+    int plots = -1, drawn = -2, errors = -1;
+    ASSERT_EQ(std::sscanf(b->selfcheck.c_str(), "plots=%d drawn=%d errors=%d", &plots, &drawn, &errors), 3)
+        << name << ": self-check line '" << b->selfcheck << "'\n" << b->log;
+    EXPECT_GE(plots, 8) << name;
+    EXPECT_EQ(drawn, plots) << name;
+    EXPECT_EQ(errors, 0) << name;
+    EXPECT_EQ(b->log.find("Uncaught"), std::string::npos) << name << ": " << b->log;
+    EXPECT_GT(fs::exists(png) ? fs::file_size(png) : 0, 50000u) << name;
+  }
+  // Bad use: a report of frequency data, an unknown model type.
+  CliRun r = ctid_run("fit " + dryer + " --frequency --report " + test::temp_path("x.html"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--report needs time-domain data"), std::string::npos) << r.err;
+  const std::string ss = write("ss.json", R"J({"type": "state_space", "A": [[-1]], "B": [[1]], "C": [[1]], "D": [[0]]})J");
+  r = ctid_run("report " + ss + " " + dryer + base + "--out " + test::temp_path("y.html"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("state_space"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(test::temp_path("y.html")));
+}
+
+TEST(Cli, ReportOfAResultFile) {
+  // ctid report RESULT.json DATA: the result of fit --json on the same record gives the same fit in the report.
+  const std::string dryer = std::string(CTID_EXAMPLES_DATA_DIR) + "/dryer.dat";
+  const std::string base = " --ts 0.08 --input 1 --output 2 --detrend mean ";
+  const std::string json = test::temp_path("dryer_result.json"), html = test::temp_path("dryer_report.html");
+  fs::remove(json);
+  fs::remove(html);
+  ASSERT_EQ(ctid_run("fit " + dryer + base + "--method srivc --nb 2 --nf 2 --nk 2 --json " + json).code, 0);
+  const CliRun r = ctid_run("report " + json + " " + dryer + base + "--out " + html);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream f(html);
+  const std::string text((std::istreambuf_iterator<char>(f)), {});
+  const double fit = parse_result_json(std::string(std::istreambuf_iterator<char>(std::ifstream(json).rdbuf()), {})).fit.fit_percent;
+  char expect[64];
+  std::snprintf(expect, sizeof expect, "fit %.4g %%", fit);
+  EXPECT_NE(text.find(expect), std::string::npos) << expect;
+  EXPECT_NE(text.find("95 % band"), std::string::npos);  // the covariance was read back
+  EXPECT_EQ(ctid_run("report " + json + " " + dryer + base + "--out " + html).code, 2);  // exists: needs --force
 }

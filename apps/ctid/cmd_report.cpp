@@ -1,0 +1,104 @@
+// ctid report RESULT.json DATA --out REPORT.html: the HTML report of a result file (ctid fit --json) on a
+// record — transfer-function results with their covariance, NARX and NDE model files (the fit statistics
+// are recomputed on DATA).
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "common.hpp"
+
+namespace ctid::cli {
+extern std::function<int()> g_run;
+
+namespace {
+struct ReportArgs {
+  std::string result, out, title;
+  DataArgs data;
+  bool force = false;
+};
+
+// Parameters and fit of a model read without its result envelope.
+template <class M>
+Result<M> bare_result(const M& model, const IdData& d, const Eigen::VectorXd& yhat) {
+  Result<M> r;
+  r.model = model;
+  r.parameters.values = model.coefficients();
+  for (const auto& t : model.terms()) r.parameters.names.push_back(t.name());
+  r.parameters.std = Eigen::VectorXd::Constant(r.parameters.values.size(), NAN);
+  r.parameters.fixed.assign(model.terms().size(), false);
+  r.fit = fit_report_or_inf(d.y().col(0), yhat, static_cast<int>(model.terms().size()));
+  return r;
+}
+
+int run(const ReportArgs& a) {
+  if (a.out.empty()) throw UsageError("give the report file with --out REPORT.html");
+  check_output_path(a.out, {a.data.path, a.result}, a.force);
+  std::ifstream in(a.result);
+  if (!in) throw InputError("cannot open " + a.result);
+  std::stringstream buf;
+  buf << in.rdbuf();
+  const std::string text = buf.str();
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(a.result + ": not JSON (" + e.what() + ")");
+  }
+  const nlohmann::json& model = j.contains("model") ? j["model"] : j;
+  const std::string type = model.is_object() && model.contains("type") && model["type"].is_string()
+                               ? model["type"].get<std::string>()
+                               : "";
+  const IdData d = a.data.load(true);
+  if (d.nu() != 1 || d.ny() != 1) throw UsageError("report needs one --input and one --output");
+  ReportOptions o;
+  o.method = j.contains("method") && j["method"].is_string() ? j["method"].get<std::string>() : type;
+  o.title = a.title.empty() ? "ctid report: " + a.result : a.title;
+  o.data_source = a.data.path;
+  std::string html;
+  try {
+    if (type == "transfer_function") {
+      html = html_report(d, parse_result_json(text, a.result), o);
+    } else if (type == "narx") {
+      const NarxModel m = parse_narx_json(text, a.result);
+      const NarxModel p = m.process();
+      const int L = std::min(p.max_lag(), d.size());
+      html = html_report(d, bare_result(m, d, p.simulate(d.u().col(0), d.y().col(0).head(L))), o);
+    } else if (type == "nde") {
+      const NdeModel m = parse_nde_json(text, a.result);
+      Eigen::VectorXd t(d.size());
+      for (int i = 0; i < d.size(); ++i) t(i) = d.time(i) - d.t0();
+      html = html_report(d, bare_result(m, d, m.simulate(d.u().col(0), t, d.intersample(0)).y), o);
+    } else {
+      throw UsageError(a.result + ": model type '" + type +
+                       "' has no report here (transfer_function, narx, nde; for FSF results use ctid fit --report)");
+    }
+  } catch (const FileError& e) {
+    throw InputError(e.what());
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+  try {
+    write_text_file(a.out, html);
+  } catch (const FileError& e) {
+    throw InputError(e.what());
+  }
+  std::printf("wrote %s\n", a.out.c_str());
+  return kOk;
+}
+}  // namespace
+
+void setup_report(CLI::App& app) {
+  auto a = std::make_shared<ReportArgs>();
+  app.add_option("RESULT", a->result, "Result or model JSON (ctid fit --json)")->required();
+  app.add_option("DATA", a->data.path, "The record to report on (CSV/.dat or .mat)")->required();
+  a->data.add_to(app, true);
+  app.add_option("--out", a->out, "The HTML file to write")->required();
+  app.add_option("--title", a->title, "Report title");
+  app.add_flag("--force", a->force, "Overwrite an existing output file");
+  app.callback([a] { g_run = [a] { return run(*a); }; });
+}
+
+}  // namespace ctid::cli

@@ -1,0 +1,43 @@
+// ctid — self-contained HTML reports of a fit: one file that opens offline (the uPlot plotting library,
+// MIT, is inlined; no CDN, no network at view time). Sections: data overview, measured vs simulated
+// output with the fit, residual auto- and cross-correlation with their 99 % bounds, Bode magnitude and
+// phase (with a confidence band where a covariance exists), step and impulse responses, the parameter
+// table with standard deviations, the method settings and warnings — and per model type: FSF compressed
+// responses with +-2 std bands; ERR tables for NARX; coefficient tables and GFRF (|H_2|) maps for NARX
+// and NDE models.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "ctid/core/types.hpp"
+#include "ctid/data/iddata.hpp"
+#include "ctid/model/fsf.hpp"
+#include "ctid/model/narx.hpp"
+#include "ctid/model/nde.hpp"
+#include "ctid/model/transfer_function.hpp"
+
+namespace ctid {
+
+struct ReportOptions {
+  std::string title;                                        ///< default: "<method> fit"
+  std::string method;                                       ///< e.g. "srivc"
+  std::vector<std::pair<std::string, std::string>> settings;  ///< shown as given (e.g. the CLI's --set values)
+  std::string data_source;                                  ///< e.g. the data file name
+  int max_lag = 25;                                         ///< residual correlation lags
+  int max_points = 4000;                                    ///< time plots are decimated (min/max pairs) above this
+};
+
+/// Report of a result on the record `data` (single input and output; the model is simulated on it).
+/// Throws InvalidArgument for data that are not SISO or too short for the correlation lags.
+std::string html_report(const IdData& data, const Result<TransferFunction>& result, const ReportOptions& options);
+std::string html_report(const IdData& data, const Result<FsfModel>& result, const ReportOptions& options);
+std::string html_report(const IdData& data, const Result<NarxModel>& result, const ReportOptions& options);
+std::string html_report(const IdData& data, const Result<NdeModel>& result, const ReportOptions& options);
+
+/// Whether the plotting library was found at build time (scripts/install-deps.sh fetches it); without it
+/// a report still holds every table and says that its plots are missing.
+bool report_has_plot_library();
+
+}  // namespace ctid

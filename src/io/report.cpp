@@ -1,0 +1,578 @@
+// Self-contained HTML reports (see include/ctid/io/report.hpp). The page carries its plot data as JSON
+// and draws it with the inlined uPlot; a self-check at the end of loading writes "plots=N drawn=M
+// errors=E" into #ctid-selfcheck (drawn = canvases with at least one painted pixel), which the
+// browser test reads.
+#include "ctid/io/report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <random>
+#include <sstream>
+
+#include "ctid/core/check.hpp"
+#include "ctid/estimate/gfrf.hpp"
+#include "ctid/simulate/lsim.hpp"
+#include "ctid/validate/metrics.hpp"
+#include "ctid/validate/residuals.hpp"
+
+namespace ctid {
+
+namespace report_assets {
+extern const char* const kUplotJs;
+extern const char* const kUplotCss;
+extern const bool kHaveUplot;
+}  // namespace report_assets
+
+bool report_has_plot_library() { return report_assets::kHaveUplot; }
+
+namespace {
+
+std::string escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+      case '&': o += "&amp;"; break;
+      case '<': o += "&lt;"; break;
+      case '>': o += "&gt;"; break;
+      case '"': o += "&quot;"; break;
+      default: o += c;
+    }
+  }
+  return o;
+}
+
+std::string json_string(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    if (c == '<') {  // keeps "</script>" out of the embedded JSON
+      o += "\\u003c";
+      continue;
+    }
+    if (static_cast<unsigned char>(c) < 0x20) continue;
+    o += c;
+  }
+  return o + "\"";
+}
+
+std::string num(double v, int digits = 6) {
+  if (!std::isfinite(v)) return "null";
+  char b[32];
+  std::snprintf(b, sizeof b, "%.*g", digits, v);
+  return b;
+}
+
+std::string json_array(const Eigen::VectorXd& v) {
+  std::string o = "[";
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    if (i) o += ',';
+    o += num(v(i));
+  }
+  return o + "]";
+}
+
+struct Series {
+  std::string label;
+  Eigen::VectorXd y;
+  bool dashed = false;
+  bool light = false;  // a band edge
+};
+
+struct Plot {
+  std::string title, xlabel, ylabel;
+  Eigen::VectorXd x;
+  std::vector<Series> series;
+  bool logx = false;
+  bool bars = false;
+};
+
+struct Heatmap {
+  std::string title, xlabel, ylabel;
+  Eigen::VectorXd x, y;
+  Eigen::MatrixXd z;  // z(i, j) at (x(j), y(i))
+};
+
+class Page {
+ public:
+  void section(const std::string& title) { body_ << "<h2>" << escape(title) << "</h2>\n"; }
+  void text(const std::string& html) { body_ << "<p>" << html << "</p>\n"; }
+  void table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows) {
+    body_ << "<table><tr>";
+    for (const auto& h : header) body_ << "<th>" << escape(h) << "</th>";
+    body_ << "</tr>\n";
+    for (const auto& r : rows) {
+      body_ << "<tr>";
+      for (const auto& c : r) body_ << "<td>" << escape(c) << "</td>";
+      body_ << "</tr>\n";
+    }
+    body_ << "</table>\n";
+  }
+  void plot(const Plot& p) {
+    const std::string id = "plot" + std::to_string(n_++);
+    body_ << "<div class=\"plot\" id=\"" << id << "\"></div>\n";
+    std::ostringstream s;
+    s << "{\"id\":\"" << id << "\",\"kind\":\"line\",\"title\":" << json_string(p.title)
+      << ",\"xlabel\":" << json_string(p.xlabel) << ",\"ylabel\":" << json_string(p.ylabel)
+      << ",\"logx\":" << (p.logx ? "true" : "false") << ",\"bars\":" << (p.bars ? "true" : "false")
+      << ",\"x\":" << json_array(p.x) << ",\"series\":[";
+    for (size_t i = 0; i < p.series.size(); ++i)
+      s << (i ? "," : "") << "{\"label\":" << json_string(p.series[i].label) << ",\"dashed\":"
+        << (p.series[i].dashed ? "true" : "false") << ",\"light\":" << (p.series[i].light ? "true" : "false")
+        << ",\"y\":" << json_array(p.series[i].y) << "}";
+    s << "]}";
+    specs_.push_back(s.str());
+  }
+  void heatmap(const Heatmap& h) {
+    const std::string id = "plot" + std::to_string(n_++);
+    body_ << "<div class=\"plot heat\" id=\"" << id << "\"></div>\n";
+    std::ostringstream s;
+    s << "{\"id\":\"" << id << "\",\"kind\":\"heatmap\",\"title\":" << json_string(h.title)
+      << ",\"xlabel\":" << json_string(h.xlabel) << ",\"ylabel\":" << json_string(h.ylabel)
+      << ",\"x\":" << json_array(h.x) << ",\"y\":" << json_array(h.y) << ",\"z\":[";
+    for (Eigen::Index i = 0; i < h.z.rows(); ++i) s << (i ? "," : "") << json_array(h.z.row(i).transpose());
+    s << "]}";
+    specs_.push_back(s.str());
+  }
+  std::string render(const std::string& title) const {
+    std::ostringstream o;
+    o << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" << escape(title)
+      << "</title>\n<style>" << report_assets::kUplotCss << "\n" << kCss << "</style>\n</head><body>\n<h1>"
+      << escape(title) << "</h1>\n";
+    if (!report_assets::kHaveUplot)
+      o << "<p class=\"warn\">This ctid was built without the plotting library (run scripts/install-deps.sh and "
+           "rebuild): the plots are missing.</p>\n";
+    o << body_.str() << "<pre id=\"ctid-selfcheck\">pending</pre>\n<script id=\"ctid-plots\" type=\"application/json\">[";
+    for (size_t i = 0; i < specs_.size(); ++i) o << (i ? ",\n" : "\n") << specs_[i];
+    o << "]</script>\n<script>" << report_assets::kUplotJs << "</script>\n<script>" << kJs << "</script>\n</body></html>\n";
+    return o.str();
+  }
+
+ private:
+  static constexpr const char* kCss = R"css(
+body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 1000px; color: #222; }
+h1 { font-size: 1.5em; } h2 { font-size: 1.15em; margin-top: 1.8em; border-bottom: 1px solid #ccc; }
+table { border-collapse: collapse; margin: 0.5em 0; font-size: 0.9em; }
+td, th { border: 1px solid #ccc; padding: 2px 8px; text-align: left; font-variant-numeric: tabular-nums; }
+.plot { margin: 0.8em 0; } .plot .title { font-weight: 600; font-size: 0.95em; }
+.warn { color: #a40; } #ctid-selfcheck { color: #888; font-size: 0.8em; }
+code { background: #f4f4f4; padding: 1px 4px; }
+)css";
+  static constexpr const char* kJs = R"js(
+(function () {
+  let errors = 0;
+  window.addEventListener('error', function () { errors++; });
+  const colors = ['#1f77b4', '#d62728', '#2ca02c', '#9467bd', '#ff7f0e', '#8c564b'];
+  const specs = JSON.parse(document.getElementById('ctid-plots').textContent);
+  function title(el, p) {
+    const t = document.createElement('div'); t.className = 'title'; t.textContent = p.title; el.appendChild(t);
+  }
+  function line(el, p) {
+    title(el, p);
+    if (typeof uPlot === 'undefined') return;
+    const data = [p.x].concat(p.series.map(s => s.y));
+    let c = 0;
+    const series = [{ label: p.xlabel }].concat(p.series.map(function (s) {
+      const col = s.light ? '#9ab' : colors[(c++) % colors.length];
+      const o = { label: s.label, stroke: col, width: s.light ? 1 : 1.5, points: { show: false } };
+      if (s.dashed || s.light) o.dash = [6, 4];
+      if (p.bars && !s.dashed) { o.paths = uPlot.paths.bars({ size: [0.3, 6] }); o.fill = col; }
+      return o;
+    }));
+    const opts = {
+      width: Math.max(400, el.clientWidth || 900), height: 260, series: series,
+      scales: { x: p.logx ? { time: false, distr: 3 } : { time: false } },
+      axes: [{ label: p.xlabel }, { label: p.ylabel }],
+      legend: { live: false }
+    };
+    new uPlot(opts, data, el);
+  }
+  function heatmap(el, p) {
+    title(el, p);
+    const W = 480, H = 400, m = 50;
+    const cv = document.createElement('canvas'); cv.width = W + m + 70; cv.height = H + m; el.appendChild(cv);
+    const g = cv.getContext('2d');
+    let lo = Infinity, hi = -Infinity;
+    p.z.forEach(r => r.forEach(v => { if (v !== null) { lo = Math.min(lo, v); hi = Math.max(hi, v); } }));
+    const nx = p.x.length, ny = p.y.length, cw = W / nx, ch = H / ny;
+    function col(v) {
+      const f = hi > lo ? (v - lo) / (hi - lo) : 0.5;
+      return 'hsl(' + Math.round(240 - 240 * f) + ',80%,' + Math.round(30 + 35 * f) + '%)';
+    }
+    for (let i = 0; i < ny; i++) for (let j = 0; j < nx; j++) {
+      const v = p.z[i][j]; if (v === null) continue;
+      g.fillStyle = col(v); g.fillRect(m + j * cw, H - (i + 1) * ch, Math.ceil(cw), Math.ceil(ch));
+    }
+    g.fillStyle = '#222'; g.font = '12px sans-serif';
+    g.fillText(p.xlabel + ' ' + p.x[0].toPrecision(3) + ' .. ' + p.x[nx - 1].toPrecision(3), m, H + 30);
+    g.save(); g.translate(14, H); g.rotate(-Math.PI / 2);
+    g.fillText(p.ylabel + ' ' + p.y[0].toPrecision(3) + ' .. ' + p.y[ny - 1].toPrecision(3), 0, 0); g.restore();
+    for (let k = 0; k <= 10; k++) {
+      g.fillStyle = col(lo + (hi - lo) * k / 10); g.fillRect(m + W + 15, H - (k + 1) * H / 11, 20, H / 11);
+    }
+    g.fillStyle = '#222'; g.fillText(hi.toPrecision(3), m + W + 38, 12); g.fillText(lo.toPrecision(3), m + W + 38, H - 2);
+  }
+  specs.forEach(function (p) {
+    const el = document.getElementById(p.id);
+    try { (p.kind === 'heatmap' ? heatmap : line)(el, p); } catch (e) { errors++; console.error(e); }
+  });
+  function check() {
+    let drawn = 0;
+    specs.forEach(function (p) {
+      const cv = document.getElementById(p.id).querySelector('canvas');
+      if (!cv || !cv.width || !cv.height) return;
+      const px = cv.getContext('2d').getImageData(0, 0, cv.width, cv.height).data;
+      for (let i = 3; i < px.length; i += 4) if (px[i] !== 0) { drawn++; return; }
+    });
+    document.getElementById('ctid-selfcheck').textContent =
+      'plots=' + specs.length + ' drawn=' + drawn + ' errors=' + errors;
+  }
+  requestAnimationFrame(function () { requestAnimationFrame(check); });
+})();
+)js";
+  std::ostringstream body_;
+  std::vector<std::string> specs_;
+  int n_ = 0;
+};
+
+// Evenly decimated sample indices (at most max_points).
+std::vector<Eigen::Index> keep(Eigen::Index n, int max_points) {
+  const Eigen::Index stride = std::max<Eigen::Index>(1, (n + max_points - 1) / max_points);
+  std::vector<Eigen::Index> k;
+  for (Eigen::Index i = 0; i < n; i += stride) k.push_back(i);
+  return k;
+}
+Eigen::VectorXd pick(const Eigen::VectorXd& v, const std::vector<Eigen::Index>& k) {
+  Eigen::VectorXd o(static_cast<Eigen::Index>(k.size()));
+  for (size_t i = 0; i < k.size(); ++i) o(static_cast<Eigen::Index>(i)) = v(k[i]);
+  return o;
+}
+
+std::string fmt(double v, int digits = 6) {
+  if (std::isnan(v)) return "-";
+  char b[32];
+  std::snprintf(b, sizeof b, "%.*g", digits, v);
+  return b;
+}
+
+template <class M>
+void overview(Page& page, const IdData& d, const Result<M>& r, const ReportOptions& o, const std::string& model_text) {
+  page.section("Summary");
+  page.text("Model: <code>" + escape(model_text) + "</code>");
+  std::vector<std::vector<std::string>> rows = {
+      {"method", o.method.empty() ? "-" : o.method},
+      {"termination", std::string(to_string(r.summary.termination)) +
+                          (r.summary.message.empty() ? "" : " (" + r.summary.message + ")")},
+      {"usable", r.usable() ? "yes" : "no"},
+      {"iterations", std::to_string(r.summary.iterations)},
+      {"time", fmt(r.summary.seconds, 3) + " s"},
+      {"fit (simulation)", fmt(r.fit.fit_percent, 4) + " %"},
+      {"MSE / AIC / BIC", fmt(r.fit.mse, 4) + " / " + fmt(r.fit.aic, 5) + " / " + fmt(r.fit.bic, 5)},
+      {"condition number", fmt(r.diagnostics.condition_number, 3)}};
+  page.table({"", ""}, rows);
+  if (!o.settings.empty()) {
+    std::vector<std::vector<std::string>> s;
+    for (const auto& [k, v] : o.settings) s.push_back({k, v});
+    page.section("Method settings");
+    page.table({"setting", "value"}, s);
+  }
+  if (!r.diagnostics.warnings.empty()) {
+    page.section("Warnings");
+    for (const auto& w : r.diagnostics.warnings) page.text("<span class=\"warn\">" + escape(w) + "</span>");
+  }
+  page.section("Data");
+  const double dur = d.duration();
+  page.table({"", ""}, {{"source", o.data_source.empty() ? "-" : o.data_source},
+                        {"samples", std::to_string(d.size())},
+                        {"sampling", d.is_uniform() ? "Ts = " + fmt(d.ts()) + " s" : "irregular"},
+                        {"duration", fmt(dur) + " s"},
+                        {"input", (d.input_names().empty() ? "u" : d.input_names()[0]) + " (" +
+                                      to_string(d.intersample(0)) + ")"},
+                        {"output", d.output_names().empty() ? "y" : d.output_names()[0]}});
+  const auto k = keep(d.size(), o.max_points);
+  const Eigen::VectorXd t = pick(d.times(), k);
+  page.plot({"Input", "time (s)", "u", t, {{"u", pick(d.u().col(0), k)}}});
+  page.plot({"Output", "time (s)", "y", t, {{"y", pick(d.y().col(0), k)}}});
+}
+
+void parameters(Page& page, const ParameterSet& p, const Eigen::VectorXd* err = nullptr) {
+  page.section("Parameters");
+  std::vector<std::vector<std::string>> rows;
+  for (int i = 0; i < p.size(); ++i) {
+    const bool fixed = i < static_cast<int>(p.fixed.size()) && p.fixed[static_cast<size_t>(i)];
+    std::vector<std::string> r = {p.names[static_cast<size_t>(i)], fmt(p.values(i)),
+                                  fixed ? "fixed" : (i < p.std.size() ? fmt(p.std(i), 3) : "-")};
+    if (err) r.push_back(i < err->size() ? fmt((*err)(i), 4) : "-");
+    rows.push_back(r);
+  }
+  if (err) page.table({"parameter", "value", "std", "ERR %"}, rows);
+  else page.table({"parameter", "value", "std"}, rows);
+}
+
+// Measured vs simulated output and the residual correlation tests.
+void validation(Page& page, const IdData& d, const Eigen::VectorXd& yhat, const ReportOptions& o) {
+  page.section("Measured and simulated output");
+  const Eigen::VectorXd y = d.y().col(0);
+  const auto k = keep(d.size(), o.max_points);
+  Eigen::VectorXd e = y - yhat;
+  const double fit = fit_report_or_inf(y, yhat, 0).fit_percent;
+  page.plot({"Output: measured and simulated (fit " + fmt(fit, 4) + " %)", "time (s)", "y", pick(d.times(), k),
+             {{"measured", pick(y, k)}, {"simulated", pick(yhat, k)}}});
+  if (!e.allFinite()) {
+    page.text("<span class=\"warn\">The simulation does not stay finite on this record: no residual tests.</span>");
+    return;
+  }
+  page.section("Residual tests");
+  const int lags = std::min(o.max_lag, d.size() / 4);
+  if (lags < 1 || e.squaredNorm() == 0) {
+    page.text("Too few samples or zero residuals: no correlation tests.");
+    return;
+  }
+  const CorrelationTest ee = residual_autocorrelation(e, lags);
+  const CorrelationTest ue = input_residual_crosscorrelation(d.u().col(0), e, lags);
+  for (const auto* c : {&ee, &ue}) {
+    const bool auto_ = c == &ee;
+    const Eigen::VectorXd x = c->lags.cast<double>();
+    const Eigen::VectorXd b = Eigen::VectorXd::Constant(x.size(), c->bound);
+    page.plot({std::string(auto_ ? "Residual autocorrelation" : "Input-residual cross-correlation") + ": " +
+                   std::to_string(c->n_outside) + " lag(s) outside the 99 % bounds",
+               "lag (samples)", "correlation", x, {{"r(k)", c->values}, {"+bound", b, true, true}, {"-bound", -b, true, true}}, false,
+               true});
+  }
+}
+
+// Log-spaced angular frequencies two decades around the magnitudes of the given poles.
+Eigen::VectorXd frequency_grid(const Eigen::VectorXcd& poles, double w_max_limit, int n = 300) {
+  double lo = INFINITY, hi = 0;
+  for (const auto& p : poles)
+    if (std::abs(p) > 0) {
+      lo = std::min(lo, std::abs(p));
+      hi = std::max(hi, std::abs(p));
+    }
+  if (!(hi > 0)) lo = hi = 1.0;
+  double a = std::log10(lo) - 2, b = std::log10(hi) + 2;
+  if (w_max_limit > 0) b = std::min(b, std::log10(w_max_limit));
+  if (b <= a) a = b - 3;
+  Eigen::VectorXd w(n);
+  for (int i = 0; i < n; ++i) w(i) = std::pow(10.0, a + (b - a) * i / (n - 1));
+  return w;
+}
+
+void bode(Page& page, const Eigen::VectorXd& w, const Eigen::VectorXcd& h, const Eigen::VectorXd* lo_mag = nullptr,
+          const Eigen::VectorXd* hi_mag = nullptr, const std::string& what = "G(jw)") {
+  page.section("Frequency response");
+  Eigen::VectorXd mag(w.size()), ph(w.size());
+  double prev = 0, offset = 0;
+  for (Eigen::Index i = 0; i < w.size(); ++i) {
+    mag(i) = 20 * std::log10(std::abs(h(i)));
+    double a = std::arg(h(i)) * 180 / std::numbers::pi;
+    if (i > 0) {  // unwrap
+      while (a + offset - prev > 180) offset -= 360;
+      while (a + offset - prev < -180) offset += 360;
+    }
+    ph(i) = prev = a + offset;
+  }
+  std::vector<Series> ms = {{"|" + what + "|", mag}};
+  if (lo_mag && hi_mag) {
+    ms.push_back({"2.5 %", (20 * lo_mag->array().log10()).matrix(), false, true});
+    ms.push_back({"97.5 %", (20 * hi_mag->array().log10()).matrix(), false, true});
+  }
+  page.plot({"Bode magnitude" + std::string(lo_mag ? " with the 95 % band from the parameter covariance" : ""),
+             "frequency (rad/s)", "dB", w, ms, true});
+  page.plot({"Bode phase", "frequency (rad/s)", "deg", w, {{"phase", ph}}, true});
+}
+
+double nyquist(const IdData& d) { return d.is_uniform() ? std::numbers::pi / d.ts() : 0.0; }
+
+// A transfer function with parameter p replaced, when the names are a1..an, b0..b(nb-1) of the model's
+// coefficients (den monic, descending); false for any other parameterisation.
+bool tf_from_parameters(const TransferFunction& g, const ParameterSet& p, const Eigen::VectorXd& v,
+                        TransferFunction* out) {
+  Eigen::VectorXd num = g.num().coefficients(), den = g.den().coefficients();
+  if (den(0) != 1.0) return false;
+  for (int i = 0; i < p.size(); ++i) {
+    const std::string& n = p.names[static_cast<size_t>(i)];
+    if (n.size() < 2 || (n[0] != 'a' && n[0] != 'b') || n.find_first_not_of("0123456789", 1) != std::string::npos)
+      continue;  // e.g. "delay": held at the model's value
+    const int k = std::stoi(n.substr(1));
+    Eigen::VectorXd& c = n[0] == 'a' ? den : num;
+    if (n[0] == 'a' ? (k < 1 || k >= c.size()) : (k < 0 || k >= c.size())) return false;
+    if (std::abs(c(k) - p.values(i)) > 1e-9 * std::max(1.0, std::abs(c(k)))) return false;  // not this ordering
+    c(k) = v(i);
+  }
+  *out = TransferFunction(num, den, g.io_delay());
+  return true;
+}
+
+}  // namespace
+
+std::string html_report(const IdData& d, const Result<TransferFunction>& r, const ReportOptions& o) {
+  CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "html_report: needs one input and one output (got {}, {})", d.nu(), d.ny());
+  Page page;
+  overview(page, d, r, o, r.model.to_string(6));
+  validation(page, d, lsim(r.model, d, 0), o);
+  parameters(page, r.parameters);
+  const Eigen::VectorXd w = frequency_grid(r.model.poles(), nyquist(d));
+  const Eigen::VectorXcd h = r.model.frequency_response(w);
+  // 95 % band of |G| from 200 draws of the parameter covariance (seeded: the report is reproducible).
+  Eigen::VectorXd lo, hi;
+  TransferFunction probe;
+  const int P = r.parameters.size();
+  if (P > 0 && r.parameters.covariance.rows() == P && r.parameters.covariance.allFinite() &&
+      tf_from_parameters(r.model, r.parameters, r.parameters.values, &probe)) {
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(r.parameters.covariance);
+    const Eigen::MatrixXd L = es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+    std::mt19937 rng(1);
+    std::normal_distribution<double> n01;
+    const int K = 200;
+    Eigen::MatrixXd mags(K, w.size());
+    int ok = 0;
+    for (int k = 0; k < K; ++k) {
+      Eigen::VectorXd z(P);
+      for (auto& v : z) v = n01(rng);
+      TransferFunction g;
+      if (tf_from_parameters(r.model, r.parameters, r.parameters.values + L * z, &g))
+        mags.row(ok++) = g.frequency_response(w).cwiseAbs().transpose();
+    }
+    if (ok == K) {
+      lo.resize(w.size());
+      hi.resize(w.size());
+      for (Eigen::Index j = 0; j < w.size(); ++j) {
+        std::vector<double> c(mags.col(j).data(), mags.col(j).data() + K);
+        std::sort(c.begin(), c.end());
+        lo(j) = c[static_cast<size_t>(0.025 * K)];
+        hi(j) = c[static_cast<size_t>(0.975 * K) - 1];
+      }
+    }
+  }
+  bode(page, w, h, lo.size() ? &lo : nullptr, hi.size() ? &hi : nullptr);
+  page.section("Step and impulse responses");
+  double slow = INFINITY;
+  for (const auto& p : r.model.poles())
+    if (p.real() < 0) slow = std::min(slow, -p.real());
+  const double horizon = std::isfinite(slow) ? 8.0 / slow + r.model.io_delay() : d.duration();
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(400, 0.0, horizon);
+  page.plot({"Step response", "time (s)", "y", t, {{"step", step_response(r.model, t)}}});
+  page.plot({"Impulse response", "time (s)", "y", t, {{"impulse", impulse_response(r.model, t)}}});
+  return page.render(o.title.empty() ? o.method + " fit" : o.title);
+}
+
+std::string html_report(const IdData& d, const Result<FsfModel>& r, const ReportOptions& o) {
+  CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "html_report: needs one input and one output (got {}, {})", d.nu(), d.ny());
+  Page page;
+  const FsfModel& m = r.model;
+  overview(page, d, r, o, "FSF model: N = " + std::to_string(m.N()) + " samples per window, n = " + std::to_string(m.n()) +
+                              " filters, T = " + fmt(m.T()) + " s");
+  Eigen::VectorXd yhat = m.simulate(d.u().col(0));
+  validation(page, d, yhat, o);
+  parameters(page, r.parameters);
+  page.section("Compressed responses (Gawthrop & Wang): +-2 std bands from the parameter covariance");
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(400, 0.0, m.T());
+  const Eigen::VectorXd s = m.step_response(t), ss = m.step_response_std(t);
+  const Eigen::VectorXd g = m.impulse_response(t), gs = m.impulse_response_std(t);
+  const bool bands = ss.allFinite();
+  std::vector<Series> sv = {{"step", s}}, gv = {{"impulse", g}};
+  if (bands) {
+    sv.push_back({"-2 std", s - 2 * ss, false, true});
+    sv.push_back({"+2 std", s + 2 * ss, false, true});
+    gv.push_back({"-2 std", g - 2 * gs, false, true});
+    gv.push_back({"+2 std", g + 2 * gs, false, true});
+  }
+  page.plot({"Step response", "time (s)", "y", t, sv});
+  page.plot({"Impulse response", "time (s)", "y", t, gv});
+  const double wmax = std::numbers::pi / m.delta() * 0.95, w0 = 2 * std::numbers::pi / m.T();
+  Eigen::VectorXd w(300);
+  for (int i = 0; i < 300; ++i) w(i) = std::pow(10.0, std::log10(0.5 * w0) + (std::log10(wmax) - std::log10(0.5 * w0)) * i / 299);
+  bode(page, w, m.frequency_response(w), nullptr, nullptr, "Gbar(e^{jw Delta})");
+  return page.render(o.title.empty() ? o.method + " fit" : o.title);
+}
+
+namespace {
+// |H_2(j w1, j w2)| on a grid (w1, w2 in (0, wmax]) of a kernel function.
+template <class F>
+Heatmap h2_map(F h2, double wmax, const std::string& what) {
+  const int n = 40;
+  Heatmap m{"|H_2(jw1, jw2)| of the " + what + " (dB)", "w1 (rad/s)", "w2 (rad/s)", Eigen::VectorXd(n),
+            Eigen::VectorXd(n), Eigen::MatrixXd(n, n)};
+  for (int i = 0; i < n; ++i) m.x(i) = m.y(i) = wmax * (i + 1) / n;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double a = std::abs(h2(std::complex<double>(0, m.x(j)), std::complex<double>(0, m.y(i))));
+      m.z(i, j) = a > 0 ? 20 * std::log10(a) : NAN;
+    }
+  return m;
+}
+}  // namespace
+
+std::string html_report(const IdData& d, const Result<NarxModel>& r, const ReportOptions& o) {
+  CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "html_report: needs one input and one output (got {}, {})", d.nu(), d.ny());
+  Page page;
+  const NarxModel p = r.model.process();
+  overview(page, d, r, o, p.to_string(6));
+  const Eigen::VectorXd y = d.y().col(0), u = d.u().col(0);
+  const int L = std::min(p.max_lag(), d.size());
+  validation(page, d, p.simulate(u, y.head(L)), o);
+  const auto err = r.diagnostics.vectors.find("err");
+  page.section("Selected terms");
+  page.text("Terms in the order of selection by forward orthogonal least squares; ERR: the error reduction ratio "
+            "(share of the output energy explained by the term).");
+  parameters(page, r.parameters, err == r.diagnostics.vectors.end() ? nullptr : &err->second);
+  const bool zoh = d.intersample(0) == Intersample::Zoh;
+  const double nyq = std::numbers::pi / p.ts();
+  Eigen::VectorXd w = frequency_grid(Eigen::VectorXcd::Constant(1, std::complex<double>(0.1 * nyq, 0.0)), 0.9 * nyq);
+  bool linear = false;
+  for (const auto& t : p.terms()) linear = linear || (t.degree() == 1 && !t.has_noise());
+  if (linear) {
+    Eigen::VectorXcd h(w.size());
+    for (Eigen::Index i = 0; i < w.size(); ++i) h(i) = narx_gfrf_ct(p, {std::complex<double>(0, w(i))}, zoh);
+    bode(page, w, h, nullptr, nullptr, "H_1(jw)");
+    if (p.degree() >= 2) {
+      page.section("Second-order GFRF");
+      page.heatmap(h2_map([&](auto a, auto b) { return narx_gfrf_ct(p, {a, b}, zoh); }, 0.5 * nyq, "NARX model"));
+    }
+  }
+  page.section("Step response");
+  const double level = std::sqrt(u.squaredNorm() / std::max<Eigen::Index>(1, u.size()));
+  const int n = std::max(4 * L, 200);
+  const Eigen::VectorXd ys = p.simulate(Eigen::VectorXd::Constant(n, level));
+  page.plot({"Response to a step of the input's RMS level (" + fmt(level, 3) + ")", "time (s)", "y",
+             time_grid(p.ts(), n), {{"step", ys}}});
+  return page.render(o.title.empty() ? o.method + " fit" : o.title);
+}
+
+std::string html_report(const IdData& d, const Result<NdeModel>& r, const ReportOptions& o) {
+  CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "html_report: needs one input and one output (got {}, {})", d.nu(), d.ny());
+  Page page;
+  const NdeModel& m = r.model;
+  overview(page, d, r, o, m.to_string(6));
+  const Eigen::VectorXd u = d.u().col(0);
+  Eigen::VectorXd t(d.size());
+  for (int i = 0; i < d.size(); ++i) t(i) = d.time(i) - d.t0();
+  const auto x0 = r.diagnostics.vectors.find("x0");
+  const NdeSimulation sim =
+      m.simulate(u, t, d.intersample(0), x0 == r.diagnostics.vectors.end() ? Eigen::VectorXd() : x0->second);
+  if (!sim.ok()) page.text("<span class=\"warn\">" + escape(sim.message) + "</span>");
+  validation(page, d, sim.y, o);
+  const auto err = r.diagnostics.vectors.find("err");
+  parameters(page, r.parameters,
+             err == r.diagnostics.vectors.end() || err->second.size() != r.parameters.size() ? nullptr : &err->second);
+  const Eigen::VectorXd w = frequency_grid(m.a().roots(), nyquist(d));
+  Eigen::VectorXcd h(w.size());
+  for (Eigen::Index i = 0; i < w.size(); ++i) h(i) = m.h1(std::complex<double>(0, w(i)));
+  bode(page, w, h, nullptr, nullptr, "H_1(jw)");
+  bool nonlinear = false;
+  for (const auto& term : m.terms()) nonlinear = nonlinear || term.degree() == 2;
+  if (nonlinear) {
+    page.section("Second-order GFRF (harmonic probing)");
+    page.heatmap(h2_map([&](auto a, auto b) { return m.h2(a, b); }, w(w.size() - 1) / 4, "equation"));
+  }
+  page.section("Step response");
+  const double level = std::sqrt(u.squaredNorm() / std::max<Eigen::Index>(1, u.size()));
+  const Eigen::VectorXd ts = Eigen::VectorXd::LinSpaced(400, 0.0, std::min(d.duration(), 20 * 2 * std::numbers::pi / w(w.size() / 2)));
+  const NdeSimulation st = m.simulate(Eigen::VectorXd::Constant(400, level), ts);
+  page.plot({"Response to a step of the input's RMS level (" + fmt(level, 3) + ")", "time (s)", "y", ts, {{"step", st.y}}});
+  return page.render(o.title.empty() ? o.method + " fit" : o.title);
+}
+
+}  // namespace ctid

@@ -1,0 +1,64 @@
+// HTML reports (io/report.hpp): content and structure; the browser check is in tests/cli (Chromium).
+#include <gtest/gtest.h>
+
+#include "ctid/core/error.hpp"
+#include "ctid/data/input_design.hpp"
+#include "ctid/estimate/fsf.hpp"
+#include "ctid/estimate/srivc.hpp"
+#include "ctid/io/report.hpp"
+#include "ctid/simulate/lsim.hpp"
+
+using namespace ctid;
+
+namespace {
+IdData plant() {
+  const TransferFunction g(Eigen::VectorXd{{4.0}}, Eigen::VectorXd{{1.0, 0.8, 4.0}});
+  const Eigen::VectorXd u = prbs(2000, {.register_length = 9, .clock_period = 3});
+  return IdData(u, add_noise_snr(lsim(g, u, time_grid(0.02, 2000)), 20.0, 3), 0.02);
+}
+int count(const std::string& s, const std::string& what) {
+  int n = 0;
+  for (size_t at = s.find(what); at != std::string::npos; at = s.find(what, at + 1)) ++n;
+  return n;
+}
+}  // namespace
+
+TEST(Report, TransferFunctionReportHasEverySection) {
+  const IdData d = plant();
+  const auto r = srivc(d, {.nb = 1, .nf = 2});
+  const std::string html = html_report(d, r, {.method = "srivc", .settings = {{"max_iterations", "50"}}});
+  for (const char* s : {"<h2>Summary</h2>", "<h2>Method settings</h2>", "<h2>Data</h2>", "Measured and simulated",
+                        "<h2>Residual tests</h2>", "<h2>Parameters</h2>", "<h2>Frequency response</h2>",
+                        "95 % band", "Step response", "Impulse response", "max_iterations"})
+    EXPECT_NE(html.find(s), std::string::npos) << s;
+  // 9 plots: input, output, compare, 2 correlations, Bode magnitude and phase, step, impulse.
+  EXPECT_EQ(count(html, "class=\"plot\""), 9);
+  EXPECT_EQ(count(html, "\"kind\":\"line\""), 9);
+  char fit[32];
+  std::snprintf(fit, sizeof fit, "fit %.4g %%", r.fit.fit_percent);
+  EXPECT_NE(html.find(fit), std::string::npos) << fit;
+  for (const char* ref : {"src=\"http", "href=\"http", "url(http", "import("})  // offline: nothing fetched
+    EXPECT_EQ(html.find(ref), std::string::npos) << ref;
+  EXPECT_TRUE(report_has_plot_library());
+}
+
+TEST(Report, TextIsEscapedAndScriptsCannotBeInjected) {
+  IdData d = plant();
+  d.set_output_names({"y</script><script>alert(1)</script>"});
+  const auto r = srivc(d, {.nb = 1, .nf = 2});
+  const std::string html = html_report(d, r, {.method = "<b>srivc</b>", .data_source = "a&b.csv"});
+  EXPECT_EQ(html.find("<b>srivc</b>"), std::string::npos);
+  EXPECT_NE(html.find("&lt;b&gt;srivc&lt;/b&gt;"), std::string::npos);
+  EXPECT_NE(html.find("a&amp;b.csv"), std::string::npos);
+  EXPECT_EQ(html.find("<script>alert(1)"), std::string::npos);
+}
+
+TEST(Report, FsfReportHasBandsAndMultiChannelDataIsRejected) {
+  const IdData d = plant();
+  const auto f = fsf(d, {.T = 20.0, .n = 31});
+  const std::string html = html_report(d, f, {.method = "fsf"});
+  EXPECT_NE(html.find("Compressed responses"), std::string::npos);
+  EXPECT_NE(html.find("\"label\":\"+2 std\""), std::string::npos);
+  const IdData mimo(Eigen::MatrixXd::Zero(100, 2), Eigen::MatrixXd::Zero(100, 1), 0.1);
+  EXPECT_THROW(html_report(mimo, srivc(d, {.nb = 1, .nf = 2}), {}), InvalidArgument);
+}
