@@ -103,6 +103,7 @@ double to_double(const std::string& key, const std::string& value) {
 int to_int(const std::string& key, const std::string& value) {
   const double v = to_double(key, value);
   if (v != std::floor(v)) throw UsageError("--set " + key + ": '" + value + "' is not a whole number");
+  if (std::abs(v) > 1e9) throw UsageError("--set " + key + ": '" + value + "' is out of range (|value| <= 1e9)");
   return static_cast<int>(v);
 }
 

@@ -262,6 +262,8 @@ Result<TransferFunction> lssvf(const IdData& data, const TfOrders& orders, const
   options.validate();
   Eigen::VectorXd grid, fits;
   double tau = options.tau;
+  CTID_REQUIRE(tau <= 1e3 * data.duration(), "lssvf: tau = {} s is more than 1000 times the record ({} s): the filtered "
+               "signals would not move", tau, data.duration());
   if (tau == 0.0) tau = choose_tau(data, orders, options, &grid, &fits);
   const PreparedData P = prepare(data, orders, options.transient_time, options.alpha, options.weights, "lssvf");
   const SvfLayout L = make_layout(orders, tau, options.fixed, "lssvf");

@@ -145,6 +145,9 @@ void check_common(const IdData& data, const TfOrders& o, const OeOptions& opt, c
                data.nu(), data.ny());
   CTID_REQUIRE(o.nk == 0 || data.is_uniform(), "{}: nk = {} needs uniformly sampled data", who, o.nk);
   CTID_REQUIRE(data.size() > o.nf + o.nb + 1, "{}: {} samples cannot determine {} parameters", who, data.size(), o.nf + o.nb);
+  const double delay = opt.delay + (o.nk > 0 ? o.nk * data.ts() : 0.0);
+  CTID_REQUIRE(delay < data.duration(), "{}: the input delay {} s is not shorter than the record ({} s)", who, delay,
+               data.duration());
   CTID_REQUIRE_OPTION(!(opt.estimate_delay && o.nb > o.nf), "{}: delay estimation needs a strictly proper model (nb <= nf)",
                       who);
 }

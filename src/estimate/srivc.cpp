@@ -225,6 +225,12 @@ Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const
   const int p = orders.nf + orders.nb;
   CTID_REQUIRE(data.size() > p, "srivc: {} samples cannot determine {} parameters", data.size(), p);
   const double base_delay = options.delay + (orders.nk > 0 ? orders.nk * data.ts() : 0.0);
+  CTID_REQUIRE(base_delay < data.duration(), "srivc: the input delay {} s is not shorter than the record ({} s)",
+               base_delay, data.duration());
+  CTID_REQUIRE(!options.estimate_delay || options.delay_max < data.duration(),
+               "srivc: delay_max = {} s is not shorter than the record ({} s)", options.delay_max, data.duration());
+  CTID_REQUIRE(!options.estimate_delay || options.delay_min < data.duration(),
+               "srivc: delay_min = {} s is not shorter than the record ({} s)", options.delay_min, data.duration());
 
   double delay = base_delay;
   Eigen::VectorXd theta;

@@ -43,6 +43,8 @@ Eigen::MatrixXd read_mat_variable(const std::string& path, const std::string& na
   if (!v) {
     std::string known;
     for (const auto& n : mat_variable_names(path)) known += (known.empty() ? "" : ", ") + n;
+    if (known.empty())
+      throw FileError(detail::format("{}: no readable variable (the file is empty, truncated or damaged)", path));
     throw FileError(detail::format("{}: no variable named '{}' (variables: {})", path, name, known));
   }
   struct Guard { matvar_t* v; ~Guard() { Mat_VarFree(v); } } guard{v};

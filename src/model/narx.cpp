@@ -78,6 +78,11 @@ std::vector<NarxTerm> narx_candidates(int degree, int ylag, int ulag, bool const
   for (int l = 1; l <= ylag; ++l) vars.push_back({NarxSignal::Output, l});
   for (int l = umin; l <= ulag; ++l) vars.push_back({NarxSignal::Input, l});
   CTID_REQUIRE(!vars.empty(), "narx_candidates: no lagged variable (ylag = {}, ulag = {})", ylag, ulag);
+  // Monomials of degree <= D in V variables: C(V + D, D); refuse before generating an impossible set.
+  double count = 1;
+  for (int d = 1; d <= degree; ++d) count = count * (static_cast<double>(vars.size()) + d) / d;
+  CTID_REQUIRE(count <= 1e7, "narx_candidates: degree {} in {} lagged signals gives {} candidate terms (at most 1e7); "
+               "reduce the lags or the degree", degree, vars.size(), count);
   std::vector<NarxTerm> out;
   if (constant) out.push_back({});
   // Monomials of each degree as non-decreasing index tuples.

@@ -21,9 +21,10 @@ struct CliRun {
   std::string out, err;
 };
 
-CliRun ctid_run(const std::string& args) {
+// Runs the CLI (after `prefix`, e.g. "timeout 120 ") with stdout captured and stderr read back.
+CliRun ctid_run(const std::string& args, const std::string& prefix = "") {
   const std::string errf = test::temp_path("stderr.txt");
-  const std::string cmd = std::string(CTID_CLI_PATH) + " " + args + " 2>" + errf;
+  const std::string cmd = prefix + std::string(CTID_CLI_PATH) + " " + args + " 2>" + errf;
   CliRun r{0, "", ""};
   FILE* p = popen(cmd.c_str(), "r");
   std::array<char, 4096> buf;
@@ -164,10 +165,11 @@ TEST(Cli, NoPartialOutputOnFailure) {
   CliRun r = ctid_run("fit " + text_csv + " --time time --input force --output position --json " + json);
   EXPECT_EQ(r.code, 3);
   EXPECT_FALSE(fs::exists(json));
-  // Unusable estimate (no excitation): exit 1; the input file is never overwritten.
+  // No excitation: refused (exit 2); the input file is never overwritten.
   const std::string flat = write("flat.csv", "time,force,position\n0,0,0\n0.1,0,0\n0.2,0,0\n0.3,0,0\n0.4,0,0\n0.5,0,0\n");
   r = ctid_run("fit " + flat + " --time time --input force --output position --set tau=1");
-  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("input 'force' is constant (0)"), std::string::npos) << r.err;
   r = ctid_run("fit " + flat + " --time time --input force --output position --set tau=1 --json " + flat + " --force");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("one of the input files"), std::string::npos);
@@ -414,14 +416,14 @@ TEST(Cli, ModalFitPolesAndResponses) {
   r = ctid_run("poles " + fp + " --ts " + ts320() + " --order 3 --generator 4 --set shifts=30,60,90,120,150");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("s^3 + 4 s^2 + 30 s + 52"), std::string::npos) << r.out;
-  // A record without output excitation: the modal regression is singular -> not usable (exit 1), named.
+  // A record whose output never moves: refused before any estimation (exit 2), named.
   Eigen::MatrixXd zero(400, 2);
   zero << Eigen::VectorXd::LinSpaced(400, -1, 1).array().sign().matrix(), Eigen::VectorXd::Zero(400);
   const std::string z = test::temp_path("zero.csv");
   write_csv(z, {"u", "y"}, zero);
   r = ctid_run("fit " + z + " --ts " + ts320() + " --method modal --nf 3 --set shifts=16,32,48 --set basis=discrete");
-  EXPECT_EQ(r.code, 1) << r.err;
-  EXPECT_NE(r.err.find("rank deficient"), std::string::npos) << r.err;
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("output 'y' is constant (0)"), std::string::npos) << r.err;
 }
 
 TEST(Cli, ModalBadInputs) {
@@ -634,4 +636,86 @@ TEST(Cli, ReportOfAResultFile) {
   EXPECT_NE(text.find(expect), std::string::npos) << expect;
   EXPECT_NE(text.find("95 % band"), std::string::npos);  // the covariance was read back
   EXPECT_EQ(ctid_run("report " + json + " " + dryer + base + "--out " + html).code, 2);  // exists: needs --force
+}
+
+TEST(Cli, RobustnessCampaignBadInputs) {
+  // Issue 7's table of bad inputs. Each must end with its documented exit code (2 usage, 3 input file), exactly one
+  // line on stderr naming the problem, within the time limit (no hang: `timeout` would give 124), without a signal,
+  // and without leaving the requested output file behind.
+  const std::string base = " --time time --input force --output position ";
+  std::string rows_ok = "time,force,position\n", rows_const = rows_ok, rows_zero = rows_ok;
+  for (int i = 0; i < 500; ++i) {
+    const double t = 0.01 * i, u = std::sin(3 * t) + 0.1 > 0 ? 1.0 : -1.0;
+    rows_ok += detail::format("{},{},{}\n", t, u, std::sin(t) + 0.1 * u);
+    rows_const += detail::format("{},1,{}\n", t, std::sin(t));
+    rows_zero += detail::format("{},{},0\n", t, u);
+  }
+  const std::string ok = write("rb_ok.csv", rows_ok), cst = write("rb_const.csv", rows_const),
+                    zero = write("rb_zero.csv", rows_zero);
+  const std::string empty = write("rb_empty.csv", ""), header = write("rb_header.csv", "time,force,position\n");
+  const std::string ragged = write("rb_ragged.csv", "time,force,position\n0,1,2\n0.1,1\n0.2,1,2\n");
+  const std::string dup = write("rb_dup.csv", "time,force,position\n0,1,2\n0.1,1,3\n0.1,1,2\n0.2,1,2\n");
+  const std::string badmat = write("rb_bad.mat", "MATLAB 5.0 MAT-file garbage");
+  std::string hdr = "MATLAB 5.0 MAT-file, Platform: GLNXA64, Created by: ctid test";
+  hdr.resize(116, ' ');
+  hdr += std::string(8, '\0') + std::string("\x00\x01", 2) + "IM" + std::string("\x0e\x00\x00\x00\xe8\x03\x00\x00", 8);
+  const std::string truncmat = write("rb_trunc.mat", hdr + std::string("\x06\x00\x00\x00", 4));
+  const std::string truncjson = write("rb_trunc.json", R"({"type": "transfer_function", "num": [1)");
+  const std::string wrongjson = write("rb_wrong.json", R"({"type": "transfer_function", "num": "x", "den": [1, 2]})");
+  const std::string dir = test::temp_path("rb_dir");
+  fs::create_directories(dir);
+  const std::string out = test::temp_path("rb_out.json");
+  struct Case {
+    std::string args;
+    int code;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      // Files and their contents.
+      {"fit " + empty + base, 3, "no data rows"},
+      {"fit " + header + base, 3, "no data rows"},
+      {"fit " + ragged + base, 3, "rb_ragged.csv:3: expected 3 fields, found 2"},
+      {"fit " + dup + base, 3, "not strictly increasing (0.1 after 0.1)"},
+      {"fit " + dir + base, 3, "rb_dir"},
+      {"fit " + badmat + " --ts 0.1 --input u --output y", 3, "cannot read"},
+      {"fit " + truncmat + " --ts 0.1 --input u --output y", 3, "no readable variable"},
+      // No information in the data.
+      {"fit " + cst + base + "--method srivc", 2, "input 'force' is constant (1)"},
+      {"fit " + cst + base + "--method fsf --set T=1 --set n=11", 2, "input 'force' is constant"},
+      {"fit " + cst + base + "--method narx", 2, "input 'force' is constant"},
+      {"fit " + zero + base + "--method tfest --nf 2", 2, "output 'position' is constant (0)"},
+      {"fit " + zero + base + "--method kia", 2, "output 'position' is constant (0)"},
+      // Structures the data cannot support.
+      {"fit " + ok + base + "--method srivc --nf 300", 2, "500 samples cannot determine 600 parameters"},
+      {"fit " + ok + base + "--method narx --set ylag=100000", 2, "candidate terms (at most 1e7)"},
+      {"fit " + ok + base + "--method narx --set ylag=100000 --set degree=1", 2, "usable rows"},
+      {"fit " + ok + base + "--method srivc --nk 100000", 2, "the input delay 1000 s is not shorter than the record"},
+      {"fit " + ok + base + "--method fsf --set T=1 --set n=100001", 2, "exceed N"},
+      // Absurd option values.
+      {"fit " + ok + base + "--method srivc --set max_iterations=1e99", 2, "out of range"},
+      {"fit " + ok + base + "--method lssvf --set tau=1e300", 2, "more than 1000 times the record"},
+      {"fit " + ok + base + "--method tfest --nf 2 --delay --set delay_max=1e300", 2, "delay_max = 1e+300 s"},
+      {"fit " + ok + base + "--method oe --set delay=1e9", 2, "is not shorter than the record"},
+      {"fit " + ok + base + "--method kia --set points=-3", 2, "-3 points"},
+      {"fit " + ok + " --ts -1 --input force --output position", 2, "--ts must be a positive"},
+      // Damaged model files and expressions.
+      {"simulate " + truncjson + " " + ok + " --time time --input force", 3, "not valid JSON"},
+      {"simulate " + wrongjson + " " + ok + " --time time --input force", 3, "\"num\" must be an array"},
+      {"validate " + truncjson + " " + ok + base, 3, "not valid JSON"},
+      {"fit " + ok + base + "--method kia --narx " + truncjson, 3, "not valid JSON"},
+      {"gfrf " + truncjson + " --order 1 --w 1", 3, "not valid JSON"},
+      {"fit " + ok + base + "--method physical --model 'k/(s+q)' --param k=1 --set T=1 --set n=11", 2,
+       "unknown symbol 'q'"},
+      {"fit " + ok + base + "--method physical --model 'k/(s+' --param k=1 --set T=1 --set n=11", 2,
+       "unexpected end of expression"},
+  };
+  for (const Case& c : cases) {
+    fs::remove(out);
+    const bool writes_json = c.args.rfind("fit ", 0) == 0;
+    const CliRun r = ctid_run(c.args + (writes_json ? " --json " + out : ""), "timeout 120 ");
+    EXPECT_EQ(r.code, c.code) << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << "\nstderr: " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+  }
 }
