@@ -2,13 +2,16 @@
 #   make demo   install dependencies, build, run `ctid demo` on the bundled data
 #   make test   install dependencies, build, run every test (ctest), then the sanitizer build's tests
 #               (AddressSanitizer + UBSan, Debug with -O1: assertions on, fast enough for the Monte Carlo tests)
+#               (between the two: each libFuzzer target for FUZZ_SECONDS under ASan + UBSan, `make fuzz`, clang)
 #   make bench  build and run the benchmarks (numbers go to docs/benchmarks.md by hand)
 BUILD      ?= build
 ASAN_BUILD ?= build-asan
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_ARGS ?=
+FUZZ_BUILD ?= build-fuzz
+FUZZ_SECONDS ?= 60
 
-.PHONY: deps build demo test test-fast test-asan bench clean
+.PHONY: deps build demo test test-fast test-asan fuzz bench clean
 
 deps:
 	@scripts/install-deps.sh
@@ -29,10 +32,24 @@ test-asan: deps
 	@cmake --build $(ASAN_BUILD) -j $(JOBS)
 	@cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ctest --output-on-failure -j $(JOBS)
 
-test: test-fast test-asan
+fuzz: deps
+	@CXX=clang++ cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=Debug "-DCMAKE_CXX_FLAGS_DEBUG=-O1 -g" -DCTID_BUILD_FUZZ=ON \
+		-DCTID_BUILD_TESTS=OFF -DCTID_BUILD_APPS=OFF -DCTID_BUILD_BENCHMARKS=OFF -DCTID_BUILD_PYTHON=OFF >/dev/null
+	@cmake --build $(FUZZ_BUILD) -j $(JOBS)
+	@mkdir -p $(FUZZ_BUILD)/fuzz-artifacts
+	@for t in expression csv json mat; do \
+		rm -rf $(FUZZ_BUILD)/corpus-$$t && cp -r tests/fuzz/corpus/$$t $(FUZZ_BUILD)/corpus-$$t && \
+		$(FUZZ_BUILD)/tests/fuzz/$${t}_fuzz -max_total_time=$(FUZZ_SECONDS) -timeout=10 -rss_limit_mb=2048 \
+			-artifact_prefix=$(FUZZ_BUILD)/fuzz-artifacts/$$t- -print_final_stats=1 $(FUZZ_BUILD)/corpus-$$t \
+			>$(FUZZ_BUILD)/fuzz-$$t.log 2>&1 || { tail -40 $(FUZZ_BUILD)/fuzz-$$t.log; exit 1; }; \
+		echo "fuzz $$t: no finding in $(FUZZ_SECONDS) s ($$(grep -o 'stat::number_of_executed_units: *[0-9]*' $(FUZZ_BUILD)/fuzz-$$t.log | grep -o '[0-9]*$$' || true) inputs)"; \
+	done
+	@echo "fuzz: 4 passed, 0 failed"
+
+test: test-fast fuzz test-asan
 
 bench: build
 	@for b in $(BUILD)/bench/bench_*; do echo "== $$b"; $$b --benchmark_min_time=0.5; done
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD)
+	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD)

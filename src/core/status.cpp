@@ -9,7 +9,7 @@ constexpr std::pair<Termination, const char*> kNames[] = {
     {Termination::Completed, "completed"},         {Termination::Converged, "converged"},
     {Termination::MaxIterations, "max_iterations"}, {Termination::RankDeficient, "rank_deficient"},
     {Termination::Unstable, "unstable"},           {Termination::NumericalFailure, "numerical_failure"},
-    {Termination::Interrupted, "interrupted"},
+    {Termination::Interrupted, "interrupted"},     {Termination::Unidentifiable, "unidentifiable"},
 };
 }  // namespace
 

@@ -276,6 +276,7 @@ Result<TransferFunction> lssvf(const IdData& data, const TfOrders& orders, const
     r.diagnostics.vectors["tau_grid_fit_percent"] = fits;
   }
   r.summary.iterations = 1;
+  tf_detail::check_cancellation(r);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }
@@ -336,6 +337,7 @@ Result<TransferFunction> ivsvf(const IdData& data, const TfOrders& orders, const
         "the IV iterations moved from a stable LSSVF start to an unstable model; try another tau or a lower order "
         "(the LSSVF estimate may be preferable)";
   }
+  tf_detail::check_cancellation(out);
   out.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }

@@ -134,6 +134,7 @@ Result<TransferFunction> refine(const IdData& data, const TfOrders& o, const Tra
     r.summary.termination = Termination::MaxIterations;
     r.summary.message = lm.message;
   }
+  tf_detail::check_cancellation(r);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }

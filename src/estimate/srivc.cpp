@@ -319,6 +319,7 @@ Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const
     r.summary.termination = Termination::Interrupted;
     r.summary.message = detail::format("interrupted after {} iterations", run.iterations);
   }
+  tf_detail::check_cancellation(r);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }
@@ -528,6 +529,7 @@ Result<TransferFunction> srivc_closed_loop(const IdData& data, const Eigen::Vect
   r.summary.iterations = std::min(it, opt.max_iterations);
   set_termination(r, run.rank_deficient, converged, opt.tolerance, opt.max_iterations,
                   "the closed-loop instrument matrix is singular; the reference does not excite every parameter");
+  tf_detail::check_cancellation(r);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

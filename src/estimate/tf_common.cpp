@@ -1,7 +1,14 @@
 // ctid internal — see tf_common.hpp.
 #include "estimate/tf_common.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <complex>
+#include <string>
+#include <vector>
+
+#include "ctid/core/check.hpp"
+#include "ctid/core/types.hpp"
 #include <limits>
 
 #include "ctid/simulate/lsim.hpp"
@@ -41,5 +48,81 @@ TransferFunction stabilized(const TransferFunction& tf) {
   }
   return TransferFunction(tf.num(), Polynomial::from_roots(p), tf.io_delay());
 }
+
+}  // namespace ctid::tf_detail
+
+namespace ctid::tf_detail {
+
+namespace {
+// d root / d coefficient k (descending, leading coefficient index 0) of polynomial c at a simple root x.
+Eigen::VectorXcd root_gradient(const Eigen::VectorXd& c, std::complex<double> x) {
+  const Eigen::Index n = c.size() - 1;
+  std::complex<double> dp = 0;  // P'(x)
+  for (Eigen::Index k = 0; k < n; ++k) dp += c(k) * static_cast<double>(n - k) * std::pow(x, static_cast<double>(n - k - 1));
+  Eigen::VectorXcd g(c.size());
+  for (Eigen::Index k = 0; k <= n; ++k) g(k) = -std::pow(x, static_cast<double>(n - k)) / dp;
+  return g;
+}
+}  // namespace
+
+template <class R>
+void check_cancellation(R& r) {
+  if (!r.summary.succeeded()) return;
+  const ParameterSet& p = r.parameters;
+  const Eigen::VectorXd den = r.model.den().coefficients(), num = r.model.num().coefficients();
+  const Eigen::Index P = p.size();
+  if (P == 0 || p.covariance.rows() != P || !p.covariance.allFinite() || num.size() < 2 || den(0) != 1.0) return;
+  // Parameter index of each coefficient (-1: not estimated).
+  std::vector<int> ia(static_cast<size_t>(den.size()), -1), ib(static_cast<size_t>(num.size()), -1);
+  for (int i = 0; i < P; ++i) {
+    const std::string& n = p.names[static_cast<size_t>(i)];
+    if (n.size() < 2 || n.size() > 4 || n.find_first_not_of("0123456789", 1) != std::string::npos) continue;
+    const int k = std::stoi(n.substr(1));
+    if (n[0] == 'a' && k >= 1 && k < den.size() && den(k) == p.values(i)) ia[static_cast<size_t>(k)] = i;
+    else if (n[0] == 'b' && k < num.size() && num(k) == p.values(i)) ib[static_cast<size_t>(k)] = i;
+    else return;  // another parameterisation
+  }
+  const Eigen::VectorXcd poles = r.model.poles(), zeros = r.model.zeros();
+  const double fastest = poles.size() ? poles.cwiseAbs().maxCoeff() : 0.0;
+  for (const auto& pole : poles)
+    for (const auto& zero : zeros) {
+      const std::complex<double> d = pole - zero;
+      // Only pairs that are close on the model's own scale can cancel (a far, poorly known zero is a
+      // coefficient near 0, not a cancellation).
+      if (std::abs(d) > 0.5 * std::max({std::abs(pole), std::abs(zero), 0.05 * fastest})) continue;
+      // Gradient of d over the parameters, then the 2 x 2 covariance of (Re d, Im d).
+      Eigen::MatrixXd J = Eigen::MatrixXd::Zero(2, P);
+      const Eigen::VectorXcd gp = root_gradient(den, pole), gz = root_gradient(num, zero);
+      for (Eigen::Index k = 0; k < den.size(); ++k)
+        if (ia[static_cast<size_t>(k)] >= 0) {
+          J(0, ia[static_cast<size_t>(k)]) += gp(k).real();
+          J(1, ia[static_cast<size_t>(k)]) += gp(k).imag();
+        }
+      for (Eigen::Index k = 0; k < num.size(); ++k)
+        if (ib[static_cast<size_t>(k)] >= 0) {
+          J(0, ib[static_cast<size_t>(k)]) -= gz(k).real();
+          J(1, ib[static_cast<size_t>(k)]) -= gz(k).imag();
+        }
+      const Eigen::Matrix2d S = J * p.covariance * J.transpose();
+      double m2;  // squared Mahalanobis distance of d from 0
+      const bool real_pair = std::abs(pole.imag()) < 1e-12 && std::abs(zero.imag()) < 1e-12;
+      if (real_pair) m2 = S(0, 0) > 0 ? d.real() * d.real() / S(0, 0) : INFINITY;
+      else {
+        const Eigen::Vector2d v(d.real(), d.imag());
+        m2 = S.determinant() > 0 ? v.dot(S.ldlt().solve(v)) : INFINITY;
+      }
+      const double limit = real_pair ? 6.63 : 9.21;  // chi^2 99 % with 1 or 2 degrees of freedom
+      if (m2 < limit) {
+        r.summary.termination = Termination::Unidentifiable;
+        r.summary.message = detail::format(
+            "the pole {} and the zero {} cancel (their distance {} is within its 99 % confidence region): the model "
+            "order is higher than the data support; reduce nf and nb",
+            pole, zero, std::abs(d));
+        return;
+      }
+    }
+}
+
+template void check_cancellation(Result<TransferFunction>&);
 
 }  // namespace ctid::tf_detail

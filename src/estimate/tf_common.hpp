@@ -19,4 +19,12 @@ double output_error_mse(const TransferFunction& g, const IdData& d);
 /// Mirror unstable poles into the left half plane (prefilters and auxiliary models must be stable).
 TransferFunction stabilized(const TransferFunction& tf);
 
+/// Near-unidentifiability check of a successful transfer-function estimate with parameters named a1..an,
+/// b0..b(nb-1) and a covariance: a pole p and a zero z whose difference is within the 99 % confidence region
+/// of its own uncertainty (linearised: dp/da_k = -p^{n-k}/A'(p), dz/db_j = -z^{m-j}/B'(z)) cancel, i.e. the
+/// order is higher than the data support. Then the termination becomes Unidentifiable with a message naming
+/// the pair. Results of other parameterisations are left alone.
+template <class R>
+void check_cancellation(R& r);
+
 }  // namespace ctid::tf_detail

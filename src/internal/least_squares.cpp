@@ -143,21 +143,26 @@ LinearSolution InstrumentalVariables::solve(double tol) const {
   s.n_rows = rows_;
   const double neff = sumw2_ > 0 ? sumw_ * sumw_ / sumw2_ : 0.0;
   const double c = sumw_ > 0 ? neff / sumw_ : 1.0;
-  // Column scaling of Z^T X for conditioning.
+  // Two-sided scaling of Z^T X: rows by the instrument norms, columns by the regressor norms, so that the
+  // result does not depend on the units of u and y (a u in uV and a y in MV give the same condition).
   const Eigen::MatrixXd zzf = zz(), xxf = xx_.selfadjointView<Eigen::Upper>();
-  Eigen::VectorXd d(p_);
-  for (int j = 0; j < p_; ++j) d(j) = std::sqrt(std::max(with_rss_ ? xxf(j, j) : zx_.col(j).norm(), 1e-300));
-  const Eigen::MatrixXd A = zx_ * d.cwiseInverse().asDiagonal();
-  s.condition = scaled_condition(zx_);
+  Eigen::VectorXd d(p_), r(p_);
+  for (int j = 0; j < p_; ++j) {
+    d(j) = std::sqrt(std::max(with_rss_ ? xxf(j, j) : zx_.col(j).norm(), 1e-300));
+    r(j) = std::sqrt(std::max(zzf(j, j), 1e-300));
+  }
+  const Eigen::MatrixXd A = r.cwiseInverse().asDiagonal() * zx_ * d.cwiseInverse().asDiagonal();
+  s.condition = scaled_condition(A);
   s.rank_deficient = !(s.condition < 1.0 / tol);
-  const Eigen::VectorXd ts = s.rank_deficient ? Eigen::VectorXd(A.completeOrthogonalDecomposition().solve(zy_))
-                                               : Eigen::VectorXd(A.fullPivLu().solve(zy_));
+  const Eigen::VectorXd b = zy_.cwiseQuotient(r);
+  const Eigen::VectorXd ts = s.rank_deficient ? Eigen::VectorXd(A.completeOrthogonalDecomposition().solve(b))
+                                               : Eigen::VectorXd(A.fullPivLu().solve(b));
   s.theta = ts.cwiseQuotient(d);
   s.rss = with_rss_ ? std::max(0.0, c * (yy_ - 2.0 * s.theta.dot(xy_) + s.theta.dot(xxf * s.theta)))
                     : std::numeric_limits<double>::quiet_NaN();
   s.sigma2 = neff > p_ ? s.rss / (neff - p_) : std::numeric_limits<double>::quiet_NaN();
   if (!s.rank_deficient) {
-    const Eigen::MatrixXd inv = zx_.fullPivLu().inverse();
+    const Eigen::MatrixXd inv = d.cwiseInverse().asDiagonal() * A.fullPivLu().inverse() * r.cwiseInverse().asDiagonal();
     s.covariance = s.sigma2 * inv * zzf * inv.transpose() / c;
   } else {
     s.covariance = Eigen::MatrixXd::Constant(p_, p_, std::numeric_limits<double>::quiet_NaN());

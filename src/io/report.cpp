@@ -393,7 +393,8 @@ bool tf_from_parameters(const TransferFunction& g, const ParameterSet& p, const 
   if (den(0) != 1.0) return false;
   for (int i = 0; i < p.size(); ++i) {
     const std::string& n = p.names[static_cast<size_t>(i)];
-    if (n.size() < 2 || (n[0] != 'a' && n[0] != 'b') || n.find_first_not_of("0123456789", 1) != std::string::npos)
+    if (n.size() < 2 || n.size() > 7 || (n[0] != 'a' && n[0] != 'b') ||
+        n.find_first_not_of("0123456789", 1) != std::string::npos)
       continue;  // e.g. "delay": held at the model's value
     const int k = std::stoi(n.substr(1));
     Eigen::VectorXd& c = n[0] == 'a' ? den : num;

@@ -57,7 +57,9 @@ NarxTerm NarxTerm::parse(const std::string& text) {
       const size_t start = i;
       while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ++i;
       if (i == start) fail("expected a lag");
+      if (i - start > 7) fail("lag larger than 1000000");
       f.lag = std::stoi(text.substr(start, i - start));
+      if (f.lag > 1000000) fail("lag larger than 1000000");
       if (i >= text.size() || text[i] != ')') fail("expected \")\"");
     }
     ++i;

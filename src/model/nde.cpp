@@ -44,6 +44,7 @@ NdeTerm NdeTerm::parse(const std::string& text) {
     const size_t start = i;
     while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ++i;
     if (i == start) fail("expected a number");
+    if (i - start > 2) fail("number larger than 99");
     return std::stoi(text.substr(start, i - start));
   };
   while (true) {

@@ -76,6 +76,7 @@ class Parser {
       const std::size_t start = pos_;
       while (pos_ < t_.size() && std::isdigit(static_cast<unsigned char>(t_[pos_]))) ++pos_;
       if (start == pos_) fail("expected a non-negative integer exponent after '^'");
+      if (pos_ - start > 3) fail("exponent larger than 64");
       auto p = make(Node::Pow, std::move(n));
       p->value = std::stod(t_.substr(start, pos_ - start));
       if (p->value > 64) fail("exponent larger than 64");

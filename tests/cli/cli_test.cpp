@@ -678,7 +678,7 @@ TEST(Cli, RobustnessCampaignBadInputs) {
       {"fit " + dup + base, 3, "not strictly increasing (0.1 after 0.1)"},
       {"fit " + dir + base, 3, "rb_dir"},
       {"fit " + badmat + " --ts 0.1 --input u --output y", 3, "cannot read"},
-      {"fit " + truncmat + " --ts 0.1 --input u --output y", 3, "no readable variable"},
+      {"fit " + truncmat + " --ts 0.1 --input u --output y", 3, "the file is truncated or damaged"},
       // No information in the data.
       {"fit " + cst + base + "--method srivc", 2, "input 'force' is constant (1)"},
       {"fit " + cst + base + "--method fsf --set T=1 --set n=11", 2, "input 'force' is constant"},

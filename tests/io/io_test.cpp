@@ -1,4 +1,5 @@
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -199,4 +200,35 @@ TEST(Json, NarxAndNdeModelsRoundTripAndBadFilesAreNamed) {
   }
   EXPECT_THROW(parse_nde_json(R"J({"type": "narx", "ts": 1, "terms": []})J"), FileError);
   EXPECT_THROW(parse_narx_json(R"J({"type": "narx", "terms": []})J"), FileError);  // no ts
+}
+
+TEST(Mat, DamagedFilesAreRefusedBeforeLibmatioAllocates) {
+  // Found by tests/fuzz/mat_fuzz: libmatio allocates the sizes a file declares (7.5 GB for a 177-byte file). The
+  // structure is now checked first: each of these gives a FileError naming the problem, quickly, with no allocation.
+  std::string hdr = "MATLAB 5.0 MAT-file, Platform: GLNXA64, Created by: ctid test";
+  hdr.resize(116, ' ');
+  hdr += std::string(8, '\0') + std::string("\x00\x01", 2) + "IM";
+  auto le32 = [](std::uint32_t v) { return std::string{char(v), char(v >> 8), char(v >> 16), char(v >> 24)}; };
+  auto file = [&](const std::string& name, const std::string& body) {
+    const std::string p = test::temp_path(name);
+    std::ofstream(p, std::ios::binary) << hdr << body;
+    return p;
+  };
+  const std::string flags = le32(6) + le32(8) + le32(6) + le32(0);  // miUINT32 flags: class double
+  // 1. The top-level element declares more bytes than the file holds.
+  const std::string cut = file("cut.mat", le32(14) + le32(112) + flags);
+  EXPECT_NE(error_of([&] { mat_variable_names(cut); }).find("declares 112 bytes but only 16 remain"), std::string::npos);
+  // 2. Inside an array, the dimensions part declares 3.7 GB.
+  const std::string dims = le32(5) + le32(0xe0530008u) + le32(1) + le32(1);
+  const std::string huge = file("huge.mat", le32(14) + le32(32) + flags + dims);
+  EXPECT_NE(error_of([&] { mat_variable_names(huge); }).find("an array part declares 3763535880 bytes"), std::string::npos);
+  // 3. Dimensions of 100000 x 100000 doubles with 8 bytes of data.
+  const std::string big = le32(5) + le32(8) + le32(100000) + le32(100000);
+  const std::string name = le32(1) + le32(1) + "x" + std::string(7, '\0');
+  const std::string data = le32(9) + le32(8) + std::string(8, '\0');
+  const std::string many = file("many.mat", le32(14) + le32(64) + flags + big + name + data);
+  EXPECT_NE(error_of([&] { mat_variable_names(many); }).find("an array of 1e+10 elements"), std::string::npos);
+  // 4. A compressed element that is not zlib data.
+  const std::string z = file("z.mat", le32(15) + le32(8) + std::string("\x78\x9c\xff\xff\xff\xff\xff\xff", 8));
+  EXPECT_NE(error_of([&] { mat_variable_names(z); }).find("compressed element"), std::string::npos);
 }

@@ -15,6 +15,7 @@ enum class Termination {
   Unstable,           ///< the estimate is an unstable model where a stable one was required
   NumericalFailure,   ///< NaN/Inf appeared during the computation
   Interrupted,        ///< the progress callback asked to stop
+  Unidentifiable,     ///< the estimate is not determined by the data (e.g. a pole-zero pair that cancels)
 };
 
 /// Lower-case identifier used in JSON files and the CLI ("converged", "max_iterations", ...).
