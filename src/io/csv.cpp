@@ -1,5 +1,7 @@
 #include "ctid/io/csv.hpp"
 
+#include <limits>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -47,7 +49,6 @@ std::vector<std::string> split(const std::string& line, char delim) {
     else cur += c;
   }
   out.push_back(trim(cur));
-  while (!out.empty() && out.back().empty()) out.pop_back();  // trailing delimiters
   return out;
 }
 
@@ -79,6 +80,8 @@ CsvTable parse_csv(const std::string& text, const std::string& source, const Csv
     if (o.comment_chars.find(line[p]) != std::string::npos) continue;
     if (delim == 0) delim = line.find(',') != std::string::npos ? ',' : (line.find(';') != std::string::npos ? ';' : ' ');
     std::vector<std::string> f = split(line, delim);
+    // Trailing delimiters ("1,2,3,"): the header's are dropped; a row's only beyond the header's width.
+    while (!f.empty() && f.back().empty() && (first || f.size() > ncol)) f.pop_back();
     if (first) {
       first = false;
       bool numeric = true;
@@ -96,6 +99,10 @@ CsvTable parse_csv(const std::string& text, const std::string& source, const Csv
       throw FileError(detail::format("{}:{}: expected {} fields, found {}", source, lineno, ncol, f.size()));
     std::vector<double> r(ncol);
     for (std::size_t i = 0; i < ncol; ++i) {
+      if (f[i].empty()) {  // an empty cell: NaN here; an error only if the column is used (iddata_from_table)
+        r[i] = std::numeric_limits<double>::quiet_NaN();
+        continue;
+      }
       if (!parse_number(f[i], r[i]))
         throw FileError(detail::format("{}:{}: column '{}' (field {}): cannot read '{}' as a number", source, lineno,
                                        t.names[i], i + 1, f[i]));

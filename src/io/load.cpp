@@ -46,6 +46,20 @@ IdData assemble(const Eigen::MatrixXd& u, const Eigen::MatrixXd& y, const Eigen:
 IdData iddata_from_table(const CsvTable& tab, const DataSpec& s) {
   check_spec(s, tab.source);
   const Eigen::Index N = tab.values.rows();
+  // Empty cells are NaN in the table; a used column must have none.
+  std::vector<std::string> used = s.inputs;
+  used.insert(used.end(), s.outputs.begin(), s.outputs.end());
+  if (!s.time.empty()) used.push_back(s.time);
+  {
+    for (const auto& name : used) {
+      const int c = tab.column(name);
+      for (Eigen::Index k = 0; k < N; ++k)
+        if (std::isnan(tab.values(k, c)))
+          throw FileError(detail::format("{}:{}: column '{}' (field {}) is empty", tab.source,
+                                         k < static_cast<Eigen::Index>(tab.line_numbers.size()) ? tab.line_numbers[k] : k + 1,
+                                         tab.names[c], c + 1));
+    }
+  }
   Eigen::MatrixXd u(N, s.inputs.size()), y(N, s.outputs.size());
   for (std::size_t j = 0; j < s.inputs.size(); ++j) u.col(j) = tab.values.col(tab.column(s.inputs[j]));
   for (std::size_t j = 0; j < s.outputs.size(); ++j) y.col(j) = tab.values.col(tab.column(s.outputs[j]));

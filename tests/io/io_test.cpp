@@ -232,3 +232,22 @@ TEST(Mat, DamagedFilesAreRefusedBeforeLibmatioAllocates) {
   const std::string z = file("z.mat", le32(15) + le32(8) + std::string("\x78\x9c\xff\xff\xff\xff\xff\xff", 8));
   EXPECT_NE(error_of([&] { mat_variable_names(z); }).find("compressed element"), std::string::npos);
 }
+
+TEST(Csv, EmptyCellsAreAnErrorOnlyInTheColumnsUsed) {
+  // The layout of the Cascaded Tanks benchmark file: a trailing comma on every line and a column ("Ts") that is
+  // filled only in the first row.
+  const std::string text = "\"u\",\"y\",\"Ts\",\n1,2,4,\n3,4,,\n5,6,,\n";
+  const CsvTable t = parse_csv(text, "tanks.csv");
+  EXPECT_EQ(t.names, (std::vector<std::string>{"u", "y", "Ts"}));
+  EXPECT_TRUE(std::isnan(t.values(1, 2)));
+  DataSpec s;
+  s.inputs = {"u"};
+  s.outputs = {"y"};
+  s.ts = 4;
+  EXPECT_EQ(iddata_from_table(t, s).y()(2, 0), 6.0);
+  s.ts = 0;
+  s.time = "Ts";
+  EXPECT_EQ(error_of([&] { iddata_from_table(t, s); }), "tanks.csv:3: column 'Ts' (field 3) is empty");
+  // A short row is still ragged, not empty.
+  EXPECT_EQ(error_of([] { parse_csv("a,b,c\n1,2,3\n1,2\n", "r.csv"); }), "r.csv:3: expected 3 fields, found 2");
+}
