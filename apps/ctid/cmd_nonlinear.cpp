@@ -92,22 +92,29 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
   KiaLinearOptions lo;
   KiaQuadraticOptions qo;
   bool refine = true;
-  lo.zoh = qo.zoh = d.intersample(0) == Intersample::Zoh;
+  KiaCubicOptions co;
+  lo.zoh = qo.zoh = co.zoh = d.intersample(0) == Intersample::Zoh;
   consume_sets(sets, [&](const std::string& k, const std::string& v) {
     if (k == "y_order") lo.y_order = to_int(k, v);
     else if (k == "u_order") lo.u_order = to_int(k, v);
     else if (k == "points") lo.points.count = to_int(k, v);
     else if (k == "max") lo.points.max = to_double(k, v);
-    else if (k == "seed") lo.points.seed = qo.points.seed = static_cast<unsigned>(to_int(k, v));
+    else if (k == "seed") lo.points.seed = qo.points.seed = co.points.seed = static_cast<unsigned>(to_int(k, v));
     else if (k == "gls_order") lo.gls_order = to_int(k, v);
     else if (k == "err_threshold") lo.err_threshold = to_double(k, v);
-    else if (k == "zoh") lo.zoh = qo.zoh = to_int(k, v) != 0;
+    else if (k == "zoh") lo.zoh = qo.zoh = co.zoh = to_int(k, v) != 0;
     else if (k == "refine") refine = to_int(k, v) != 0;
     else if (k == "quadratic") {
       try {
         for (const auto& t : split(v)) qo.candidates.push_back(NdeTerm::parse(t));
       } catch (const InvalidArgument& e) {
         throw UsageError(std::string("--set quadratic: ") + e.what());
+      }
+    } else if (k == "cubic") {
+      try {
+        for (const auto& t : split(v)) co.candidates.push_back(NdeTerm::parse(t));
+      } catch (const InvalidArgument& e) {
+        throw UsageError(std::string("--set cubic: ") + e.what());
       }
     } else if (k == "qpoints") qo.points.count = to_int(k, v);
     else if (k == "qmax") qo.points.max = to_double(k, v);
@@ -132,24 +139,27 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
   }
   if (!sets.empty())
     throw UsageError("--set " + sets.begin()->first + ": not a setting of kia (settings: y_order, u_order, points, max, "
-                     "seed, gls_order, err_threshold, zoh, refine, quadratic=y^2,y*Dy, qpoints, qmax, qgls_order, "
+                     "seed, gls_order, err_threshold, zoh, refine, quadratic=y^2,y*Dy, cubic=y^3, qpoints, qmax, qgls_order, "
                      "qerr_threshold, and the narx settings)");
   Result<NdeModel> r;
   try {
     r = kia_linear(narx, lo);
-    if (!qo.candidates.empty()) {
-      const Result<NdeModel> lin = r;
-      r = kia_quadratic(narx, lin.model, qo);
-      r.parameters.names.insert(r.parameters.names.begin(), lin.parameters.names.begin(), lin.parameters.names.end());
-      Eigen::VectorXd v(lin.parameters.size() + r.parameters.values.size());
-      v << lin.parameters.values, r.parameters.values;
-      r.parameters.values = v;
-      r.parameters.std = Eigen::VectorXd::Constant(v.size(), NAN);
-      r.parameters.fixed.assign(v.size(), false);
+    // Each higher stage returns its own coefficients; prepend the earlier stages' to the table.
+    auto stack = [&](const Result<NdeModel>& before, Result<NdeModel> next) {
+      next.parameters.names.insert(next.parameters.names.begin(), before.parameters.names.begin(),
+                                   before.parameters.names.end());
+      Eigen::VectorXd v(before.parameters.size() + next.parameters.values.size());
+      v << before.parameters.values, next.parameters.values;
+      next.parameters.values = v;
+      next.parameters.std = Eigen::VectorXd::Constant(v.size(), NAN);
+      next.parameters.fixed.assign(v.size(), false);
       Eigen::VectorXd e(v.size());
-      e << lin.diagnostics.vectors.at("err"), r.diagnostics.vectors.at("err");
-      r.diagnostics.vectors["err"] = e;
-    }
+      e << before.diagnostics.vectors.at("err"), next.diagnostics.vectors.at("err");
+      next.diagnostics.vectors["err"] = e;
+      return next;
+    };
+    if (!qo.candidates.empty()) r = stack(r, kia_quadratic(narx, r.model, qo));
+    if (!co.candidates.empty()) r = stack(r, kia_cubic(narx, r.model, co));
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }

@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# The real-data gallery (docs/gallery.md), run by ctest as `gallery`: every entry identifies models with the
+# ctid command line, validates them on held-out data and writes an HTML report. Entries whose data folder is
+# absent are skipped. Each checked number must stay within the bound printed next to it, or the run fails.
+# Usage: docs/gallery/run.sh CTID_BINARY OUT_DIR SHARED_DATA_DIR EXAMPLES_DATA_DIR
+set -euo pipefail
+ctid="$1"; out="$2"; shared="$3"; examples="$4"
+mkdir -p "$out"
+cd "$out"
+fail=0
+check() {  # check NAME VALUE OP BOUND   (OP: lt | gt)
+  local ok
+  ok=$(awk -v v="$2" -v b="$4" -v op="$3" 'BEGIN { print (op == "lt" ? (v < b) : (v > b)) ? 1 : 0 }')
+  if [ "$ok" = 1 ]; then echo "  $1 = $2 (bound: $3 $4)"; else echo "  FAILED: $1 = $2 (bound: $3 $4)"; fail=1; fi
+}
+fit_of() { "$ctid" validate "$@" | awk '/^fit:/ { print $2; exit }'; }
+mse_of() { "$ctid" validate "$@" | awk '/^fit:/ { for (i = 1; i < NF; ++i) if ($i == "MSE") print $(i + 1); exit }'; }
+# RMS of (simulated - measured) after removing the measured mean, skipping the first 50 samples:
+# rms SIM.csv DATA.csv COLUMN_OF_Y_IN_DATA
+rms() {
+  awk -F, -v col="$3" 'NR == FNR { if (FNR > 1) { y[FNR - 1] = $col; m += $col; n++ } next }
+                       FNR > 1 { s[FNR - 1] = $NF }
+                       END { m /= n; for (k = 51; k <= n; ++k) { e = s[k] - (y[k] - m); acc += e * e; c++ } printf "%.6f", sqrt(acc / c) }' "$2" "$1"
+}
+
+echo "== hair dryer (DaISy, bundled): SRIVC, tfest and modal functions; validation on the last 30 %"
+dryer="$examples/dryer.dat"
+head -700 "$dryer" > dryer_est.dat
+tail -300 "$dryer" > dryer_val.dat
+d="--ts 0.08 --input 1 --output 2 --detrend mean"
+"$ctid" fit dryer_est.dat $d --method srivc --nb 2 --nf 2 --nk 2 --json dryer_srivc.json --report dryer_srivc.html --force >/dev/null
+"$ctid" fit dryer_est.dat $d --method tfest --nb 2 --nf 2 --nk 2 --json dryer_tfest.json --force >/dev/null
+"$ctid" fit dryer_est.dat $d --method modal --nf 2 --nk 2 --set shifts=1,2 --set basis=discrete --json dryer_modal.json --force >/dev/null
+"$ctid" fit dryer_est.dat $d --method fsf --set T=4 --set n=21 --report dryer_fsf.html --force >/dev/null
+check "SRIVC validation fit %" "$(fit_of dryer_srivc.json dryer_val.dat $d)" gt 85
+check "tfest validation fit %" "$(fit_of dryer_tfest.json dryer_val.dat $d)" gt 85
+check "modal validation fit %" "$(fit_of dryer_modal.json dryer_val.dat $d)" gt 80
+
+tanks="$shared/cascaded_tanks/dataBenchmark.csv"
+if [ -f "$tanks" ]; then
+  echo "== cascaded tanks (nonlinearbenchmark.org): linear CT models and a NARX model; test-record RMSE (V)"
+  e="--ts 4 --input uEst --output yEst --detrend mean"
+  v="--ts 4 --input uVal --output yVal --detrend mean"
+  "$ctid" fit "$tanks" $e --method srivc --nb 1 --nf 2 --json tanks_srivc.json --report tanks_srivc.html --force >/dev/null
+  "$ctid" fit "$tanks" $e --method tfest --nb 1 --nf 3 --json tanks_tfest.json --force >/dev/null
+  check "SRIVC [1 2] test RMSE (reference: best linear approximation 0.75)" \
+    "$(awk -v m="$(mse_of tanks_srivc.json "$tanks" $v)" 'BEGIN { printf "%.4f", sqrt(m) }')" lt 0.75
+  check "tfest [1 3] test RMSE" "$(awk -v m="$(mse_of tanks_tfest.json "$tanks" $v)" 'BEGIN { printf "%.4f", sqrt(m) }')" lt 0.75
+  "$ctid" fit "$tanks" $e --method narx --set degree=3 --set ylag=3 --set ulag=3 --set criterion=bic --json tanks_narx.json \
+    --report tanks_narx.html --force >/dev/null
+  "$ctid" simulate tanks_narx.json "$tanks" --ts 4 --input uVal --detrend mean --out tanks_narx_sim.csv --force >/dev/null
+  check "NARX (degree 3, lags 3, BIC) free-run test RMSE" "$(rms tanks_narx_sim.csv "$tanks" 4)" lt 0.75
+else
+  echo "== cascaded tanks: SKIPPED ($tanks not available)"
+fi
+
+sb="$shared/silverbox/SNLS80mV.csv"
+if [ -f "$sb" ]; then
+  echo "== Silverbox (nonlinearbenchmark.org): NARX, then the continuous-time Duffing equation by KIA + output error;"
+  echo "   free-run RMS (V) on the arrow (full) test record"
+  sed -n '1p;40652,60651p' "$sb" > sb_est.csv      # 20000 samples of the multisine part
+  sed -n '1p;40652,45651p' "$sb" > sb_est5k.csv    # 5000 of them for the output-error refinement
+  sed -n '1p;102,40576p' "$sb" > sb_test.csv       # the arrow test [100, 40575)
+  s="--ts 0.0016384 --input V1 --output V2 --detrend mean"
+  "$ctid" fit sb_est.csv $s --method narx --set degree=3 --set ylag=3 --set ulag=3 --set max_terms=10 --set criterion=aic \
+    --json sb_narx.json --report sb_narx.html --force >/dev/null
+  "$ctid" fit sb_est5k.csv $s --intersample foh --method kia --narx sb_narx.json --set max=1000 --set quadratic=y^2 \
+    --set cubic=y^3 --json sb_nde.json --report sb_kia.html --force | grep -E "^(NDE|refined)"
+  "$ctid" simulate sb_narx.json sb_test.csv --ts 0.0016384 --input V1 --detrend mean --out sb_narx_sim.csv --force >/dev/null
+  "$ctid" simulate sb_nde.json sb_test.csv --ts 0.0016384 --input V1 --detrend mean --intersample foh --out sb_nde_sim.csv \
+    --force >/dev/null
+  check "NARX free-run RMS (references: SysIdentPy NARX 0.00415, SUBNET 0.00579)" "$(rms sb_narx_sim.csv sb_test.csv 2)" lt 0.0045
+  check "KIA + output-error Duffing equation free-run RMS" "$(rms sb_nde_sim.csv sb_test.csv 2)" lt 0.0015
+else
+  echo "== Silverbox: SKIPPED ($sb not available)"
+fi
+
+echo "reports: $(ls "$out"/*.html | wc -l) HTML files in $out"
+exit $fail
