@@ -143,13 +143,42 @@ class V5Checker {
   bool swap_;
 };
 
+// Level 4 files (no header): a sequence of matrices, each a 20-byte header (type MOPT, rows, columns,
+// imaginary flag, name length) followed by the name and rows x columns values (x 2 when complex).
+void check_v4(const std::string& path, const std::vector<unsigned char>& b) {
+  auto bad = [&](const std::string& what) {
+    throw FileError(detail::format("cannot read '{}' as a MATLAB .mat file: {}", path, what));
+  };
+  std::size_t i = 0;
+  while (i < b.size()) {
+    if (b.size() - i < 20) bad("not a level 5 file, and not a valid level 4 file (a header is cut off)");
+    auto word = [&](std::size_t k, bool big) {
+      const unsigned char* p = b.data() + i + 4 * k;
+      return big ? std::uint32_t(p[3]) | std::uint32_t(p[2]) << 8 | std::uint32_t(p[1]) << 16 | std::uint32_t(p[0]) << 24
+                 : std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
+    };
+    const bool big = word(0, false) > 9999;  // MOPT in the other byte order
+    const std::uint32_t type = word(0, big), rows = word(1, big), cols = word(2, big), imag = word(3, big),
+                        name = word(4, big);
+    if (type > 4999 || (type / 10) % 10 > 5 || imag > 1)
+      bad("not a level 5 file, and not a valid level 4 file (bad matrix type)");
+    static constexpr int kSize[] = {8, 4, 4, 2, 2, 1};
+    const double bytes = double(rows) * double(cols) * kSize[(type / 10) % 10] * (1 + imag) + double(name);
+    if (bytes > double(b.size() - i - 20))
+      bad(detail::format("a level 4 matrix declares {} bytes but only {} remain (the file is truncated or damaged)",
+                         bytes, b.size() - i - 20));
+    i += 20 + static_cast<std::size_t>(bytes);
+  }
+}
+
 void check_mat_structure(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
   std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-  if (bytes.size() < 128) return;  // not level 5: libmatio decides
-  const bool le = bytes[126] == 'I' && bytes[127] == 'M', be = bytes[126] == 'M' && bytes[127] == 'I';
+  const bool header = bytes.size() >= 128;
+  const bool le = header && bytes[126] == 'I' && bytes[127] == 'M', be = header && bytes[126] == 'M' && bytes[127] == 'I';
+  if (!le && !be) return check_v4(path, bytes);
   const unsigned version = le ? bytes[124] | bytes[125] << 8 : bytes[125] | bytes[124] << 8;
-  if ((!le && !be) || version != 0x0100) return;  // level 7.3 (HDF5) or not a MAT file
+  if (version != 0x0100) return;  // level 7.3 (HDF5): left to HDF5
   V5Checker(path, be).sequence(bytes.data() + 128, bytes.size() - 128, 0, true);
 }
 

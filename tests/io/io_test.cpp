@@ -251,3 +251,11 @@ TEST(Csv, EmptyCellsAreAnErrorOnlyInTheColumnsUsed) {
   // A short row is still ragged, not empty.
   EXPECT_EQ(error_of([] { parse_csv("a,b,c\n1,2,3\n1,2\n", "r.csv"); }), "r.csv:3: expected 3 fields, found 2");
 }
+
+TEST(Mat, DamagedLevel4FilesAreRefused) {
+  // Found by tests/fuzz/mat_fuzz: a file without a level 5 header is read by libmatio as level 4, whose matrix
+  // header declared 1.7e9 x 1.7e9 values (1.9 GB resident before this check).
+  const std::string p = test::temp_path("v4.mat");
+  std::ofstream(p, std::ios::binary) << std::string(4, '\0') << std::string(100, 'e') << std::string(130, '4');
+  EXPECT_NE(error_of([&] { mat_variable_names(p); }).find("not a valid level 4 file"), std::string::npos);
+}
