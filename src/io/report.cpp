@@ -296,6 +296,31 @@ void overview(Page& page, const IdData& d, const Result<M>& r, const ReportOptio
   page.plot({"Output", "time (s)", "y", t, {{"y", pick(d.y().col(0), k)}}});
 }
 
+// Method-specific numbers (Diagnostics::scalars and short vectors), e.g. SRIVC's delay, the LSSVF filter
+// constant, KIA's GLS iterations, and the modal-function diagnostics (condition of each order's regression).
+void diagnostics(Page& page, const Diagnostics& g) {
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& [k, v] : g.scalars) rows.push_back({k, fmt(v)});
+  for (const auto& [k, v] : g.vectors) {
+    if (v.size() == 0 || v.size() > 24) continue;
+    std::string s;
+    for (Eigen::Index i = 0; i < v.size(); ++i) s += (i ? ", " : "") + fmt(v(i), 4);
+    rows.push_back({k, s});
+  }
+  if (rows.empty()) return;
+  page.section("Diagnostics");
+  const auto cond = g.vectors.find("condition_by_order");
+  if (cond != g.vectors.end()) {
+    page.text("Modal functions (El-Shafey): condition_by_order is the condition number of the modal regression of each "
+              "order j = 0, 1, .. (large values: the shifts or windows do not separate the modes; the estimate of that "
+              "order is unreliable).");
+    Eigen::VectorXd j = Eigen::VectorXd::LinSpaced(cond->second.size(), 0, static_cast<double>(cond->second.size() - 1));
+    page.plot({"Modal regressions: log10 of the condition number by order", "order j", "log10 condition", j,
+               {{"log10 cond", cond->second.array().log10().matrix()}}, false, true});
+  }
+  page.table({"diagnostic", "value"}, rows);
+}
+
 void parameters(Page& page, const ParameterSet& p, const Eigen::VectorXd* err = nullptr) {
   page.section("Parameters");
   std::vector<std::vector<std::string>> rows;
@@ -414,6 +439,7 @@ std::string html_report(const IdData& d, const Result<TransferFunction>& r, cons
   overview(page, d, r, o, r.model.to_string(6));
   validation(page, d, lsim(r.model, d, 0), o);
   parameters(page, r.parameters);
+  diagnostics(page, r.diagnostics);
   const Eigen::VectorXd w = frequency_grid(r.model.poles(), nyquist(d));
   const Eigen::VectorXcd h = r.model.frequency_response(w);
   // 95 % band of |G| from 200 draws of the parameter covariance (seeded: the report is reproducible).
@@ -468,6 +494,7 @@ std::string html_report(const IdData& d, const Result<FsfModel>& r, const Report
   Eigen::VectorXd yhat = m.simulate(d.u().col(0));
   validation(page, d, yhat, o);
   parameters(page, r.parameters);
+  diagnostics(page, r.diagnostics);
   page.section("Compressed responses (Gawthrop & Wang): +-2 std bands from the parameter covariance");
   const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(400, 0.0, m.T());
   const Eigen::VectorXd s = m.step_response(t), ss = m.step_response_std(t);
@@ -519,6 +546,7 @@ std::string html_report(const IdData& d, const Result<NarxModel>& r, const Repor
   page.text("Terms in the order of selection by forward orthogonal least squares; ERR: the error reduction ratio "
             "(share of the output energy explained by the term).");
   parameters(page, r.parameters, err == r.diagnostics.vectors.end() ? nullptr : &err->second);
+  diagnostics(page, r.diagnostics);
   const bool zoh = d.intersample(0) == Intersample::Zoh;
   const double nyq = std::numbers::pi / p.ts();
   Eigen::VectorXd w = frequency_grid(Eigen::VectorXcd::Constant(1, std::complex<double>(0.1 * nyq, 0.0)), 0.9 * nyq);
@@ -558,6 +586,7 @@ std::string html_report(const IdData& d, const Result<NdeModel>& r, const Report
   const auto err = r.diagnostics.vectors.find("err");
   parameters(page, r.parameters,
              err == r.diagnostics.vectors.end() || err->second.size() != r.parameters.size() ? nullptr : &err->second);
+  diagnostics(page, r.diagnostics);
   const Eigen::VectorXd w = frequency_grid(m.a().roots(), nyquist(d));
   Eigen::VectorXcd h(w.size());
   for (Eigen::Index i = 0; i < w.size(); ++i) h(i) = m.h1(std::complex<double>(0, w(i)));

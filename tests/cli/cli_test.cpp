@@ -581,6 +581,7 @@ TEST(Cli, ReportsOpenInABrowserWithEveryPlotDrawn) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"srivc", "fit " + dryer + base + "--method srivc --nb 2 --nf 2 --nk 2"},
       {"fsf", "fit " + dryer + base + "--method fsf --set T=4 --set n=21"},
+      {"modal", "fit " + dryer + base + "--method modal --nf 2 --nk 2 --set shifts=1,2 --set basis=discrete"},
       {"narx", "fit " + bl + " --ts 0.0025 --method narx --set ylag=6 --set ulag=6"},
       {"kia", "fit " + bl + " --ts 0.0025 --method kia --set ylag=6 --set ulag=6 --set quadratic=y^2,y*Dy"},
   };
@@ -593,6 +594,7 @@ TEST(Cli, ReportsOpenInABrowserWithEveryPlotDrawn) {
     const std::string text((std::istreambuf_iterator<char>(f)), {});
     EXPECT_NE(text.find("Residual tests"), std::string::npos) << name;
     EXPECT_NE(text.find("Parameters"), std::string::npos) << name;
+    if (name == "modal") EXPECT_NE(text.find("Modal functions (El-Shafey)"), std::string::npos);
     for (const char* ref : {"src=\"http", "href=\"http", "url(http"}) EXPECT_EQ(text.find(ref), std::string::npos) << name;
     EXPECT_TRUE(report_has_plot_library());
     const std::string png = std::string(CTID_TEST_OUTPUT_DIR) + "/report_" + name + ".png";

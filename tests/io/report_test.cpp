@@ -4,6 +4,7 @@
 #include "ctid/core/error.hpp"
 #include "ctid/data/input_design.hpp"
 #include "ctid/estimate/fsf.hpp"
+#include "ctid/estimate/modal.hpp"
 #include "ctid/estimate/srivc.hpp"
 #include "ctid/io/report.hpp"
 #include "ctid/simulate/lsim.hpp"
@@ -40,6 +41,26 @@ TEST(Report, TransferFunctionReportHasEverySection) {
   for (const char* ref : {"src=\"http", "href=\"http", "url(http", "import("})  // offline: nothing fetched
     EXPECT_EQ(html.find(ref), std::string::npos) << ref;
   EXPECT_TRUE(report_has_plot_library());
+}
+
+TEST(Report, DiagnosticsSectionShowsMethodNumbers) {
+  // SRIVC reports its delay and noise variance; a modal-function fit (El-Shafey, two sinusoids driving
+  // (13 s + 52)/(s^3 + 4 s^2 + 30 s + 52), noise-free) its condition number by order, with a plot.
+  const IdData d = plant();
+  const std::string h = html_report(d, srivc(d, {.nb = 1, .nf = 2}), {.method = "srivc"});
+  EXPECT_NE(h.find("<h2>Diagnostics</h2>"), std::string::npos);
+  EXPECT_NE(h.find("noise_variance"), std::string::npos);
+  const TransferFunction s3(Polynomial{13.0, 52.0}, Polynomial{1.0, 4.0, 30.0, 52.0});
+  const double Ts = 3.141592653589793 / 420;
+  const InputGenerator g = InputGenerator::sinusoid(4.0, 1.0) + InputGenerator::sinusoid(1.5, 0.0, 0.7);
+  const Eigen::VectorXd t = time_grid(Ts, 1500);
+  const IdData sines(g(t), lsim(s3.to_state_space(), g, t), Ts);
+  const auto m = modal_fit(sines, 3, {.shifts = Eigen::Vector3d(40 * Ts, 80 * Ts, 120 * Ts), .functions = 10}, &g);
+  ASSERT_TRUE(m.usable());
+  const std::string hm = html_report(sines, m, {.method = "modal"});
+  EXPECT_NE(hm.find("Modal functions (El-Shafey)"), std::string::npos);
+  EXPECT_NE(hm.find("condition_by_order"), std::string::npos);
+  EXPECT_EQ(count(hm, "class=\"plot\""), 10);  // the 9 of a transfer-function report + the condition plot
 }
 
 TEST(Report, TextIsEscapedAndScriptsCannotBeInjected) {
