@@ -36,6 +36,23 @@ check "SRIVC validation fit %" "$(fit_of dryer_srivc.json dryer_val.dat $d)" gt 
 check "tfest validation fit %" "$(fit_of dryer_tfest.json dryer_val.dat $d)" gt 85
 check "modal validation fit %" "$(fit_of dryer_modal.json dryer_val.dat $d)" gt 80
 
+winding="$shared/daisy_winding_process/winding.dat"
+if [ -f "$winding" ]; then
+  echo "== winding process (DaISy): five inputs -> each web tension, MISO SRIVC with a common denominator;"
+  echo "   validation fit on the last 30 %"
+  head -1750 "$winding" > winding_est.dat
+  tail -750 "$winding" > winding_val.dat
+  w="--ts 0.1 --input 1 --input 2 --input 3 --input 4 --input 5 --detrend mean"
+  for y in 6 7; do
+    "$ctid" fit winding_est.dat $w --output $y --method srivc --nf 1 --set common_denominator=1 --json winding_$y.json \
+      --force >/dev/null
+  done
+  check "tension T1 (column 6), first order: validation fit %" "$(fit_of winding_6.json winding_val.dat $w --output 6)" gt 55
+  check "tension T3 (column 7), first order: validation fit %" "$(fit_of winding_7.json winding_val.dat $w --output 7)" gt 42
+else
+  echo "== winding process: SKIPPED ($winding not available)"
+fi
+
 tanks="$shared/cascaded_tanks/dataBenchmark.csv"
 if [ -f "$tanks" ]; then
   echo "== cascaded tanks (nonlinearbenchmark.org): linear CT models and a NARX model; test-record RMSE (V)"
