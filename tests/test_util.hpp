@@ -11,9 +11,20 @@
 
 #include <Eigen/Dense>
 
+#include "ctid/data/iddata.hpp"
+#include "ctid/data/input_design.hpp"
 #include "ctid/model/transfer_function.hpp"
+#include "ctid/simulate/lsim.hpp"
 
 namespace ctid::test {
+
+/// 4/(s^2 + 0.8 s + 4) driven by a PRBS (register 9, clock 3), 2000 samples at 20 ms, 20 dB output noise (seed 3):
+/// an ordinary record on which the iterative estimators take several iterations.
+inline IdData second_order_record() {
+  const TransferFunction g(Eigen::VectorXd{{4.0}}, Eigen::VectorXd{{1.0, 0.8, 4.0}});
+  const Eigen::VectorXd u = prbs(2000, {.register_length = 9, .clock_period = 3});
+  return IdData(u, add_noise_snr(lsim(g, u, time_grid(0.02, 2000)), 20.0, 3), 0.02);
+}
 
 /// Step response by residues (distinct poles): y(t) = G(0) + sum_i N(p_i)/(p_i D'(p_i)) e^{p_i (t - Td)}.
 /// An independent closed form, not using the matrix exponential.

@@ -211,14 +211,8 @@ Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOe
     r.summary.termination = Termination::NumericalFailure;
     r.summary.message = "the model cannot be simulated on these data, even with its nonlinear terms removed";
     yfit = Eigen::VectorXd::Constant(N, NAN);
-  } else if (lm.interrupted) {
-    r.summary.termination = Termination::Interrupted;
-    r.summary.message = lm.message;
-  } else if (lm.converged) {
-    r.summary.termination = Termination::Converged;
   } else {
-    r.summary.termination = Termination::MaxIterations;
-    r.summary.message = lm.message;
+    internal::set_termination(r.summary, lm);
   }
   r.fit = fit_report_or_inf(y, yfit, p);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -125,14 +125,8 @@ Result<TransferFunction> refine(const IdData& data, const TfOrders& o, const Tra
   if (!std::isfinite(lm.cost)) {
     r.summary.termination = Termination::Unstable;
     r.summary.message = "the starting model is unstable or cannot be simulated; give a stable initial model";
-  } else if (lm.interrupted) {
-    r.summary.termination = Termination::Interrupted;
-    r.summary.message = lm.message;
-  } else if (lm.converged) {
-    r.summary.termination = Termination::Converged;
   } else {
-    r.summary.termination = Termination::MaxIterations;
-    r.summary.message = lm.message;
+    internal::set_termination(r.summary, lm);
   }
   tf_detail::check_cancellation(r);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -140,9 +140,7 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
     res.summary.termination = Termination::NumericalFailure;
     res.summary.message = "the model cannot be evaluated at the initial parameters";
   } else {
-    res.summary.termination =
-        lm.interrupted ? Termination::Interrupted : lm.converged ? Termination::Converged : Termination::MaxIterations;
-    res.summary.message = lm.converged ? "" : lm.message;
+    internal::set_termination(res.summary, lm);
   }
   res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return res;

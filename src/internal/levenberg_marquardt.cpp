@@ -7,6 +7,14 @@
 
 namespace ctid::internal {
 
+void set_termination(Summary& s, const LmResult& lm) {
+  s.iterations = lm.iterations;
+  s.termination = lm.interrupted ? Termination::Interrupted
+                  : lm.converged ? Termination::Converged
+                                 : Termination::MaxIterations;
+  s.message = lm.converged && !lm.interrupted ? "" : lm.message;
+}
+
 LmResult levenberg_marquardt(const LmEvaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& lo,
                              const Eigen::VectorXd& hi, const LmOptions& o) {
   const Eigen::Index p = x.size();

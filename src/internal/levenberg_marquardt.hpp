@@ -8,6 +8,8 @@
 
 #include <Eigen/Dense>
 
+#include "ctid/core/status.hpp"
+
 namespace ctid::internal {
 
 struct LmOptions {
@@ -30,6 +32,9 @@ struct LmResult {
 /// evaluate(x, r, J) fills r (and J when J != nullptr); returns false when the model
 /// cannot be evaluated at x (e.g. an unstable simulation), which rejects the step.
 using LmEvaluate = std::function<bool(const Eigen::VectorXd& x, Eigen::VectorXd& r, Eigen::MatrixXd* J)>;
+
+/// How a search that could evaluate its start ended: Interrupted, Converged or MaxIterations (with the message).
+void set_termination(Summary& summary, const LmResult& lm);
 
 LmResult levenberg_marquardt(const LmEvaluate& evaluate, Eigen::VectorXd x0, const Eigen::VectorXd& lower,
                              const Eigen::VectorXd& upper, const LmOptions& options);

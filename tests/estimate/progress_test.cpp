@@ -11,16 +11,13 @@
 #include "ctid/estimate/oe.hpp"
 #include "ctid/estimate/srivc.hpp"
 #include "ctid/simulate/lsim.hpp"
+#include "test_util.hpp"
 
 using namespace ctid;
 
 namespace {
 // Second-order plant 1/(s^2 + 0.8 s + 4), PRBS input, 20 dB output noise: several SRIVC and LM iterations.
-IdData plant() {
-  const TransferFunction g(Eigen::VectorXd{{4.0}}, Eigen::VectorXd{{1.0, 0.8, 4.0}});
-  const Eigen::VectorXd u = prbs(2000, {.register_length = 9, .clock_period = 3});
-  return IdData(u, add_noise_snr(lsim(g, u, time_grid(0.02, 2000)), 20.0, 3), 0.02);
-}
+IdData plant() { return test::second_order_record(); }
 
 // Stops at the given iteration of the given stage, recording the calls.
 struct Stopper {

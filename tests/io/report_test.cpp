@@ -8,15 +8,12 @@
 #include "ctid/estimate/srivc.hpp"
 #include "ctid/io/report.hpp"
 #include "ctid/simulate/lsim.hpp"
+#include "test_util.hpp"
 
 using namespace ctid;
 
 namespace {
-IdData plant() {
-  const TransferFunction g(Eigen::VectorXd{{4.0}}, Eigen::VectorXd{{1.0, 0.8, 4.0}});
-  const Eigen::VectorXd u = prbs(2000, {.register_length = 9, .clock_period = 3});
-  return IdData(u, add_noise_snr(lsim(g, u, time_grid(0.02, 2000)), 20.0, 3), 0.02);
-}
+IdData plant() { return test::second_order_record(); }
 int count(const std::string& s, const std::string& what) {
   int n = 0;
   for (size_t at = s.find(what); at != std::string::npos; at = s.find(what, at + 1)) ++n;
