@@ -53,6 +53,21 @@ else
   echo "== winding process: SKIPPED ($winding not available)"
 fi
 
+exchanger="$shared/daisy_heat_exchanger/exchanger.dat"
+if [ -f "$exchanger" ]; then
+  echo "== heat exchanger (DaISy): flow -> outlet temperature, linear CT models; validation fit on the last 1000 samples"
+  head -3000 "$exchanger" > exchanger_est.dat
+  tail -1000 "$exchanger" > exchanger_val.dat
+  x="--ts 1 --input 2 --output 3 --detrend linear"
+  "$ctid" fit exchanger_est.dat $x --method srivc --nb 1 --nf 1 --json exchanger_srivc.json --force >/dev/null
+  "$ctid" fit exchanger_est.dat $x --method tfest --nb 2 --nf 2 --json exchanger_tfest.json --report exchanger_tfest.html \
+    --force >/dev/null
+  check "SRIVC [1 1] validation fit %" "$(fit_of exchanger_srivc.json exchanger_val.dat $x)" gt 38
+  check "tfest [2 2] validation fit %" "$(fit_of exchanger_tfest.json exchanger_val.dat $x)" gt 40
+else
+  echo "== heat exchanger: SKIPPED ($exchanger not available)"
+fi
+
 tanks="$shared/cascaded_tanks/dataBenchmark.csv"
 if [ -f "$tanks" ]; then
   echo "== cascaded tanks (nonlinearbenchmark.org): linear CT models and a NARX model; test-record RMSE (V)"
