@@ -1,7 +1,7 @@
 // Self-contained HTML reports (see include/ctid/io/report.hpp). The page carries its plot data as JSON
 // and draws it with the inlined uPlot; a self-check at the end of loading writes "plots=N drawn=M
-// errors=E" into #ctid-selfcheck (drawn = canvases with at least one painted pixel), which the
-// browser test reads.
+// errors=E" into #ctid-selfcheck (drawn = canvases with at least one painted pixel; run from a timer after
+// uPlot's drawing microtasks), which the browser test reads.
 #include "ctid/io/report.hpp"
 
 #include <algorithm>
@@ -228,7 +228,8 @@ code { background: #f4f4f4; padding: 1px 4px; }
     document.getElementById('ctid-selfcheck').textContent =
       'plots=' + specs.length + ' drawn=' + drawn + ' errors=' + errors;
   }
-  requestAnimationFrame(function () { requestAnimationFrame(check); });
+  // uPlot draws in a microtask; a timer runs after it (animation frames need not come in a headless browser).
+  setTimeout(check, 0);
 })();
 )js";
   std::ostringstream body_;
