@@ -227,9 +227,7 @@ Result<TransferFunction> tf_from_frequency(const FrequencyData& data, const TfOr
   r.diagnostics.scalars["noise_variance"] = sigma2;
   r.diagnostics.scalars["frequency_scale"] = w0;
   r.diagnostics.scalars["sk_iterations"] = sk_done;
-  r.summary.iterations = lm.iterations;
-  r.summary.termination = lm.converged ? Termination::Converged : Termination::MaxIterations;
-  r.summary.message = lm.converged ? "" : lm.message;
+  internal::set_termination(r.summary, lm);
   if (r.summary.succeeded() && !r.model.is_stable())
     r.diagnostics.warnings.push_back("the fitted model is unstable (frequency data do not constrain stability)");
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
