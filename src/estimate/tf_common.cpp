@@ -49,6 +49,34 @@ TransferFunction stabilized(const TransferFunction& tf) {
   return TransferFunction(tf.num(), Polynomial::from_roots(p), tf.io_delay());
 }
 
+std::vector<TfCoefficient> tf_coefficients(const TransferFunction& g, const ParameterSet& p) {
+  const Eigen::VectorXd& den = g.den().coefficients();
+  const Eigen::VectorXd& num = g.num().coefficients();
+  if (den.size() == 0 || den(0) != 1.0) return {};
+  std::vector<TfCoefficient> map(static_cast<size_t>(p.size()));
+  for (int i = 0; i < p.size(); ++i) {
+    const std::string& n = p.names[static_cast<size_t>(i)];
+    if (n.size() < 2 || n.size() > 7 || (n[0] != 'a' && n[0] != 'b') ||
+        n.find_first_not_of("0123456789", 1) != std::string::npos)
+      continue;  // e.g. "delay"
+    const int k = std::stoi(n.substr(1));
+    const Eigen::VectorXd& c = n[0] == 'a' ? den : num;
+    if (k < (n[0] == 'a' ? 1 : 0) || k >= c.size() ||
+        std::abs(c(k) - p.values(i)) > 1e-9 * std::max(1.0, std::abs(c(k))))
+      return {};
+    map[static_cast<size_t>(i)] = {n[0], k};
+  }
+  return map;
+}
+
+TransferFunction with_coefficients(const TransferFunction& g, const std::vector<TfCoefficient>& map,
+                                   const Eigen::VectorXd& v) {
+  Eigen::VectorXd num = g.num().coefficients(), den = g.den().coefficients();
+  for (size_t i = 0; i < map.size(); ++i)
+    if (map[i].poly) (map[i].poly == 'a' ? den : num)(map[i].index) = v(static_cast<Eigen::Index>(i));
+  return TransferFunction(num, den, g.io_delay());
+}
+
 }  // namespace ctid::tf_detail
 
 namespace ctid::tf_detail {
@@ -71,17 +99,13 @@ void check_cancellation(R& r) {
   const ParameterSet& p = r.parameters;
   const Eigen::VectorXd den = r.model.den().coefficients(), num = r.model.num().coefficients();
   const Eigen::Index P = p.size();
-  if (P == 0 || p.covariance.rows() != P || !p.covariance.allFinite() || num.size() < 2 || den(0) != 1.0) return;
+  if (P == 0 || p.covariance.rows() != P || !p.covariance.allFinite() || num.size() < 2) return;
+  const std::vector<TfCoefficient> map = tf_coefficients(r.model, p);
+  if (map.empty()) return;  // another parameterisation
   // Parameter index of each coefficient (-1: not estimated).
   std::vector<int> ia(static_cast<size_t>(den.size()), -1), ib(static_cast<size_t>(num.size()), -1);
-  for (int i = 0; i < P; ++i) {
-    const std::string& n = p.names[static_cast<size_t>(i)];
-    if (n.size() < 2 || n.size() > 4 || n.find_first_not_of("0123456789", 1) != std::string::npos) continue;
-    const int k = std::stoi(n.substr(1));
-    if (n[0] == 'a' && k >= 1 && k < den.size() && den(k) == p.values(i)) ia[static_cast<size_t>(k)] = i;
-    else if (n[0] == 'b' && k < num.size() && num(k) == p.values(i)) ib[static_cast<size_t>(k)] = i;
-    else return;  // another parameterisation
-  }
+  for (size_t i = 0; i < map.size(); ++i)
+    if (map[i].poly) (map[i].poly == 'a' ? ia : ib)[static_cast<size_t>(map[i].index)] = static_cast<int>(i);
   const Eigen::VectorXcd poles = r.model.poles(), zeros = r.model.zeros();
   const double fastest = poles.size() ? poles.cwiseAbs().maxCoeff() : 0.0;
   for (const auto& pole : poles)

@@ -3,7 +3,9 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <vector>
 
+#include "ctid/core/types.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/estimate/orders.hpp"
 #include "ctid/model/transfer_function.hpp"
@@ -18,6 +20,20 @@ TransferFunction tf_of(const Eigen::VectorXd& p, const TfOrders& o, double delay
 double output_error_mse(const TransferFunction& g, const IdData& d);
 /// Mirror unstable poles into the left half plane (prefilters and auxiliary models must be stable).
 TransferFunction stabilized(const TransferFunction& tf);
+
+/// Which transfer-function coefficient each parameter of p is: for a parameter named a<k> (denominator
+/// coefficient k, descending, of a monic denominator) or b<k> (numerator coefficient k) whose value equals
+/// that coefficient of g, {'a' or 'b', k}; other names (e.g. "delay") get {0, -1} and are held at g's value.
+/// Returns an empty vector when g's denominator is not monic or a name a<k>/b<k> does not match g (another
+/// parameterisation, e.g. physical parameters).
+struct TfCoefficient {
+  char poly = 0;  // 'a' (denominator), 'b' (numerator) or 0 (not a coefficient)
+  int index = -1;
+};
+std::vector<TfCoefficient> tf_coefficients(const TransferFunction& g, const ParameterSet& p);
+/// g with the coefficients named by map (from tf_coefficients) set to v.
+TransferFunction with_coefficients(const TransferFunction& g, const std::vector<TfCoefficient>& map,
+                                   const Eigen::VectorXd& v);
 
 /// Near-unidentifiability check of a successful transfer-function estimate with parameters named a1..an,
 /// b0..b(nb-1) and a covariance: a pole p and a zero z whose difference is within the 99 % confidence region

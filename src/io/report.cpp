@@ -16,6 +16,7 @@
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/validate/metrics.hpp"
 #include "ctid/validate/residuals.hpp"
+#include "estimate/tf_common.hpp"
 
 namespace ctid {
 
@@ -411,27 +412,6 @@ void bode(Page& page, const Eigen::VectorXd& w, const Eigen::VectorXcd& h, const
 
 double nyquist(const IdData& d) { return d.is_uniform() ? std::numbers::pi / d.ts() : 0.0; }
 
-// A transfer function with parameter p replaced, when the names are a1..an, b0..b(nb-1) of the model's
-// coefficients (den monic, descending); false for any other parameterisation.
-bool tf_from_parameters(const TransferFunction& g, const ParameterSet& p, const Eigen::VectorXd& v,
-                        TransferFunction* out) {
-  Eigen::VectorXd num = g.num().coefficients(), den = g.den().coefficients();
-  if (den(0) != 1.0) return false;
-  for (int i = 0; i < p.size(); ++i) {
-    const std::string& n = p.names[static_cast<size_t>(i)];
-    if (n.size() < 2 || n.size() > 7 || (n[0] != 'a' && n[0] != 'b') ||
-        n.find_first_not_of("0123456789", 1) != std::string::npos)
-      continue;  // e.g. "delay": held at the model's value
-    const int k = std::stoi(n.substr(1));
-    Eigen::VectorXd& c = n[0] == 'a' ? den : num;
-    if (n[0] == 'a' ? (k < 1 || k >= c.size()) : (k < 0 || k >= c.size())) return false;
-    if (std::abs(c(k) - p.values(i)) > 1e-9 * std::max(1.0, std::abs(c(k)))) return false;  // not this ordering
-    c(k) = v(i);
-  }
-  *out = TransferFunction(num, den, g.io_delay());
-  return true;
-}
-
 }  // namespace
 
 std::string html_report(const IdData& d, const Result<TransferFunction>& r, const ReportOptions& o) {
@@ -445,33 +425,28 @@ std::string html_report(const IdData& d, const Result<TransferFunction>& r, cons
   const Eigen::VectorXcd h = r.model.frequency_response(w);
   // 95 % band of |G| from 200 draws of the parameter covariance (seeded: the report is reproducible).
   Eigen::VectorXd lo, hi;
-  TransferFunction probe;
   const int P = r.parameters.size();
-  if (P > 0 && r.parameters.covariance.rows() == P && r.parameters.covariance.allFinite() &&
-      tf_from_parameters(r.model, r.parameters, r.parameters.values, &probe)) {
+  const std::vector<tf_detail::TfCoefficient> map = tf_detail::tf_coefficients(r.model, r.parameters);
+  if (P > 0 && r.parameters.covariance.rows() == P && r.parameters.covariance.allFinite() && !map.empty()) {
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(r.parameters.covariance);
     const Eigen::MatrixXd L = es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
     std::mt19937 rng(1);
     std::normal_distribution<double> n01;
     const int K = 200;
     Eigen::MatrixXd mags(K, w.size());
-    int ok = 0;
     for (int k = 0; k < K; ++k) {
       Eigen::VectorXd z(P);
       for (auto& v : z) v = n01(rng);
-      TransferFunction g;
-      if (tf_from_parameters(r.model, r.parameters, r.parameters.values + L * z, &g))
-        mags.row(ok++) = g.frequency_response(w).cwiseAbs().transpose();
+      const TransferFunction g = tf_detail::with_coefficients(r.model, map, r.parameters.values + L * z);
+      mags.row(k) = g.frequency_response(w).cwiseAbs().transpose();
     }
-    if (ok == K) {
-      lo.resize(w.size());
-      hi.resize(w.size());
-      for (Eigen::Index j = 0; j < w.size(); ++j) {
-        std::vector<double> c(mags.col(j).data(), mags.col(j).data() + K);
-        std::sort(c.begin(), c.end());
-        lo(j) = c[static_cast<size_t>(0.025 * K)];
-        hi(j) = c[static_cast<size_t>(0.975 * K) - 1];
-      }
+    lo.resize(w.size());
+    hi.resize(w.size());
+    for (Eigen::Index j = 0; j < w.size(); ++j) {
+      std::vector<double> c(mags.col(j).data(), mags.col(j).data() + K);
+      std::sort(c.begin(), c.end());
+      lo(j) = c[static_cast<size_t>(0.025 * K)];
+      hi(j) = c[static_cast<size_t>(0.975 * K) - 1];
     }
   }
   bode(page, w, h, lo.size() ? &lo : nullptr, hi.size() ? &hi : nullptr);
