@@ -58,12 +58,13 @@ def _columns(a, name):
 
 def _from_arrays(cls, u, y, ts=None, t=None, t0=0.0, input_names=None, output_names=None, intersample=None):
     """A record from arrays shaped (n_samples,) or (n_samples, n_channels): uniform with ts (and t0), or at the
-    strictly increasing times t. u may be None or empty for a time series."""
+    strictly increasing times t (uniform when every step is within 1e-6 of the mean step, as in ctid.load).
+    u may be None or empty for a time series."""
     y = _columns(y, "y")
     u = _np.zeros((y.shape[0], 0)) if u is None else _columns(u, "u")
     if (ts is None) == (t is None):
         raise InvalidArgument("IdData.from_arrays: give either ts (uniform sampling) or t (sample times)")
-    d = IdData(u, y, float(ts), float(t0)) if t is None else IdData(u, y, _np.asarray(t, dtype=float).ravel())
+    d = IdData(u, y, float(ts), float(t0)) if t is None else IdData.from_times(u, y, _np.asarray(t, dtype=float).ravel())
     if input_names is not None:
         d.input_names = list(input_names)
     if output_names is not None:

@@ -48,6 +48,8 @@ void bind_core(py::module_& m) {
       .def(py::init<Eigen::MatrixXd, Eigen::MatrixXd, double, double>(), py::arg("u"), py::arg("y"), py::arg("ts"),
            py::arg("t0") = 0.0)
       .def(py::init<Eigen::MatrixXd, Eigen::MatrixXd, Eigen::VectorXd>(), py::arg("u"), py::arg("y"), py::arg("t"))
+      .def_static("from_times", &IdData::from_times, py::arg("u"), py::arg("y"), py::arg("t"),
+                  "Samples at times t; uniform when every step is within 1e-6 of the mean step.")
       .def_property_readonly("u", &IdData::u)
       .def_property_readonly("y", &IdData::y)
       .def_property_readonly("ts", &IdData::ts)

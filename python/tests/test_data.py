@@ -40,7 +40,18 @@ def test_load_bundled_dryer(tmp_path):
 
 
 def test_from_pandas_when_available():
+    # pandas is installed by scripts/install-deps.sh (python3-pandas); elsewhere the test skips.
     pd = pytest.importorskip("pandas")
-    frame = pd.DataFrame({"t": np.arange(5) * 0.1, "u": np.ones(5), "y": np.arange(5.0)})
-    d = ctid.IdData.from_pandas(frame, inputs=["u"], outputs=["y"], time="t")
-    assert d.input_names == ["u"] and len(d) == 5
+    frame = pd.DataFrame({"t": np.arange(5) * 0.1, "u": np.ones(5, dtype=int), "y": np.arange(5.0),
+                          "w": np.linspace(0, 1, 5)})
+    d = ctid.IdData.from_pandas(frame, inputs=["u", "w"], outputs=["y"], time="t")
+    assert d.input_names == ["u", "w"] and d.output_names == ["y"] and len(d) == 5
+    np.testing.assert_array_equal(d.u, frame[["u", "w"]].to_numpy(dtype=float))  # ints converted, columns kept
+    np.testing.assert_array_equal(d.y[:, 0], frame["y"].to_numpy())
+    assert d.is_uniform and d.ts == pytest.approx(0.1)
+    assert ctid.IdData.from_pandas(frame, inputs=["u"], outputs=["y"], ts=0.5).times[-1] == pytest.approx(2.0)
+    with pytest.raises(KeyError, match="nope"):
+        ctid.IdData.from_pandas(frame, inputs=["nope"], outputs=["y"], ts=1.0)
+    bad = frame.assign(y=[0.0, 1.0, float("nan"), 3.0, 4.0])
+    with pytest.raises(ValueError, match="NaN|non-finite|Inf"):
+        ctid.IdData.from_pandas(bad, inputs=["u"], outputs=["y"], ts=1.0)

@@ -46,6 +46,17 @@ IdData::IdData(Eigen::MatrixXd u, Eigen::MatrixXd y, Eigen::VectorXd t)
   check_and_init();
 }
 
+IdData IdData::from_times(Eigen::MatrixXd u, Eigen::MatrixXd y, Eigen::VectorXd t) {
+  const Eigen::Index N = t.size();
+  if (N > 1 && t.allFinite()) {
+    const double h = (t(N - 1) - t(0)) / double(N - 1);
+    bool uniform = h > 0;
+    for (Eigen::Index k = 1; k < N && uniform; ++k) uniform = std::abs((t(k) - t(k - 1)) - h) <= 1e-6 * h;
+    if (uniform) return IdData(std::move(u), std::move(y), h, t(0));
+  }
+  return IdData(std::move(u), std::move(y), std::move(t));
+}
+
 void IdData::check_and_init() {
   CTID_REQUIRE(y_.cols() >= 1, "IdData: at least one output channel is needed (y has {} columns)", y_.cols());
   CTID_REQUIRE(y_.rows() >= 1, "IdData: at least one sample is needed (y has {} rows)", y_.rows());

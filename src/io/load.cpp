@@ -26,12 +26,7 @@ IdData assemble(const Eigen::MatrixXd& u, const Eigen::MatrixXd& y, const Eigen:
         throw FileError(detail::format("{}: time column '{}' is not strictly increasing ({} after {})", where, s.time,
                                        (*t)(k), (*t)(k - 1)));
       }
-    // Uniform within rounding -> keep as uniform data (exact Ts = mean step).
-    const Eigen::Index N = t->size();
-    const double h = N > 1 ? ((*t)(N - 1) - (*t)(0)) / double(N - 1) : 1.0;
-    bool uniform = N > 1;
-    for (Eigen::Index k = 1; k < N && uniform; ++k) uniform = std::abs(((*t)(k) - (*t)(k - 1)) - h) <= 1e-6 * h;
-    d = uniform ? IdData(u, y, h, (*t)(0)) : IdData(u, y, *t);
+    d = IdData::from_times(u, y, *t);
   } else {
     d = IdData(u, y, s.ts);
   }

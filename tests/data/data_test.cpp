@@ -18,6 +18,17 @@ TEST(IdData, UniformAndIrregularTimes) {
   EXPECT_FALSE(r.is_uniform());
   EXPECT_THROW(r.ts(), InvalidArgument);
   EXPECT_DOUBLE_EQ(r.time(2), 0.35);
+  // from_times: steps of 0.1 with rounding (0.30000000000000004) are uniform; a 1e-5 relative jitter is not.
+  Eigen::VectorXd t(5);
+  for (int k = 0; k < 5; ++k) t(k) = 1.0 + k * 0.1;
+  const IdData f = IdData::from_times(Eigen::VectorXd::Ones(5), Eigen::VectorXd::Ones(5), t);
+  ASSERT_TRUE(f.is_uniform());
+  EXPECT_NEAR(f.ts(), 0.1, 1e-15);
+  EXPECT_DOUBLE_EQ(f.t0(), 1.0);
+  t(2) += 1e-6;
+  EXPECT_FALSE(IdData::from_times(Eigen::VectorXd::Ones(5), Eigen::VectorXd::Ones(5), t).is_uniform());
+  EXPECT_THROW(IdData::from_times(Eigen::VectorXd::Ones(2), Eigen::VectorXd::Ones(2), Eigen::Vector2d(1.0, 1.0)),
+               InvalidArgument);
 }
 
 TEST(IdData, BadInputMessagesNameTheValues) {

@@ -37,6 +37,10 @@ class IdData {
   IdData(Eigen::MatrixXd u, Eigen::MatrixXd y, double ts, double t0 = 0.0);
   /// Explicit, strictly increasing sample times t (length N).
   IdData(Eigen::MatrixXd u, Eigen::MatrixXd y, Eigen::VectorXd t);
+  /// Samples at the strictly increasing times t, kept as uniform data (Ts = mean step, t0 = t[0]) when every
+  /// step is within 1e-6 of the mean step (a time column written with rounding), else irregular. Used by the
+  /// file readers and Python's from_arrays; errors as the constructors.
+  static IdData from_times(Eigen::MatrixXd u, Eigen::MatrixXd y, Eigen::VectorXd t);
 
   int size() const { return static_cast<int>(y_.rows()); }
   int nu() const { return static_cast<int>(u_.cols()); }
