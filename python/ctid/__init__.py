@@ -13,10 +13,9 @@ import numpy as _np
 
 from . import _ctid
 from ._ctid import (  # noqa: F401  (re-exported)
-    CorrelationTest, FileError, FsfModel, IdData, InputGenerator, InvalidArgument, InvalidOptions, NarxModel, NarxTerm,
-    ModalWindow, NdeModel, NdeSimulation, NdeTerm, NonlinearCorrelationTests, PhysicalModel, TransferFunction,
-    add_noise_snr,
-    fit_percent, html_report, input_residual_crosscorrelation, load, narx_candidates, narx_noise_candidates,
+    CorrelationTest, FileError, FrequencyData, FsfModel, IdData, InputGenerator, InvalidArgument, InvalidOptions,
+    MisoModel, ModalWindow, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm, NonlinearCorrelationTests,
+    PhysicalModel, TransferFunction, add_noise_snr, fit_percent, html_report, input_residual_crosscorrelation, load, narx_candidates, narx_noise_candidates,
     nonlinear_correlation_tests, prbs, read_narx_json, read_nde_json, residual_autocorrelation, time_grid,
 )
 
@@ -104,7 +103,7 @@ def _report(result):
     return "\n".join(lines)
 
 
-for _cls in (_ctid.TransferFunctionResult, _ctid.FsfResult, _ctid.NarxResult, _ctid.NdeResult):
+for _cls in (_ctid.TransferFunctionResult, _ctid.MisoResult, _ctid.FsfResult, _ctid.NarxResult, _ctid.NdeResult):
     _cls.__repr__ = _report
     _cls.report = _report
 
@@ -134,6 +133,38 @@ def oe(data, nb, nf, nk=0, **options):
 def tfest(data, nb, nf, nk=0, **options):
     """SRIVC start, then output-error refinement (options: OeOptions)."""
     return _ctid.tfest(data, nb, nf, nk, _options(_ctid.OeOptions, "tfest", options))
+
+
+def srivc_miso(data, orders, **options):
+    """SRIVC with several inputs: orders is one (nb, nf, nk) per input (options: SrivcMisoOptions, e.g.
+    common_denominator=True, delays=[..] in s)."""
+    return _ctid.srivc_miso(data, [tuple(o) for o in orders], _options(_ctid.SrivcMisoOptions, "srivc_miso", options))
+
+
+def srivc_closed_loop(data, reference, nb, nf, nk=0, **options):
+    """Closed-loop SRIVC: data holds the plant input and output, reference the reference signal (one value per
+    sample); options: ClosedLoopOptions, controller= the known TransferFunction (required)."""
+    if "controller" not in options:
+        raise InvalidOptions("srivc_closed_loop: the known controller is required (controller=TransferFunction(...))")
+    return _ctid.srivc_closed_loop(data, _np.asarray(reference, dtype=float).ravel(), nb, nf, nk,
+                                   _options(_ctid.ClosedLoopOptions, "srivc_closed_loop", options))
+
+
+def tf_from_frequency(data, nb, nf, **options):
+    """Transfer function fitted to frequency-response data (a FrequencyData, or a pair (w, G) of arrays);
+    options: FrequencyFitOptions."""
+    if not isinstance(data, FrequencyData):
+        w, g = data
+        data = FrequencyData(_np.asarray(w, dtype=float), _np.asarray(g, dtype=complex))
+    return _ctid.tf_from_frequency(data, nb, nf, _options(_ctid.FrequencyFitOptions, "tf_from_frequency", options))
+
+
+def select_order(data, nb, nf, nk=(0, 0), rank_by="yic", **srivc_options):
+    """Rank every structure of the (min, max) ranges nb, nf, nk by SRIVC fits (CONTSID's srivcstruc);
+    rank_by: yic, rt2, aic or bic; further keywords are SrivcOptions. Returns OrderCandidates, usable first."""
+    o = _options(_ctid.OrderSelectionOptions, "select_order", {"rank_by": rank_by})
+    o.srivc = _options(_ctid.SrivcOptions, "select_order", srivc_options)
+    return _ctid.select_order(data, tuple(nb), tuple(nf), tuple(nk), o)
 
 
 def fsf(data, **options):
@@ -228,6 +259,8 @@ def simulate(model, data, **kwargs):
     t = data.times - data.t0
     if isinstance(model, TransferFunction):
         return model.simulate(u, t, data.intersample[0])
+    if isinstance(model, MisoModel):
+        return model.simulate(data)
     if isinstance(model, FsfModel):
         return model.simulate(u)
     if isinstance(model, NarxModel):

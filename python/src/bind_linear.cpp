@@ -1,5 +1,6 @@
-// ctid Python module — linear transfer-function estimators: Johansson's LSSVF/IVSVF, SRIVC, output error
-// and tfest (options structs field for field; ctid/__init__.py turns keyword arguments into them).
+// ctid Python module — linear transfer-function estimators: Johansson's LSSVF/IVSVF, SRIVC (SISO, MISO,
+// closed loop), output error, tfest, fits to frequency-response data and order selection (options structs
+// field for field; ctid/__init__.py turns keyword arguments into them).
 #include "common.hpp"
 
 namespace ctid::python {
@@ -57,11 +58,108 @@ void bind_linear(py::module_& m) {
       .def_readwrite("delay", &OeOptions::delay)
       .def_readwrite("srivc", &OeOptions::srivc);
 
+  py::class_<SrivcMisoOptions>(m, "SrivcMisoOptions")
+      .def(py::init<>())
+      .def_readwrite("max_iterations", &SrivcMisoOptions::max_iterations)
+      .def_readwrite("tolerance", &SrivcMisoOptions::tolerance)
+      .def_readwrite("common_denominator", &SrivcMisoOptions::common_denominator)
+      .def_readwrite("delays", &SrivcMisoOptions::delays);
+  py::class_<ClosedLoopOptions>(m, "ClosedLoopOptions")
+      .def(py::init<>())
+      .def_readwrite("controller", &ClosedLoopOptions::controller)
+      .def_readwrite("reference_at_plant_input", &ClosedLoopOptions::reference_at_plant_input)
+      .def_property(
+          "reference_intersample", [](const ClosedLoopOptions& o) { return to_string(o.reference_intersample); },
+          [](ClosedLoopOptions& o, const std::string& s) { o.reference_intersample = intersample_from_string(s); })
+      .def_readwrite("max_iterations", &ClosedLoopOptions::max_iterations)
+      .def_readwrite("tolerance", &ClosedLoopOptions::tolerance);
+  py::class_<FrequencyData>(m, "FrequencyData", "G(jw) at angular frequencies w (rad/s).")
+      .def(py::init<Eigen::VectorXd, Eigen::VectorXcd>(), py::arg("w"), py::arg("response"))
+      .def_static("from_spectra", &FrequencyData::from_spectra, py::arg("w"), py::arg("U"), py::arg("Y"),
+                  "G = Y / U from input and output spectra at w.")
+      .def_property_readonly("w", &FrequencyData::w)
+      .def_property_readonly("response", &FrequencyData::response)
+      .def("__len__", &FrequencyData::size);
+  py::class_<FrequencyFitOptions>(m, "FrequencyFitOptions")
+      .def(py::init<>())
+      .def_readwrite("sk_iterations", &FrequencyFitOptions::sk_iterations)
+      .def_readwrite("refine", &FrequencyFitOptions::refine)
+      .def_readwrite("max_iterations", &FrequencyFitOptions::max_iterations)
+      .def_readwrite("tolerance", &FrequencyFitOptions::tolerance)
+      .def_readwrite("estimate_delay", &FrequencyFitOptions::estimate_delay)
+      .def_readwrite("delay", &FrequencyFitOptions::delay)
+      .def_readwrite("require_stable", &FrequencyFitOptions::require_stable);
+  py::enum_<OrderCriterion>(m, "OrderCriterion")
+      .value("Yic", OrderCriterion::Yic)
+      .value("Rt2", OrderCriterion::Rt2)
+      .value("Aic", OrderCriterion::Aic)
+      .value("Bic", OrderCriterion::Bic);
+  py::class_<OrderSelectionOptions>(m, "OrderSelectionOptions")
+      .def(py::init<>())
+      .def_readwrite("srivc", &OrderSelectionOptions::srivc)
+      .def_readwrite("rank_by", &OrderSelectionOptions::rank_by);
+  py::class_<OrderCandidate>(m, "OrderCandidate", "One ranked structure of select_order.")
+      .def_property_readonly("orders",
+                             [](const OrderCandidate& c) { return py::make_tuple(c.orders.nb, c.orders.nf, c.orders.nk); })
+      .def_readonly("yic", &OrderCandidate::yic)
+      .def_readonly("rt2", &OrderCandidate::rt2)
+      .def_readonly("aic", &OrderCandidate::aic)
+      .def_readonly("bic", &OrderCandidate::bic)
+      .def_readonly("fit_percent", &OrderCandidate::fit_percent)
+      .def_readonly("usable", &OrderCandidate::usable)
+      .def_readonly("termination", &OrderCandidate::termination)
+      .def("__repr__", [](const OrderCandidate& c) {
+        return detail::format("[nb={} nf={} nk={}] yic {:.4g}, rt2 {:.4g}, fit {:.2f} %{}", c.orders.nb, c.orders.nf,
+                              c.orders.nk, c.yic, c.rt2, c.fit_percent, c.usable ? "" : " (not usable: " + c.termination + ")");
+      });
+  py::class_<MisoModel>(m, "MisoModel", "y = sum_i G_i(s) u_i: one transfer function per input.")
+      .def(py::init<>())
+      .def_readwrite("channels", &MisoModel::channels)
+      .def_property_readonly("nu", &MisoModel::nu)
+      .def("is_stable", &MisoModel::is_stable)
+      .def("simulate", [](const MisoModel& g, const IdData& d) { return lsim(g, d); }, py::arg("data"),
+           "Exact simulation from rest of the inputs of data (their intersample behaviour).")
+      .def("__repr__", [](const MisoModel& g) { return g.to_string(6); });
+  bind_result<MisoModel>(m, "MisoResult");
+
   def_tf_estimator<LssvfOptions>(m, "lssvf", &lssvf, "Johansson (1986) least squares on state-variable-filtered signals.");
   def_tf_estimator<IvsvfOptions>(m, "ivsvf", &ivsvf, "Johansson's regression with instrumental variables.");
   def_tf_estimator<SrivcOptions>(m, "srivc", &srivc, "Simplified refined instrumental variables (SISO).");
   def_tf_estimator<OeOptions>(m, "oe", &oe, "Continuous-time output error (Levenberg-Marquardt).");
   def_tf_estimator<OeOptions>(m, "tfest", &tfest, "SRIVC start, then output-error refinement.");
+  m.def(
+      "srivc_miso",
+      [](const IdData& d, const std::vector<std::tuple<int, int, int>>& orders, const SrivcMisoOptions& o) {
+        std::vector<TfOrders> to;
+        for (const auto& [nb, nf, nk] : orders) to.push_back({nb, nf, nk});
+        return interruptible([&] { return srivc_miso(d, to, o); });
+      },
+      py::arg("data"), py::arg("orders"), py::arg("options") = SrivcMisoOptions{},
+      "SRIVC with several inputs; orders: one (nb, nf, nk) per input.");
+  m.def(
+      "srivc_closed_loop",
+      [](const IdData& d, const Eigen::VectorXd& reference, int nb, int nf, int nk, const ClosedLoopOptions& o) {
+        return interruptible([&] { return srivc_closed_loop(d, reference, TfOrders{nb, nf, nk}, o); });
+      },
+      py::arg("data"), py::arg("reference"), py::arg("nb"), py::arg("nf"), py::arg("nk"), py::arg("options"),
+      "Closed-loop SRIVC with a known controller (instruments from the reference).");
+  m.def(
+      "tf_from_frequency",
+      [](const FrequencyData& d, int nb, int nf, const FrequencyFitOptions& o) {
+        return interruptible([&] { return tf_from_frequency(d, TfOrders{nb, nf, 0}, o); });
+      },
+      py::arg("data"), py::arg("nb"), py::arg("nf"), py::arg("options") = FrequencyFitOptions{},
+      "Sanathanan-Koerner iterations, then output-error refinement on G(jw).");
+  m.def(
+      "select_order",
+      [](const IdData& d, std::pair<int, int> nb, std::pair<int, int> nf, std::pair<int, int> nk,
+         const OrderSelectionOptions& o) {
+        return interruptible([&] {
+          return select_order(d, {nb.first, nb.second}, {nf.first, nf.second}, {nk.first, nk.second}, o);
+        });
+      },
+      py::arg("data"), py::arg("nb"), py::arg("nf"), py::arg("nk"), py::arg("options") = OrderSelectionOptions{},
+      "Fit every [nb nf nk] of the (min, max) ranges by SRIVC; ranked, usable first.");
 }
 
 }  // namespace ctid::python

@@ -73,3 +73,66 @@ def test_ctrl_c_interrupts_a_long_estimation():
     assert r.summary.termination == "interrupted"
     assert 1 <= len(r.parameters) < 20
     assert not r.usable()
+
+
+def test_srivc_miso_noise_free_recovers_both_channels():
+    # y = 2/(s + 1) u1 + (s + 3)/(s^2 + 2 s + 5) u2, two independent PRBS, noise-free: SRIVC is exact up to
+    # its convergence tolerance (1e-7), so the coefficients agree to 1e-4.
+    t = ctid.time_grid(0.02, 3000)
+    u1 = ctid.prbs(3000, register_length=10, clock_period=4)
+    u2 = ctid.prbs(3000, register_length=8, clock_period=7)
+    g1, g2 = ctid.TransferFunction([2.0], [1.0, 1.0]), ctid.TransferFunction([1.0, 3.0], [1.0, 2.0, 5.0])
+    y = g1.simulate(u1, t) + g2.simulate(u2, t)
+    d = ctid.IdData.from_arrays(np.column_stack([u1, u2]), y, ts=0.02)
+    r = ctid.srivc_miso(d, [(1, 1, 0), (2, 2, 0)], max_iterations=50)
+    assert r.usable(), r.summary.message
+    np.testing.assert_allclose(r.model.channels[0].den, [1, 1], atol=1e-4)
+    np.testing.assert_allclose(r.model.channels[1].num, [1, 3], atol=1e-4)
+    np.testing.assert_allclose(ctid.simulate(r, d), y, atol=1e-4 * np.abs(y).max())
+    assert "u1" in repr(r.model) and "fit:" in repr(r)
+    with pytest.raises(ValueError, match="input"):
+        ctid.srivc_miso(d, [(1, 1, 0)])
+
+
+def test_srivc_closed_loop_with_known_pi_controller():
+    # Plant G = 1/(s^2 + 1.2 s + 2) under C = (2 s + 1)/s, reference added at the plant input: u = r - C y.
+    # Closed loop: y/r = B Dc / (A Dc + B Nc), u/r = A Dc / (A Dc + B Nc), simulated in continuous time, so u is
+    # not held between samples as the estimator assumes: an O(Ts) error (measured 0.8 % on a1 at Ts = 0.01 s,
+    # 0.08 % at 0.001 s), hence the 2 % tolerance on noise-free data.
+    a, b, nc, dc = [1.0, 1.2, 2.0], [1.0], [2.0, 1.0], [1.0, 0.0]
+    cl = np.polyadd(np.polymul(a, dc), np.polymul(b, nc))
+    t = ctid.time_grid(0.01, 6000)
+    r_ = ctid.prbs(6000, register_length=10, clock_period=20)
+    y = ctid.TransferFunction(np.polymul(b, dc), cl).simulate(r_, t)
+    u = ctid.TransferFunction(np.polymul(a, dc), cl).simulate(r_, t)
+    d = ctid.IdData.from_arrays(u, y, ts=0.01)
+    res = ctid.srivc_closed_loop(d, r_, 1, 2, controller=ctid.TransferFunction(nc, dc))
+    assert res.usable(), res.summary.message
+    np.testing.assert_allclose(res.model.den, a, rtol=0.02)
+    np.testing.assert_allclose(res.model.num, b, rtol=0.02)
+    with pytest.raises(ctid.InvalidOptions, match="controller"):
+        ctid.srivc_closed_loop(d, r_, 1, 2)
+
+
+def test_tf_from_frequency_exact_data_and_pairs():
+    # 60 exact samples of 4/(s^2 + 0.8 s + 4) (log-spaced 0.1..30 rad/s): the fit returns it to 1e-8.
+    g = ctid.TransferFunction([4.0], [1.0, 0.8, 4.0])
+    w = np.logspace(-1, np.log10(30), 60)
+    r = ctid.tf_from_frequency((w, g.freqresp(w)), 1, 2)
+    assert r.usable(), r.summary.message
+    np.testing.assert_allclose(r.model.den, [1, 0.8, 4], atol=1e-8)
+    f = ctid.FrequencyData.from_spectra(w, np.ones(60, complex), g.freqresp(w))
+    assert len(f) == 60 and ctid.tf_from_frequency(f, 1, 2, refine=False).model.dc_gain() == pytest.approx(1, abs=1e-8)
+    with pytest.raises(ctid.InvalidArgument, match="increasing"):
+        ctid.FrequencyData(w[::-1], g.freqresp(w[::-1]))
+
+
+def test_select_order_ranks_the_true_structure_first(plant):
+    # 20 dB noise on 4/(s^2 + 0.8 s + 4): by YIC and by BIC the true [1 2 0] ranks first among nf 1..3.
+    _, d = plant
+    for rank_by in ("yic", "bic"):
+        ranked = ctid.select_order(d, nb=(1, 2), nf=(1, 3), rank_by=rank_by)
+        assert ranked[0].orders == (1, 2, 0), (rank_by, ranked[:3])
+        assert ranked[0].usable and ranked[0].fit_percent > 85
+    with pytest.raises(ValueError, match="must be one of"):
+        ctid.select_order(d, nb=(1, 1), nf=(1, 2), rank_by="mdl")

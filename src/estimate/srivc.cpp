@@ -360,18 +360,29 @@ Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& or
     ch.push_back({data.u().col(i), data.intersample(i),
                   (opt.delays.empty() ? 0.0 : opt.delays[i]) + (orders[i].nk > 0 ? orders[i].nk * data.ts() : 0.0),
                   orders[i].nb});
-  // Start: SISO SRIVC of y on each input alone (the other inputs act as noise).
-  std::vector<Eigen::VectorXd> th(K);
-  for (int i = 0; i < K; ++i) {
-    IdData di = data.select({i}, {0});
-    SrivcOptions so;
-    so.delay = ch[i].delay;
-    so.max_iterations = 10;
-    th[i] = srivc(di, {orders[i].nb, orders[i].nf, 0}, so).parameters.values;
-  }
   auto channel_model = [&](int i, const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
     return tf_detail::make_tf(a, b, ch[i].delay);
   };
+  // Start, input by input: SISO SRIVC of y minus the outputs of the channels fitted before (the later inputs
+  // act as noise). Fitting every channel on y alone instead gives starts biased by all other inputs (at
+  // equal input powers a 0 dB "noise"), from which the iterations can end rank-deficient.
+  std::vector<Eigen::VectorXd> th(K);
+  {
+    Eigen::VectorXd rest = y;
+    for (int i = 0; i < K; ++i) {
+      const Eigen::MatrixXd ui = data.u().col(i);
+      IdData rk = data.is_uniform() ? IdData(ui, rest, data.ts(), data.t0()) : IdData(ui, rest, t);
+      rk.set_intersample(data.intersample(i));
+      SrivcOptions so;
+      so.delay = ch[i].delay;
+      so.max_iterations = 20;
+      const Result<TransferFunction> s = srivc(rk, {orders[i].nb, orders[i].nf, 0}, so);
+      th[i] = s.parameters.values;
+      const TransferFunction gi = tf_detail::stabilized(channel_model(i, th[i].head(orders[i].nf), th[i].tail(orders[i].nb)));
+      th[i] = tf_detail::params_of(gi, {orders[i].nb, orders[i].nf, 0});
+      rest -= lsim(gi, data, i);
+    }
+  }
   Result<MisoModel> r;
   SrivcRun last;
   bool converged = false, failed = false;
@@ -419,7 +430,9 @@ Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& or
         if (s.rank_deficient) { failed = true; break; }
         change = std::max(change, relative_change(s.theta, th[i]));
         th[i] = s.theta;
-        xhat[i] = lsim(channel_model(i, th[i].head(orders[i].nf), th[i].tail(orders[i].nb)), data, i);
+        // The other channels see this one through its simulated output: an unstable intermediate estimate
+        // would swamp them, so it is simulated with its poles mirrored into the left half plane.
+        xhat[i] = lsim(tf_detail::stabilized(channel_model(i, th[i].head(orders[i].nf), th[i].tail(orders[i].nb))), data, i);
         const int pi = orders[i].nf + orders[i].nb;
         zz_blocks.block(off, off, pi, pi) = s.zz;
         off += pi;

@@ -243,6 +243,31 @@ TEST(SrivcMiso, DifferentDenominatorsNoiseFreeExactAndNoisyWithinUncertainty) {
   for (int i = 0; i < 6; ++i) EXPECT_LT(std::abs(n.parameters.values(i) - kMisoTheta(i)), 3 * n.parameters.std(i)) << i;
 }
 
+TEST(SrivcMiso, SeparateDenominatorsConvergeWhateverTheInputOrder) {
+  // y = (s + 3)/(s^2 + 2 s + 5) u1 + 2/(s + 1) u2, two PRBS of equal power (10-bit, clock 4 and 8-bit, clock 7),
+  // Ts = 0.02 s, 3000 samples, noise-free. Regression: starting every channel from a SISO fit on y alone (the
+  // other input a 0 dB "noise") gave channel 1 a pole at +0.02 and the backfitting ended rank-deficient (in
+  // 12 of 72 input/order/noise combinations); with the sequential start and stabilised channel outputs all
+  // 72 converge. Noise-free the estimate is exact to the convergence tolerance (1e-7; bound 1e-6).
+  const double Ts = 0.02;
+  const Eigen::VectorXd t = time_grid(Ts, 3000);
+  const Eigen::VectorXd u1 = prbs(3000, {.register_length = 8, .clock_period = 7});
+  const Eigen::VectorXd u2 = prbs(3000, {.register_length = 10, .clock_period = 4});
+  const TransferFunction g1(Eigen::VectorXd{{1.0, 3.0}}, Eigen::VectorXd{{1.0, 2.0, 5.0}});
+  const TransferFunction g2(Eigen::VectorXd{{2.0}}, Eigen::VectorXd{{1.0, 1.0}});
+  const Eigen::VectorXd y = lsim(g1, u1, t, Intersample::Zoh) + lsim(g2, u2, t, Intersample::Zoh);
+  Eigen::MatrixXd u(3000, 2);
+  u << u1, u2;
+  const auto r = srivc_miso(IdData(u, y, Ts), {{2, 2, 0}, {1, 1, 0}});
+  ASSERT_EQ(r.summary.termination, Termination::Converged) << r.summary.message;
+  EXPECT_LT(max_rel(r.parameters.values, Eigen::VectorXd{{2.0, 5.0, 1.0, 3.0, 1.0, 2.0}}), 1e-6);
+  Eigen::MatrixXd swapped(3000, 2);
+  swapped << u2, u1;
+  const auto s = srivc_miso(IdData(swapped, y, Ts), {{1, 1, 0}, {2, 2, 0}});
+  ASSERT_EQ(s.summary.termination, Termination::Converged) << s.summary.message;
+  EXPECT_LT(max_rel(s.parameters.values, Eigen::VectorXd{{1.0, 2.0, 2.0, 5.0, 1.0, 3.0}}), 1e-6);
+}
+
 TEST(SrivcMiso, CommonDenominatorNoiseFreeExact) {
   const Miso m;
   const TransferFunction c1(Eigen::VectorXd{{2.0}}, Eigen::VectorXd{{1.0, 1.5, 4.0}});
