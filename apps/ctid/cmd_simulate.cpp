@@ -75,17 +75,20 @@ int run(const SimArgs& a) {
   } else if (const auto* tf = std::get_if<TransferFunction>(&m)) {
     if (d.nu() != 1) throw UsageError(detail::format("the transfer function has 1 input but {} input columns were selected", d.nu()));
     y = lsim(*tf, d, 0);
+    require_finite_simulation(y, d, unstable_poles(MisoModel{{*tf}}));
     ynames = {"y"};
   } else if (const auto* mm = std::get_if<MisoModel>(&m)) {
     if (d.nu() != mm->nu())
       throw UsageError(detail::format("the model has {} inputs but {} input columns were selected", mm->nu(), d.nu()));
     y = lsim(*mm, d);
+    require_finite_simulation(y, d, unstable_poles(*mm));
     ynames = {"y"};
   } else {
     const auto& ss = std::get<StateSpace>(m);
     if (d.nu() != ss.nu())
       throw UsageError(detail::format("the model has {} inputs but {} input columns were selected", ss.nu(), d.nu()));
     y = lsim(ss, d);
+    require_finite_simulation(y, d, "");
     for (int j = 0; j < ss.ny(); ++j) ynames.push_back("y" + std::to_string(j + 1));
   }
   if (!std::isnan(a.snr)) {

@@ -43,6 +43,7 @@ int run(const ValArgs& a) {
                                     d.nu(), d.ny()));
   if (a.lags < 1 || a.lags >= d.size()) throw UsageError(detail::format("--lags must be in [1, {}]", d.size() - 1));
   const Eigen::VectorXd yhat = lsim(miso, d);
+  require_finite_simulation(yhat, d, unstable_poles(miso));
   const Eigen::VectorXd y = d.y().col(0);
   int np = 0;
   for (const auto& c : miso.channels) np += c.num().degree() + 1 + c.order();

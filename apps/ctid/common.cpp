@@ -93,6 +93,31 @@ std::map<std::string, std::string> parse_sets(const std::vector<std::string>& se
   return m;
 }
 
+void require_finite_simulation(const Eigen::MatrixXd& y, const IdData& d, const std::string& why) {
+  // Diverged: a non-finite sample, or samples so large that their squares overflow (then every fit measure
+  // and correlation would be Inf or 0/Inf).
+  double acc = 0;
+  for (Eigen::Index k = 0; k < y.rows(); ++k) {
+    acc += y.row(k).squaredNorm();
+    if (!std::isfinite(acc))
+      throw NotUsable(detail::format("the simulated output is not finite from sample {} (t = {} s) on: the model diverges "
+                                     "on these inputs{}",
+                                     k, d.time(static_cast<int>(k)), why));
+  }
+}
+
+std::string unstable_poles(const MisoModel& m) {
+  std::string s;
+  for (int i = 0; i < m.nu(); ++i)
+    for (const auto& p : m.channels[static_cast<size_t>(i)].poles())
+      if (p.real() >= 0) {
+        char z[64];
+        std::snprintf(z, sizeof z, "%.6g%+.6gj", p.real(), p.imag());
+        s += (s.empty() ? "; unstable poles: " : ", ") + (m.nu() > 1 ? "u" + std::to_string(i + 1) + ": " : std::string()) + z;
+      }
+  return s;
+}
+
 double to_double(const std::string& key, const std::string& value) {
   char* end = nullptr;
   const double v = std::strtod(value.c_str(), &end);

@@ -56,6 +56,13 @@ template <class F>
 void consume_sets(std::map<std::string, std::string>& sets, F&& handler) {
   for (auto it = sets.begin(); it != sets.end();) it = handler(it->first, it->second) ? sets.erase(it) : std::next(it);
 }
+/// Throws NotUsable naming the first sample at which a simulated output y (columns = outputs) on d is not
+/// finite or its sum of squares overflows,
+/// with `why` (e.g. the unstable poles): a diverging simulation is never written or scored.
+void require_finite_simulation(const Eigen::MatrixXd& y, const IdData& d, const std::string& why);
+/// "; unstable poles: ..." for the channels of m with poles in the closed right half plane ("" if none).
+std::string unstable_poles(const MisoModel& m);
+
 double to_double(const std::string& key, const std::string& value);
 int to_int(const std::string& key, const std::string& value);
 

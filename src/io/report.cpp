@@ -346,7 +346,7 @@ void validation(Page& page, const IdData& d, const Eigen::VectorXd& yhat, const 
   const double fit = fit_report_or_inf(y, yhat, 0).fit_percent;
   page.plot({"Output: measured and simulated (fit " + fmt(fit, 4) + " %)", "time (s)", "y", pick(d.times(), k),
              {{"measured", pick(y, k)}, {"simulated", pick(yhat, k)}}});
-  if (!e.allFinite()) {
+  if (!std::isfinite(e.squaredNorm())) {  // non-finite, or so large that the squares overflow
     page.text("<span class=\"warn\">The simulation does not stay finite on this record: no residual tests.</span>");
     return;
   }

@@ -15,6 +15,7 @@ CorrelationTest residual_autocorrelation(const Eigen::VectorXd& e_in, int M) {
   CTID_REQUIRE(M >= 1 && M < N, "residual_autocorrelation: max_lag must be in [1, N-1] = [1, {}] (got {})", N - 1, M);
   const Eigen::VectorXd e = e_in.array() - e_in.mean();
   const double r0 = e.squaredNorm();
+  CTID_REQUIRE(std::isfinite(r0), "residual_autocorrelation: the residuals are not finite or overflow (a diverging simulation?)");
   CTID_REQUIRE(r0 > 0, "residual_autocorrelation: the residuals are identically zero");
   CorrelationTest r;
   r.lags = Eigen::VectorXi::LinSpaced(M + 1, 0, M);
@@ -34,6 +35,8 @@ CorrelationTest input_residual_crosscorrelation(const Eigen::VectorXd& u_in, con
   const Eigen::VectorXd e = e_in.array() - e_in.mean();
   const Eigen::VectorXd u = u_in.array() - u_in.mean();
   const double norm = std::sqrt(u.squaredNorm() * e.squaredNorm());
+  CTID_REQUIRE(std::isfinite(norm),
+               "input_residual_crosscorrelation: the input or the residuals are not finite or overflow (a diverging simulation?)");
   CTID_REQUIRE(norm > 0, "input_residual_crosscorrelation: the input or the residuals are constant");
   CorrelationTest r;
   r.lags = Eigen::VectorXi::LinSpaced(2 * M + 1, -M, M);

@@ -664,6 +664,8 @@ TEST(Cli, RobustnessCampaignBadInputs) {
   const std::string truncmat = write("rb_trunc.mat", hdr + std::string("\x06\x00\x00\x00", 4));
   const std::string truncjson = write("rb_trunc.json", R"({"type": "transfer_function", "num": [1)");
   const std::string wrongjson = write("rb_wrong.json", R"({"type": "transfer_function", "num": "x", "den": [1, 2]})");
+  // 1/(s - 500) over the 5 s record grows like e^2500: its simulation overflows.
+  const std::string unstable = write("rb_unstable.json", R"({"type": "transfer_function", "num": [1], "den": [1, -500]})");
   const std::string dir = test::temp_path("rb_dir");
   fs::create_directories(dir);
   const std::string out = test::temp_path("rb_out.json");
@@ -704,6 +706,9 @@ TEST(Cli, RobustnessCampaignBadInputs) {
       {"simulate " + truncjson + " " + ok + " --time time --input force", 3, "not valid JSON"},
       {"simulate " + wrongjson + " " + ok + " --time time --input force", 3, "\"num\" must be an array"},
       {"validate " + truncjson + " " + ok + base, 3, "not valid JSON"},
+      // A model that diverges on the data is not scored (its residual tests used to "pass": 0/Inf correlations).
+      {"validate " + unstable + " " + ok + base + "--json " + out, 1, "the model diverges on these inputs; unstable poles: 500+0j"},
+      {"simulate " + unstable + " " + ok + " --time time --input force --out " + out, 1, "the model diverges"},
       {"fit " + ok + base + "--method kia --narx " + truncjson, 3, "not valid JSON"},
       {"gfrf " + truncjson + " --order 1 --w 1", 3, "not valid JSON"},
       {"fit " + ok + base + "--method physical --model 'k/(s+q)' --param k=1 --set T=1 --set n=11", 2,

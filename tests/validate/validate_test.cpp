@@ -45,4 +45,9 @@ TEST(Residuals, WhiteNoisePassesColouredFails) {
   EXPECT_NEAR(x.values(13), 0.5 / std::sqrt(1.25), 0.03);
   EXPECT_FALSE(x.passed());
   EXPECT_THROW(residual_autocorrelation(e, 0), InvalidArgument);
+  // Residuals of a diverging simulation (squares overflow): an error, not correlations of 0/Inf that "pass".
+  Eigen::VectorXd big = e;
+  big.tail(10).setConstant(1e300);
+  EXPECT_THROW(residual_autocorrelation(big, 10), InvalidArgument);
+  EXPECT_THROW(input_residual_crosscorrelation(u, big, 10), InvalidArgument);
 }
