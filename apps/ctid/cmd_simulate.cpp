@@ -19,42 +19,6 @@ struct SimArgs {
   bool force = false;
 };
 
-// Nonlinear model files (Billings & Li): NARX simulated at its own sampling period from rest, NDE integrated at
-// the data's sample times with the data's intersample behaviour. An escaping simulation is an error (exit 1).
-bool simulate_nonlinear(const SimArgs& a, const IdData& d, Eigen::MatrixXd& y) {
-  std::optional<NarxModel> narx;
-  std::optional<NdeModel> nde;
-  try {
-    narx = read_narx_json(a.model);
-  } catch (const FileError&) {
-    try {
-      nde = read_nde_json(a.model);
-    } catch (const FileError&) {
-      return false;
-    }
-  }
-  if (d.nu() != 1) throw UsageError(detail::format("the model has 1 input but {} input columns were selected", d.nu()));
-  if (narx) {
-    if (!d.is_uniform() || std::abs(d.ts() - narx->ts()) > 1e-9 * narx->ts())
-      throw UsageError(detail::format("the NARX model runs at Ts = {} s; the data must be uniformly sampled at it",
-                                      narx->ts()));
-    bool escaped = false;
-    y = narx->process().simulate(d.u().col(0), {}, &escaped);
-    if (escaped) throw NotUsable(a.model + ": the NARX simulation escapes (blows up) for this input");
-  } else {
-    Eigen::VectorXd t(d.size());
-    for (int i = 0; i < d.size(); ++i) t(i) = d.time(i) - d.t0();
-    NdeSimulation s;
-    try {
-      s = nde->simulate(d.u().col(0), t, d.intersample(0));
-    } catch (const InvalidArgument& e) {
-      throw UsageError(a.model + ": " + e.what());
-    }
-    if (!s.ok()) throw NotUsable(a.model + ": " + s.message);
-    y = s.y;
-  }
-  return true;
-}
 
 int run(const SimArgs& a) {
   check_output_path(a.out, {a.data.path, a.model}, a.force);
@@ -66,7 +30,7 @@ int run(const SimArgs& a) {
   try {
     m = read_model_json(a.model);
   } catch (const FileError& e) {
-    nonlinear = simulate_nonlinear(a, d, y);
+    nonlinear = simulate_nonlinear(a.model, d, y);
     if (!nonlinear) throw InputError(e.what());
     ynames = {"y"};
   }

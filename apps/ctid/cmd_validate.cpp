@@ -1,6 +1,7 @@
-// ctid validate MODEL.json DATA [--json OUT.json]
+// ctid validate MODEL.json DATA [--json OUT.json]: fit and residual tests of a linear, NARX or NDE model on a record.
 #include <cstdio>
 #include <functional>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -26,27 +27,62 @@ nlohmann::json corr_json(const CorrelationTest& c) {
           {"passed", c.passed()}};
 }
 
+// The "model" member of a NARX/NDE result file (already read successfully), or the bare model file itself.
+nlohmann::json nonlinear_model_json(const std::string& path) {
+  nlohmann::json j = nlohmann::json::parse(read_text_file(path));
+  return j.contains("model") ? j["model"] : j;
+}
+
 int run(const ValArgs& a) {
   check_output_path(a.json, {a.data.path, a.model}, a.force);
-  LinearModel m;
-  try {
-    m = read_model_json(a.model);
-  } catch (const FileError& e) {
-    throw InputError(e.what());
-  }
-  if (std::holds_alternative<StateSpace>(m)) throw UsageError("validate supports transfer-function and MISO models");
-  const IdData d = a.data.load(true);
-  const MisoModel miso = std::holds_alternative<MisoModel>(m) ? std::get<MisoModel>(m)
-                                                              : MisoModel{{std::get<TransferFunction>(m)}};
-  if (d.ny() != 1 || d.nu() != miso.nu())
-    throw UsageError(detail::format("the model has {} inputs and 1 output; {} inputs and {} outputs were selected", miso.nu(),
-                                    d.nu(), d.ny()));
-  if (a.lags < 1 || a.lags >= d.size()) throw UsageError(detail::format("--lags must be in [1, {}]", d.size() - 1));
-  const Eigen::VectorXd yhat = lsim(miso, d);
-  require_finite_simulation(yhat, d, unstable_poles(miso));
-  const Eigen::VectorXd y = d.y().col(0);
+  // Linear models (transfer function, MISO) are simulated exactly from rest; NARX and NDE model files as by
+  // `ctid simulate` (NARX at its Ts from rest, NDE by the adaptive integrator).
+  std::optional<LinearModel> linear;
+  std::string description;
+  nlohmann::json model_json;
   int np = 0;
-  for (const auto& c : miso.channels) np += c.num().degree() + 1 + c.order();
+  try {
+    linear = read_model_json(a.model);
+    if (std::holds_alternative<StateSpace>(*linear)) throw UsageError("validate supports transfer-function, MISO, NARX and NDE models");
+  } catch (const FileError& e) {
+    try {
+      const NarxModel m = read_narx_json(a.model);
+      description = m.to_string(6);
+      np = static_cast<int>(m.coefficients().size());
+      model_json = nonlinear_model_json(a.model);
+    } catch (const FileError&) {
+      try {
+        const NdeModel m = read_nde_json(a.model);
+        description = m.to_string(6);
+        np = static_cast<int>(m.coefficients().size());
+        model_json = nonlinear_model_json(a.model);
+      } catch (const FileError&) {
+        throw InputError(e.what());
+      }
+    }
+  }
+  const IdData d = a.data.load(true);
+  if (d.ny() != 1) throw UsageError(detail::format("validate compares one output; {} were selected", d.ny()));
+  if (a.lags < 1 || a.lags >= d.size()) throw UsageError(detail::format("--lags must be in [1, {}]", d.size() - 1));
+  Eigen::VectorXd yhat;
+  if (linear) {
+    const MisoModel miso = std::holds_alternative<MisoModel>(*linear) ? std::get<MisoModel>(*linear)
+                                                                       : MisoModel{{std::get<TransferFunction>(*linear)}};
+    if (d.nu() != miso.nu())
+      throw UsageError(detail::format("the model has {} inputs and 1 output; {} inputs and {} outputs were selected",
+                                      miso.nu(), d.nu(), d.ny()));
+    yhat = lsim(miso, d);
+    require_finite_simulation(yhat, d, unstable_poles(miso));
+    for (const auto& c : miso.channels) np += c.num().degree() + 1 + c.order();
+    description = miso.to_string(6);
+    model_json = nlohmann::json::parse(model_to_json(*linear));
+  } else {
+    Eigen::MatrixXd ys;
+    simulate_nonlinear(a.model, d, ys);
+    yhat = ys.col(0);
+    require_finite_simulation(yhat, d, "");
+  }
+  const Eigen::VectorXd y = d.y().col(0);
   FitReport f;
   try {
     f = fit_report(y, yhat, np);
@@ -57,7 +93,7 @@ int run(const ValArgs& a) {
   const CorrelationTest ac = residual_autocorrelation(e, a.lags);
   std::vector<CorrelationTest> xcs;
   for (int i = 0; i < d.nu(); ++i) xcs.push_back(input_residual_crosscorrelation(d.u().col(i), e, a.lags));
-  std::printf("model:  %s\n", miso.to_string(6).c_str());
+  std::printf("model:  %s\n", description.c_str());
   std::printf("fit: %.2f %%   NRMSE %.4g   MSE %.4g   (%d samples)\n", f.fit_percent, f.nrmse, f.mse, f.n_samples);
   std::printf("residual whiteness (lags 1..%d): %d outside the 99 %% bound %.3g -> %s\n", a.lags, ac.n_outside, ac.bound,
               ac.passed() ? "passed" : "not white");
@@ -67,7 +103,7 @@ int run(const ValArgs& a) {
   if (!a.json.empty()) {
     nlohmann::json j;
     j["ctid_version"] = version();
-    j["model"] = nlohmann::json::parse(model_to_json(m));
+    j["model"] = model_json;
     j["fit"] = {{"fit_percent", f.fit_percent}, {"nrmse", f.nrmse}, {"mse", f.mse}, {"n_samples", f.n_samples}};
     j["residual_autocorrelation"] = corr_json(ac);
     j["input_residual_crosscorrelation"] = nlohmann::json::array();

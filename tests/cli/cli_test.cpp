@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "ctid/ctid.hpp"
 #include "test_util.hpp"
@@ -516,6 +517,20 @@ TEST(Cli, NarxKiaAndGfrf) {
   fs::remove(sim);
   r = ctid_run("simulate " + narx + " " + data + " --ts 0.0025 --input u --out " + sim);
   ASSERT_EQ(r.code, 0) << r.err;
+  // validate scores NARX and NDE files as it does linear ones: the fit printed is fit_percent of the simulated
+  // output (the same simulation as `simulate`) against the record, to the 4 printed digits.
+  const Eigen::VectorXd ynarx = read_csv(sim).values.col(2);
+  const std::string vj = test::temp_path("nde_validate.json");
+  for (const std::string& model : {nde, narx}) {
+    fs::remove(vj);
+    r = ctid_run("validate " + model + " " + data + " --ts 0.0025 --input u --output y --json " + vj);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const double expected = fit_percent(m.col(1), model == nde ? ysim : ynarx);
+    const nlohmann::json vjs = nlohmann::json::parse(read_text_file(vj));
+    EXPECT_NEAR(vjs["fit"]["fit_percent"].get<double>(), expected, 1e-9 * std::abs(expected)) << model;
+    EXPECT_EQ(vjs["model"]["type"], model == nde ? "nde" : "narx") << vjs["model"].dump();
+    EXPECT_NE(r.out.find("residual whiteness"), std::string::npos) << r.out;
+  }
   const std::string escaping =
       write("escape.json", R"J({"type": "nde", "terms": [{"name": "Dy", "value": 1}, {"name": "y^2", "value": -1}, {"name": "u", "value": 5}]})J");  // Dy = y^2 - 5u, mean(u) < 0
   fs::remove(sim);
