@@ -38,7 +38,7 @@ int run(const ValArgs& a) {
   // Linear models (transfer function, MISO) are simulated exactly from rest; NARX and NDE model files as by
   // `ctid simulate` (NARX at its Ts from rest, NDE by the adaptive integrator).
   std::optional<LinearModel> linear;
-  std::string description;
+  std::string description, unstable;
   nlohmann::json model_json;
   int np = 0;
   try {
@@ -72,7 +72,8 @@ int run(const ValArgs& a) {
       throw UsageError(detail::format("the model has {} inputs and 1 output; {} inputs and {} outputs were selected",
                                       miso.nu(), d.nu(), d.ny()));
     yhat = lsim(miso, d);
-    require_finite_simulation(yhat, d, unstable_poles(miso));
+    unstable = unstable_poles(miso);
+    require_finite_simulation(yhat, d, unstable);
     for (const auto& c : miso.channels) np += c.num().degree() + 1 + c.order();
     description = miso.to_string(6);
     model_json = nlohmann::json::parse(model_to_json(*linear));
@@ -94,6 +95,8 @@ int run(const ValArgs& a) {
   std::vector<CorrelationTest> xcs;
   for (int i = 0; i < d.nu(); ++i) xcs.push_back(input_residual_crosscorrelation(d.u().col(i), e, a.lags));
   std::printf("model:  %s\n", description.c_str());
+  if (!unstable.empty())  // finite on this record, but growing: the numbers below say little beyond it
+    std::printf("note: the model is unstable%s\n", unstable.c_str());
   std::printf("fit: %.2f %%   NRMSE %.4g   MSE %.4g   (%d samples)\n", f.fit_percent, f.nrmse, f.mse, f.n_samples);
   std::printf("residual whiteness (lags 1..%d): %d outside the 99 %% bound %.3g -> %s\n", a.lags, ac.n_outside, ac.bound,
               ac.passed() ? "passed" : "not white");

@@ -105,6 +105,12 @@ TEST(Cli, FitWritesJsonThatSimulateAndValidateRead) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("fit: 99.9"), std::string::npos) << r.out;
   EXPECT_NE(read_text_file(vj).find("residual_autocorrelation"), std::string::npos);
+  EXPECT_EQ(r.out.find("unstable"), std::string::npos) << r.out;
+  // An unstable model whose simulation stays finite on the record is scored, with a note naming its poles.
+  const std::string slow = write("slow_unstable.json", R"({"type": "transfer_function", "num": [1], "den": [1, -0.1]})");
+  r = ctid_run("validate " + slow + " " + good_csv() + " --time time --input force --output position");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("note: the model is unstable; unstable poles: 0.1+0j"), std::string::npos) << r.out;
 }
 
 TEST(Cli, IvsvfAndRlsMethods) {
