@@ -52,11 +52,7 @@ int finish(const Result<M>& r, const std::string& method, const IdData& d, const
     write_result_json(a.json, r, method);
     std::printf("wrote %s\n", a.json.c_str());
   }
-  if constexpr (std::is_same_v<M, MisoModel>) {
-    if (!a.report.empty()) std::fprintf(stderr, "ctid: warning: --report is not available for multi-input models\n");
-  } else {
-    write_report(a.report, d, r, method, a.sets, a.data.path);
-  }
+  write_report(a.report, d, r, method, a.sets, a.data.path);
   if (!r.usable()) {
     std::fprintf(stderr, "ctid: the estimate is not usable: %s\n",
                  r.summary.message.empty() ? to_string(r.summary.termination) : r.summary.message.c_str());

@@ -52,7 +52,8 @@ int run(const ReportArgs& a) {
                                ? model["type"].get<std::string>()
                                : "";
   const IdData d = a.data.load(true);
-  if (d.nu() != 1 || d.ny() != 1) throw UsageError("report needs one --input and one --output");
+  if (d.ny() != 1 || (d.nu() != 1 && type != "miso"))
+    throw UsageError("report needs one --input (one per model input for a miso result) and one --output");
   ReportOptions o;
   o.method = j.contains("method") && j["method"].is_string() ? j["method"].get<std::string>() : type;
   o.title = a.title.empty() ? "ctid report: " + a.result : a.title;
@@ -61,6 +62,8 @@ int run(const ReportArgs& a) {
   try {
     if (type == "transfer_function") {
       html = html_report(d, parse_result_json(text, a.result), o);
+    } else if (type == "miso") {
+      html = html_report(d, parse_miso_result_json(text, a.result), o);
     } else if (type == "narx") {
       const NarxModel m = parse_narx_json(text, a.result);
       const NarxModel p = m.process();
@@ -73,7 +76,7 @@ int run(const ReportArgs& a) {
       html = html_report(d, bare_result(m, d, m.simulate(d.u().col(0), t, d.intersample(0)).y), o);
     } else {
       throw UsageError(a.result + ": model type '" + type +
-                       "' has no report here (transfer_function, narx, nde; for FSF results use ctid fit --report)");
+                       "' has no report here (transfer_function, miso, narx, nde; for FSF results use ctid fit --report)");
     }
   } catch (const FileError& e) {
     throw InputError(e.what());

@@ -121,6 +121,7 @@ void bind_linear(py::module_& m) {
            "Exact simulation from rest of the inputs of data (their intersample behaviour).")
       .def("__repr__", [](const MisoModel& g) { return g.to_string(6); });
   bind_result<MisoModel>(m, "MisoResult");
+  def_report<MisoModel>(m);
 
   def_tf_estimator<LssvfOptions>(m, "lssvf", &lssvf, "Johansson (1986) least squares on state-variable-filtered signals.");
   def_tf_estimator<IvsvfOptions>(m, "ivsvf", &ivsvf, "Johansson's regression with instrumental variables.");

@@ -277,13 +277,10 @@ void write_result_json(const std::string& path, const Result<NdeModel>& r, const
   write_text_file(path, result_to_json(r, method) + "\n");
 }
 
-Result<TransferFunction> parse_result_json(const std::string& text, const std::string& source) {
-  const Reader rd{source};
-  const json j = parse_text(text, rd);
-  Result<TransferFunction> r;
-  const LinearModel m = model_from(j, rd);
-  if (!std::holds_alternative<TransferFunction>(m)) rd.fail("the result's model is not a transfer function");
-  r.model = std::get<TransferFunction>(m);
+namespace {
+// Parameters, fit, summary and diagnostics of a result file (the envelope around its model).
+template <class M>
+void read_envelope(const json& j, const Reader& rd, Result<M>& r) {
   try {
     const json& ps = rd.member(j, "parameters", "the result");
     const int np = static_cast<int>(ps.size());
@@ -323,6 +320,28 @@ Result<TransferFunction> parse_result_json(const std::string& text, const std::s
   } catch (const InvalidArgument& e) {
     rd.fail(std::string("malformed result: ") + e.what());
   }
+}
+}  // namespace
+
+Result<TransferFunction> parse_result_json(const std::string& text, const std::string& source) {
+  const Reader rd{source};
+  const json j = parse_text(text, rd);
+  Result<TransferFunction> r;
+  const LinearModel m = model_from(j, rd);
+  if (!std::holds_alternative<TransferFunction>(m)) rd.fail("the result's model is not a transfer function");
+  r.model = std::get<TransferFunction>(m);
+  read_envelope(j, rd, r);
+  return r;
+}
+
+Result<MisoModel> parse_miso_result_json(const std::string& text, const std::string& source) {
+  const Reader rd{source};
+  const json j = parse_text(text, rd);
+  Result<MisoModel> r;
+  const LinearModel m = model_from(j, rd);
+  if (!std::holds_alternative<MisoModel>(m)) rd.fail("the result's model is not a multi-input (miso) model");
+  r.model = std::get<MisoModel>(m);
+  read_envelope(j, rd, r);
   return r;
 }
 

@@ -258,6 +258,12 @@ std::string fmt(double v, int digits = 6) {
   return b;
 }
 
+std::string input_name(const IdData& d, int i) {
+  return i < static_cast<int>(d.input_names().size()) && !d.input_names()[static_cast<size_t>(i)].empty()
+             ? d.input_names()[static_cast<size_t>(i)]
+             : (d.nu() > 1 ? "u" + std::to_string(i + 1) : "u");
+}
+
 template <class M>
 void overview(Page& page, const IdData& d, const Result<M>& r, const ReportOptions& o, const std::string& model_text) {
   page.section("Summary");
@@ -285,16 +291,20 @@ void overview(Page& page, const IdData& d, const Result<M>& r, const ReportOptio
   }
   page.section("Data");
   const double dur = d.duration();
+  std::string inputs;
+  for (int i = 0; i < d.nu(); ++i)
+    inputs += (i ? ", " : "") + input_name(d, i) + " (" + to_string(d.intersample(i)) + ")";
   page.table({"", ""}, {{"source", o.data_source.empty() ? "-" : o.data_source},
                         {"samples", std::to_string(d.size())},
                         {"sampling", d.is_uniform() ? "Ts = " + fmt(d.ts()) + " s" : "irregular"},
                         {"duration", fmt(dur) + " s"},
-                        {"input", (d.input_names().empty() ? "u" : d.input_names()[0]) + " (" +
-                                      to_string(d.intersample(0)) + ")"},
+                        {d.nu() > 1 ? "inputs" : "input", inputs},
                         {"output", d.output_names().empty() ? "y" : d.output_names()[0]}});
   const auto k = keep(d.size(), o.max_points);
   const Eigen::VectorXd t = pick(d.times(), k);
-  page.plot({"Input", "time (s)", "u", t, {{"u", pick(d.u().col(0), k)}}});
+  std::vector<Series> us;
+  for (int i = 0; i < d.nu(); ++i) us.push_back({input_name(d, i), pick(d.u().col(i), k)});
+  page.plot({d.nu() > 1 ? "Inputs" : "Input", "time (s)", "u", t, us});
   page.plot({"Output", "time (s)", "y", t, {{"y", pick(d.y().col(0), k)}}});
 }
 
@@ -356,14 +366,15 @@ void validation(Page& page, const IdData& d, const Eigen::VectorXd& yhat, const 
     page.text("Too few samples or zero residuals: no correlation tests.");
     return;
   }
-  const CorrelationTest ee = residual_autocorrelation(e, lags);
-  const CorrelationTest ue = input_residual_crosscorrelation(d.u().col(0), e, lags);
-  for (const auto* c : {&ee, &ue}) {
-    const bool auto_ = c == &ee;
+  std::vector<std::pair<std::string, CorrelationTest>> tests = {{"Residual autocorrelation", residual_autocorrelation(e, lags)}};
+  for (int i = 0; i < d.nu(); ++i)
+    tests.push_back({"Input-residual cross-correlation" + (d.nu() > 1 ? " (" + input_name(d, i) + ")" : std::string()),
+                     input_residual_crosscorrelation(d.u().col(i), e, lags)});
+  for (const auto& [title, test] : tests) {
+    const CorrelationTest* c = &test;
     const Eigen::VectorXd x = c->lags.cast<double>();
     const Eigen::VectorXd b = Eigen::VectorXd::Constant(x.size(), c->bound);
-    page.plot({std::string(auto_ ? "Residual autocorrelation" : "Input-residual cross-correlation") + ": " +
-                   std::to_string(c->n_outside) + " lag(s) outside the 99 % bounds",
+    page.plot({title + ": " + std::to_string(c->n_outside) + " lag(s) outside the 99 % bounds",
                "lag (samples)", "correlation", x, {{"r(k)", c->values}, {"+bound", b, true, true}, {"-bound", -b, true, true}}, false,
                true});
   }
@@ -386,28 +397,54 @@ Eigen::VectorXd frequency_grid(const Eigen::VectorXcd& poles, double w_max_limit
   return w;
 }
 
-void bode(Page& page, const Eigen::VectorXd& w, const Eigen::VectorXcd& h, const Eigen::VectorXd* lo_mag = nullptr,
-          const Eigen::VectorXd* hi_mag = nullptr, const std::string& what = "G(jw)") {
+// Bode magnitude and (unwrapped) phase of one or more responses hs = {(label, H(jw))} on the grid w; the
+// 95 % magnitude band (lo_mag, hi_mag) goes with a single response.
+void bode(Page& page, const Eigen::VectorXd& w, const std::vector<std::pair<std::string, Eigen::VectorXcd>>& hs,
+          const Eigen::VectorXd* lo_mag = nullptr, const Eigen::VectorXd* hi_mag = nullptr) {
   page.section("Frequency response");
-  Eigen::VectorXd mag(w.size()), ph(w.size());
-  double prev = 0, offset = 0;
-  for (Eigen::Index i = 0; i < w.size(); ++i) {
-    mag(i) = 20 * std::log10(std::abs(h(i)));
-    double a = std::arg(h(i)) * 180 / std::numbers::pi;
-    if (i > 0) {  // unwrap
-      while (a + offset - prev > 180) offset -= 360;
-      while (a + offset - prev < -180) offset += 360;
+  std::vector<Series> ms, ps;
+  for (const auto& [label, h] : hs) {
+    Eigen::VectorXd mag(w.size()), ph(w.size());
+    double prev = 0, offset = 0;
+    for (Eigen::Index i = 0; i < w.size(); ++i) {
+      mag(i) = 20 * std::log10(std::abs(h(i)));
+      double a = std::arg(h(i)) * 180 / std::numbers::pi;
+      if (i > 0) {  // unwrap
+        while (a + offset - prev > 180) offset -= 360;
+        while (a + offset - prev < -180) offset += 360;
+      }
+      ph(i) = prev = a + offset;
     }
-    ph(i) = prev = a + offset;
+    ms.push_back({"|" + label + "|", mag});
+    ps.push_back({hs.size() > 1 ? label : "phase", ph});
   }
-  std::vector<Series> ms = {{"|" + what + "|", mag}};
   if (lo_mag && hi_mag) {
     ms.push_back({"2.5 %", (20 * lo_mag->array().log10()).matrix(), false, true});
     ms.push_back({"97.5 %", (20 * hi_mag->array().log10()).matrix(), false, true});
   }
   page.plot({"Bode magnitude" + std::string(lo_mag ? " with the 95 % band from the parameter covariance" : ""),
              "frequency (rad/s)", "dB", w, ms, true});
-  page.plot({"Bode phase", "frequency (rad/s)", "deg", w, {{"phase", ph}}, true});
+  page.plot({"Bode phase", "frequency (rad/s)", "deg", w, ps, true});
+}
+
+// Step and impulse responses of the given channels over 8 slowest time constants (+ delay).
+void time_responses(Page& page, const std::vector<std::pair<std::string, TransferFunction>>& gs, double fallback) {
+  page.section("Step and impulse responses");
+  double slow = INFINITY, delay = 0;
+  for (const auto& [label, g] : gs) {
+    for (const auto& p : g.poles())
+      if (p.real() < 0) slow = std::min(slow, -p.real());
+    delay = std::max(delay, g.io_delay());
+  }
+  const double horizon = std::isfinite(slow) ? 8.0 / slow + delay : fallback;
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(400, 0.0, horizon);
+  std::vector<Series> step, impulse;
+  for (const auto& [label, g] : gs) {
+    step.push_back({gs.size() > 1 ? label : "step", step_response(g, t)});
+    impulse.push_back({gs.size() > 1 ? label : "impulse", impulse_response(g, t)});
+  }
+  page.plot({"Step response", "time (s)", "y", t, step});
+  page.plot({"Impulse response", "time (s)", "y", t, impulse});
 }
 
 double nyquist(const IdData& d) { return d.is_uniform() ? std::numbers::pi / d.ts() : 0.0; }
@@ -449,15 +486,32 @@ std::string html_report(const IdData& d, const Result<TransferFunction>& r, cons
       hi(j) = c[static_cast<size_t>(0.975 * K) - 1];
     }
   }
-  bode(page, w, h, lo.size() ? &lo : nullptr, hi.size() ? &hi : nullptr);
-  page.section("Step and impulse responses");
-  double slow = INFINITY;
-  for (const auto& p : r.model.poles())
-    if (p.real() < 0) slow = std::min(slow, -p.real());
-  const double horizon = std::isfinite(slow) ? 8.0 / slow + r.model.io_delay() : d.duration();
-  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(400, 0.0, horizon);
-  page.plot({"Step response", "time (s)", "y", t, {{"step", step_response(r.model, t)}}});
-  page.plot({"Impulse response", "time (s)", "y", t, {{"impulse", impulse_response(r.model, t)}}});
+  bode(page, w, {{"G(jw)", h}}, lo.size() ? &lo : nullptr, hi.size() ? &hi : nullptr);
+  time_responses(page, {{"G", r.model}}, d.duration());
+  return page.render(o.title.empty() ? o.method + " fit" : o.title);
+}
+
+std::string html_report(const IdData& d, const Result<MisoModel>& r, const ReportOptions& o) {
+  CTID_REQUIRE(d.ny() == 1 && d.nu() == r.model.nu(), "html_report: the model has {} inputs and 1 output (data: {}, {})",
+               r.model.nu(), d.nu(), d.ny());
+  Page page;
+  overview(page, d, r, o, r.model.to_string(6));
+  validation(page, d, lsim(r.model, d), o);
+  parameters(page, r.parameters);
+  diagnostics(page, r.diagnostics);
+  Eigen::VectorXcd poles(0);
+  std::vector<std::pair<std::string, Eigen::VectorXcd>> hs;
+  std::vector<std::pair<std::string, TransferFunction>> gs;
+  for (int i = 0; i < r.model.nu(); ++i) {
+    const TransferFunction& g = r.model.channels[static_cast<size_t>(i)];
+    poles.conservativeResize(poles.size() + g.order());
+    poles.tail(g.order()) = g.poles();
+    gs.push_back({"G" + std::to_string(i + 1) + " (" + input_name(d, i) + ")", g});
+  }
+  const Eigen::VectorXd w = frequency_grid(poles, nyquist(d));
+  for (const auto& [label, g] : gs) hs.push_back({label, g.frequency_response(w)});
+  bode(page, w, hs);
+  time_responses(page, gs, d.duration());
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }
 
@@ -488,7 +542,7 @@ std::string html_report(const IdData& d, const Result<FsfModel>& r, const Report
   const double wmax = std::numbers::pi / m.delta() * 0.95, w0 = 2 * std::numbers::pi / m.T();
   Eigen::VectorXd w(300);
   for (int i = 0; i < 300; ++i) w(i) = std::pow(10.0, std::log10(0.5 * w0) + (std::log10(wmax) - std::log10(0.5 * w0)) * i / 299);
-  bode(page, w, m.frequency_response(w), nullptr, nullptr, "Gbar(e^{jw Delta})");
+  bode(page, w, {{"Gbar(e^{jw Delta})", m.frequency_response(w)}});
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }
 
@@ -531,7 +585,7 @@ std::string html_report(const IdData& d, const Result<NarxModel>& r, const Repor
   if (linear) {
     Eigen::VectorXcd h(w.size());
     for (Eigen::Index i = 0; i < w.size(); ++i) h(i) = narx_gfrf_ct(p, {std::complex<double>(0, w(i))}, zoh);
-    bode(page, w, h, nullptr, nullptr, "H_1(jw)");
+    bode(page, w, {{"H_1(jw)", h}});
     if (p.degree() >= 2) {
       page.section("Second-order GFRF");
       page.heatmap(h2_map([&](auto a, auto b) { return narx_gfrf_ct(p, {a, b}, zoh); }, 0.5 * nyq, "NARX model"));
@@ -566,7 +620,7 @@ std::string html_report(const IdData& d, const Result<NdeModel>& r, const Report
   const Eigen::VectorXd w = frequency_grid(m.a().roots(), nyquist(d));
   Eigen::VectorXcd h(w.size());
   for (Eigen::Index i = 0; i < w.size(); ++i) h(i) = m.h1(std::complex<double>(0, w(i)));
-  bode(page, w, h, nullptr, nullptr, "H_1(jw)");
+  bode(page, w, {{"H_1(jw)", h}});
   bool nonlinear = false;
   for (const auto& term : m.terms()) nonlinear = nonlinear || term.degree() == 2;
   if (nonlinear) {

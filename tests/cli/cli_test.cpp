@@ -584,8 +584,8 @@ std::optional<BrowserRun> open_in_browser(const std::string& html, const std::st
 }  // namespace
 
 TEST(Cli, ReportsOpenInABrowserWithEveryPlotDrawn) {
-  // One report per model type: SRIVC and FSF on the bundled hair dryer, NARX and KIA (+ output-error refinement)
-  // on the Billings & Li system (33). Each must load with no console error and every plot drawn (canvas with
+  // One report per model type: SRIVC and FSF on the bundled hair dryer, MISO SRIVC on two simulated inputs, NARX
+  // and KIA (+ output-error refinement) on the Billings & Li system (33). Each must load with no console error and every plot drawn (canvas with
   // painted pixels); the screenshots go to the build tree (docs/images holds copies).
   const std::string dryer = std::string(CTID_EXAMPLES_DATA_DIR) + "/dryer.dat";
   const std::string base = " --ts 0.08 --input 1 --output 2 --detrend mean ";
@@ -599,7 +599,17 @@ TEST(Cli, ReportsOpenInABrowserWithEveryPlotDrawn) {
   m << u, truth.simulate(u, time_grid(0.0025, N), Intersample::Zoh, {}, 1e-11).y;
   const std::string bl = test::temp_path("bl_report.csv");
   write_csv(bl, {"u", "y"}, m);
+  // Two inputs through (s + 3)/(s^2 + 2 s + 5) and 2/(s + 1) (MISO SRIVC, noise-free).
+  Eigen::MatrixXd mu(2000, 2);
+  mu << prbs(2000, {.register_length = 8, .clock_period = 7}), prbs(2000, {.register_length = 10, .clock_period = 4});
+  const MisoModel g2{{TransferFunction(Eigen::VectorXd{{1.0, 3.0}}, Eigen::VectorXd{{1.0, 2.0, 5.0}}),
+                      TransferFunction(Eigen::VectorXd{{2.0}}, Eigen::VectorXd{{1.0, 1.0}})}};
+  Eigen::MatrixXd mm(2000, 3);
+  mm << mu, lsim(g2, IdData(mu, Eigen::VectorXd::Zero(2000), 0.02));
+  const std::string miso = test::temp_path("miso_report.csv");
+  write_csv(miso, {"u1", "u2", "y"}, mm);
   const std::vector<std::pair<std::string, std::string>> cases = {
+      {"miso", "fit " + miso + " --ts 0.02 --input u1 --input u2 --output y --method srivc --nb 2,1 --nf 2,1"},
       {"srivc", "fit " + dryer + base + "--method srivc --nb 2 --nf 2 --nk 2"},
       {"fsf", "fit " + dryer + base + "--method fsf --set T=4 --set n=21"},
       {"modal", "fit " + dryer + base + "--method modal --nf 2 --nk 2 --set shifts=1,2 --set basis=discrete"},
@@ -630,8 +640,21 @@ TEST(Cli, ReportsOpenInABrowserWithEveryPlotDrawn) {
     EXPECT_EQ(b->log.find("Uncaught"), std::string::npos) << name << ": " << b->log;
     EXPECT_GT(fs::exists(png) ? fs::file_size(png) : 0, 50000u) << name;
   }
+  // ctid report of a MISO result file: the same fit as the result says, both channels.
+  const std::string mj = test::temp_path("miso_result.json"), mh = test::temp_path("miso_result.html");
+  fs::remove(mj);
+  fs::remove(mh);
+  const std::string mio = " --ts 0.02 --input u1 --input u2 --output y ";
+  ASSERT_EQ(ctid_run("fit " + miso + mio + "--method srivc --nb 2,1 --nf 2,1 --json " + mj).code, 0);
+  CliRun r = ctid_run("report " + mj + " " + miso + mio + "--out " + mh);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string mt = read_text_file(mh);
+  char fit[64];
+  std::snprintf(fit, sizeof fit, "fit %.4g %%", parse_miso_result_json(read_text_file(mj)).fit.fit_percent);
+  EXPECT_NE(mt.find(fit), std::string::npos) << fit;
+  EXPECT_NE(mt.find("G2 (u2)"), std::string::npos);
   // Bad use: a report of frequency data, an unknown model type.
-  CliRun r = ctid_run("fit " + dryer + " --frequency --report " + test::temp_path("x.html"));
+  r = ctid_run("fit " + dryer + " --frequency --report " + test::temp_path("x.html"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--report needs time-domain data"), std::string::npos) << r.err;
   const std::string ss = write("ss.json", R"J({"type": "state_space", "A": [[-1]], "B": [[1]], "C": [[1]], "D": [[0]]})J");

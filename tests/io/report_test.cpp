@@ -40,6 +40,28 @@ TEST(Report, TransferFunctionReportHasEverySection) {
   EXPECT_TRUE(report_has_plot_library());
 }
 
+TEST(Report, MultiInputReportHasAChannelPerInput) {
+  // Two inputs through (s + 3)/(s^2 + 2 s + 5) and 2/(s + 1), noise-free, MISO SRIVC: the report shows both
+  // inputs, a cross-correlation test per input, and one Bode/step/impulse series per channel.
+  const double Ts = 0.02;
+  const Eigen::VectorXd t = time_grid(Ts, 2000);
+  Eigen::MatrixXd u(2000, 2);
+  u << prbs(2000, {.register_length = 8, .clock_period = 7}), prbs(2000, {.register_length = 10, .clock_period = 4});
+  const MisoModel g{{TransferFunction(Eigen::VectorXd{{1.0, 3.0}}, Eigen::VectorXd{{1.0, 2.0, 5.0}}),
+                     TransferFunction(Eigen::VectorXd{{2.0}}, Eigen::VectorXd{{1.0, 1.0}})}};
+  IdData d(u, lsim(g, IdData(u, Eigen::VectorXd::Zero(2000), Ts)), Ts);
+  d.set_input_names({"fan", "heater"});
+  const auto r = srivc_miso(d, {{2, 2, 0}, {1, 1, 0}});
+  ASSERT_TRUE(r.usable()) << r.summary.message;
+  const std::string html = html_report(d, r, {.method = "srivc"});
+  for (const char* s : {"fan (zoh), heater (zoh)", "Input-residual cross-correlation (fan)",
+                        "Input-residual cross-correlation (heater)", "G1 (fan)", "G2 (heater)", "u2.b0"})
+    EXPECT_NE(html.find(s), std::string::npos) << s;
+  // 10 plots: inputs, output, compare, autocorrelation, 2 cross-correlations, Bode magnitude and phase, step, impulse.
+  EXPECT_EQ(count(html, "class=\"plot\""), 10);
+  EXPECT_THROW(html_report(d.select({0}, {0}), r, {}), InvalidArgument);
+}
+
 TEST(Report, DiagnosticsSectionShowsMethodNumbers) {
   // SRIVC reports its delay and noise variance; a modal-function fit (El-Shafey, two sinusoids driving
   // (13 s + 52)/(s^3 + 4 s^2 + 30 s + 52), noise-free) its condition number by order, with a plot.

@@ -34,7 +34,11 @@ LinearModel read_model_json(const std::string& path);
 void write_model_json(const std::string& path, const LinearModel& model);
 
 std::string result_to_json(const Result<TransferFunction>& result, const std::string& method, int indent = 2);
+/// A result written by result_to_json read back (model, parameters, covariance, fit, summary, diagnostics).
+/// Throws FileError naming `source` when the model is of another type or a member is malformed.
 Result<TransferFunction> parse_result_json(const std::string& text, const std::string& source = "<json>");
+/// The same for a multi-input result (model type "miso").
+Result<MisoModel> parse_miso_result_json(const std::string& text, const std::string& source = "<json>");
 /// Atomic write (temporary file, then rename). Throws FileError.
 void write_result_json(const std::string& path, const Result<TransferFunction>& result, const std::string& method);
 std::string result_to_json(const Result<MisoModel>& result, const std::string& method, int indent = 2);

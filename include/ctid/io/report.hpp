@@ -14,6 +14,7 @@
 #include "ctid/core/types.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/model/fsf.hpp"
+#include "ctid/model/miso.hpp"
 #include "ctid/model/narx.hpp"
 #include "ctid/model/nde.hpp"
 #include "ctid/model/transfer_function.hpp"
@@ -29,9 +30,11 @@ struct ReportOptions {
   int max_points = 4000;                                    ///< time plots are decimated (min/max pairs) above this
 };
 
-/// Report of a result on the record `data` (single input and output; the model is simulated on it).
-/// Throws InvalidArgument for data that are not SISO or too short for the correlation lags.
+/// Report of a result on the record `data` (single input and output — for a MisoModel one input per channel;
+/// the model is simulated on it). Throws InvalidArgument for data that do not match the model or are too
+/// short for the correlation lags.
 std::string html_report(const IdData& data, const Result<TransferFunction>& result, const ReportOptions& options);
+std::string html_report(const IdData& data, const Result<MisoModel>& result, const ReportOptions& options);
 std::string html_report(const IdData& data, const Result<FsfModel>& result, const ReportOptions& options);
 std::string html_report(const IdData& data, const Result<NarxModel>& result, const ReportOptions& options);
 std::string html_report(const IdData& data, const Result<NdeModel>& result, const ReportOptions& options);
