@@ -52,7 +52,8 @@ if [ -f "$winding" ]; then
   check "tension T3 (column 7), first order: validation fit %" "$(fit_of winding_7.json winding_val.dat $w --output 7)" gt 42
   # Separate first-order denominators (backfitting): T1 converges and validates better; for T3 the correlated
   # reel speeds leave the instrumental-variable matrix singular, which ctid reports (exit 1).
-  "$ctid" fit winding_est.dat $w --output 6 --method srivc --nf 1 --json winding_6s.json --force >/dev/null
+  "$ctid" fit winding_est.dat $w --output 6 --method srivc --nf 1 --json winding_6s.json --report winding_6s.html \
+    --force >/dev/null
   check "tension T1, separate denominators: validation fit %" "$(fit_of winding_6s.json winding_val.dat $w --output 6)" gt 62
   code=0
   "$ctid" fit winding_est.dat $w --output 7 --method srivc --nf 1 --json winding_7s.json --force >/dev/null 2>&1 || code=$?
@@ -92,7 +93,7 @@ if [ -f "$dryer2" ]; then
   i="--ts 10 --input 2 --input 3 --input 4 --detrend mean"
   for y in 5 6 7; do
     "$ctid" fit dryer2_est.dat $i --output $y --method srivc --nf 1 --set common_denominator=1 --json dryer2_$y.json \
-      --force >/dev/null
+      --report dryer2_$y.html --force >/dev/null
   done
   check "dry bulb temperature (column 5): validation fit %" "$(fit_of dryer2_5.json dryer2_val.dat $i --output 5)" gt 30
   check "wet bulb temperature (column 6): validation fit %" "$(fit_of dryer2_6.json dryer2_val.dat $i --output 6)" gt 25
@@ -110,8 +111,8 @@ if [ -f "$wall" ]; then
   tail -504 "$wall" > wall_val.dat
   m="--ts 1 --input 1 --input 2 --output 3 --detrend mean"
   "$ctid" fit wall_est.dat $m --method srivc --nf 1 --nb 1,1 --set common_denominator=1 --json wall_11.json --force >/dev/null
-  "$ctid" fit wall_est.dat $m --method srivc --nf 1 --nb 2,2 --set common_denominator=1 --json wall_12.json --force \
-    > wall_12.txt
+  "$ctid" fit wall_est.dat $m --method srivc --nf 1 --nb 2,2 --set common_denominator=1 --json wall_12.json \
+    --report wall_12.html --force > wall_12.txt
   check "strictly proper first order: validation fit %" "$(fit_of wall_11.json wall_val.dat $m)" gt 25
   check "with a direct term (nb = 2): validation fit %" "$(fit_of wall_12.json wall_val.dat $m)" gt 80
   # Static gains b1/a1 of the two channels: a flux driven by the temperature difference has opposite, equal gains.
