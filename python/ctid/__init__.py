@@ -13,13 +13,24 @@ import numpy as _np
 
 from . import _ctid
 from ._ctid import (  # noqa: F401  (re-exported)
-    CorrelationTest, FileError, FrequencyData, FsfModel, IdData, InputGenerator, InvalidArgument, InvalidOptions,
-    MisoModel, ModalWindow, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm, NonlinearCorrelationTests,
-    PhysicalModel, TransferFunction, add_noise_snr, fit_percent, html_report, input_residual_crosscorrelation, load, narx_candidates, narx_noise_candidates,
-    nonlinear_correlation_tests, prbs, read_narx_json, read_nde_json, residual_autocorrelation, time_grid,
+    CorrelationTest, DeadbeatObserver, FileError, FrequencyData, FsfModel, IdData, InputGenerator, InvalidArgument,
+    InvalidOptions, MisoModel, ModalModel, ModalWindow, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm,
+    NonlinearCorrelationTests, PhysicalModel, TransferFunction, add_noise_snr, fit_percent, html_report,
+    input_residual_crosscorrelation, load, narx_candidates, narx_noise_candidates, nonlinear_correlation_tests,
+    piecewise_constant_windows, prbs, read_narx_json, read_nde_json, residual_autocorrelation, time_grid,
 )
 
 __version__ = _ctid.__version__
+
+
+def _enum(enum_cls, value, who, key):
+    """An enumeration member from its name (case-insensitive); members pass through."""
+    if not isinstance(value, str):
+        return value
+    members = {name.lower(): m for name, m in enum_cls.__members__.items()}
+    if value.lower() not in members:
+        raise ValueError(f"{who}: option '{key}' must be one of {', '.join(members)} (got '{value}')")
+    return members[value.lower()]
 
 
 def _options(cls, who, kwargs):
@@ -32,11 +43,8 @@ def _options(cls, who, kwargs):
         current = getattr(o, key)
         if isinstance(value, dict) and type(current).__module__.startswith("ctid"):  # a nested options struct
             value = _options(type(current), f"{who}.{key}", value)
-        elif isinstance(value, str) and hasattr(type(current), "__members__"):
-            members = {name.lower(): m for name, m in type(current).__members__.items()}
-            if value.lower() not in members:
-                raise ValueError(f"{who}: option '{key}' must be one of {', '.join(members)} (got '{value}')")
-            value = members[value.lower()]
+        elif hasattr(type(current), "__members__"):
+            value = _enum(type(current), value, who, key)
         setattr(o, key, value)
     return o
 
@@ -103,7 +111,7 @@ def _report(result):
     return "\n".join(lines)
 
 
-for _cls in (_ctid.TransferFunctionResult, _ctid.MisoResult, _ctid.FsfResult, _ctid.NarxResult, _ctid.NdeResult):
+for _cls in (_ctid.TransferFunctionResult, _ctid.MisoResult, _ctid.ModalResult, _ctid.FsfResult, _ctid.NarxResult, _ctid.NdeResult):
     _cls.__repr__ = _report
     _cls.report = _report
 
@@ -211,9 +219,46 @@ def nde_oe(data, initial, **options):
 def modal_fit(data, nb, input=None, **options):
     """El-Shafey (1987) modal-function identification (options: ModalOptions; shifts= is required; input: an
     InputGenerator for a generated input, None for a piecewise-constant one)."""
+    return _ctid.modal_fit(data, nb, _modal_options("modal_fit", options), input)
+
+
+def _modal_options(who, options):
     if "windows" in options:
         options["windows"] = [w if isinstance(w, ModalWindow) else ModalWindow(*w) for w in options["windows"]]
-    return _ctid.modal_fit(data, nb, _options(_ctid.ModalOptions, "modal_fit", options), input)
+    return _options(_ctid.ModalOptions, who, options)
+
+
+def modal_estimate(data, input, **options):
+    """El-Shafey modal parameters p_j and modal-function coefficients q_j (options: ModalOptions; shifts= is
+    required). input: the InputGenerator of a generated input, or the sampled input basis (N x n_c; data.u
+    for a piecewise-constant input, with windows=piecewise_constant_windows(...))."""
+    if not isinstance(input, InputGenerator):
+        input = _np.asarray(input, dtype=float).reshape(data.u.shape[0], -1)
+    return _ctid.modal_estimate(data, input, _modal_options("modal_estimate", options))
+
+
+def modal_frequency_response(data, model, period, harmonics, window_start, rule="simpson"):
+    """El-Shafey ch. 5: H(j k w_o) at the harmonics k of a periodic input (period in s) from one period
+    starting at window_start (>= the largest shift); model: a ModalModel (or result) with p_0."""
+    return _ctid.modal_frequency_response(data, getattr(model, "model", model), period, list(harmonics), window_start,
+                                          _enum(_ctid.Quadrature, rule, "modal_frequency_response", "rule"))
+
+
+def modal_step_response(data, model, level_period, horizon):
+    """El-Shafey ch. 5: step response on [0, horizon] from a piecewise-constant input whose levels change at
+    multiples of level_period; model: p_0 for the shifts i * level_period."""
+    return _ctid.modal_step_response(data, getattr(model, "model", model), level_period, horizon)
+
+
+def modal_impulse_from_step(step, negative_shifts, To, functions=6, rule="simpson"):
+    """El-Shafey ch. 5: impulse response from a step response (a TimeResponse) with negative shifts (s)."""
+    return _ctid.modal_impulse_from_step(step, _np.asarray(negative_shifts, dtype=float), To, functions,
+                                         _enum(_ctid.Quadrature, rule, "modal_impulse_from_step", "rule"))
+
+
+def prony(y, ts, **options):
+    """Prony's method (options: PronyOptions: order, spacing, equations, start)."""
+    return _ctid.prony(_np.asarray(y, dtype=float), ts, _options(_ctid.PronyOptions, "prony", options))
 
 
 def free_response_poles(y, ts, **options):

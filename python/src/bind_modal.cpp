@@ -1,5 +1,6 @@
-// ctid Python module — El-Shafey (1987): modal functions, parametric identification by modal_fit, and poles
-// from a free-response data matrix (Theorem 4.3).
+// ctid Python module — El-Shafey (1987): modal functions and parameters (modal_estimate), parametric
+// identification (modal_fit), poles from a free-response data matrix (Theorem 4.3) against Prony, the
+// nonparametric frequency, step and impulse responses (ch. 5) and the minimum-time observer (ch. 6).
 #include "common.hpp"
 
 namespace ctid::python {
@@ -39,6 +40,75 @@ void bind_modal(py::module_& m) {
         }, py::arg("data"), py::arg("nb"), py::arg("options"), py::arg("input") = nullptr,
         "Transfer function by modal functions (El-Shafey): generated input (Theorems 4.1-4.2) or piecewise-constant input.");
 
+  py::class_<ModalModel>(m, "ModalModel", "Modal parameters p_j (rows of P) and modal-function coefficients q_j (rows of Q).")
+      .def(py::init<Eigen::VectorXd, Eigen::MatrixXd, Eigen::MatrixXd>(), py::arg("shifts"), py::arg("P"), py::arg("Q"))
+      .def_property_readonly("shifts", &ModalModel::shifts)
+      .def_property_readonly("P", &ModalModel::P)
+      .def_property_readonly("Q", &ModalModel::Q)
+      .def_property_readonly("order", &ModalModel::order)
+      .def_property_readonly("max_order", &ModalModel::max_order)
+      .def("characteristic_polynomial", [](const ModalModel& mm) { return mm.characteristic_polynomial().coefficients(); },
+           "Theorem 4.1: the monic denominator, descending powers (needs max_order >= order).")
+      .def("transfer_function", &ModalModel::transfer_function, py::arg("input"),
+           "Theorems 4.1 and 4.2 with the generator of the input the Q refer to.")
+      .def("__repr__", [](const ModalModel& mm) {
+        return detail::format("ModalModel(order {}, derivatives 0..{})", mm.order(), mm.max_order());
+      });
+  bind_result<ModalModel>(m, "ModalResult");
+  m.def("piecewise_constant_windows", &piecewise_constant_windows, py::arg("data"), py::arg("settle"),
+        py::arg("min_length") = 0.0, "Windows of constant input from `settle` s after each level switch.");
+  m.def("modal_estimate", [](const IdData& d, const InputGenerator& g, const ModalOptions& o) {
+          return interruptible([&] { return modal_estimate(d, g, o); });
+        }, py::arg("data"), py::arg("input"), py::arg("options"), "p_j and q_j with a known input generator.");
+  m.def("modal_estimate", [](const IdData& d, const Eigen::MatrixXd& basis, const ModalOptions& o) {
+          return interruptible([&] { return modal_estimate(d, basis, o); });
+        }, py::arg("data"), py::arg("input"), py::arg("options"),
+        "p_j and q_j with the input basis sampled (N x n_c; u itself for a piecewise-constant input).");
+
+  py::class_<TimeResponse>(m, "TimeResponse")
+      .def_readonly("t", &TimeResponse::t)
+      .def_readonly("value", &TimeResponse::value);
+  py::class_<HarmonicResponse>(m, "HarmonicResponse")
+      .def_readonly("response", &HarmonicResponse::response)
+      .def_readonly("nu", &HarmonicResponse::nu)
+      .def_readonly("q", &HarmonicResponse::q);
+  py::class_<ImpulseFromStep>(m, "ImpulseFromStep")
+      .def_readonly("impulse", &ImpulseFromStep::impulse)
+      .def_readonly("p1", &ImpulseFromStep::p1)
+      .def_readonly("q10", &ImpulseFromStep::q10)
+      .def_readonly("g_To", &ImpulseFromStep::g_To);
+  m.def("modal_frequency_response", &modal_frequency_response, py::arg("data"), py::arg("model"), py::arg("period"),
+        py::arg("harmonics"), py::arg("window_start"), py::arg("rule") = Quadrature::Simpson,
+        "ES 5.1-5.14: H(j k w_o) at harmonics k of a periodic input, transients annihilated by p_0.");
+  m.def("modal_step_response", &modal_step_response, py::arg("data"), py::arg("model"), py::arg("level_period"),
+        py::arg("horizon"), "ES 5.15-5.37: step response from a piecewise-constant input (levels change at i T).");
+  m.def("modal_impulse_from_step", &modal_impulse_from_step, py::arg("step"), py::arg("negative_shifts"), py::arg("To"),
+        py::arg("functions") = 6, py::arg("rule") = Quadrature::Simpson,
+        "ES 5.38-5.42: impulse response from a step response with negative shifts.");
+
+  py::class_<DeadbeatObserver>(m, "DeadbeatObserver", "El-Shafey's minimum-time (dead-beat) state observer (ch. 6).")
+      .def_static("from_model", &DeadbeatObserver::from_model, py::arg("model"), py::arg("T"), py::arg("ts"))
+      .def_static("from_step_response", &DeadbeatObserver::from_step_response, py::arg("model"), py::arg("step"),
+                  py::arg("T"))
+      .def_property_readonly("order", &DeadbeatObserver::order)
+      .def_property_readonly("period", &DeadbeatObserver::period)
+      .def_property_readonly("offsets", &DeadbeatObserver::offsets)
+      .def_property_readonly("P", &DeadbeatObserver::P)
+      .def("Qbar", &DeadbeatObserver::Qbar, py::arg("offset"))
+      .def("r", &DeadbeatObserver::r, py::arg("offset"))
+      .def_property_readonly("q_tilde0", &DeadbeatObserver::q_tilde0)
+      .def("Q_discrete", &DeadbeatObserver::Q_discrete)
+      .def("reconstruct", &DeadbeatObserver::reconstruct, py::arg("data"),
+           "Phase-variable state at every sample (NaN for the first n level periods).")
+      .def("markov_parameters", &DeadbeatObserver::markov_parameters, py::arg("p_n"), py::arg("g_inf"));
+
+  py::class_<PronyOptions>(m, "PronyOptions")
+      .def(py::init<>())
+      .def_readwrite("order", &PronyOptions::order)
+      .def_readwrite("spacing", &PronyOptions::spacing)
+      .def_readwrite("equations", &PronyOptions::equations)
+      .def_readwrite("start", &PronyOptions::start);
+
   py::class_<FreeResponseOptions>(m, "FreeResponseOptions")
       .def(py::init<>())
       .def_readwrite("shifts", &FreeResponseOptions::shifts)
@@ -54,6 +124,7 @@ void bind_modal(py::module_& m) {
       .def_readonly("warnings", &PoleEstimate::warnings);
   m.def("free_response_poles", &free_response_poles, py::arg("y"), py::arg("ts"), py::arg("options"),
         "Poles from a free-response data matrix (El-Shafey Theorem 4.3).");
+  m.def("prony", &prony, py::arg("y"), py::arg("ts"), py::arg("options"), "Prony's method (poles modulo 2 pi / T).");
 }
 
 }  // namespace ctid::python

@@ -32,6 +32,66 @@ def test_free_response_poles_theorem_4_3():
     assert sorted(abs(p.poles.imag))[0] == pytest.approx(3, abs=0.01)
 
 
+def test_modal_frequency_response_from_a_square_wave():
+    # El-Shafey Ex. 5.1 (as tests/estimate/modal_test.cpp): S3 under a +-1 square wave of period 2 pi, Ts = pi/420;
+    # p_0 from the constant-input windows; H(jk) at the odd harmonics within 2e-6 of the truth (C++: same bound).
+    ts = math.pi / 420
+    u = np.where((np.arange(1000) // 420) % 2 == 0, 1.0, -1.0)
+    d = ctid.IdData.from_arrays(u, S3.simulate(u, ctid.time_grid(ts, 1000)), ts=ts)
+    shifts = np.array([40, 80, 120]) * ts
+    m = ctid.modal_estimate(d, d.u, shifts=shifts, basis="discrete",
+                            windows=ctid.piecewise_constant_windows(d, shifts[-1]))
+    assert m.usable() and m.model.order == 3
+    h = ctid.modal_frequency_response(d, m, 2 * math.pi, [1, 3, 5, 7, 9, 11], 120 * ts)
+    k = np.array([1, 3, 5, 7, 9, 11])
+    np.testing.assert_allclose(h.response.w, k)
+    truth = S3.freqresp(k.astype(float))
+    assert np.max(np.abs(h.response.response - truth) / np.abs(truth)) < 2e-6
+    assert h.nu[0, 0] == pytest.approx(1.4363, abs=1e-4)  # Table 5.1, first row
+    with pytest.raises(ctid.InvalidArgument):
+        ctid.modal_frequency_response(d, m, 2 * math.pi, [2], 120 * ts)  # even harmonics are not excited
+    with pytest.raises(ValueError, match="must be one of"):
+        ctid.modal_frequency_response(d, m, 2 * math.pi, [1], 120 * ts, rule="gauss")
+
+
+def test_modal_step_and_impulse_responses_and_the_observer():
+    # El-Shafey Ex. 5.2/5.3 (modal_test.cpp): S3, levels +1, +2, -1, -2 of 80 Ts each, Ts = pi/320, T = 20 Ts:
+    # the step response equals the true one to 1e-9, the impulse response (negative shifts) to 1e-5, p_1 and q_10
+    # the published (-1.6728, 8.1618, 11.2474) and 17.736 to 5e-4 relative.
+    ts = math.pi / 320
+    T = 20 * ts
+    u = np.repeat([1.0, 2.0, -1.0, -2.0], 80)
+    d = ctid.IdData.from_arrays(u, S3.simulate(u, ctid.time_grid(ts, 320)), ts=ts)
+    shifts = np.array([T, 2 * T, 3 * T])
+    m = ctid.modal_estimate(d, d.u, shifts=shifts, basis="discrete", windows=ctid.piecewise_constant_windows(d, 3 * T))
+    g = ctid.modal_step_response(d, m, T, 640 * ts)
+    assert np.max(np.abs(g.value - S3.step(g.t))) < 1e-9
+    imp = ctid.modal_impulse_from_step(g, -np.array([40, 80, 120]) * ts, 192 * ts)
+    assert np.max(np.abs(imp.impulse.value - S3.impulse(imp.impulse.t))) < 1e-5
+    np.testing.assert_allclose(imp.p1, [-1.6728, 8.1618, 11.2474], atol=5e-4 * 11.25)
+    assert imp.q10 == pytest.approx(17.736, rel=5e-4)
+    # Minimum-time observer (ch. 6) from the model: after n = 3 level periods the reconstructed phase-variable
+    # state reproduces the output (x_1 = y) to 1e-9; before, NaN.
+    obs = ctid.DeadbeatObserver.from_model(S3, T, ts)
+    assert obs.order == 3 and obs.offsets == 20
+    x = obs.reconstruct(d)
+    assert np.isnan(x[59, 0])
+    assert np.max(np.abs(x[60:, 0] - d.y[60:, 0])) < 1e-9
+    with pytest.raises(ctid.InvalidArgument):
+        ctid.modal_step_response(d, m, 10 * ts, 640 * ts)  # shifts are not multiples of the level period
+
+
+def test_prony_aliases_where_the_data_matrix_does_not():
+    # A 100 rad/s cosine sampled at 33 Tw = 2 pi / (3 * 666) * 33 s per Prony sample aliases: Prony returns the
+    # frequency modulo 2 pi / T and says so.
+    tw = 2 * math.pi / 3 / 666
+    t = ctid.time_grid(tw, 2000)
+    y = np.exp(-t) * np.sin(3 * t) + np.cos(100 * t)
+    p = ctid.prony(y, tw, order=4, spacing=33, equations=40)
+    assert any("alias" in w or "2 pi" in w for w in p.warnings)
+    assert max(abs(p.poles.imag)) <= math.pi / (33 * tw) + 1e-9
+
+
 def test_physical_parameters_from_the_fsf_step_response(plant):
     # G(s) = k w^2/(s^2 + 2 z w s + w^2) with k = 1, w = 2, z = 0.2 (the plant fixture) at 20 dB.
     _, d = plant
