@@ -17,7 +17,7 @@ from ._ctid import (  # noqa: F401  (re-exported)
     InvalidOptions, MisoModel, ModalModel, ModalWindow, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm,
     NonlinearCorrelationTests, PhysicalModel, TransferFunction, add_noise_snr, fit_percent, html_report,
     input_residual_crosscorrelation, load, narx_candidates, narx_noise_candidates, nonlinear_correlation_tests,
-    piecewise_constant_windows, prbs, read_narx_json, read_nde_json, residual_autocorrelation, time_grid,
+    one_sided_dft, piecewise_constant_windows, prbs, read_narx_json, read_nde_json, residual_autocorrelation, time_grid,
 )
 
 __version__ = _ctid.__version__
@@ -178,6 +178,13 @@ def select_order(data, nb, nf, nk=(0, 0), rank_by="yic", **srivc_options):
 def fsf(data, **options):
     """Gawthrop & Wang (2005) frequency-sampling-filter model (options: FsfOptions; T is required)."""
     return _ctid.fsf(data, _options(_ctid.FsfOptions, "fsf", options))
+
+
+def fsf_from_spectra(U, Y, L, ts, **options):
+    """Gawthrop & Wang stage 1 from the one-sided DFTs U, Y (ctid.one_sided_dft(x, L), L >= M + N) of input
+    and output records sampled at ts (options: FsfOptions; T is required, b must be 0)."""
+    return _ctid.fsf_from_spectra(_np.asarray(U, dtype=complex), _np.asarray(Y, dtype=complex), L, ts,
+                                  _options(_ctid.FsfOptions, "fsf_from_spectra", options))
 
 
 def frols(data, candidates, **options):

@@ -32,6 +32,14 @@ void bind_fsf(py::module_& m) {
       "fsf",
       [](const IdData& d, const FsfOptions& o) { return interruptible([&] { return fsf(d, o); }); },
       py::arg("data"), py::arg("options"), "Stage 1 of Gawthrop & Wang: the FSF model by least squares.");
+  m.def(
+      "fsf_from_spectra",
+      [](const Eigen::VectorXcd& U, const Eigen::VectorXcd& Y, int L, double ts, const FsfOptions& o) {
+        return interruptible([&] { return fsf_from_spectra(U, Y, L, ts, o); });
+      },
+      py::arg("U"), py::arg("Y"), py::arg("L"), py::arg("ts"), py::arg("options"),
+      "Stage 1 from one-sided DFTs (bins 0..L/2) of records zero-padded to L >= M + N (GW 24-29).");
+  m.def("one_sided_dft", &one_sided_dft, py::arg("x"), py::arg("L"), "Bins 0..L/2 of x zero-padded to length L (even).");
 }
 
 }  // namespace ctid::python

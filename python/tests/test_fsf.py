@@ -23,3 +23,17 @@ def test_fsf_options_are_checked(plant):
         ctid.fsf(d, T=20.0, n=30)  # even
     with pytest.raises(TypeError, match="unknown option"):
         ctid.fsf(d, T=20.0, filters=31)
+
+
+def test_fsf_from_spectra_equals_the_time_domain_fit(plant):
+    # GW 24-29: with records zero-padded to L >= M + N the frequency-domain normal equations are the time-domain
+    # ones, so theta agrees to rounding (C++ test: 1e-8 with the window a = 2; here a = 0.5 and relative 1e-8).
+    _, d = plant
+    u, y = d.u[:, 0], d.y[:, 0]
+    L = 1 << int(np.ceil(np.log2(len(u) + 1000)))
+    td = ctid.fsf(d, T=20.0, n=31, a=0.5)
+    fd = ctid.fsf_from_spectra(ctid.one_sided_dft(u, L), ctid.one_sided_dft(y, L), L, d.ts, T=20.0, n=31, a=0.5)
+    assert fd.usable()
+    assert np.max(np.abs(fd.model.theta - td.model.theta)) < 1e-8 * np.max(np.abs(td.model.theta))
+    with pytest.raises(ctid.InvalidOptions):
+        ctid.fsf_from_spectra(ctid.one_sided_dft(u, L), ctid.one_sided_dft(y, L), L, d.ts, T=20.0, n=31, b=1.0)
