@@ -45,17 +45,16 @@ int run(const ValArgs& a) {
     linear = read_model_json(a.model);
     if (std::holds_alternative<StateSpace>(*linear)) throw UsageError("validate supports transfer-function, MISO, NARX and NDE models");
   } catch (const FileError& e) {
-    try {
-      const NarxModel m = read_narx_json(a.model);
+    const auto describe = [&](const auto& m) {
       description = m.to_string(6);
       np = static_cast<int>(m.coefficients().size());
       model_json = nonlinear_model_json(a.model);
+    };
+    try {
+      describe(read_narx_json(a.model));
     } catch (const FileError&) {
       try {
-        const NdeModel m = read_nde_json(a.model);
-        description = m.to_string(6);
-        np = static_cast<int>(m.coefficients().size());
-        model_json = nonlinear_model_json(a.model);
+        describe(read_nde_json(a.model));
       } catch (const FileError&) {
         throw InputError(e.what());
       }

@@ -323,26 +323,26 @@ void read_envelope(const json& j, const Reader& rd, Result<M>& r) {
 }
 }  // namespace
 
-Result<TransferFunction> parse_result_json(const std::string& text, const std::string& source) {
+namespace {
+template <class M>
+Result<M> parse_linear_result(const std::string& text, const std::string& source, const char* what) {
   const Reader rd{source};
   const json j = parse_text(text, rd);
-  Result<TransferFunction> r;
+  Result<M> r;
   const LinearModel m = model_from(j, rd);
-  if (!std::holds_alternative<TransferFunction>(m)) rd.fail("the result's model is not a transfer function");
-  r.model = std::get<TransferFunction>(m);
+  if (!std::holds_alternative<M>(m)) rd.fail(std::string("the result's model is not ") + what);
+  r.model = std::get<M>(m);
   read_envelope(j, rd, r);
   return r;
 }
+}  // namespace
+
+Result<TransferFunction> parse_result_json(const std::string& text, const std::string& source) {
+  return parse_linear_result<TransferFunction>(text, source, "a transfer function");
+}
 
 Result<MisoModel> parse_miso_result_json(const std::string& text, const std::string& source) {
-  const Reader rd{source};
-  const json j = parse_text(text, rd);
-  Result<MisoModel> r;
-  const LinearModel m = model_from(j, rd);
-  if (!std::holds_alternative<MisoModel>(m)) rd.fail("the result's model is not a multi-input (miso) model");
-  r.model = std::get<MisoModel>(m);
-  read_envelope(j, rd, r);
-  return r;
+  return parse_linear_result<MisoModel>(text, source, "a multi-input (miso) model");
 }
 
 void write_result_json(const std::string& path, const Result<TransferFunction>& r, const std::string& method) {
