@@ -111,9 +111,57 @@ def _report(result):
     return "\n".join(lines)
 
 
-for _cls in (_ctid.TransferFunctionResult, _ctid.MisoResult, _ctid.ModalResult, _ctid.FsfResult, _ctid.NarxResult, _ctid.NdeResult):
+for _cls in (_ctid.TransferFunctionResult, _ctid.MisoResult, _ctid.ModalResult, _ctid.FsfResult, _ctid.NarxResult,
+             _ctid.NdeResult):
     _cls.__repr__ = _report
     _cls.report = _report
+
+
+# ---- responses of the models that have no closed form in C++ ----
+
+def _miso_columns(method):
+    def f(self, x):
+        """One column per input channel."""
+        return _np.column_stack([getattr(g, method)(_np.asarray(x, dtype=float)) for g in self.channels])
+    f.__name__ = method
+    return f
+
+
+MisoModel.freqresp = _miso_columns("freqresp")
+MisoModel.step = _miso_columns("step")
+MisoModel.impulse = _miso_columns("impulse")
+
+
+def _nde_freqresp(self, w):
+    """The linear part's frequency response H_1(jw) (w in rad/s)."""
+    return _np.array([self.h1(1j * x) for x in _np.atleast_1d(_np.asarray(w, dtype=float))])
+
+
+def _nde_step(self, t, amplitude=1.0):
+    """Response from rest to the step amplitude * 1(t) (amplitude matters: the model is nonlinear)."""
+    t = _np.asarray(t, dtype=float)
+    s = self.simulate(_np.full(t.size, float(amplitude)), t - t[0])
+    if not s.ok():
+        raise InvalidArgument(f"NdeModel.step: the simulation escapes ({s.message})")
+    return s.y
+
+
+def _narx_freqresp(self, w, zoh=True):
+    """The linear part's frequency response H_1(jw) read as continuous-time (zoh: hold factor removed)."""
+    return _np.array([self.gfrf([1j * x], zoh) for x in _np.atleast_1d(_np.asarray(w, dtype=float))])
+
+
+def _narx_step(self, t, amplitude=1.0):
+    """Free-run response from rest to the step amplitude * 1(t); t must be on the model's grid k * ts."""
+    t = _np.asarray(t, dtype=float)
+    k = (t - t[0]) / self.ts
+    if _np.max(_np.abs(k - _np.round(k))) > 1e-6 or _np.any(_np.diff(_np.round(k)) != 1):
+        raise InvalidArgument(f"NarxModel.step: t must be consecutive samples of the model's Ts = {self.ts} s")
+    return self.process().simulate(_np.full(t.size, float(amplitude)))
+
+
+NdeModel.freqresp, NdeModel.step = _nde_freqresp, _nde_step
+NarxModel.freqresp, NarxModel.step = _narx_freqresp, _narx_step
 
 
 # ---- estimators with keyword options (names as in C++) ----

@@ -4,7 +4,7 @@ Every function draws on `ax` (or new axes) and returns the axes it drew on.
 """
 import numpy as np
 
-from . import FsfModel, InvalidArgument, TransferFunction, input_residual_crosscorrelation, \
+from . import FsfModel, InvalidArgument, MisoModel, TransferFunction, input_residual_crosscorrelation, \
     residual_autocorrelation, simulate
 
 
@@ -74,8 +74,9 @@ def bode(model, w=None, confidence=True, ax=None):
     axes = _axes(ax, 2)
     m = getattr(model, "model", model)
     if w is None:
-        if isinstance(m, TransferFunction):
-            mag = np.abs(m.poles()) if m.order else np.array([1.0])
+        if isinstance(m, (TransferFunction, MisoModel)):
+            poles = np.concatenate([g.poles() for g in m.channels]) if isinstance(m, MisoModel) else m.poles()
+            mag = np.abs(poles) if poles.size else np.array([1.0])
             mag = mag[mag > 0] if np.any(mag > 0) else np.array([1.0])
             w = np.logspace(np.log10(mag.min()) - 2, np.log10(mag.max()) + 2, 400)
         elif isinstance(m, FsfModel):
@@ -83,8 +84,8 @@ def bode(model, w=None, confidence=True, ax=None):
         else:
             raise InvalidArgument(f"bode: give w for a {type(m).__name__}")
     h = m.freqresp(w)
-    axes[0].semilogx(w, 20 * np.log10(np.abs(h)), lw=1.2)
-    axes[1].semilogx(w, np.degrees(np.unwrap(np.angle(h))), lw=1.2)
+    axes[0].semilogx(w, 20 * np.log10(np.abs(h)), lw=1.2)  # a multi-input model: a curve per channel
+    axes[1].semilogx(w, np.degrees(np.unwrap(np.angle(h), axis=0)), lw=1.2)
     if confidence:
         lo = hi = None
         if isinstance(m, FsfModel) and m.covariance.size:
@@ -110,10 +111,13 @@ def _response(kind, model, t, ax):
     if t is None:
         if isinstance(m, FsfModel):
             t = np.linspace(0, m.T, 400)
-        else:
-            re = np.abs(np.real(m.poles()))
+        elif isinstance(m, (TransferFunction, MisoModel)):
+            poles = np.concatenate([g.poles() for g in m.channels]) if isinstance(m, MisoModel) else m.poles()
+            re = np.abs(np.real(poles))
             re = re[re > 0]
             t = np.linspace(0, 8 / re.min() if re.size else 10.0, 400)
+        else:
+            raise InvalidArgument(f"{kind}: give t for a {type(m).__name__}")
     y = m.step(t) if kind == "step" else m.impulse(t)
     ax.plot(t, y, lw=1.2)
     if isinstance(m, FsfModel) and m.covariance.size:

@@ -25,6 +25,14 @@ def test_plots_draw_and_return_axes(plant, tmp_path):
     y = ax.lines[0].get_ydata()
     assert y[-1] == pytest.approx(1.0, abs=0.05)
     ctid.plot.impulse(r)
+    # A two-input model: a Bode and step curve per channel; the responses are the channels' columns.
+    t = ctid.time_grid(0.02, 2000)
+    u2 = ctid.prbs(2000, register_length=8, clock_period=7)
+    d2 = ctid.IdData.from_arrays(np.column_stack([d.u[:, 0], u2]), d.y[:, 0] + g.simulate(u2, t), ts=0.02)
+    m = ctid.srivc_miso(d2, [(1, 2, 0), (1, 2, 0)])
+    assert m.model.freqresp([1.0, 2.0]).shape == (2, 2) and m.model.step(t).shape == (2000, 2)
+    np.testing.assert_allclose(m.model.step(t)[:, 1], m.model.channels[1].step(t))
+    assert len(ctid.plot.bode(m)[0].lines) == 2 and len(ctid.plot.step(m).lines) == 2
     plt.savefig(tmp_path / "last.png")
     assert (tmp_path / "last.png").stat().st_size > 1000
     plt.close("all")
