@@ -58,6 +58,11 @@ if [ -f "$winding" ]; then
   code=0
   "$ctid" fit winding_est.dat $w --output 7 --method srivc --nf 1 --json winding_7s.json --force >/dev/null 2>&1 || code=$?
   check "tension T3, separate denominators: exit code (1 = not usable, reported)" "$code" gt 0.5
+  # T3 with a common third-order denominator converges and validates best.
+  "$ctid" fit winding_est.dat $w --output 7 --method srivc --nf 3 --set common_denominator=1 --json winding_7c3.json \
+    --force >/dev/null
+  check "tension T3, common third-order denominator: validation fit %" \
+    "$(fit_of winding_7c3.json winding_val.dat $w --output 7)" gt 50
 else
   echo "== winding process: SKIPPED ($winding not available)"
 fi
