@@ -86,7 +86,9 @@ LinearModel model_from(const json& root, const Reader& rd) {
   const std::string t = type.get<std::string>();
   try {
     if (t == "transfer_function") {
-      const double delay = m.contains("io_delay") ? to_num(m.at("io_delay")) : 0.0;
+      if (m.contains("io_delay") && !m.at("io_delay").is_number())
+        rd.fail("\"io_delay\" must be a number (seconds)");
+      const double delay = m.contains("io_delay") ? m.at("io_delay").get<double>() : 0.0;
       return TransferFunction(rd.vector(rd.member(m, "num", "the model"), "num"), rd.vector(rd.member(m, "den", "the model"), "den"),
                               delay);
     }

@@ -1,4 +1,4 @@
-// libFuzzer target for the JSON model and result readers (linear models, results, NARX and NDE models;
+// libFuzzer target for the JSON model and result readers (linear models, TF and MISO results, NARX and NDE models;
 // issue 7). Any input must either be read or throw ctid::FileError / ctid::InvalidArgument.
 #include <cstddef>
 #include <cstdint>
@@ -18,6 +18,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   };
   guarded([&] { (void)ctid::parse_model_json(text, "<fuzz>"); });
   guarded([&] { (void)ctid::parse_result_json(text, "<fuzz>"); });
+  guarded([&] { (void)ctid::parse_miso_result_json(text, "<fuzz>"); });
   guarded([&] { (void)ctid::parse_narx_json(text, "<fuzz>"); });
   guarded([&] { (void)ctid::parse_nde_json(text, "<fuzz>"); });
   return 0;

@@ -136,6 +136,12 @@ TEST(Json, MalformedFilesAreFileErrors) {
             std::string::npos);
   EXPECT_NE(error_of([] { parse_model_json("{\"type\": \"narx\"}", "m.json"); }).find("\"narx\""), std::string::npos);
   EXPECT_THROW(read_model_json("/nonexistent.json"), FileError);
+  // Fuzz finding (tests/fuzz/corpus/json/regression-io-delay-string.json): a non-numeric io_delay ended in
+  // std::terminate (an uncaught json type_error).
+  EXPECT_EQ(error_of([] {
+              parse_model_json(R"({"type": "transfer_function", "num": [1], "den": [1, 2], "io_delay": "D^2y"})", "m.json");
+            }),
+            "m.json: \"io_delay\" must be a number (seconds)");
 }
 
 TEST(Mat, WriteReadAndLoad) {
