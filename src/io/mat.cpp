@@ -95,6 +95,8 @@ class V5Checker {
     for (std::uint32_t k = 0; k < size; k += 4) {
       const auto d = static_cast<std::int32_t>(u32(dims + k));
       if (d < 0) bad("a negative array dimension");
+      if (cls != 5 && static_cast<double>(d) > static_cast<double>(n) + 8)  // also when another dimension is 0
+        bad(detail::format("an array dimension of {} in {} bytes", d, n));
       count *= d;
     }
     if (cls != 5 && count > static_cast<double>(n - i) + 8) bad(detail::format("an array of {} elements in {} bytes", count, n - i));
@@ -162,6 +164,13 @@ void check_v4(const std::string& path, const std::vector<unsigned char>& b) {
                         name = word(4, big);
     if (type > 4999 || (type / 10) % 10 > 5 || imag > 1)
       bad("not a level 5 file, and not a valid level 4 file (bad matrix type)");
+    // libmatio reads the sizes as signed 32-bit numbers (a negative one became a 1.8e19 dimension), and it
+    // allocates by the row count even when there are no columns (5 GB for a 126-byte file): no dimension may
+    // exceed the file's size.
+    if (rows > 0x7fffffffu || cols > 0x7fffffffu)
+      bad("not a level 5 file, and not a valid level 4 file (a negative matrix dimension)");
+    if (rows > b.size() || cols > b.size())
+      bad(detail::format("a level 4 matrix declares {} x {} values in a file of {} bytes", rows, cols, b.size()));
     static constexpr int kSize[] = {8, 4, 4, 2, 2, 1};
     const double bytes = double(rows) * double(cols) * kSize[(type / 10) % 10] * (1 + imag) + double(name);
     if (bytes > double(b.size() - i - 20))
@@ -178,7 +187,14 @@ void check_mat_structure(const std::string& path) {
   const bool le = header && bytes[126] == 'I' && bytes[127] == 'M', be = header && bytes[126] == 'M' && bytes[127] == 'I';
   if (!le && !be) return check_v4(path, bytes);
   const unsigned version = le ? bytes[124] | bytes[125] << 8 : bytes[125] | bytes[124] << 8;
-  if (version != 0x0100) return;  // level 7.3 (HDF5): left to HDF5
+  if (version == 0x0200) return;  // level 7.3 (HDF5): left to HDF5
+  // Any other version word would be read by libmatio as level 5 without this check (a fuzz input with
+  // version 0x0110 made it allocate 2 GB).
+  if (version != 0x0100) {
+    char hex[16];
+    std::snprintf(hex, sizeof hex, "0x%04x", version);
+    throw FileError(detail::format("cannot read '{}' as a MATLAB .mat file: unknown version {} in the header", path, hex));
+  }
   V5Checker(path, be).sequence(bytes.data() + 128, bytes.size() - 128, 0, true);
 }
 
@@ -223,6 +239,9 @@ Eigen::MatrixXd read_mat_variable(const std::string& path, const std::string& na
   struct Guard { matvar_t* v; ~Guard() { Mat_VarFree(v); } } guard{v};
   if (v->rank != 2) throw FileError(detail::format("{}: variable '{}' has {} dimensions (2 expected)", path, name, v->rank));
   if (v->isComplex) throw FileError(detail::format("{}: variable '{}' is complex (real expected)", path, name));
+  if (v->dims[0] > 0x7fffffffu || v->dims[1] > 0x7fffffffu)  // the structure checks should make this impossible
+    throw FileError(detail::format("{}: variable '{}' declares {} x {} values (the file is damaged)", path, name, v->dims[0],
+                                   v->dims[1]));
   Eigen::MatrixXd out(static_cast<Eigen::Index>(v->dims[0]), static_cast<Eigen::Index>(v->dims[1]));
   switch (v->class_type) {
     case MAT_C_DOUBLE: copy_as_double<double>(v->data, out); break;
