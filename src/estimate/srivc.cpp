@@ -366,7 +366,7 @@ Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& or
   // Start, input by input: SISO SRIVC of y minus the outputs of the channels fitted before (the later inputs
   // act as noise). Fitting every channel on y alone instead gives starts biased by all other inputs (at
   // equal input powers a 0 dB "noise"), from which the iterations can end rank-deficient.
-  std::vector<Eigen::VectorXd> th(K);
+  std::vector<Eigen::VectorXd> th(K), xhat(K);  // channel parameters and simulated channel outputs
   {
     Eigen::VectorXd rest = y;
     for (int i = 0; i < K; ++i) {
@@ -380,7 +380,8 @@ Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& or
       th[i] = s.parameters.values;
       const TransferFunction gi = tf_detail::stabilized(channel_model(i, th[i].head(orders[i].nf), th[i].tail(orders[i].nb)));
       th[i] = tf_detail::params_of(gi, {orders[i].nb, orders[i].nf, 0});
-      rest -= lsim(gi, data, i);
+      xhat[i] = lsim(gi, data, i);
+      rest -= xhat[i];
     }
   }
   Result<MisoModel> r;
@@ -416,9 +417,6 @@ Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& or
   } else {
     // Backfitting: channel i is refitted on y minus the other channels' model outputs.
     Eigen::MatrixXd zz_blocks = Eigen::MatrixXd::Zero(p, p);
-    std::vector<Eigen::VectorXd> xhat(K);
-    for (int i = 0; i < K; ++i)
-      xhat[i] = lsim(channel_model(i, th[i].head(orders[i].nf), th[i].tail(orders[i].nb)), data, i);
     for (it = 1; it <= opt.max_iterations; ++it) {
       double change = 0;
       int off = 0;
