@@ -30,8 +30,10 @@ int run(const SimArgs& a) {
   try {
     m = read_model_json(a.model);
   } catch (const FileError& e) {
-    nonlinear = simulate_nonlinear(a.model, d, y);
-    if (!nonlinear) throw InputError(e.what());
+    const std::optional<NonlinearModel> nl = read_nonlinear_model(a.model);
+    if (!nl) throw InputError(e.what());
+    y = simulate_nonlinear(*nl, d, a.model);
+    nonlinear = true;
     ynames = {"y"};
   }
   if (nonlinear) {

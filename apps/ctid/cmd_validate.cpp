@@ -38,27 +38,19 @@ int run(const ValArgs& a) {
   // Linear models (transfer function, MISO) are simulated exactly from rest; NARX and NDE model files as by
   // `ctid simulate` (NARX at its Ts from rest, NDE by the adaptive integrator).
   std::optional<LinearModel> linear;
+  std::optional<NonlinearModel> nonlinear;
   std::string description, unstable;
-  nlohmann::json model_json;
   int np = 0;
   try {
     linear = read_model_json(a.model);
     if (std::holds_alternative<StateSpace>(*linear)) throw UsageError("validate supports transfer-function, MISO, NARX and NDE models");
   } catch (const FileError& e) {
-    const auto describe = [&](const auto& m) {
+    nonlinear = read_nonlinear_model(a.model);
+    if (!nonlinear) throw InputError(e.what());
+    std::visit([&](const auto& m) {
       description = m.to_string(6);
       np = static_cast<int>(m.coefficients().size());
-      model_json = nonlinear_model_json(a.model);
-    };
-    try {
-      describe(read_narx_json(a.model));
-    } catch (const FileError&) {
-      try {
-        describe(read_nde_json(a.model));
-      } catch (const FileError&) {
-        throw InputError(e.what());
-      }
-    }
+    }, *nonlinear);
   }
   const IdData d = a.data.load(true);
   if (d.ny() != 1) throw UsageError(detail::format("validate compares one output; {} were selected", d.ny()));
@@ -75,11 +67,8 @@ int run(const ValArgs& a) {
     require_finite_simulation(yhat, d, unstable);
     for (const auto& c : miso.channels) np += c.num().degree() + 1 + c.order();
     description = miso.to_string(6);
-    model_json = nlohmann::json::parse(model_to_json(*linear));
   } else {
-    Eigen::MatrixXd ys;
-    simulate_nonlinear(a.model, d, ys);
-    yhat = ys.col(0);
+    yhat = simulate_nonlinear(*nonlinear, d, a.model);
     require_finite_simulation(yhat, d, "");
   }
   const Eigen::VectorXd y = d.y().col(0);
@@ -105,7 +94,7 @@ int run(const ValArgs& a) {
   if (!a.json.empty()) {
     nlohmann::json j;
     j["ctid_version"] = version();
-    j["model"] = model_json;
+    j["model"] = linear ? nlohmann::json::parse(model_to_json(*linear)) : nonlinear_model_json(a.model);
     j["fit"] = {{"fit_percent", f.fit_percent}, {"nrmse", f.nrmse}, {"mse", f.mse}, {"n_samples", f.n_samples}};
     j["residual_autocorrelation"] = corr_json(ac);
     j["input_residual_crosscorrelation"] = nlohmann::json::array();

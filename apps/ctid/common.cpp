@@ -93,39 +93,39 @@ std::map<std::string, std::string> parse_sets(const std::vector<std::string>& se
   return m;
 }
 
-bool simulate_nonlinear(const std::string& model, const IdData& d, Eigen::MatrixXd& y) {
-  std::optional<NarxModel> narx;
-  std::optional<NdeModel> nde;
+std::optional<NonlinearModel> read_nonlinear_model(const std::string& path) {
   try {
-    narx = read_narx_json(model);
+    return read_narx_json(path);
   } catch (const FileError&) {
-    try {
-      nde = read_nde_json(model);
-    } catch (const FileError&) {
-      return false;
-    }
   }
+  try {
+    return read_nde_json(path);
+  } catch (const FileError&) {
+    return std::nullopt;
+  }
+}
+
+Eigen::VectorXd simulate_nonlinear(const NonlinearModel& m, const IdData& d, const std::string& source) {
   if (d.nu() != 1) throw UsageError(detail::format("the model has 1 input but {} input columns were selected", d.nu()));
-  if (narx) {
+  if (const auto* narx = std::get_if<NarxModel>(&m)) {
     if (!d.is_uniform() || std::abs(d.ts() - narx->ts()) > 1e-9 * narx->ts())
       throw UsageError(detail::format("the NARX model runs at Ts = {} s; the data must be uniformly sampled at it",
                                       narx->ts()));
     bool escaped = false;
-    y = narx->process().simulate(d.u().col(0), {}, &escaped);
-    if (escaped) throw NotUsable(model + ": the NARX simulation escapes (blows up) for this input");
-  } else {
-    Eigen::VectorXd t(d.size());
-    for (int i = 0; i < d.size(); ++i) t(i) = d.time(i) - d.t0();
-    NdeSimulation s;
-    try {
-      s = nde->simulate(d.u().col(0), t, d.intersample(0));
-    } catch (const InvalidArgument& e) {
-      throw UsageError(model + ": " + e.what());
-    }
-    if (!s.ok()) throw NotUsable(model + ": " + s.message);
-    y = s.y;
+    Eigen::VectorXd y = narx->process().simulate(d.u().col(0), {}, &escaped);
+    if (escaped) throw NotUsable(source + ": the NARX simulation escapes (blows up) for this input");
+    return y;
   }
-  return true;
+  Eigen::VectorXd t(d.size());
+  for (int i = 0; i < d.size(); ++i) t(i) = d.time(i) - d.t0();
+  NdeSimulation s;
+  try {
+    s = std::get<NdeModel>(m).simulate(d.u().col(0), t, d.intersample(0));
+  } catch (const InvalidArgument& e) {
+    throw UsageError(source + ": " + e.what());
+  }
+  if (!s.ok()) throw NotUsable(source + ": " + s.message);
+  return s.y;
 }
 
 void require_finite_simulation(const Eigen::MatrixXd& y, const IdData& d, const std::string& why) {

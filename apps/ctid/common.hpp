@@ -2,7 +2,9 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -56,10 +58,13 @@ template <class F>
 void consume_sets(std::map<std::string, std::string>& sets, F&& handler) {
   for (auto it = sets.begin(); it != sets.end();) it = handler(it->first, it->second) ? sets.erase(it) : std::next(it);
 }
-/// Nonlinear model files (Billings & Li) simulated on d's single input: NARX at its own sampling period from
-/// rest, NDE integrated at the data's sample times with the data's intersample behaviour. Returns false when
-/// the file is neither; an escaping simulation throws NotUsable (exit 1), a wrong input count UsageError.
-bool simulate_nonlinear(const std::string& model, const IdData& d, Eigen::MatrixXd& y);
+/// A nonlinear model file (Billings & Li): NARX or NDE; nullopt when the file is neither.
+using NonlinearModel = std::variant<NarxModel, NdeModel>;
+std::optional<NonlinearModel> read_nonlinear_model(const std::string& path);
+/// A nonlinear model simulated on d's single input: NARX at its own sampling period from rest, NDE integrated
+/// at the data's sample times with the data's intersample behaviour. `source` names the model in messages. An
+/// escaping simulation throws NotUsable (exit 1), a wrong input count or sampling UsageError.
+Eigen::VectorXd simulate_nonlinear(const NonlinearModel& m, const IdData& d, const std::string& source);
 /// Throws NotUsable naming the first sample at which a simulated output y (columns = outputs) on d is not
 /// finite or its sum of squares overflows,
 /// with `why` (e.g. the unstable poles): a diverging simulation is never written or scored.
