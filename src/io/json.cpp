@@ -49,6 +49,14 @@ struct Reader {
     }
     return v;
   }
+  // A count (samples, parameters, iterations): a whole number in [0, INT_MAX].
+  int count(const json& j, const char* what) const {
+    const double v = j.is_number() ? j.get<double>() : kNaN;
+    if (!(v >= 0 && v <= std::numeric_limits<int>::max()) || v != std::floor(v))
+      fail(detail::format("\"{}\" must be a whole number in [0, {}], got {}", what, std::numeric_limits<int>::max(),
+                          j.dump()));
+    return static_cast<int>(v);
+  }
   Eigen::MatrixXd matrix(const json& j, const char* what) const {
     if (!j.is_array()) fail(detail::format("\"{}\" must be an array of rows", what));
     if (j.empty()) return Eigen::MatrixXd(0, 0);
@@ -303,11 +311,11 @@ void read_envelope(const json& j, const Reader& rd, Result<M>& r) {
     r.fit.aic = to_num(f.at("aic"));
     r.fit.aicc = to_num(f.at("aicc"));
     r.fit.bic = to_num(f.at("bic"));
-    r.fit.n_samples = f.at("n_samples").get<int>();
-    r.fit.n_parameters = f.at("n_parameters").get<int>();
+    r.fit.n_samples = rd.count(f.at("n_samples"), "fit.n_samples");
+    r.fit.n_parameters = rd.count(f.at("n_parameters"), "fit.n_parameters");
     const json& s = rd.member(j, "summary", "the result");
     r.summary.termination = termination_from_string(s.at("termination").get<std::string>());
-    r.summary.iterations = s.at("iterations").get<int>();
+    r.summary.iterations = rd.count(s.at("iterations"), "summary.iterations");
     r.summary.seconds = s.at("seconds").get<double>();
     r.summary.message = s.at("message").get<std::string>();
     if (j.contains("diagnostics")) {

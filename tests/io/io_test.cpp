@@ -125,6 +125,20 @@ TEST(Json, ModelAndResultRoundTrip) {
   EXPECT_NE(text.find("\"method\": \"lssvf\""), std::string::npos);
   // The envelope is accepted where a model is expected.
   EXPECT_EQ(std::get<TransferFunction>(parse_model_json(text)).io_delay(), 0.25);
+  // Fuzz finding (tests/fuzz/corpus/json/regression-count-out-of-range.json): a count of 1.67e71 was converted to
+  // int (undefined behaviour); counts must be whole numbers in [0, INT_MAX].
+  auto with_samples = [&](const std::string& v) {
+    std::string t = text;
+    const std::string key = "\"n_samples\": 1000";
+    t.replace(t.find(key), key.size(), "\"n_samples\": " + v);
+    return t;
+  };
+  EXPECT_EQ(error_of([&] { parse_result_json(with_samples("1.66667e+71"), "r.json"); }),
+            "r.json: \"fit.n_samples\" must be a whole number in [0, 2147483647], got 1.66667e+71");
+  EXPECT_THROW(parse_result_json(with_samples("-3"), "r.json"), FileError);
+  EXPECT_THROW(parse_result_json(with_samples("2.5"), "r.json"), FileError);
+  EXPECT_THROW(parse_result_json(with_samples("\"many\""), "r.json"), FileError);
+  EXPECT_EQ(parse_result_json(with_samples("1e3")).fit.n_samples, 1000);
 }
 
 TEST(Json, MalformedFilesAreFileErrors) {
