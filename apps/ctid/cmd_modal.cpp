@@ -21,7 +21,7 @@ std::vector<double> to_list(const std::string& key, const std::string& value) {
 }
 
 int whole_samples(const std::string& key, double v) {
-  if (!(std::abs(v - std::round(v)) <= 1e-9) || v < 0)
+  if (!(std::abs(v - std::round(v)) <= 1e-9) || v < 0 || v > 1e9)
     throw UsageError(detail::format("--set {}: {} is not a whole number of samples", key, v));
   return static_cast<int>(std::lround(v));
 }

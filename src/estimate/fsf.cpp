@@ -59,6 +59,7 @@ Result<FsfModel> fsf(const IdData& data, const FsfOptions& o) {
   CTID_REQUIRE(data.is_uniform(), "fsf: needs uniformly sampled data");
   const double Ts = data.ts();
   const double Nd = o.T / Ts;
+  CTID_REQUIRE(Nd <= 1e9, "fsf: T = {} s is more than 1e9 sampling periods of {} s", o.T, Ts);
   const int N = static_cast<int>(std::lround(Nd));
   CTID_REQUIRE(std::abs(Nd - N) <= 1e-9 * std::max(1.0, Nd) && N >= 1,
                "fsf: T = {} s is not a whole multiple of the sampling period {} s (T/Ts = {})", o.T, Ts, Nd);
@@ -209,6 +210,7 @@ Result<FsfModel> fsf_from_spectra(const Eigen::VectorXcd& Uin, const Eigen::Vect
                "fsf_from_spectra: one-sided spectra of length L/2 + 1 = {} expected (U has {}, Y has {})", L / 2 + 1,
                Uin.size(), Yin.size());
   const double Nd = o.T / Ts;
+  CTID_REQUIRE(Nd <= 1e9, "fsf_from_spectra: T = {} s is more than 1e9 sampling periods of {} s", o.T, Ts);
   const int N = static_cast<int>(std::lround(Nd));
   CTID_REQUIRE(std::abs(Nd - N) <= 1e-9 * std::max(1.0, Nd), "fsf_from_spectra: T = {} s is not a whole multiple of Ts = {} s",
                o.T, Ts);

@@ -21,7 +21,7 @@ namespace {
 // A whole number of sampling periods, or InvalidArgument naming `what`.
 int samples_of(double seconds, double Ts, const std::string& what) {
   const double r = seconds / Ts;
-  CTID_REQUIRE(std::isfinite(r) && std::abs(r - std::round(r)) <= 1e-9 * std::max(1.0, std::abs(r)),
+  CTID_REQUIRE(std::isfinite(r) && std::abs(r) <= 1e9 && std::abs(r - std::round(r)) <= 1e-9 * std::max(1.0, std::abs(r)),
                "modal: {} = {} s is not a whole multiple of the sampling period {} s ({} periods)", what, seconds, Ts, r);
   return static_cast<int>(std::lround(r));
 }
@@ -126,7 +126,7 @@ std::vector<ModalWindow> piecewise_constant_windows(const IdData& data, double s
   CTID_REQUIRE(std::isfinite(settle) && settle >= 0, "piecewise_constant_windows: settle must be >= 0 (got {})", settle);
   const Eigen::VectorXd u = data.u().col(0);
   const double Ts = data.ts();
-  const int s = static_cast<int>(std::ceil(settle / Ts - 1e-9));
+  const int s = static_cast<int>(std::min(std::ceil(settle / Ts - 1e-9), data.size() + 1.0));  // no overflow
   std::vector<ModalWindow> out;
   int begin = 0;  // first sample of the current level
   for (int i = 1; i <= data.size(); ++i) {
@@ -666,6 +666,7 @@ TimeResponse modal_step_response(const IdData& data, const ModalModel& model, do
   CTID_REQUIRE(qr.rank() == n + 1, "modal_step_response: the input level sequences [u(k) .. u(k-{})] span only {} of {} "
                "dimensions; use more distinct levels", n, qr.rank(), n + 1);
   const Eigen::MatrixXd DL = modal_delta_l(p0.transpose());  // lower triangular, unit diagonal
+  CTID_REQUIRE(horizon / Ts <= 1e8, "modal_step_response: horizon {} s is more than 1e8 sampling periods", horizon);
   const int steps = static_cast<int>(std::floor(horizon / Ts + 1e-9));
   const int blocks = std::max(n + 1, steps / m + 1);  // g(s + i T), i = 0..blocks-1
   Eigen::MatrixXd G(m, blocks);

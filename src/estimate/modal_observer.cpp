@@ -14,7 +14,7 @@ namespace ctid {
 namespace {
 int whole(double a, double b, const char* what) {
   const double r = a / b;
-  CTID_REQUIRE(std::isfinite(r) && r >= 1 - 1e-9 && std::abs(r - std::round(r)) <= 1e-9 * r,
+  CTID_REQUIRE(std::isfinite(r) && r >= 1 - 1e-9 && r <= 1e9 && std::abs(r - std::round(r)) <= 1e-9 * r,
                "DeadbeatObserver: {} ({} s / {} s = {}) must be a whole number >= 1", what, a, b, r);
   return static_cast<int>(std::lround(r));
 }

@@ -239,7 +239,7 @@ Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const
     const double dmax = options.delay_max >= 0 ? options.delay_max : 0.1 * data.duration();
     const double h = data.is_uniform() ? data.ts() : data.duration() / std::max(1, data.size() - 1);
     int G = options.delay_grid > 0 ? options.delay_grid
-                                   : std::min(200, static_cast<int>(std::floor((dmax - options.delay_min) / h)) + 1);
+                                   : static_cast<int>(std::min(200.0, std::floor((dmax - options.delay_min) / h) + 1));
     G = std::max(G, 2);
     grid.resize(G);
     grid_cost.resize(G);

@@ -126,6 +126,9 @@ ShiftChoice choose_modal_shifts(const TransferFunction& prior, double Ts, double
   const StateSpace pv = phase_variable_form(prior);
   const int n = pv.nx();
   CTID_REQUIRE(std::isfinite(Ts) && Ts > 0, "choose_modal_shifts: Ts must be > 0 (got {})", Ts);
+  CTID_REQUIRE(std::isfinite(max_shift) && max_shift / (n * Ts) <= 1e5,
+               "choose_modal_shifts: max_shift = {} s must be finite and at most 1e5 n Ts = {} s", max_shift,
+               1e5 * n * Ts);
   const int kmax = static_cast<int>(std::floor(max_shift / (n * Ts) + 1e-9));
   CTID_REQUIRE(kmax >= 1, "choose_modal_shifts: max_shift = {} s is shorter than n Ts = {} s", max_shift, n * Ts);
   ShiftChoice c;

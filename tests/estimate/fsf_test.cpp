@@ -227,6 +227,7 @@ TEST(Fsf, BadInputs) {
   EXPECT_THROW(fsf(d, {.T = 1.0, .n = 20}), InvalidOptions);           // even n
   EXPECT_THROW(fsf(d, {.T = 1.005, .n = 21}), InvalidArgument);        // T not a multiple of Ts
   EXPECT_THROW(fsf(d, {.T = 10.0, .n = 21}), InvalidArgument);         // T longer than the record
+  EXPECT_THROW(fsf(d, {.T = 1e300, .n = 21}), InvalidArgument);        // T/Ts beyond int: an error, no overflow
   EXPECT_THROW(fsf(d, {.T = 0.1, .n = 21}), InvalidArgument);          // n > N
   EXPECT_THROW(fsf(d, {.T = 1.0, .n = 21, .a = 1, .b = 2}), InvalidOptions);  // b > a
   EXPECT_THROW(fsf(d, {.T = 1.0, .n = 21, .a = 400}), InvalidArgument);      // a*T = 400 > 300: e^{2aT} overflows

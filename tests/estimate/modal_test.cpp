@@ -465,6 +465,7 @@ TEST(ModalResponses, Tables53And54StepAndImpulseResponsesFromPiecewiseConstantDa
   // Bad input: positive shifts, shifts that are not i T, input changing inside a level period.
   EXPECT_THROW(modal_impulse_from_step(g, -neg, 192 * Ts), InvalidArgument);
   EXPECT_THROW(modal_step_response(d, m.model, 10 * Ts, 640 * Ts), InvalidArgument);
+  EXPECT_THROW(modal_step_response(d, m.model, 20 * Ts, 1e300), InvalidArgument);  // no int overflow
 }
 
 TEST(ModalFit, PiecewiseConstantInputsGiveTheTransferFunctionByBothRoutes) {

@@ -205,6 +205,10 @@ TEST(Srivc, BadInputs) {
   o.delay_min = 2;
   o.delay_max = 1;
   EXPECT_THROW(srivc(d, {1, 1, 0}, o), InvalidOptions);  // empty delay range
+  o.estimate_delay = true;
+  o.delay_min = 0;
+  o.delay_max = 1e300;  // the grid size is computed without int overflow; the delays exceed the record
+  EXPECT_THROW(srivc(d, {1, 1, 0}, o), InvalidArgument);
   o = {};
   o.delay = -1;
   EXPECT_THROW(srivc(d, {1, 1, 0}, o), InvalidOptions);

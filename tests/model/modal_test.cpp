@@ -192,4 +192,6 @@ TEST(ModalParameters, ShiftHelperMinimisesTheConditionOfPsi) {
   EXPECT_LE(c.condition, modal_parameters(kS3, Eigen::Vector3d(40 * Ts, 80 * Ts, 120 * Ts), 0).condition + 1e-9);
   EXPECT_GT(c.conditions(0), 100 * c.condition);  // one-sample spacing: psi nearly singular
   EXPECT_THROW(choose_modal_shifts(kS3, Ts, 2 * Ts), InvalidArgument);
+  EXPECT_THROW(choose_modal_shifts(kS3, Ts, std::numeric_limits<double>::infinity()), InvalidArgument);  // no int overflow
+  EXPECT_THROW(choose_modal_shifts(kS3, Ts, 1e9), InvalidArgument);
 }
