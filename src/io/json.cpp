@@ -123,7 +123,7 @@ LinearModel model_from(const json& root, const Reader& rd) {
 json parse_text(const std::string& text, const Reader& rd) {
   try {
     return json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error, or out_of_range for a number like 1e99999
     rd.fail(std::string("not valid JSON: ") + e.what());
   }
 }
