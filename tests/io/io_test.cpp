@@ -267,6 +267,13 @@ TEST(Mat, DamagedFilesAreRefusedBeforeLibmatioAllocates) {
   const std::string v = test::temp_path("version.mat");
   std::ofstream(v, std::ios::binary) << odd << le32(14) + le32(16) + flags;
   EXPECT_NE(error_of([&] { mat_variable_names(v); }).find("unknown version 0x0110"), std::string::npos);
+  // 6. A sparse array (class 5) whose parts are damaged: only the header is read before the class is refused
+  //    (tests/fuzz/corpus/mat/regression-sparse-read-as-data.mat: Mat_VarRead allocated 3 GB for a 368-byte file).
+  const std::string sparse_flags = le32(6) + le32(8) + le32(5) + le32(0);
+  const std::string dims_769x8 = le32(5) + le32(8) + le32(769) + le32(8);
+  const std::string sparse = file("sparse.mat", le32(14) + le32(64) + sparse_flags + dims_769x8 + name + data);
+  EXPECT_EQ(mat_variable_names(sparse), std::vector<std::string>{"x"});
+  EXPECT_EQ(error_of([&] { read_mat_variable(sparse, "x"); }), sparse + ": variable 'x' is not a numeric array");
 }
 
 TEST(Csv, EmptyCellsAreAnErrorOnlyInTheColumnsUsed) {
