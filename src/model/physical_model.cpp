@@ -2,9 +2,11 @@
 // evaluated with polynomials whose coefficients carry exact gradients. See physical_model.hpp.
 #include "ctid/model/physical_model.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <functional>
+#include <utility>
 
 #include "ctid/core/check.hpp"
 
@@ -205,6 +207,40 @@ Ratio eval(const Node& n, const Eigen::VectorXd& theta) {
   CTID_ASSERT(false);
 }
 
+// Degrees of the numerator and denominator the expansion of `n` works with (an upper bound of the reduced
+// degrees: eval's polynomial sizes follow the tree, not the values), saturating instead of overflowing.
+std::pair<double, double> expanded_degrees(const Node& n) {
+  switch (n.kind) {
+    case Node::Number:
+    case Node::Symbol: return {0, 0};
+    case Node::S: return {1, 0};
+    case Node::Neg: return expanded_degrees(*n.a);
+    case Node::Pow: {
+      const auto [xn, xd] = expanded_degrees(*n.a);
+      return {xn * n.value, xd * n.value};
+    }
+    default: break;
+  }
+  const auto [xn, xd] = expanded_degrees(*n.a);
+  const auto [yn, yd] = expanded_degrees(*n.b);
+  switch (n.kind) {
+    case Node::Mul: return {xn + yn, xd + yd};
+    case Node::Div: return {xn + yd, xd + yn};
+    default: return {std::max(xn + yd, yn + xd), xd + yd};  // Add, Sub
+  }
+}
+
+// The expansion's cost grows with the square of these degrees: (s^55 + k)^55 is refused here rather than
+// expanded to degree 3025 (a 10-second fuzz input).
+std::unique_ptr<Node> bounded(std::unique_ptr<Node> root, const std::string& text) {
+  constexpr double kMaxDegree = 100;
+  const auto [dn, dd] = expanded_degrees(*root);
+  CTID_REQUIRE(std::max(dn, dd) <= kMaxDegree,
+               "expression \"{}\": expanding it gives polynomials in s of degree {} (at most {} supported)", text,
+               std::max(dn, dd), kMaxDegree);
+  return root;
+}
+
 }  // namespace
 
 struct PhysicalModel::Compiled {
@@ -221,7 +257,7 @@ PhysicalModel::PhysicalModel(const std::string& expression, std::vector<std::str
       CTID_REQUIRE(names_[i] != names_[j], "PhysicalModel: parameter '{}' is declared twice", names_[i]);
   }
   auto c = std::make_shared<Compiled>();
-  c->root = Parser(expr_, &names_, nullptr).parse();
+  c->root = bounded(Parser(expr_, &names_, nullptr).parse(), expr_);
   c_ = c;
 }
 
@@ -258,7 +294,7 @@ PhysicalModel PhysicalModel::from_state_space(const std::vector<std::vector<std:
       CTID_REQUIRE(static_cast<Eigen::Index>(M[i].size()) == e.cols, "PhysicalModel: row {} of {} has {} entries ({} expected)",
                    i + 1, which, M[i].size(), e.cols);
       e.n.emplace_back();
-      for (const auto& t : M[i]) e.n.back().push_back(std::shared_ptr<Node>(Parser(t, &names, nullptr).parse().release()));
+      for (const auto& t : M[i]) e.n.back().push_back(std::shared_ptr<Node>(bounded(Parser(t, &names, nullptr).parse(), t).release()));
     }
     e.text = M;
     return e;

@@ -29,3 +29,16 @@ TEST(FuzzRegression, HugeNumbersInTermsAndExpressionsAreRejected) {
   EXPECT_NE(message_of([] { (void)PhysicalModel("k/s^" + std::string(400, '9'), {"k"}); }).find("exponent larger than 64"),
             std::string::npos);
 }
+
+TEST(FuzzRegression, NestedPowersAreRefusedBeforeTheyAreExpanded) {
+  // tests/fuzz/corpus/expression/regression-nested-power.txt: (s^55 + ...)^55 was expanded to degree 3025 with a
+  // gradient per coefficient (> 10 s, a fuzz timeout). Degrees above 100 are now refused when parsing; here 55 x 55.
+  EXPECT_EQ(message_of([] { (void)PhysicalModel("k1/(s*k1/(s^55+k-+k2)^55+k-+k2)", {"k", "k1", "k2"}); }),
+            "expression \"k1/(s*k1/(s^55+k-+k2)^55+k-+k2)\": expanding it gives polynomials in s of degree 3025 (at most "
+            "100 supported)");
+  // The bound counts what the expansion multiplies: 1/(s+1)^50 + 1/(s+2)^50 is degree 100 and is accepted.
+  const PhysicalModel ok("1/(s+a)^50 + 1/(s+b)^50", {"a", "b"});
+  EXPECT_EQ(ok.transfer_function(Eigen::Vector2d(1, 2)).den().degree(), 100);
+  EXPECT_THROW(PhysicalModel("1/(s+a)^50 + 1/(s+b)^51", {"a", "b"}), InvalidArgument);
+  EXPECT_THROW(PhysicalModel::from_state_space({{"(s+a)^60*(s+a)^60"}}, {{"1"}}, {{"1"}}, {{"0"}}, {"a"}), InvalidArgument);
+}
