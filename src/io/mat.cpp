@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -159,11 +160,19 @@ void check_v4(const std::string& path, const std::vector<unsigned char>& b) {
       return big ? std::uint32_t(p[3]) | std::uint32_t(p[2]) << 8 | std::uint32_t(p[1]) << 16 | std::uint32_t(p[0]) << 24
                  : std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
     };
-    const bool big = word(0, false) > 9999;  // MOPT in the other byte order
-    const std::uint32_t type = word(0, big), rows = word(1, big), cols = word(2, big), imag = word(3, big),
-                        name = word(4, big);
-    if (type > 4999 || (type / 10) % 10 > 5 || imag > 1)
+    // libmatio reads the type word MOPT in either byte order (whichever is <= 4052), but the other header words
+    // in the byte order its M digit names (0 little-endian, 1 big-endian): a file whose two orders disagree
+    // made it allocate a 671 MB name (tests/fuzz/corpus/mat/regression-v4-byte-orders-disagree.mat).
+    constexpr bool kHostBig = std::endian::native == std::endian::big;
+    const bool read_big = kHostBig != (word(0, kHostBig) > 4052);  // libmatio swaps MOPT when out of range
+    const std::uint32_t mopt = word(0, read_big);
+    if (mopt > 1052 || (mopt / 10) % 10 > 5)
       bad("not a level 5 file, and not a valid level 4 file (bad matrix type)");
+    const bool big = mopt >= 1000;  // M = 1: IEEE big-endian
+    if (big != read_big)
+      bad("not a level 5 file, and not a valid level 4 file (the matrix type and its byte order disagree)");
+    const std::uint32_t type = mopt, rows = word(1, big), cols = word(2, big), imag = word(3, big), name = word(4, big);
+    if (imag > 1) bad("not a level 5 file, and not a valid level 4 file (bad matrix type)");
     // libmatio reads the sizes as signed 32-bit numbers (a negative one became a 1.8e19 dimension), and it
     // allocates by the row count even when there are no columns (5 GB for a 126-byte file): no dimension may
     // exceed the file's size.

@@ -312,4 +312,16 @@ TEST(Mat, DamagedLevel4FilesAreRefused) {
   std::ofstream(rows, std::ios::binary) << std::string("\x20\0\0\0\0\0\x01\x4b\0\0\0\0\0\0\0\0\x02\0\0\0x\0", 22);
   EXPECT_NE(error_of([&] { read_mat_variable(rows, "x"); }).find("declares 1258356736 x 0 values in a file of 22 bytes"),
             std::string::npos);
+  // tests/fuzz/corpus/mat/regression-v4-byte-orders-disagree.mat: the type word is valid only big-endian (40) but
+  // says M = 0 (little-endian), so libmatio read the name length 0x00000028 little-endian and allocated 671 MB.
+  const std::string mixed = test::temp_path("v4mixed.mat");
+  std::ofstream(mixed, std::ios::binary) << std::string("\0\0\0\x28", 4) << std::string(12, '\0')
+                                         << std::string("\0\0\0\x28", 4) << std::string(40, 'x');
+  EXPECT_NE(error_of([&] { mat_variable_names(mixed); }).find("the matrix type and its byte order disagree"),
+            std::string::npos);
+  // A consistent big-endian level 4 file (M = 1, type 1000: big-endian doubles) still reads: x = [1.5; -2].
+  const std::string be = test::temp_path("v4be.mat");
+  std::ofstream(be, std::ios::binary) << std::string("\0\0\x03\xe8\0\0\0\x02\0\0\0\x01\0\0\0\0\0\0\0\x02x\0", 22)
+                                      << std::string("\x3f\xf8\0\0\0\0\0\0\xc0\0\0\0\0\0\0\0", 16);
+  EXPECT_EQ(read_mat_variable(be, "x"), Eigen::MatrixXd(Eigen::Vector2d(1.5, -2.0)));
 }
