@@ -208,7 +208,7 @@ Ratio eval(const Node& n, const Eigen::VectorXd& theta) {
 }
 
 // Degrees of the numerator and denominator the expansion of `n` works with (an upper bound of the reduced
-// degrees: eval's polynomial sizes follow the tree, not the values), saturating instead of overflowing.
+// degrees: eval's polynomial sizes follow the tree, not the values), in double so that nesting cannot overflow.
 std::pair<double, double> expanded_degrees(const Node& n) {
   switch (n.kind) {
     case Node::Number:

@@ -35,7 +35,8 @@ class PhysicalModel {
  public:
   /// Parse `expression`. Every symbol other than `s` must be in `parameters` (the order of
   /// Theta). Throws InvalidArgument with the column (1-based) of a syntax error or an unknown
-  /// symbol, and for an expression that is not a proper rational function of s.
+  /// symbol, for an exponent above 64, for an expression whose expansion reaches polynomials of
+  /// degree above 100 in s, and for one that is not a proper rational function of s.
   PhysicalModel(const std::string& expression, std::vector<std::string> parameters);
   /// A state-space structure whose entries are expressions of the parameters (no s), given
   /// row by row, e.g. A = {{"0", "1"}, {"-k/m", "-d/m"}}, B = {{"0"}, {"1/m"}}, C = {{"1", "0"}},
