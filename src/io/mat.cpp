@@ -171,7 +171,7 @@ void check_v4(const std::string& path, const std::vector<unsigned char>& b) {
     const bool big = mopt >= 1000;  // M = 1: IEEE big-endian
     if (big != read_big)
       bad("not a level 5 file, and not a valid level 4 file (the matrix type and its byte order disagree)");
-    const std::uint32_t type = mopt, rows = word(1, big), cols = word(2, big), imag = word(3, big), name = word(4, big);
+    const std::uint32_t rows = word(1, big), cols = word(2, big), imag = word(3, big), name = word(4, big);
     if (imag > 1) bad("not a level 5 file, and not a valid level 4 file (bad matrix type)");
     // libmatio reads the sizes as signed 32-bit numbers (a negative one became a 1.8e19 dimension), and it
     // allocates by the row count even when there are no columns (5 GB for a 126-byte file): no dimension may
@@ -181,7 +181,7 @@ void check_v4(const std::string& path, const std::vector<unsigned char>& b) {
     if (rows > b.size() || cols > b.size())
       bad(detail::format("a level 4 matrix declares {} x {} values in a file of {} bytes", rows, cols, b.size()));
     static constexpr int kSize[] = {8, 4, 4, 2, 2, 1};
-    const double bytes = double(rows) * double(cols) * kSize[(type / 10) % 10] * (1 + imag) + double(name);
+    const double bytes = double(rows) * double(cols) * kSize[(mopt / 10) % 10] * (1 + imag) + double(name);
     if (bytes > double(b.size() - i - 20))
       bad(detail::format("a level 4 matrix declares {} bytes but only {} remain (the file is truncated or damaged)",
                          bytes, b.size() - i - 20));
