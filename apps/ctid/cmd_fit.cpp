@@ -54,8 +54,7 @@ int finish(const Result<M>& r, const std::string& method, const IdData& d, const
   }
   write_report(a.report, d, r, method, a.sets, a.data.path);
   if (!r.usable()) {
-    std::fprintf(stderr, "ctid: the estimate is not usable: %s\n",
-                 r.summary.message.empty() ? to_string(r.summary.termination) : r.summary.message.c_str());
+    std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", r.why_not_usable().c_str());
     return kNotUsable;
   }
   return kOk;

@@ -192,7 +192,7 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
       r = oe;
     } else {
       std::fprintf(stderr, "ctid: warning: the output-error refinement failed (%s); keeping the KIA model\n",
-                   oe.summary.message.c_str());
+                   oe.why_not_usable().c_str());
     }
   }
   if (!json.empty()) {
@@ -201,7 +201,7 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
   }
   write_report(report, d, r, refine ? "kia+oe" : "kia", set_list, narx_file);
   if (!r.usable()) {
-    std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", r.summary.message.c_str());
+    std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", r.why_not_usable().c_str());
     return kNotUsable;
   }
   return kOk;

@@ -43,7 +43,11 @@ void bind_result(py::module_& m, const char* name) {
       .def_readonly("fit", &R::fit)
       .def_readonly("summary", &R::summary)
       .def_readonly("diagnostics", &R::diagnostics)
-      .def("usable", &R::usable, "Whether the estimate can be trusted (succeeded, finite parameters).");
+      .def("usable", &R::usable, "Whether the estimate can be trusted (the rules of why_not_usable).")
+      .def("why_not_usable", &R::why_not_usable,
+           "Why the estimate cannot be trusted ('' when it can): the estimator failed, a parameter is not finite, "
+           "the fit is not better than the output's mean, a standard deviation is zero or not finite, the covariance "
+           "is not positive semi-definite, or no parameter differs significantly from zero.");
 }
 
 /// ctid.html_report(data, result, path, method="", title="", settings={}) for Result<Model>: writes the

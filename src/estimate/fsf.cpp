@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <complex>
 #include <numbers>
 #include <vector>
@@ -169,6 +170,9 @@ Result<FsfModel> fsf(const IdData& data, const FsfOptions& o) {
   r.fit.n_samples = M;
   r.fit.n_parameters = p;
   r.fit.mse = sol.rss / std::max(1.0, double(sol.n_rows));
+  // The FSF model predicts the output from the input window: its fit is that of the regression.
+  r.fit.nrmse = sol.tss > 0 ? std::sqrt(sol.rss / sol.tss) : std::numeric_limits<double>::infinity();
+  r.fit.fit_percent = 100.0 * (1.0 - r.fit.nrmse);
   r.diagnostics.scalars["b"] = o.b;
   r.diagnostics.scalars["residual_rms"] = std::sqrt(r.fit.mse);
   if (o.b > 0 && M > N)

@@ -179,7 +179,12 @@ Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& inp
     Q.row(j) = theta.tail(nc).transpose();
     cov.block(j * p, j * p, p, p) = sol.covariance.topLeftCorner(p, p);
     cond(j) = sol.condition;
-    if (j == 0) res.fit.mse = sol.rss / std::max<long long>(1, sol.n_rows);
+    if (j == 0) {
+      // No simulated output at this stage: the fit is that of the order-0 modal regression.
+      res.fit.mse = sol.rss / std::max<long long>(1, sol.n_rows);
+      res.fit.nrmse = sol.tss > 0 ? std::sqrt(sol.rss / sol.tss) : std::numeric_limits<double>::infinity();
+      res.fit.fit_percent = 100.0 * (1.0 - res.fit.nrmse);
+    }
     if (sol.rank_deficient) {
       res.summary.termination = Termination::RankDeficient;
       res.summary.message = detail::format("the order-{} modal regression is rank deficient (condition {}): the input "
@@ -295,8 +300,18 @@ Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& inp
   }
   res.parameters.values.resize((J + 1) * p);
   for (int j = 0; j <= J; ++j) res.parameters.values.segment(j * p, p) << P.row(j).transpose(), Q.row(j).transpose();
-  res.parameters.covariance = cov;
   res.parameters.std = cov.diagonal().cwiseMax(0.0).cwiseSqrt();
+  if (res.summary.succeeded() && !cov.allFinite()) {
+    // As many equations as unknowns (e.g. as many modal functions as parameters): no residual is left to
+    // estimate the noise from, so the uncertainty is unknown (not zero, not singular).
+    cov.resize(0, 0);
+    res.parameters.std.setConstant(std::numeric_limits<double>::quiet_NaN());
+    res.diagnostics.warnings.push_back(detail::format(
+        "the regressions are exactly determined (no residual degrees of freedom for the {} unknowns per order): "
+        "standard deviations are unknown; use more functions, windows or samples to get them",
+        p));
+  }
+  res.parameters.covariance = cov;
   res.parameters.fixed.assign((J + 1) * p, false);
   res.fit.n_samples = N;
   res.fit.n_parameters = p;

@@ -51,6 +51,7 @@ LinearSolution StreamingLeastSquares::solve(double tol) {
   const Eigen::MatrixXd R = Ra.topLeftCorner(p_, p_);
   const Eigen::VectorXd z = Ra.col(p_).head(p_);
   s.rss = Ra(p_, p_) * Ra(p_, p_);
+  s.tss = c * ym2_;
   s.condition = scaled_condition(R);
   s.rank_deficient = !(s.condition < 1.0 / tol);
   if (s.rank_deficient) {
@@ -100,6 +101,7 @@ LinearSolution GramLeastSquares::solve(double tol) {
   const Eigen::VectorXd ts = ldlt.solve(gxy.cwiseQuotient(d));
   s.theta = ts.cwiseQuotient(d);
   s.rss = std::max(0.0, G(p_, p_) - gxy.dot(s.theta));
+  s.tss = c * ym2_;
   s.sigma2 = neff > p_ ? s.rss / (neff - p_) : std::numeric_limits<double>::quiet_NaN();
   if (!s.rank_deficient) {
     const Eigen::MatrixXd inv = ldlt.solve(Eigen::MatrixXd::Identity(p_, p_));

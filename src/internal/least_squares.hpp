@@ -19,6 +19,7 @@ struct LinearSolution {
   Eigen::MatrixXd covariance;   // sigma^2 * (X^T W X)^{-1} (LS) or the IV sandwich
   double sigma2 = 0.0;          // residual variance estimate
   double rss = 0.0;             // weighted residual sum of squares
+  double tss = 0.0;             // weighted sum of squares of the targets about their weighted mean (rss's scale)
   double condition = 0.0;       // of the column-scaled problem
   bool rank_deficient = false;
   long long n_rows = 0;
@@ -32,8 +33,7 @@ class StreamingLeastSquares {
     const double sw = std::sqrt(w);
     for (int j = 0; j < p_; ++j) buf_(fill_, j) = sw * x[j];
     buf_(fill_, p_) = sw * y;
-    sumw_ += w;
-    sumw2_ += w * w;
+    track_target(y, w);
     ++rows_;
     if (++fill_ == buf_.rows()) compress();
   }
@@ -48,6 +48,17 @@ class StreamingLeastSquares {
   Eigen::HouseholderQR<Eigen::MatrixXd> qr_;
   long long rows_ = 0;
   double sumw_ = 0.0, sumw2_ = 0.0;
+  double ymean_ = 0.0, ym2_ = 0.0;  // weighted mean and sum of squared deviations of the targets (West 1979)
+  void track_target(double y, double w) {
+    const double wn = sumw_ + w;
+    if (wn > 0) {
+      const double delta = y - ymean_;
+      ymean_ += delta * w / wn;
+      ym2_ += w * delta * (y - ymean_);
+    }
+    sumw_ = wn;
+    sumw2_ += w * w;
+  }
 };
 
 /// Weighted least squares by accumulating the augmented Gram matrix [X y]^T W [X y]
@@ -64,8 +75,7 @@ class GramLeastSquares {
     double* r = &buf_(0, fill_);
     for (int j = 0; j < p_; ++j) r[j] = sw * x[j];
     r[p_] = sw * y;
-    sumw_ += w;
-    sumw2_ += w * w;
+    track_target(y, w);
     ++rows_;
     if (++fill_ == buf_.cols()) flush();
   }
@@ -80,6 +90,17 @@ class GramLeastSquares {
   Eigen::Index fill_ = 0;
   long long rows_ = 0;
   double sumw_ = 0.0, sumw2_ = 0.0;
+  double ymean_ = 0.0, ym2_ = 0.0;  // weighted mean and sum of squared deviations of the targets (West 1979)
+  void track_target(double y, double w) {
+    const double wn = sumw_ + w;
+    if (wn > 0) {
+      const double delta = y - ymean_;
+      ymean_ += delta * w / wn;
+      ym2_ += w * delta * (y - ymean_);
+    }
+    sumw_ = wn;
+    sumw2_ += w * w;
+  }
 };
 
 /// Above this column-scaled condition number the Gram solution loses more than about

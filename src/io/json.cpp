@@ -245,7 +245,8 @@ std::string result_json(const Result<M>& r, const std::string& method, int inden
                   {"iterations", r.summary.iterations},
                   {"seconds", r.summary.seconds},
                   {"message", r.summary.message},
-                  {"usable", r.usable()}};
+                  {"usable", r.usable()},
+                  {"not_usable_because", r.why_not_usable()}};
   json d;
   d["condition_number"] = num(r.diagnostics.condition_number);
   d["warnings"] = r.diagnostics.warnings;

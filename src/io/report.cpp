@@ -272,7 +272,7 @@ void overview(Page& page, const IdData& d, const Result<M>& r, const ReportOptio
       {"method", o.method.empty() ? "-" : o.method},
       {"termination", std::string(to_string(r.summary.termination)) +
                           (r.summary.message.empty() ? "" : " (" + r.summary.message + ")")},
-      {"usable", r.usable() ? "yes" : "no"},
+      {"usable", r.usable() ? "yes" : "no: " + r.why_not_usable()},
       {"iterations", std::to_string(r.summary.iterations)},
       {"time", fmt(r.summary.seconds, 3) + " s"},
       {"fit (simulation)", fmt(r.fit.fit_percent, 4) + " %"},

@@ -32,7 +32,7 @@ TEST(Core, TerminationNamesRoundTrip) {
 TEST(Core, ResultUsable) {
   Result<int> r;
   r.parameters.values = Eigen::VectorXd::Ones(2);
-  EXPECT_TRUE(r.usable());
+  EXPECT_TRUE(r.usable()) << r.why_not_usable();
   r.parameters.values(1) = NAN;
   EXPECT_FALSE(r.usable());
   r.parameters.values(1) = 1;
@@ -41,4 +41,62 @@ TEST(Core, ResultUsable) {
   r.parameters.names = {"a1", "b0"};
   EXPECT_EQ(r.parameters.index("b0"), 1);
   EXPECT_THROW(r.parameters.index("c"), InvalidArgument);
+}
+
+// The usability rules of core/types.hpp, one case each; the expected words are those of the reasons.
+TEST(Core, UsabilityRulesNameTheCause) {
+  auto base = [] {
+    Result<int> r;
+    r.parameters.names = {"a1", "b0"};
+    r.parameters.values = Eigen::Vector2d(2.0, 3.0);
+    r.parameters.covariance = Eigen::Matrix2d{{0.01, 0.002}, {0.002, 0.04}};
+    r.parameters.fixed = {false, false};
+    r.fit.n_samples = 1000;
+    r.fit.n_parameters = 2;
+    r.fit.nrmse = 0.2;
+    r.fit.fit_percent = 80;
+    return r;
+  };
+  EXPECT_TRUE(base().usable()) << base().why_not_usable();
+  auto r = base();
+  r.summary.termination = Termination::MaxIterations;
+  r.summary.message = "no convergence in 50 iterations";
+  EXPECT_EQ(r.why_not_usable(), "no convergence in 50 iterations");
+  r = base();
+  r.fit.fit_percent = -19;
+  r.fit.nrmse = 1.19;
+  EXPECT_NE(r.why_not_usable().find("worse than the output's mean"), std::string::npos);
+  r.fit.fit_percent = -INFINITY;
+  EXPECT_NE(r.why_not_usable().find("diverges"), std::string::npos);
+  r = base();
+  r.parameters.covariance(1, 1) = 0;
+  r.parameters.covariance(0, 1) = r.parameters.covariance(1, 0) = 0;
+  EXPECT_NE(r.why_not_usable().find("standard deviation of b0 is 0"), std::string::npos) << r.why_not_usable();
+  r.parameters.fixed[1] = true;  // a fixed parameter has no variance: fine
+  EXPECT_TRUE(r.usable()) << r.why_not_usable();
+  r = base();
+  r.parameters.covariance(0, 1) = r.parameters.covariance(1, 0) = 0.05;  // correlation 2.5: not PSD
+  EXPECT_NE(r.why_not_usable().find("not positive semi-definite"), std::string::npos);
+  r = base();
+  r.parameters.covariance(0, 0) = NAN;
+  EXPECT_NE(r.why_not_usable().find("not finite"), std::string::npos);
+  r = base();
+  r.parameters.covariance = Eigen::Matrix3d::Identity();
+  EXPECT_NE(r.why_not_usable().find("3 x 3 for 2 parameters"), std::string::npos);
+  // F test: 4 parameters, N = 1000. R^2 = 0.004 (what 4 parameters fitted to noise explain: d/N) gives
+  // F = 1.0 below the 95 % point 2.37 of F(4, inf); R^2 = 0.02 gives F = 5.1 above it.
+  r = base();
+  r.fit.n_parameters = 4;
+  r.fit.nrmse = std::sqrt(1 - 0.004);
+  r.fit.fit_percent = 100 * (1 - r.fit.nrmse);
+  EXPECT_NE(r.why_not_usable().find("no more of the output than 4 parameters fitted to noise"), std::string::npos);
+  r.fit.nrmse = std::sqrt(1 - 0.02);
+  r.fit.fit_percent = 100 * (1 - r.fit.nrmse);
+  EXPECT_TRUE(r.usable()) << r.why_not_usable();
+  // Noise-free exact fit: zero covariance is the truth, not a singular information matrix.
+  r = base();
+  r.fit.nrmse = 1e-9;
+  r.fit.fit_percent = 100;
+  r.parameters.covariance.setZero();
+  EXPECT_TRUE(r.usable()) << r.why_not_usable();
 }

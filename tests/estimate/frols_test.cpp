@@ -76,7 +76,7 @@ TEST(Frols, FindsTheTrueStructureOnNoiseFreeData) {
     EXPECT_EQ(names(r3.model), names(truth())) << "degree " << degree;
   }
   const auto r = frols(d, narx_candidates(2, 2, 2), {.max_terms = 10, .err_tolerance = 1e-14});
-  ASSERT_TRUE(r.usable()) << r.summary.message;
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_EQ(names(r.model), names(truth()));
   EXPECT_LT(r.diagnostics.scalars.at("esr"), 1e-14);
   for (size_t i = 0; i < r.model.terms().size(); ++i)

@@ -58,7 +58,7 @@ TEST(Fsf, WithNEqualToNReproducesAnyFirExactly) {
   for (Eigen::Index i = 0; i < u.size(); ++i)
     for (int l = 0; l < N && l <= i; ++l) y(i) += g(l) * u(i - l);
   const auto r = fsf(IdData(u, y, 0.1), {.T = N * 0.1, .n = N});
-  ASSERT_TRUE(r.usable()) << r.summary.message;
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_LT((r.model.discrete_impulse_response() - g).cwiseAbs().maxCoeff(), 1e-10);
   EXPECT_LT((r.model.simulate(u) - y).cwiseAbs().maxCoeff(), 1e-9);
 }
@@ -92,7 +92,7 @@ TEST(Fsf, EstimatesEqualThoseFromDirectFirRegressors) {
   }
   const Eigen::VectorXd theta = Phi.colPivHouseholderQr().solve(Y);
   const auto r = fsf(IdData(u, y, D), {.T = N * D, .n = n, .a = a, .b = b, .weights = w});
-  ASSERT_TRUE(r.usable()) << r.summary.message;
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_LT((r.parameters.values - theta).cwiseAbs().maxCoeff(), 1e-9 * theta.cwiseAbs().maxCoeff());
 }
 
@@ -152,7 +152,7 @@ TEST(Fsf, UnstableCircuitStandInCompressesToTheShiftedStepResponse) {
   const Eigen::VectorXd truth = step_response(shifted, t);
   for (int n : {11, 21}) {
     const auto r = fsf(IdData(u, y, Ts), {.T = 8.0, .n = n, .a = 2.0});
-    ASSERT_TRUE(r.usable());
+    ASSERT_TRUE(r.usable()) << r.why_not_usable();
     EXPECT_LT((r.model.step_response(t) - truth).cwiseAbs().maxCoeff(), 8e-3) << n;
     EXPECT_TRUE(r.diagnostics.warnings.empty());
   }
@@ -181,7 +181,7 @@ TEST(Fsf, FromSpectraAgreesWithTheTimeDomain) {
   int L = 2;
   while (L < M + 800) L *= 2;
   const auto fd = fsf_from_spectra(one_sided_dft(u, L), one_sided_dft(y, L), L, Ts, {.T = 8.0, .n = 21, .a = 2.0});
-  ASSERT_TRUE(fd.usable());
+  ASSERT_TRUE(fd.usable()) << fd.why_not_usable();
   EXPECT_LT((td.parameters.values - fd.parameters.values).cwiseAbs().maxCoeff(), 1e-8);
   EXPECT_THROW(fsf_from_spectra(one_sided_dft(u, L), one_sided_dft(y, L), L, Ts, {.T = 8.0, .n = 21, .a = 2.0, .b = 1.0}),
                InvalidOptions);

@@ -82,7 +82,7 @@ TEST(JohanssonExample1, NoiseBiasesLeastSquaresAndIvRemovesMostOfIt) {
     IvsvfOptions io;
     io.svf.tau = 0.3;
     const auto iv = ivsvf(d, {1, 1, 0}, io);
-    ASSERT_TRUE(iv.usable()) << iv.summary.message;
+    ASSERT_TRUE(iv.usable()) << iv.why_not_usable();
     ls_a += ls.parameters.value("a1") / R;
     ls_b += ls.parameters.value("b0") / R;
     iv_a += iv.parameters.value("a1") / R;

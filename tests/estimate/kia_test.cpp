@@ -129,7 +129,7 @@ Eigen::MatrixXd end_to_end(unsigned seed, double snr_db) {
   const auto lin = kia_linear(narx, {.y_order = 2, .u_order = 0});  // hold factor on: the data were held
   const auto q = kia_quadratic(narx, lin.model, {.candidates = {NdeTerm::parse("y^2"), NdeTerm::parse("y*Dy")}});
   const auto refined = nde_oe(d, q.model);
-  EXPECT_TRUE(refined.usable()) << refined.summary.message;
+  EXPECT_TRUE(refined.usable()) << refined.why_not_usable();
   const NdeModel kia = q.model.normalized();
   Eigen::MatrixXd e(2, 5);
   int i = 0;
@@ -224,7 +224,7 @@ TEST(Kia, SilverboxRealData) {
   IdData short_train(u.segment(40650, 5000), y.segment(40650, 5000), all.ts());
   short_train.set_intersample(Intersample::Foh);
   const auto refined = nde_oe(short_train, c.model);
-  ASSERT_TRUE(refined.usable()) << refined.summary.message;
+  ASSERT_TRUE(refined.usable()) << refined.why_not_usable();
   EXPECT_GT(refined.model.coefficient("y^3"), 0.0);
   const NdeSimulation sim = refined.model.simulate(ua, t, Intersample::Foh, x0);
   ASSERT_TRUE(sim.ok()) << sim.message;

@@ -55,7 +55,7 @@ TEST(Lssvf, NoiseFreeRecoveryConvergesAsTsSquared) {
   o.tau = 0.5;
   const auto coarse = lssvf(simulate(kG, 0.01, 60), {2, 2, 0}, o);
   const auto fine = lssvf(simulate(kG, 0.001, 60), {2, 2, 0}, o);
-  ASSERT_TRUE(fine.usable());
+  ASSERT_TRUE(fine.usable()) << fine.why_not_usable();
   EXPECT_EQ(fine.summary.termination, Termination::Completed);
   EXPECT_LT(max_rel_error(fine, kTruth), 3e-6);
   EXPECT_LT(max_rel_error(coarse, kTruth), 3e-4);
@@ -89,7 +89,7 @@ TEST(Lssvf, FixedCoefficientsAndShorterNumeratorAndDelay) {
   o.tau = 0.5;
   o.fixed = {{"a2", 4.0}};
   const auto r = lssvf(d, {1, 2, 3}, o);
-  ASSERT_TRUE(r.usable());
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_NEAR(r.parameters.value("a1"), 1.2, 3e-6 * 1.2);
   EXPECT_EQ(r.parameters.value("a2"), 4.0);
   EXPECT_TRUE(r.parameters.fixed[1]);
@@ -114,7 +114,7 @@ TEST(Lssvf, IrregularSampling) {
   LssvfOptions o;
   o.tau = 0.4;
   const auto r = lssvf(d, {2, 2, 0}, o);
-  ASSERT_TRUE(r.usable());
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_LT(max_rel_error(r, kTruth), 2e-5);
 }
 

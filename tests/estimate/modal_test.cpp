@@ -62,7 +62,7 @@ TEST(ModalEstimate, Table31DiscreteSamplesReproduceTheTrueValues) {
   ModalOptions o{.shifts = kShifts3, .basis = ModalBasis::Discrete, .stride = 20};
   o.windows = {{120 * kTs420, 180 * kTs420}, {564 * kTs420, 180 * kTs420}};
   const auto r = modal_estimate(d, d.u(), o);
-  ASSERT_TRUE(r.usable()) << r.summary.message;
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   const Eigen::MatrixXd P = modal_parameters(kS3, kShifts3, 0).P;
   EXPECT_LT(max_rel(r.model.P(), P), 1e-9);
   EXPECT_NEAR(r.model.Q()(0, 0), (1 + P.sum()) * kS3.dc_gain(), 1e-9);
@@ -87,7 +87,7 @@ TEST(ModalEstimate, Table32ContinuousDataFourierAndWalshGiveTheTrueValues) {
                      .quadrature = rule};
       o.windows = {{120 * kTs420, 320 * kTs420}, {564 * kTs420, 320 * kTs420}};
       const auto r = modal_estimate(d, d.u(), o);
-      ASSERT_TRUE(r.usable()) << r.summary.message;
+      ASSERT_TRUE(r.usable()) << r.why_not_usable();
       EXPECT_LT(max_rel(r.model.P(), P), 1e-9) << static_cast<int>(basis) << " " << static_cast<int>(rule);
       EXPECT_NEAR(r.model.Q()(0, 0), (1 + P.sum()) * kS3.dc_gain(), 1e-9);
     }
@@ -106,7 +106,7 @@ TEST(ModalEstimate, Tables36And37FourierAndWalshRecursionsToTheThirdDerivative) 
                    .functions = basis == ModalBasis::Fourier ? 6 : 8};
     o.windows = {{120 * kTs420, 384 * kTs420}};
     const auto r = modal_estimate(d, g, o);
-    ASSERT_TRUE(r.usable()) << r.summary.message;
+    ASSERT_TRUE(r.usable()) << r.why_not_usable();
     // Simpson at Ts = pi/420: measured relative errors <= 2.5e-7 (j = 1, 2), Appendix B asks ~1e-6.
     for (int j = 0; j <= 3; ++j) {
       EXPECT_LT(max_rel(r.model.P().row(j), P.row(j)), 1e-6) << "basis " << static_cast<int>(basis) << " j " << j;
@@ -147,7 +147,7 @@ TEST(ModalEstimate, TheoremsFourOneAndFourTwoGiveTheTransferFunction) {
   ModalOptions o{.shifts = kShifts3, .functions = 10};
   o.windows = {{120 * kTs420, 1344 * kTs420}};
   const auto r = modal_transfer_function(d, g, o);
-  ASSERT_TRUE(r.usable()) << r.summary.message;
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_LT((r.model.den().coefficients() - kS3.den().coefficients()).cwiseAbs().maxCoeff(), 1e-4 * 52);
   EXPECT_NEAR(r.model.num().coefficient_of_power(1), 13.0, 1e-4 * 52);
   EXPECT_NEAR(r.model.num().coefficient_of_power(0), 52.0, 1e-4 * 52);
@@ -331,7 +331,7 @@ TEST(ModalEstimate, Tables38To312PrefilteredPairsOfATwoFrequencyInput) {
       ModalOptions o{.shifts = T, .basis = basis, .max_order = 3, .functions = basis == ModalBasis::Fourier ? 6 : 8};
       o.windows = {{320 * Ts, 384 * Ts}};
       const auto r = modal_estimate(f, left, o);
-      ASSERT_TRUE(r.usable()) << r.summary.message;
+      ASSERT_TRUE(r.usable()) << r.why_not_usable();
       EXPECT_LT(max_rel(r.model.P(), P), 1e-6) << "pair " << k << " basis " << static_cast<int>(basis);
       for (int j = 0; j <= 3; ++j) {
         const Eigen::Vector2d q = q_true(kS3, T, P.row(j), j, pairs[k].w, left.c());
@@ -378,7 +378,7 @@ TEST(ModalEstimate, Tables41And42PrefiltersAndTheOutputModalFunctionRoute) {
     o.windows = {{340 * kTs420, 140 * kTs420}};
     const InputGenerator left = modal_filter(f.keep, f.shifts, f.l);
     const auto r = modal_estimate(modal_filter(d, f.shifts, f.l), left, o);
-    ASSERT_TRUE(r.usable()) << r.summary.message;
+    ASSERT_TRUE(r.usable()) << r.why_not_usable();
     EXPECT_LT(max_rel(r.model.P(), P), 1e-8);
     ex.push_back({r.model, left});
   }
@@ -481,7 +481,7 @@ TEST(ModalFit, PiecewiseConstantInputsGiveTheTransferFunctionByBothRoutes) {
   const Eigen::Vector3d shifts(16 * Ts, 32 * Ts, 48 * Ts);
   for (auto basis : {ModalBasis::Walsh, ModalBasis::Discrete}) {
     const auto r = modal_fit(d, 2, {.shifts = shifts, .basis = basis, .functions = 8});
-    ASSERT_TRUE(r.usable()) << r.summary.message;
+    ASSERT_TRUE(r.usable()) << r.why_not_usable();
     EXPECT_LT(max_rel(r.model.den().coefficients(), kS3.den().coefficients()), 1e-6) << static_cast<int>(basis);
     EXPECT_NEAR(r.model.num().coefficient_of_power(1), 13.0, 1e-5);
     EXPECT_NEAR(r.model.num().coefficient_of_power(0), 52.0, 1e-5);
@@ -515,7 +515,7 @@ TEST(ModalEstimate, Tables313And314SquareWaveAnnihilatedToAFreeResponse) {
     ModalOptions o{.shifts = T, .basis = basis, .max_order = 4, .functions = 8};
     o.windows = {{370 * kTs420, (basis == ModalBasis::Walsh ? 416 : 420) * kTs420}};  // Walsh: 52 samples per block
     const auto r = modal_estimate(f, Eigen::MatrixXd(N, 0), o);
-    ASSERT_TRUE(r.usable()) << r.summary.message;
+    ASSERT_TRUE(r.usable()) << r.why_not_usable();
     for (int j = 0; j <= 4; ++j)
       EXPECT_LT(max_rel(r.model.P().row(j), P.row(j)), 5e-6) << "basis " << static_cast<int>(basis) << " j " << j;
   }

@@ -44,7 +44,7 @@ TEST(NdeOe, RecoversCoefficientsAndInitialStateFromAPerturbedStart) {
   Eigen::VectorXd c = truth.coefficients();
   c.tail(5) *= 1.15;  // every free coefficient 15 % off
   const auto r = nde_oe(d, NdeModel(truth.terms(), c * 2.0));  // a scaled start: y's coefficient is normalised back to 1
-  ASSERT_TRUE(r.usable()) << r.summary.message;
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_EQ(r.summary.termination, Termination::Converged);
   for (const char* s : {"Dy", "D^2y", "u", "y^2", "y*Dy"})
     EXPECT_NEAR(r.model.coefficient(s), truth.coefficient(s), 1e-5 * std::abs(truth.coefficient(s))) << s;
@@ -70,7 +70,7 @@ TEST(NdeOe, SensitivitiesAgreeWithFiniteDifferences) {
   for (auto& v : noisy) v += e(rng);
   d = IdData(d.u(), noisy, 0.0025);
   const auto r = nde_oe(d, truth);
-  ASSERT_TRUE(r.usable());
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   const int m = 6, p = 7;  // free: Dy, D^2y, u, y^2, y*Dy, y(0), Dy(0)
   const std::vector<int> slot{1, 2, 3, 4, 5, 6, 7};
   auto sim = [&](const Eigen::VectorXd& theta) {
@@ -105,7 +105,7 @@ TEST(NdeOe, StartThatEscapesIsShrunkTowardsItsLinearPart) {
   const NdeSimulation bad = bl33(-0.06).simulate(d.u().col(0), time_grid(0.0025, 800));
   ASSERT_FALSE(bad.ok());
   const auto r = nde_oe(d, bl33(-0.06), {.estimate_initial_state = false});
-  ASSERT_TRUE(r.usable()) << r.summary.message;
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_LT(r.diagnostics.scalars.at("start_scale"), 1.0);
   ASSERT_EQ(r.diagnostics.warnings.size(), 1u);
   EXPECT_NEAR(r.model.coefficient("y*Dy"), -0.006, 1e-4 * 0.006);
@@ -116,7 +116,7 @@ TEST(NdeOe, FixedTermsAreHeld) {
   const NdeModel truth = bl33();
   const IdData d = record(truth, 600);
   const auto r = nde_oe(d, bl33(-0.006, -1.1), {.estimate_initial_state = false, .fixed = {"u"}});
-  ASSERT_TRUE(r.usable());
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_DOUBLE_EQ(r.model.coefficient("u"), -1.1);
   EXPECT_EQ(r.parameters.std(r.parameters.index("u")), 0.0);
   EXPECT_EQ(r.parameters.size(), 6);  // no initial-state parameters
@@ -129,7 +129,7 @@ TEST(NdeOe, ModelWithoutYIsNormalisedByItsHighestDerivative) {
   const NdeModel truth = model({"Dy", "D^2y", "u", "Dy^3"}, {2.0, 1.0, -1.0, 0.5});
   const IdData d = record(truth, 1000);
   const auto r = nde_oe(d, model({"Dy", "D^2y", "u", "Dy^3"}, {1.6, 1.0, -0.9, 0.6}), {.estimate_initial_state = false});
-  ASSERT_TRUE(r.usable()) << r.summary.message;
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_DOUBLE_EQ(r.model.coefficient("D^2y"), 1.0);
   EXPECT_NEAR(r.model.coefficient("Dy"), 2.0, 1e-5);
   EXPECT_NEAR(r.model.coefficient("Dy^3"), 0.5, 1e-5);

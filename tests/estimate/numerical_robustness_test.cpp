@@ -44,7 +44,7 @@ TEST(NumericalRobustness, BadlyScaledSignals) {
   // scaled problem as rank deficient (condition 3e13).
   const IdData d = record(0.01, 4000, 5, 30.0);
   const auto ref = srivc(d, {.nb = 1, .nf = 2});
-  ASSERT_TRUE(ref.usable());
+  ASSERT_TRUE(ref.usable()) << ref.why_not_usable();
   for (const double k : {1e6, 1e-6}) {
     const IdData s(d.u() / k, d.y() * k, d.ts());
     for (int m = 0; m < 3; ++m) {

@@ -57,7 +57,7 @@ TEST(Srivc, NoiseFreeIrregularSamplingIsExact) {
   IdData d(u, lsim(g, u, t, Intersample::Foh), t);
   d.set_intersample(Intersample::Foh);
   const auto r = srivc(d, {1, 2, 0});
-  ASSERT_TRUE(r.usable()) << r.summary.message;
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_LT(max_rel(r.parameters.values, Eigen::VectorXd{{2.8, 4.0, 5.0}}), 1e-6);
 }
 
@@ -68,7 +68,7 @@ TEST(Srivc, NoiseFreeStiffSystemIsExact) {
   const Eigen::VectorXd u = prbs(N, {.register_length = 7, .clock_period = 10});
   const IdData d(u, lsim(g, u, time_grid(2.0, N)), 2.0);
   const auto r = srivc(d, {2, 2, 0});
-  ASSERT_TRUE(r.usable()) << r.summary.message;
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   // Monic form: (0.1 s + 0.001)/(s^2 + 0.105 s + 0.0005).
   const Eigen::VectorXd truth{{0.105, 0.0005, 0.1, 0.001}};
   EXPECT_LT(max_rel(r.parameters.values, truth), 1e-6) << r.model.to_string(10);
@@ -85,7 +85,7 @@ TEST(Srivc, NoiseFreeNonIntegerDelayIsFound) {
   o.estimate_delay = true;
   o.srivc.delay_max = 15;
   const auto r = tfest(d, {1, 2, 0}, o);
-  ASSERT_TRUE(r.usable()) << r.summary.message;
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_NEAR(r.model.io_delay(), 8.037, 1e-6);
   EXPECT_LT(max_rel(r.parameters.values.head(3), Eigen::VectorXd{{4.0, 4.0, 12.0}}), 1e-6);
 }
@@ -179,7 +179,7 @@ TEST(OutputError, FixedParametersAndBounds) {
   o.fixed = {{"a4", 1600.0}};
   o.bounds = {{"a1", {0.0, 4.9}}};
   const auto r = tfest(d, {2, 4, 0}, o);
-  ASSERT_TRUE(r.usable()) << r.summary.message;
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_EQ(r.parameters.value("a4"), 1600.0);
   EXPECT_TRUE(r.parameters.fixed[3]);
   EXPECT_EQ(r.parameters.std(3), 0.0);
@@ -243,7 +243,7 @@ TEST(SrivcMiso, DifferentDenominatorsNoiseFreeExactAndNoisyWithinUncertainty) {
   EXPECT_NEAR(r.model.channels[1].io_delay(), 0.05, 1e-15);
   // 10 dB: every estimate within 3 reported standard deviations of the truth (measured: within 1.2).
   const auto n = srivc_miso(IdData(m.u, add_noise_snr(m.x, 10.0, 3), 0.01), {{1, 2, 3}, {1, 2, 5}});
-  ASSERT_TRUE(n.usable());
+  ASSERT_TRUE(n.usable()) << n.why_not_usable();
   for (int i = 0; i < 6; ++i) EXPECT_LT(std::abs(n.parameters.values(i) - kMisoTheta(i)), 3 * n.parameters.std(i)) << i;
 }
 
@@ -331,7 +331,7 @@ TEST(SrivcClosedLoop, ConsistentWhereOpenLoopSrivcIsBiased) {
     const IdData d(u, ym, Ts);
     ol.row(s) = srivc(d, {2, 2, 0}).parameters.values.transpose();
     const auto c = srivc_closed_loop(d, r, {2, 2, 0}, o);
-    ASSERT_TRUE(c.usable()) << c.summary.message;
+    ASSERT_TRUE(c.usable()) << c.why_not_usable();
     cl.row(s) = c.parameters.values.transpose();
   }
   const Eigen::VectorXd truth{{0.5, 1.0, 1.0, 1.0}};
@@ -354,7 +354,7 @@ TEST(FrequencyFit, RaoGarnierFrequencyResponse) {
   for (int k = 0; k < 250; ++k) w(k) = 0.1 * std::pow(1000.0, k / 249.0);
   const Eigen::VectorXcd G = kRao.frequency_response(w);
   const auto exact = tf_from_frequency(FrequencyData(w, G), {2, 4, 0});
-  ASSERT_TRUE(exact.usable());
+  ASSERT_TRUE(exact.usable()) << exact.why_not_usable();
   EXPECT_LT(max_rel(exact.parameters.values, kRaoTheta), 1e-6);  // noise-free: exact
   // Complex noise of std 1.5 on each part, 30 runs: every run converges near the truth
   // (a1 within 5 sd; measured worst 3.2) and the means are within 3.5 standard errors.

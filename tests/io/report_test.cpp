@@ -52,7 +52,7 @@ TEST(Report, MultiInputReportHasAChannelPerInput) {
   IdData d(u, lsim(g, IdData(u, Eigen::VectorXd::Zero(2000), Ts)), Ts);
   d.set_input_names({"fan", "heater"});
   const auto r = srivc_miso(d, {{2, 2, 0}, {1, 1, 0}});
-  ASSERT_TRUE(r.usable()) << r.summary.message;
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
   const std::string html = html_report(d, r, {.method = "srivc"});
   for (const char* s : {"fan (zoh), heater (zoh)", "Input-residual cross-correlation (fan)",
                         "Input-residual cross-correlation (heater)", "G1 (fan)", "G2 (heater)", "u2.b0"})
@@ -75,7 +75,7 @@ TEST(Report, DiagnosticsSectionShowsMethodNumbers) {
   const Eigen::VectorXd t = time_grid(Ts, 1500);
   const IdData sines(g(t), lsim(s3.to_state_space(), g, t), Ts);
   const auto m = modal_fit(sines, 3, {.shifts = Eigen::Vector3d(40 * Ts, 80 * Ts, 120 * Ts), .functions = 10}, &g);
-  ASSERT_TRUE(m.usable());
+  ASSERT_TRUE(m.usable()) << m.why_not_usable();
   const std::string hm = html_report(sines, m, {.method = "modal"});
   EXPECT_NE(hm.find("Modal functions (El-Shafey)"), std::string::npos);
   EXPECT_NE(hm.find("condition_by_order"), std::string::npos);

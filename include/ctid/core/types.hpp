@@ -32,6 +32,8 @@ struct ParameterSet {
 ///   nrmse = ||e|| / ||y - mean(y)||,  mse = V
 ///   fpe = V (1 + d/N)/(1 - d/N),  aic = N ln V + 2 d,  aicc = aic + 2 d (d+1)/(N-d-1),
 ///   bic = N ln V + d ln N.
+/// Estimators that compute no simulated output (fsf, modal_estimate) report the fit of their
+/// regression (target against its prediction). n_samples = 0: no fit was computed.
 struct FitReport {
   double fit_percent = 0.0;
   double nrmse = 0.0;
@@ -52,6 +54,21 @@ struct Diagnostics {
   std::map<std::string, Eigen::VectorXd> vectors;  ///< method-specific vectors (e.g. "theta_tau")
 };
 
+/// The rules every estimator's result is judged by (docs/guide.md, "When is a fit usable").
+/// Returns "" when all hold, otherwise the first that fails, worded for the user:
+///  1. the algorithm succeeded (Summary::succeeded()); otherwise Summary::message (or the termination);
+///  2. every parameter value is finite;
+///  3. where a fit was computed (fit.n_samples > 0): fit_percent is finite and > 0, i.e. the model's
+///     output is closer to the data than the output's mean is (a diverging simulation gives -Inf);
+///  4. where a covariance was computed (non-empty): it is finite and positive semi-definite over the
+///     free parameters, and every free parameter's standard deviation is finite and > 0 (zero or
+///     non-finite means a singular information matrix: the data do not determine that parameter);
+///     zero is accepted only for an exact fit (nrmse < 1e-6: noise-free data);
+///  5. the free parameters are jointly significant: where a fit was computed, the overall F test
+///     F = (R^2/d) / ((1-R^2)/(N-d)), R^2 = 1 - nrmse^2, reaches its 95 % point (otherwise the data
+///     cannot tell the model from no model, as for a fit to pure noise).
+std::string usability_problem(const Summary& summary, const ParameterSet& parameters, const FitReport& fit);
+
 /// What every estimator returns: the model plus everything needed to judge it.
 template <class Model>
 struct Result {
@@ -61,12 +78,11 @@ struct Result {
   Summary summary;
   Diagnostics diagnostics;
 
-  /// Whether the estimate can be trusted: the algorithm succeeded and every free
-  /// parameter is finite. Warnings do not make a result unusable.
-  bool usable() const {
-    if (!summary.succeeded()) return false;
-    return parameters.values.allFinite();
-  }
+  /// Why the estimate cannot be trusted, or "" when it can (see usability_problem()).
+  std::string why_not_usable() const { return usability_problem(summary, parameters, fit); }
+  /// Whether the estimate can be trusted: why_not_usable() is empty. Warnings do not make a
+  /// result unusable.
+  bool usable() const { return why_not_usable().empty(); }
 };
 
 }  // namespace ctid
