@@ -29,7 +29,7 @@ std::string find_dryer(const std::string& given) {
 }
 
 int run(const DemoArgs& a) {
-  check_output_path(a.json, {}, a.force);
+  check_outputs({a.json}, {a.data}, a.force);
   DataArgs da;
   da.path = find_dryer(a.data);
   da.inputs = {"1"};

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <set>
 #include <type_traits>
 
 #include "common.hpp"
@@ -25,7 +26,31 @@ struct FitArgs {
   std::string w = "w", re = "re", im = "im", u_re, u_im, y_re, y_im;
   std::string json, narx, report;
   bool force = false;
+  std::set<std::string> given;  ///< long names of the options given on the command line
 };
+
+// Options that belong to some methods only: given to another, they are errors, never silently ignored.
+void reject_flags_that_do_not_apply(const FitArgs& a) {
+  auto has = [&](const char* f) { return a.given.count(f) > 0; };
+  auto refuse = [&](const char* f, const std::string& why) { throw UsageError("--" + std::string(f) + " " + why); };
+  const std::string m = a.method;
+  const bool tf_data = m == "srivc" || m == "oe" || m == "tfest";
+  if (has("reference") && a.controller.empty()) refuse("reference", "needs --closed-loop-controller FILE (without it the fit would be open loop)");
+  if (has("closed-loop-controller") && m != "srivc") refuse("closed-loop-controller", "needs --method srivc (got " + m + ")");
+  if (has("responses") && m != "fsf") refuse("responses", "writes FSF responses: it needs --method fsf (got " + m + ")");
+  if (has("narx") && m != "kia") refuse("narx", "gives KIA its NARX model: it needs --method kia (got " + m + ")");
+  if (has("via") && m != "physical") refuse("via", "chooses the route of --method physical (got " + m + ")");
+  if (a.via != "fsf" && a.via != "frequency" && a.via != "raw") refuse("via", "must be fsf, frequency or raw (got '" + a.via + "')");
+  for (const char* f : {"model", "param"})
+    if (has(f) && m != "physical") refuse(f, "describes the model of --method physical (got " + m + ")");
+  if (has("delay") && !tf_data) refuse("delay", "(delay estimation) needs --method srivc, oe or tfest (got " + m + ")");
+  for (const char* f : {"nb", "nf", "nk"})
+    if (has(f) && (m == "narx" || m == "kia" || m == "fsf" || m == "physical"))
+      refuse(f, "sets transfer-function orders; " + m + " has its own structure settings (--set)");
+  if (!a.frequency)
+    for (const char* f : {"w", "re", "im", "u-re", "u-im", "y-re", "y-im"})
+      if (has(f)) refuse(f, "names a column of frequency data: it needs --frequency");
+}
 
 // Apply --set keys to LSSVF options; consumed keys are erased.
 void apply_svf_sets(std::map<std::string, std::string>& s, LssvfOptions& o) {
@@ -286,10 +311,6 @@ int run_fsf(const FitArgs& a, const IdData& d) {
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }
-  if (!a.responses.empty()) {
-    check_output_path(a.responses + "_time.csv", {a.data.path}, a.force);
-    check_output_path(a.responses + "_freq.csv", {a.data.path}, a.force);
-  }
   const int code = finish(r, "fsf", d, a);
   if (!a.responses.empty()) write_fsf_responses(a.responses, r.model);
   return code;
@@ -410,8 +431,10 @@ int run_modal(const FitArgs& a, const IdData& d0) {
 }
 
 int run(const FitArgs& a) {
-  check_output_path(a.json, {a.data.path}, a.force);
-  check_output_path(a.report, {a.data.path, a.json}, a.force);
+  reject_flags_that_do_not_apply(a);
+  check_outputs({a.json, a.report, a.responses.empty() ? "" : a.responses + "_time.csv",
+                 a.responses.empty() ? "" : a.responses + "_freq.csv"},
+                {a.data.path, a.narx, a.controller}, a.force);
   if (!a.controller.empty()) return run_closed_loop(a);
   if (a.frequency && !a.report.empty()) throw UsageError("--report needs time-domain data (not --frequency)");
   if (a.frequency) return run_frequency(a);
@@ -463,7 +486,6 @@ int run(const FitArgs& a) {
   }
   if (a.method == "fsf" || a.method == "physical") {
     if (d.nu() != 1) throw UsageError(detail::format("{} needs one input (selected {})", a.method, d.nu()));
-    if (a.via != "fsf" && a.via != "frequency" && a.via != "raw") throw UsageError("--via must be fsf, frequency or raw");
     return a.method == "fsf" ? run_fsf(a, d) : run_physical(a, d);
   }
   if (a.method == "modal") return run_modal(a, d);
@@ -564,7 +586,12 @@ void setup_fit(CLI::App& app) {
   app.add_option("--json", a->json, "Write the result (model, parameters, fit) to this JSON file");
   app.add_option("--report", a->report, "Write a self-contained HTML report (plots, tests, parameters) to this file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
-  app.callback([a] { g_run = [a] { return run(*a); }; });
+  app.callback([a, &app] {
+    for (const CLI::Option* o : app.get_options())
+      if (o->count() > 0)
+        for (const auto& n : o->get_lnames()) a->given.insert(n);
+    g_run = [a] { return run(*a); };
+  });
 }
 
 }  // namespace ctid::cli

@@ -103,10 +103,10 @@ int run_poles(PolesArgs a) {
       throw InputError(e.what());
     }
   }
-  a.data.inputs = a.data.outputs;  // the response only; no input is used
-  const IdData d = a.data.load(true);
+  a.data.inputs = a.data.outputs;  // the response only, loaded as the one column; no input is used
+  const IdData d = a.data.load(false);
   const double Ts = d.ts();
-  const Eigen::VectorXd y = d.y().col(0);
+  const Eigen::VectorXd y = d.u().col(0);
   auto sets = parse_sets(a.sets);
   FreeResponseOptions o;
   std::vector<double> shifts, gen = a.generator;
@@ -118,7 +118,10 @@ int run_poles(PolesArgs a) {
     else if (k == "spacing") spacing = whole_samples(k, to_double(k, v));
     else if (k == "pairs") pairs = to_int(k, v);
     else if (k == "generator") gen = to_list(k, v);
-    else if (k == "quadrature") o.quadrature = v == "trapezoid" ? Quadrature::Trapezoid : Quadrature::Simpson;
+    else if (k == "quadrature") {
+      if (v != "simpson" && v != "trapezoid") throw UsageError("--set quadrature: use simpson or trapezoid (got '" + v + "')");
+      o.quadrature = v == "trapezoid" ? Quadrature::Trapezoid : Quadrature::Simpson;
+    }
     else if (k == "prony_spacing") p_spacing = whole_samples(k, to_double(k, v));
     else if (k == "prony_equations") p_equations = to_int(k, v);
     else if (k == "prony_start") p_start = whole_samples(k, to_double(k, v));
@@ -188,7 +191,7 @@ struct ResponseArgs {
 };
 
 int run_response(const ResponseArgs& a) {
-  check_output_path(a.out, {a.data.path}, a.force);
+  check_outputs({a.out}, {a.data.path}, a.force);
   if (a.order < 1) throw UsageError("--order must be >= 1");
   const IdData d = a.data.load(true);
   if (d.nu() != 1 || d.ny() != 1) throw UsageError("response needs one --input and one --output");

@@ -35,7 +35,7 @@ Result<M> bare_result(const M& model, const IdData& d, const Eigen::VectorXd& yh
 
 int run(const ReportArgs& a) {
   if (a.out.empty()) throw UsageError("give the report file with --out REPORT.html");
-  check_output_path(a.out, {a.data.path, a.result}, a.force);
+  check_outputs({a.out}, {a.data.path, a.result}, a.force);
   std::ifstream in(a.result);
   if (!in) throw InputError("cannot open " + a.result);
   std::stringstream buf;

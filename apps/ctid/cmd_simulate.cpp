@@ -21,7 +21,7 @@ struct SimArgs {
 
 
 int run(const SimArgs& a) {
-  check_output_path(a.out, {a.data.path, a.model}, a.force);
+  check_outputs({a.out}, {a.data.path, a.model}, a.force);
   const IdData d = a.data.load(false);
   Eigen::MatrixXd y;
   std::vector<std::string> ynames;

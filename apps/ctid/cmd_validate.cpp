@@ -34,7 +34,7 @@ nlohmann::json nonlinear_model_json(const std::string& path) {
 }
 
 int run(const ValArgs& a) {
-  check_output_path(a.json, {a.data.path, a.model}, a.force);
+  check_outputs({a.json}, {a.data.path, a.model}, a.force);
   // Linear models (transfer function, MISO) are simulated exactly from rest; NARX and NDE model files as by
   // `ctid simulate` (NARX at its Ts from rest, NDE by the adaptive integrator).
   std::optional<LinearModel> linear;

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <unistd.h>
 #include <type_traits>
 
 namespace ctid::cli {
@@ -33,33 +34,48 @@ IdData DataArgs::load(bool need_output) const {
   spec.inputs = inputs;
   spec.outputs = outputs;
   try {
-    const bool is_mat = path.size() > 4 && path.substr(path.size() - 4) == ".mat";
-    if (!is_mat && (inputs.empty() || (need_output && outputs.empty()))) {
-      // Default columns: everything that is not the time column, inputs first, output last.
-      const CsvTable tab = read_csv(path);
+    // Column (CSV) or variable (.mat) names; the table is read once.
+    const bool is_mat = is_mat_file(path);
+    std::optional<CsvTable> tab;
+    std::vector<std::string> names;
+    if (is_mat) {
+      names = mat_variable_names(path);
+    } else {
+      tab = read_csv(path);
+      names = tab->names;
+    }
+    // Two selections are the same column when they name the same position (CSV) or variable (.mat).
+    auto same = [&](const std::string& a, const std::string& b) { return tab ? tab->column(a) == tab->column(b) : a == b; };
+    if (inputs.empty() || (need_output && outputs.empty())) {
+      // Default columns (documented in --help and docs/guide.md): everything that is not the time column, inputs
+      // first, output last.
       std::vector<std::string> rest;
-      const int tcol = time.empty() ? -1 : tab.column(time);
-      for (int c = 0; c < static_cast<int>(tab.names.size()); ++c)
-        if (c != tcol) rest.push_back(tab.names[c]);
+      for (const auto& n : names)
+        if (time.empty() || !same(n, time)) rest.push_back(n);
       if (need_output && outputs.empty()) {
         if (rest.size() != 2 && inputs.empty()) {
           std::string cols;
-          for (const auto& n : tab.names) cols += (cols.empty() ? "" : ", ") + n;
-          throw UsageError(path + ": choose columns with --input and --output (columns: " + cols + ")");
+          for (const auto& n : names) cols += (cols.empty() ? "" : ", ") + n;
+          throw UsageError(path + ": choose columns with --input and --output (" + (is_mat ? "variables: " : "columns: ") +
+                           cols + ")");
         }
+        if (rest.empty()) throw UsageError(path + ": no column left for the output; use --output");
         spec.outputs = {rest.back()};
         rest.pop_back();
       }
       if (inputs.empty()) {
+        if (need_output)
+          std::erase_if(rest, [&](const std::string& n) { return same(n, spec.outputs.front()); });
         if (rest.empty()) throw UsageError(path + ": no column left for the input; use --input");
         spec.inputs = need_output ? rest : std::vector<std::string>{rest.front()};
       }
-      if (!need_output) spec.outputs = {spec.inputs.front()};  // placeholder output for loading only
-      IdData d = iddata_from_table(tab, spec);
-      return detrend == "none" ? d : d.detrend(detrend == "mean" ? Detrend::Mean : Detrend::Linear);
     }
-    if (!need_output) spec.outputs = {inputs.front()};
-    IdData d = load_iddata(path, spec);
+    if (need_output)
+      for (const auto& o : spec.outputs)
+        for (const auto& in : spec.inputs)
+          if (same(o, in)) throw UsageError(detail::format("'{}' is selected both as an input and as the output", o));
+    if (!need_output) spec.outputs = {spec.inputs.front()};  // placeholder output for loading only
+    IdData d = tab ? iddata_from_table(*tab, spec) : load_iddata(path, spec);
     return detrend == "none" ? d : d.detrend(detrend == "mean" ? Detrend::Mean : Detrend::Linear);
   } catch (const FileError& e) {
     throw InputError(e.what());
@@ -67,20 +83,41 @@ IdData DataArgs::load(bool need_output) const {
     const std::string what = e.what();
     // An unknown column is a usage problem; everything else is about the file's content.
     if (what.find("no column named") != std::string::npos || what.find("no variable named") != std::string::npos ||
-        what.find("column position") != std::string::npos)
+        what.find("column position") != std::string::npos || what.find("are the same column") != std::string::npos ||
+        what.find("is the time column") != std::string::npos)
       throw UsageError(what);
     throw InputError(path + ": " + what);
   }
 }
 
-void check_output_path(const std::string& out, const std::vector<std::string>& inputs, bool force) {
+void check_outputs(const std::vector<std::string>& outs_in, const std::vector<std::string>& inputs, bool force) {
   namespace fs = std::filesystem;
-  if (out.empty()) return;
+  std::vector<std::string> outs;
+  for (const auto& o : outs_in)
+    if (!o.empty()) outs.push_back(o);
   std::error_code ec;
-  for (const auto& in : inputs)
-    if (!in.empty() && fs::exists(in) && fs::exists(out) && fs::equivalent(in, out, ec))
-      throw UsageError("refusing to write '" + out + "': it is one of the input files");
-  if (fs::exists(out) && !force) throw UsageError("'" + out + "' exists; use --force to overwrite it");
+  // Where each output lands (a symlink is written through; a device, FIFO or directory is refused).
+  std::vector<fs::path> lands;
+  for (const auto& out : outs) {
+    std::string target;
+    try {
+      target = resolve_output_file(out);
+    } catch (const FileError& e) {
+      throw UsageError(e.what());
+    }
+    const fs::path abs = fs::weakly_canonical(fs::absolute(target, ec), ec);
+    for (size_t k = 0; k < lands.size(); ++k)
+      if (lands[k] == abs) throw UsageError("two outputs of this command name the same file '" + out + "' (and '" + outs[k] + "')");
+    lands.push_back(abs);
+    for (const auto& in : inputs)
+      if (!in.empty() && fs::exists(in, ec) && fs::exists(target, ec) && fs::equivalent(in, target, ec))
+        throw UsageError("refusing to write '" + out + "': it is the input file '" + in + "'");
+    if (fs::exists(target, ec) && !force) throw UsageError("'" + out + "' exists; use --force to overwrite it");
+    const fs::path dir = abs.has_parent_path() ? abs.parent_path() : fs::path(".");
+    if (!fs::is_directory(dir, ec)) throw UsageError("cannot write '" + out + "': the directory '" + dir.string() + "' does not exist");
+    if (::access(dir.c_str(), W_OK) != 0)
+      throw UsageError("cannot write '" + out + "': the directory '" + dir.string() + "' is not writable");
+  }
 }
 
 std::map<std::string, std::string> parse_sets(const std::vector<std::string>& sets) {
@@ -88,7 +125,10 @@ std::map<std::string, std::string> parse_sets(const std::vector<std::string>& se
   for (const auto& s : sets) {
     const auto eq = s.find('=');
     if (eq == std::string::npos || eq == 0) throw UsageError("--set needs KEY=VALUE (got '" + s + "')");
-    m[s.substr(0, eq)] = s.substr(eq + 1);
+    const auto [it, fresh] = m.emplace(s.substr(0, eq), s.substr(eq + 1));
+    if (!fresh)
+      throw UsageError("--set " + it->first + " is given twice ('" + it->second + "' and '" + s.substr(eq + 1) +
+                       "'); give it once");
   }
   return m;
 }

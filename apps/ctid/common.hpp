@@ -47,8 +47,12 @@ struct DataArgs {
   IdData load(bool need_output) const;
 };
 
-/// Output file guard: refuses to overwrite an input file, and an existing file unless --force.
-void check_output_path(const std::string& out, const std::vector<std::string>& inputs, bool force);
+/// Output file guard, run before any computation; every failure is a UsageError (exit 2). Refuses an output
+/// that is one of `inputs` (data, model, controller, NARX, result files; compared after resolving symlinks), two
+/// outputs that name the same file, an existing file without --force, a device/FIFO/directory even with --force
+/// (a symlink is written through to its regular target), and a directory that does not exist or is not writable.
+/// Empty names are skipped.
+void check_outputs(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs, bool force);
 
 /// "KEY=VALUE" pairs from --set.
 std::map<std::string, std::string> parse_sets(const std::vector<std::string>& sets);

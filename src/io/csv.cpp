@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
+#include <string_view>
 
 #include "ctid/core/check.hpp"
 #include "ctid/io/file.hpp"
@@ -62,10 +63,19 @@ bool parse_number(const std::string& s, double& v) {
 
 }  // namespace
 
-CsvTable parse_csv(const std::string& text, const std::string& source, const CsvReadOptions& o) {
+CsvTable parse_csv(const std::string& text_in, const std::string& source, const CsvReadOptions& o) {
   CsvTable t;
   t.source = source;
-  std::istringstream in(text);
+  // What is not a text table is named, not parsed field by field.
+  if (text_in.size() >= 2 && static_cast<unsigned char>(text_in[0]) == 0x1f && static_cast<unsigned char>(text_in[1]) == 0x8b)
+    throw FileError(detail::format("{}: the file is gzip-compressed; decompress it first (gunzip)", source));
+  if (text_in.rfind("\x89HDF", 0) == 0 || text_in.rfind("MATLAB", 0) == 0)
+    throw FileError(detail::format("{}: this is a MATLAB .mat file, not a text table; name it *.mat", source));
+  if (text_in.find('\0') != std::string::npos)
+    throw FileError(detail::format("{}: the file is binary (it holds NUL bytes), not a text table", source));
+  // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first field.
+  const std::string_view text = std::string_view(text_in).substr(text_in.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0);
+  std::istringstream in{std::string(text)};
   std::string line;
   int lineno = 0;
   char delim = o.delimiter == '\t' ? ' ' : o.delimiter;
@@ -74,6 +84,9 @@ CsvTable parse_csv(const std::string& text, const std::string& source, const Csv
   std::size_t ncol = 0;
   while (std::getline(in, line)) {
     ++lineno;
+    if (line.size() > kMaxLineBytes)
+      throw FileError(detail::format("{}:{}: the line has {} bytes, more than the limit of {} (is this a text table?)", source,
+                                     lineno, line.size(), kMaxLineBytes));
     if (!line.empty() && line.back() == '\r') line.pop_back();
     const auto p = line.find_first_not_of(" \t");
     if (p == std::string::npos) continue;
@@ -91,6 +104,11 @@ CsvTable parse_csv(const std::string& text, const std::string& source, const Csv
       ncol = f.size();
       if (header) {
         for (std::size_t i = 0; i < f.size(); ++i) t.names.push_back(f[i].empty() ? std::to_string(i + 1) : f[i]);
+        for (std::size_t i = 0; i < t.names.size(); ++i)
+          for (std::size_t k = 0; k < i; ++k)
+            if (t.names[i] == t.names[k])
+              throw FileError(detail::format("{}:{}: column name '{}' appears twice (fields {} and {}); names must be unique",
+                                             source, lineno, t.names[i], k + 1, i + 1));
         continue;
       }
       for (std::size_t i = 0; i < f.size(); ++i) t.names.push_back(std::to_string(i + 1));

@@ -1,5 +1,6 @@
 #include "ctid/io/load.hpp"
 
+#include <cctype>
 #include <cmath>
 
 #include "ctid/core/check.hpp"
@@ -38,8 +39,36 @@ IdData assemble(const Eigen::MatrixXd& u, const Eigen::MatrixXd& y, const Eigen:
 
 }  // namespace
 
+namespace {
+// The same column selected twice (by name or position) would fit a spurious channel: refused. Inputs among
+// themselves, outputs among themselves, and the time column against both.
+template <class Key>
+void check_distinct(const DataSpec& s, const std::string& source, Key key) {
+  auto twice = [&](const std::vector<std::string>& v, const char* what) {
+    for (std::size_t i = 0; i < v.size(); ++i)
+      for (std::size_t k = 0; k < i; ++k)
+        CTID_REQUIRE(key(v[i]) != key(v[k]), "{}: {} '{}' and '{}' are the same column; select each once", source, what, v[k],
+                     v[i]);
+  };
+  twice(s.inputs, "inputs");
+  twice(s.outputs, "outputs");
+  if (s.time.empty()) return;
+  for (const auto* v : {&s.inputs, &s.outputs})
+    for (const auto& n : *v)
+      CTID_REQUIRE(key(n) != key(s.time), "{}: '{}' is the time column; it cannot also be an input or output", source, n);
+}
+}  // namespace
+
+bool is_mat_file(const std::string& path) {
+  if (path.size() <= 4) return false;
+  std::string ext = path.substr(path.size() - 4);
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".mat";
+}
+
 IdData iddata_from_table(const CsvTable& tab, const DataSpec& s) {
   check_spec(s, tab.source);
+  check_distinct(s, tab.source, [&](const std::string& n) { return tab.column(n); });
   const Eigen::Index N = tab.values.rows();
   // Empty cells are NaN in the table; a used column must have none.
   std::vector<std::string> used = s.inputs;
@@ -66,9 +95,9 @@ IdData iddata_from_table(const CsvTable& tab, const DataSpec& s) {
 }
 
 IdData load_iddata(const std::string& path, const DataSpec& s) {
-  const bool is_mat = path.size() > 4 && path.compare(path.size() - 4, 4, ".mat") == 0;
-  if (!is_mat) return iddata_from_table(read_csv(path, s.csv), s);
+  if (!is_mat_file(path)) return iddata_from_table(read_csv(path, s.csv), s);
   check_spec(s, path);
+  check_distinct(s, path, [](const std::string& n) { return n; });
   auto vec = [&](const std::string& name) {
     const Eigen::MatrixXd m = read_mat_variable(path, name);
     if (m.rows() != 1 && m.cols() != 1)

@@ -7,6 +7,7 @@
 #include <bit>
 #include <cstdint>
 #include <cstdio>
+#include <dlfcn.h>
 #include <fstream>
 #include <iterator>
 #include <vector>
@@ -14,6 +15,7 @@
 #include <matio.h>
 
 #include "ctid/core/check.hpp"
+#include "ctid/io/file.hpp"
 
 namespace ctid {
 
@@ -207,10 +209,25 @@ void check_mat_structure(const std::string& path) {
   V5Checker(path, be).sequence(bytes.data() + 128, bytes.size() - 128, 0, true);
 }
 
+// The library never prints (DESIGN.md §4): libmatio's own log messages are dropped (its failures come back as
+// return values, which become FileError), and so is the HDF5 error stack that a damaged level 7.3 file makes
+// HDF5 print (29-69 lines). H5Eset_auto2 is looked up at run time in the HDF5 that libmatio loaded, so ctid
+// does not link HDF5 itself; when it is absent there is nothing to silence.
+void quiet_matio_and_hdf5() {
+  static const bool done = [] {
+    Mat_LogInitFunc("ctid", [](int, char*) {});
+    using SetAuto = int (*)(std::int64_t, void*, void*);
+    if (void* f = dlsym(RTLD_DEFAULT, "H5Eset_auto2")) reinterpret_cast<SetAuto>(f)(0 /* H5E_DEFAULT */, nullptr, nullptr);
+    return true;
+  }();
+  (void)done;
+}
+
 struct MatFile {
   mat_t* m = nullptr;
   explicit MatFile(const std::string& path) {
-    if (access(path.c_str(), R_OK) != 0) throw FileError(detail::format("cannot open '{}': no such readable file", path));
+    require_readable_regular_file(path);
+    quiet_matio_and_hdf5();
     check_mat_structure(path);
     m = Mat_Open(path.c_str(), MAT_ACC_RDONLY);
     if (!m) throw FileError(detail::format("cannot read '{}' as a MATLAB .mat file", path));
@@ -285,7 +302,8 @@ Eigen::MatrixXd read_mat_variable(const std::string& path, const std::string& na
   return out;
 }
 
-void write_mat(const std::string& path, const std::map<std::string, Eigen::MatrixXd>& vars) {
+void write_mat(const std::string& out, const std::map<std::string, Eigen::MatrixXd>& vars) {
+  const std::string path = resolve_output_file(out);
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
   mat_t* m = Mat_CreateVer(tmp.c_str(), nullptr, MAT_FT_MAT5);
   if (!m) throw FileError(detail::format("cannot write '{}'", path));

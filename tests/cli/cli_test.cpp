@@ -179,7 +179,7 @@ TEST(Cli, NoPartialOutputOnFailure) {
   EXPECT_NE(r.err.find("input 'force' is constant (0)"), std::string::npos) << r.err;
   r = ctid_run("fit " + flat + " --time time --input force --output position --set tau=1 --json " + flat + " --force");
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("one of the input files"), std::string::npos);
+  EXPECT_NE(r.err.find("it is the input file"), std::string::npos) << r.err;
   EXPECT_EQ(read_csv(flat).values.rows(), 6);
 }
 

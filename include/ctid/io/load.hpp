@@ -20,9 +20,13 @@ struct DataSpec {
   CsvReadOptions csv;                ///< delimiter, header and comment handling
 };
 
+/// Whether `path` ends in .mat (any letter case): such files are read with libmatio, others as text.
+bool is_mat_file(const std::string& path);
+
 /// Load by extension (.mat -> libmatio, anything else -> delimited text). Throws
 /// FileError for file problems (path:line) and for a non-increasing time column;
-/// InvalidArgument for an unknown column or a bad spec (no output, no time axis).
+/// InvalidArgument for an unknown column or a bad spec (no output, no time axis, a column selected twice
+/// among the inputs or among the outputs, the time column selected as an input or output).
 IdData load_iddata(const std::string& path, const DataSpec& spec);
 /// Build from an already-read table.
 IdData iddata_from_table(const CsvTable& table, const DataSpec& spec);
