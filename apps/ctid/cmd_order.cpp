@@ -54,6 +54,10 @@ int run(const OrderArgs& a) {
   for (const auto& k : c)
     std::printf("%4d  %2d %2d %2d %10.3f %9.4f %11.1f %11.1f %8.2f  %s\n", ++i, k.orders.nb, k.orders.nf, k.orders.nk, k.yic,
                 k.rt2, k.aic, k.bic, k.fit_percent, k.termination.c_str());
+  if (interrupt_requested()) {
+    std::fprintf(stderr, "ctid: interrupted after %zu of the structures; the table ranks those fitted\n", c.size());
+    return kNotUsable;
+  }
   return c.empty() || !c.front().usable ? kNotUsable : kOk;
 }
 }  // namespace

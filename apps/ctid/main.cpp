@@ -1,13 +1,56 @@
 // ctid — command-line tool. Subcommands: fit, simulate, validate, order, poles, response, gfrf, demo (DESIGN.md §8).
 // Exit codes: 0 ok, 1 estimate not usable, 2 usage, 3 input file error; one line on stderr.
+#include <atomic>
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <functional>
+#include <unistd.h>
 
 #include "common.hpp"
 
 namespace ctid::cli {
 std::function<int()> g_run;
+
+namespace {
+volatile std::sig_atomic_t g_sigint = 0;
+extern "C" void on_sigint(int) {
+  if (g_sigint) std::_Exit(130);  // a second Ctrl-C: stop at once
+  g_sigint = 1;
 }
+
+// Progress and Ctrl-C for every estimator of the library (core/progress.hpp): the first Ctrl-C asks the
+// estimator to stop (it returns its best iterate as "interrupted", exit 1); on a terminal, work that runs for
+// more than 1.5 s shows one status line on stderr (stage and iteration), erased at the end.
+class CliProgress {
+ public:
+  CliProgress()
+      : tty_(::isatty(STDERR_FILENO) != 0),
+        start_(std::chrono::steady_clock::now()),
+        scope_([this](const ProgressEvent& e) { return on_event(e); }) {
+    std::signal(SIGINT, on_sigint);
+  }
+  ~CliProgress() {
+    if (shown_) std::fprintf(stderr, "\r\033[K");
+  }
+
+ private:
+  bool on_event(const ProgressEvent& e) {
+    const auto now = std::chrono::steady_clock::now();
+    if (tty_ && now - start_ > std::chrono::milliseconds(1500) && now - last_ > std::chrono::milliseconds(200)) {
+      last_ = now;
+      shown_ = true;
+      std::fprintf(stderr, "\r\033[Kctid: %s, step %d, %.0f s (Ctrl-C stops)", e.stage, e.iteration,
+                   std::chrono::duration<double>(now - start_).count());
+    }
+    return g_sigint == 0;
+  }
+  bool tty_, shown_ = false;
+  std::chrono::steady_clock::time_point start_, last_{};
+  ProgressScope scope_;
+};
+}  // namespace
+}  // namespace ctid::cli
 
 int main(int argc, char** argv) {
   using namespace ctid::cli;
@@ -36,6 +79,7 @@ int main(int argc, char** argv) {
     return kUsage;
   }
   try {
+    const CliProgress progress;
     return g_run ? g_run() : kUsage;
   } catch (const UsageError& e) {
     std::fprintf(stderr, "ctid: %s\n", e.what());

@@ -155,9 +155,9 @@ void bind_linear(py::module_& m) {
       "select_order",
       [](const IdData& d, std::pair<int, int> nb, std::pair<int, int> nf, std::pair<int, int> nk,
          const OrderSelectionOptions& o) {
-        return interruptible([&] {
-          return select_order(d, {nb.first, nb.second}, {nf.first, nf.second}, {nk.first, nk.second}, o);
-        });
+        return interruptible(
+            [&] { return select_order(d, {nb.first, nb.second}, {nf.first, nf.second}, {nk.first, nk.second}, o); },
+            OnInterrupt::Raise);
       },
       py::arg("data"), py::arg("nb"), py::arg("nf"), py::arg("nk"), py::arg("options") = OrderSelectionOptions{},
       "Fit every [nb nf nk] of the (min, max) ranges by SRIVC; ranked, usable first.");

@@ -14,14 +14,18 @@ namespace py = pybind11;
 
 namespace ctid::python {
 
-/// Runs f() with the GIL released. Ctrl-C is noticed at the estimator's next progress report (the
-/// callback takes the GIL and checks for signals) and ends the run with Termination::Interrupted; the
-/// best iterate is returned and the KeyboardInterrupt is consumed (the result says what happened).
+/// What Ctrl-C does to a call: a single estimation returns its best iterate as Termination::Interrupted
+/// (the result says what happened); a routine that runs several estimations (select_order) raises
+/// KeyboardInterrupt once it has stopped.
+enum class OnInterrupt { ReturnResult, Raise };
+
+/// Runs f() with the GIL released. Ctrl-C is noticed at the estimator's next progress report (every
+/// iteration and every grid point: the callback takes the GIL and checks for signals); the library's stop
+/// request is sticky within the call, so every later fit of a multi-fit routine stops at once.
 template <class F>
-auto interruptible(F&& f) {
+auto interruptible(F&& f, OnInterrupt on = OnInterrupt::ReturnResult) {
   bool stop = false;
   ProgressScope scope([&stop](const ProgressEvent&) {
-    if (stop) return false;
     py::gil_scoped_acquire gil;
     if (PyErr_CheckSignals() != 0) {
       PyErr_Clear();
@@ -29,8 +33,15 @@ auto interruptible(F&& f) {
     }
     return !stop;
   });
-  py::gil_scoped_release release;
-  return f();
+  auto result = [&] {
+    py::gil_scoped_release release;
+    return f();
+  }();
+  if (stop && on == OnInterrupt::Raise) {
+    PyErr_SetNone(PyExc_KeyboardInterrupt);
+    throw py::error_already_set();
+  }
+  return result;
 }
 
 /// Binds Result<Model> as a Python class `name` (model, parameters, fit, summary, diagnostics, usable()).

@@ -1,6 +1,7 @@
 import os
 import signal
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -136,3 +137,46 @@ def test_select_order_ranks_the_true_structure_first(plant):
         assert ranked[0].usable and ranked[0].fit_percent > 85
     with pytest.raises(ValueError, match="must be one of"):
         ctid.select_order(d, nb=(1, 1), nf=(1, 2), rank_by="mdl")
+
+
+def _second_order_record(n, seed=3):
+    # 2/(s^2 + 0.6 s + 1) on a random binary input, 10 % output noise.
+    rng = np.random.default_rng(seed)
+    u = np.repeat(np.where(rng.random(n // 20 + 1) < 0.5, -1.0, 1.0), 20)[:n]
+    g = ctid.TransferFunction([2.0], [1.0, 0.6, 1.0])
+    y = g.simulate(u, ctid.time_grid(0.05, n))
+    return ctid.IdData.from_arrays(u, y + 0.1 * np.std(y) * rng.standard_normal(n), ts=0.05)
+
+
+def _interrupt_after(seconds):
+    timer = threading.Timer(seconds, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    return timer
+
+
+def test_ctrl_c_stops_order_selection_and_raises_keyboard_interrupt():
+    # 120 structures on 20000 samples take several seconds; SIGINT after 0.3 s must stop the whole search within
+    # about a second (each structure and each SRIVC iteration checks) and raise KeyboardInterrupt. Before issue 13
+    # the next fits saw the consumed interrupt at their first iteration and segfaulted.
+    d = _second_order_record(20000)
+    timer = _interrupt_after(0.3)
+    t0 = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        ctid.select_order(d, (1, 4), (1, 6), (0, 9))
+    timer.join()
+    assert time.monotonic() - t0 < 2.0
+    # The interrupt does not stay set: the next fit runs to the end.
+    r = ctid.srivc(d, 1, 2)
+    assert r.summary.termination == "converged" and r.usable(), r.why_not_usable()
+    assert r.parameters["b0"] == pytest.approx(2.0, rel=0.05)
+
+
+def test_ctrl_c_stops_a_delay_grid_within_a_second():
+    # 10000 delay grid points on 20000 samples take minutes; the grid checks for Ctrl-C at every point.
+    d = _second_order_record(20000)
+    timer = _interrupt_after(0.3)
+    t0 = time.monotonic()
+    r = ctid.srivc(d, 1, 2, estimate_delay=True, delay_max=50.0, delay_grid=10000)
+    timer.join()
+    assert time.monotonic() - t0 < 1.5
+    assert r.summary.termination == "interrupted" and not r.usable()

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "ctid/core/check.hpp"
+#include "ctid/core/progress.hpp"
 #include "ctid/signal/svf.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/validate/metrics.hpp"
@@ -21,7 +22,8 @@ void LssvfOptions::validate() const {
   CTID_REQUIRE_OPTION(std::isfinite(alpha) && alpha >= 0, "lssvf: alpha must be >= 0 (got {})", alpha);
   CTID_REQUIRE_OPTION(std::isfinite(transient_time) && transient_time >= 0,
                       "lssvf: transient_time must be >= 0 (got {} s)", transient_time);
-  CTID_REQUIRE_OPTION(tau_grid_size >= 2, "lssvf: tau_grid_size must be >= 2 (got {})", tau_grid_size);
+  CTID_REQUIRE_OPTION(tau_grid_size >= 2 && tau_grid_size <= kMaxTauGrid, "lssvf: tau_grid_size must be in [2, {}] (got {})",
+                      kMaxTauGrid, tau_grid_size);
   for (const auto& [name, v] : fixed)
     CTID_REQUIRE_OPTION(std::isfinite(v), "lssvf: fixed value of {} must be finite (got {})", name, v);
   if (data_filter) {
@@ -233,6 +235,7 @@ double choose_tau(const IdData& data, const TfOrders& o, const LssvfOptions& opt
   double best_tau = lo, best_fit = -std::numeric_limits<double>::infinity();
   bool have = false;
   for (int i = 0; i < G; ++i) {
+    if (!report_progress("tau_grid", i + 1, best_fit)) break;  // interrupted: the best tau so far
     const double tau = lo * std::pow(hi / lo, double(i) / (G - 1));
     grid(i) = tau;
     fits(i) = -std::numeric_limits<double>::infinity();
@@ -277,6 +280,10 @@ Result<TransferFunction> lssvf(const IdData& data, const TfOrders& orders, const
   }
   r.summary.iterations = 1;
   tf_detail::check_cancellation(r);
+  if (interrupt_requested()) {
+    r.summary.termination = Termination::Interrupted;
+    r.summary.message = "interrupted during the choice of tau";
+  }
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

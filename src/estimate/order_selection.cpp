@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "ctid/core/check.hpp"
+#include "ctid/core/progress.hpp"
 
 namespace ctid {
 
@@ -32,10 +33,18 @@ std::vector<OrderCandidate> select_order(const IdData& data, OrderRange nb, Orde
   const Eigen::VectorXd y = data.y().col(0);
   const double sy2 = (y.array() - y.mean()).square().mean();
   CTID_REQUIRE(sy2 > 0, "select_order: the output is constant");
+  long long count = 0;
+  for (int f = nf.min; f <= nf.max; ++f)
+    count += static_cast<long long>(std::max(0, std::min(nb.max, f + 1) - nb.min + 1)) * (nk.max - nk.min + 1);
+  CTID_REQUIRE_OPTION(count <= kMaxOrderCandidates,
+                      "select_order: the ranges give {} structures, more than the limit of {}; narrow --nb/--nf/--nk",
+                      count, kMaxOrderCandidates);
   std::vector<OrderCandidate> out;
+  int done = 0;
   for (int f = nf.min; f <= nf.max; ++f)
     for (int b = nb.min; b <= std::min(nb.max, f + 1); ++b)
       for (int k = nk.min; k <= nk.max; ++k) {
+        if (!report_progress("select_order", ++done, NAN)) goto ranked;  // interrupted: rank what was fitted
         OrderCandidate c;
         c.orders = TfOrders{b, f, k};
         const Result<TransferFunction> r = srivc(data, c.orders, options.srivc);
@@ -57,6 +66,7 @@ std::vector<OrderCandidate> select_order(const IdData& data, OrderRange nb, Orde
         if (!std::isfinite(c.yic)) c.usable = false;
         out.push_back(c);
       }
+ranked:
   auto key = [&](const OrderCandidate& c) {
     switch (options.rank_by) {
       case OrderCriterion::Yic: return c.yic;

@@ -25,7 +25,9 @@ void SrivcOptions::validate() const {
   CTID_REQUIRE_OPTION(std::isfinite(delay_max), "srivc: delay_max must be finite (got {})", delay_max);
   CTID_REQUIRE_OPTION(delay_max < 0 || delay_max >= delay_min, "srivc: the delay range [{}, {}] s is empty", delay_min,
                       delay_max);
-  CTID_REQUIRE_OPTION(delay_grid >= 0, "srivc: delay_grid must be >= 0 (got {})", delay_grid);
+  CTID_REQUIRE_OPTION(delay_grid >= 0 && delay_grid <= kMaxDelayGrid,
+                      "srivc: delay_grid must be in [0, {}] points (got {}); a finer grid adds nothing the refinement "
+                      "does not", kMaxDelayGrid, delay_grid);
 }
 
 
@@ -246,6 +248,11 @@ Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const
     double best = std::numeric_limits<double>::infinity();
     Eigen::VectorXd warm;
     for (int i = 0; i < G; ++i) {
+      if (!report_progress("delay_grid", i + 1, best)) {  // interrupted: keep the points done so far
+        grid.conservativeResize(i);
+        grid_cost.conservativeResize(i);
+        break;
+      }
       const double dl = options.delay_min + (dmax - options.delay_min) * i / double(G - 1);
       grid(i) = dl;
       // The first grid point starts from the user's model or LSSVF; the others from their
@@ -264,7 +271,8 @@ Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const
     // output-error cost over one grid step on either side.
     const double step = (dmax - options.delay_min) / double(G - 1);
     double lo = std::max(options.delay_min, delay - step), hi = std::min(dmax, delay + step);
-    for (int outer = 0; outer < 40; ++outer) {
+    if (theta.size() == 0) theta = initial_theta(data, orders, delay, options);  // interrupted before the first point
+    for (int outer = 0; outer < 40 && !interrupt_requested(); ++outer) {
       theta = srivc_fixed_delay(data, orders, delay, theta, options, options.max_iterations).theta;
       auto cost = [&](double dl) { return output_error_mse(tf_of(theta, orders, dl), data); };
       const double gr = 0.5 * (std::sqrt(5.0) - 1.0);
@@ -296,7 +304,7 @@ Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const
   r.fit = fit_report_or_inf(data.y().col(0), lsim(r.model, data, 0), p + (options.estimate_delay ? 1 : 0));
   // Covariance sigma^2 (sum zeta zeta^T)^{-1}, sigma^2 from the output error.
   const double sigma2 = r.fit.mse * data.size() / std::max(1, data.size() - p);
-  if (!run.rank_deficient && std::isfinite(sigma2)) {
+  if (!run.rank_deficient && std::isfinite(sigma2) && run.zz.rows() == p) {  // no zz when interrupted before a step
     r.parameters.covariance = sigma2 * run.zz.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
     r.parameters.std = r.parameters.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
   } else {

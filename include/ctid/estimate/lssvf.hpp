@@ -45,8 +45,9 @@ struct LssvfOptions {
   std::map<std::string, double> fixed;
   /// Optional extra data filter F(s) applied to both sides (stable, proper, no delay).
   std::optional<TransferFunction> data_filter;
-  /// Number of tau candidates for the automatic choice (>= 2).
+  /// Number of tau candidates for the automatic choice, in [2, kMaxTauGrid].
   int tau_grid_size = 12;
+  static constexpr int kMaxTauGrid = 1000;
   /// Throws InvalidOptions naming the field.
   void validate() const;
 };

@@ -36,9 +36,15 @@ struct OrderSelectionOptions {
   OrderCriterion rank_by = OrderCriterion::Yic;
 };
 
+/// The most structures one select_order call fits (each is an SRIVC fit).
+inline constexpr int kMaxOrderCandidates = 2000;
+
 /// Fit every structure with nb in [nb.min, nb.max], nf in [nf.min, nf.max], nk in
 /// [nk.min, nk.max] (nb <= nf + 1) and return them ranked: usable candidates first, by
-/// the chosen criterion. Throws InvalidOptions for empty or invalid ranges.
+/// the chosen criterion; a candidate is usable when its SRIVC result is (Result::usable()) and its YIC is
+/// finite. Throws InvalidOptions for empty or invalid ranges and for more than kMaxOrderCandidates
+/// structures. Reports progress once per structure ("select_order"); when asked to stop it returns the
+/// structures fitted so far (interrupt_requested() is then true).
 std::vector<OrderCandidate> select_order(const IdData& data, OrderRange nb, OrderRange nf, OrderRange nk,
                                          const OrderSelectionOptions& options = {});
 

@@ -36,7 +36,8 @@ struct SrivcOptions {
   bool estimate_delay = false;
   double delay_min = 0.0;        ///< s, >= 0
   double delay_max = -1.0;       ///< s; < 0: 10 % of the record
-  int delay_grid = 0;            ///< grid points; 0: one per sample period (at most 200)
+  int delay_grid = 0;            ///< grid points in [0, kMaxDelayGrid]; 0: one per sample period (at most 200)
+  static constexpr int kMaxDelayGrid = 10000;
   void validate() const;
 };
 
