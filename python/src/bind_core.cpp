@@ -90,8 +90,12 @@ void bind_core(py::module_& m) {
       py::arg("intersample") = "zoh", "Load a CSV or .mat record by column / variable names.");
 
   py::class_<TransferFunction>(m, "TransferFunction", "G(s) = e^{-s delay} B(s)/A(s), descending powers of s.")
-      .def(py::init<const Eigen::VectorXd&, const Eigen::VectorXd&, double>(), py::arg("num"), py::arg("den"),
-           py::arg("delay") = 0.0)
+      .def(py::init([](const Eigen::VectorXd& num, const Eigen::VectorXd& den, double delay) {
+             TransferFunction g(num, den, delay);
+             if (const std::string why = parasitic_pole_problem(g); !why.empty()) throw InvalidArgument("TransferFunction: " + why);
+             return g;
+           }),
+           py::arg("num"), py::arg("den"), py::arg("delay") = 0.0)
       .def_property_readonly("num", [](const TransferFunction& g) { return g.num().coefficients(); })
       .def_property_readonly("den", [](const TransferFunction& g) { return g.den().coefficients(); })
       .def_property_readonly("delay", &TransferFunction::io_delay)

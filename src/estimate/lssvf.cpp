@@ -280,6 +280,7 @@ Result<TransferFunction> lssvf(const IdData& data, const TfOrders& orders, const
   }
   r.summary.iterations = 1;
   tf_detail::check_cancellation(r);
+  tf_detail::warn_poles_beyond_bandwidth(r, data);
   if (interrupt_requested()) {
     r.summary.termination = Termination::Interrupted;
     r.summary.message = "interrupted during the choice of tau";

@@ -1,6 +1,7 @@
 // Output error and tfest — see include/ctid/estimate/oe.hpp.
 #include "ctid/estimate/oe.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -57,13 +58,19 @@ Result<TransferFunction> refine(const IdData& data, const TfOrders& o, const Tra
   CTID_REQUIRE_OPTION(!free.empty(), "oe: every parameter is fixed; nothing to estimate");
   const int p = static_cast<int>(free.size());
   Eigen::VectorXd lo = Eigen::VectorXd::Constant(p, -INFINITY), hi = Eigen::VectorXd::Constant(p, INFINITY), x0(p);
+  // The delay stays in the range the delay search used (delay_min, delay_max; default 10 % of the record).
+  const double delay_hi = opt.srivc.delay_max >= 0 ? opt.srivc.delay_max : 0.1 * data.duration();
   for (int j = 0; j < p; ++j) {
     x0(j) = full(free[j]);
-    if (names[free[j]] == "delay") lo(j) = 0.0;
+    if (names[free[j]] == "delay") {
+      lo(j) = opt.srivc.delay_min;
+      hi(j) = delay_hi;
+      x0(j) = std::clamp(x0(j), lo(j), hi(j));
+    }
     const auto b = opt.bounds.find(names[free[j]]);
     if (b != opt.bounds.end()) {
       lo(j) = std::max(lo(j), b->second.first);
-      hi(j) = b->second.second;
+      hi(j) = std::min(hi(j), b->second.second);
     }
   }
   for (const auto& [k, b] : opt.bounds) {
@@ -78,9 +85,10 @@ Result<TransferFunction> refine(const IdData& data, const TfOrders& o, const Tra
     const double T = opt.estimate_delay ? f(nt) : fixed_delay;
     return tf_detail::tf_of(f.head(nt), o, std::max(0.0, T));
   };
+  // Unstable and marginally stable models (an integrator the user fixed, an unstable plant recorded in open
+  // loop) are simulated exactly like any other; a step whose simulation overflows is rejected by LM.
   auto evaluate = [&](const Eigen::VectorXd& x, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
     const TransferFunction g = model_of(x);
-    if (!g.is_stable()) return false;
     r = y - lsim(g, data, 0);
     if (!r.allFinite()) return false;
     if (J) {
@@ -123,14 +131,30 @@ Result<TransferFunction> refine(const IdData& data, const TfOrders& o, const Tra
   }
   r.summary.iterations = lm.iterations;
   if (!std::isfinite(lm.cost)) {
-    r.summary.termination = Termination::Unstable;
-    r.summary.message = "the starting model is unstable or cannot be simulated; give a stable initial model";
+    r.summary.termination = Termination::NumericalFailure;
+    r.summary.message = "the simulation of the starting model overflows on this record (its poles are far in the right "
+                        "half plane); fix or bound the coefficients (--set fix.NAME, lower.NAME, upper.NAME)";
   } else {
     internal::set_termination(r.summary, lm);
   }
+  if (!r.model.is_stable() && std::isfinite(lm.cost))
+    r.diagnostics.warnings.push_back(detail::format("the model is not asymptotically stable (poles {}): its response to "
+                                                    "a bounded input can grow without bound",
+                                                    tf_detail::poles_text(r.model)));
   tf_detail::check_cancellation(r);
+  tf_detail::warn_poles_beyond_bandwidth(r, data);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
+}
+
+// The starting model of the refinement: the equation-error (SRIVC) model as it is when it simulates better than
+// its stabilised copy (an unstable plant recorded in open loop), else the stabilised copy.
+TransferFunction starting_model(const TransferFunction& s, const IdData& data) {
+  const TransferFunction st = tf_detail::stabilized(s);
+  if (s.is_stable()) return s;
+  const Eigen::VectorXd y = data.y().col(0);
+  const double raw = (y - lsim(s, data, 0)).squaredNorm(), stab = (y - lsim(st, data, 0)).squaredNorm();
+  return std::isfinite(raw) && raw < stab ? s : st;
 }
 
 void check_common(const IdData& data, const TfOrders& o, const OeOptions& opt, const char* who) {
@@ -163,7 +187,7 @@ Result<TransferFunction> oe(const IdData& data, const TfOrders& orders, const Oe
     SrivcOptions so = options.srivc;
     so.estimate_delay = true;
     if (options.initial) so.initial = TransferFunction(options.initial->num(), options.initial->den());
-    start = tf_detail::stabilized(srivc(data, orders, so).model);
+    start = starting_model(srivc(data, orders, so).model, data);
   } else if (options.initial) {
     CTID_REQUIRE_OPTION(options.initial->order() == orders.nf, "oe: the initial model has order {} but nf = {}",
                         options.initial->order(), orders.nf);
@@ -174,7 +198,7 @@ Result<TransferFunction> oe(const IdData& data, const TfOrders& orders, const Oe
     so.delay = options.delay;
     so.max_iterations = 1;  // LSSVF start plus one refinement: a cheap equation-error initial model
     const Result<TransferFunction> s = srivc(data, orders, so);
-    start = tf_detail::stabilized(s.model);
+    start = starting_model(s.model, data);
   }
   return refine(data, orders, start, options, t0);
 }
@@ -187,7 +211,7 @@ Result<TransferFunction> tfest(const IdData& data, const TfOrders& orders, const
   so.estimate_delay = options.estimate_delay;
   if (options.initial) so.initial = options.initial;
   const Result<TransferFunction> s = srivc(data, orders, so);
-  Result<TransferFunction> r = refine(data, orders, tf_detail::stabilized(s.model), options, t0);
+  Result<TransferFunction> r = refine(data, orders, starting_model(s.model, data), options, t0);
   r.diagnostics.scalars["srivc_iterations"] = s.summary.iterations;
   r.diagnostics.scalars["srivc_fit_percent"] = s.fit.fit_percent;
   return r;

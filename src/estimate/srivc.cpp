@@ -86,7 +86,9 @@ void set_termination(Result<M>& r, bool rank_deficient, bool converged, double t
   }
   if (r.summary.succeeded() && !r.model.is_stable()) {
     r.summary.termination = Termination::Unstable;
-    r.summary.message = "SRIVC converged to an unstable model (the prefilter was kept stable during the iterations)";
+    r.summary.message = "SRIVC converged to an unstable model (its prefilter is kept stable, so its estimate of an "
+                        "unstable plant is not consistent); for a plant that is unstable in open loop use tfest or oe, "
+                        "which fit unstable models by output error";
   }
 }
 
@@ -328,6 +330,7 @@ Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const
     r.summary.message = detail::format("interrupted after {} iterations", run.iterations);
   }
   tf_detail::check_cancellation(r);
+  tf_detail::warn_poles_beyond_bandwidth(r, data);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

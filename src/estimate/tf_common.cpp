@@ -2,6 +2,7 @@
 #include "estimate/tf_common.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <complex>
 #include <string>
@@ -37,6 +38,35 @@ double output_error_mse(const TransferFunction& g, const IdData& d) {
   const Eigen::VectorXd yhat = lsim(g, d, 0);
   if (!yhat.allFinite()) return std::numeric_limits<double>::infinity();
   return (d.y().col(0) - yhat).squaredNorm() / double(d.size());
+}
+
+std::string poles_text(const TransferFunction& g) {
+  std::string s;
+  for (const auto& p : g.poles()) {
+    char z[64];
+    if (p.imag() == 0) std::snprintf(z, sizeof z, "%.6g", p.real());
+    else std::snprintf(z, sizeof z, "%.6g%+.6gj", p.real(), p.imag());
+    s += (s.empty() ? "" : ", ") + std::string(z);
+  }
+  return s;
+}
+
+double nyquist(const IdData& d) {
+  const double h = d.is_uniform() ? d.ts() : d.duration() / std::max(1, d.size() - 1);
+  return 3.14159265358979323846 / h;
+}
+
+bool warn_poles_beyond_bandwidth(Result<TransferFunction>& r, const IdData& d) {
+  const double wn = nyquist(d);
+  for (const auto& p : r.model.poles())
+    if (std::abs(p) > 10 * wn) {
+      r.diagnostics.warnings.push_back(detail::format(
+          "a pole at {} rad/s is more than 10 times the Nyquist frequency ({} rad/s): the data cannot resolve it; a "
+          "lower order (nf = {}) likely describes them as well",
+          std::abs(p), wn, r.model.order() - 1));
+      return true;
+    }
+  return false;
 }
 
 TransferFunction stabilized(const TransferFunction& tf) {

@@ -35,6 +35,14 @@ std::vector<TfCoefficient> tf_coefficients(const TransferFunction& g, const Para
 TransferFunction with_coefficients(const TransferFunction& g, const std::vector<TfCoefficient>& map,
                                    const Eigen::VectorXd& v);
 
+/// "p1, p2, ..." (6 significant digits, complex poles as re+imj).
+std::string poles_text(const TransferFunction& g);
+/// The Nyquist frequency of d in rad/s (pi over the mean sample interval).
+double nyquist(const IdData& d);
+/// A warning for each pole of r.model faster than 10 times the data's Nyquist frequency: the data cannot
+/// resolve it (a lower order likely describes them as well). Returns whether there was one.
+bool warn_poles_beyond_bandwidth(Result<TransferFunction>& r, const IdData& d);
+
 /// Near-unidentifiability check of a successful transfer-function estimate with parameters named a1..an,
 /// b0..b(nb-1) and a covariance: a pole p and a zero z whose difference is within the 99 % confidence region
 /// of its own uncertainty (linearised: dp/da_k = -p^{n-k}/A'(p), dz/db_j = -z^{m-j}/B'(z)) cancel, i.e. the

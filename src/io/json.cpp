@@ -97,8 +97,10 @@ LinearModel model_from(const json& root, const Reader& rd) {
       if (m.contains("io_delay") && !m.at("io_delay").is_number())
         rd.fail("\"io_delay\" must be a number (seconds)");
       const double delay = m.contains("io_delay") ? m.at("io_delay").get<double>() : 0.0;
-      return TransferFunction(rd.vector(rd.member(m, "num", "the model"), "num"), rd.vector(rd.member(m, "den", "the model"), "den"),
-                              delay);
+      TransferFunction g(rd.vector(rd.member(m, "num", "the model"), "num"), rd.vector(rd.member(m, "den", "the model"), "den"),
+                         delay);
+      if (const std::string why = parasitic_pole_problem(g); !why.empty()) rd.fail(why);
+      return g;
     }
     if (t == "miso") {
       const json& ch = rd.member(m, "channels", "the model");

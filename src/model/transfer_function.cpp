@@ -59,4 +59,20 @@ std::string TransferFunction::to_string(int precision) const {
   return os.str();
 }
 
+std::string parasitic_pole_problem(const TransferFunction& g) {
+  // With den = s^n + a1 s^(n-1) + ... + an and |a1| huge, one pole is about -a1 and the others are the roots of
+  // a1 s^(n-1) + ... + an (computing all roots at once loses the slow ones to rounding).
+  if (g.order() < 2) return "";
+  const Eigen::VectorXd& a = g.den().coefficients();
+  const double fast = std::abs(a(1));
+  const Eigen::VectorXd rest = a.tail(a.size() - 1) / a(1);
+  if (!rest.allFinite()) return "";
+  const Eigen::VectorXcd slow = Polynomial(rest).roots();
+  const double next = slow.size() ? slow.cwiseAbs().maxCoeff() : 0.0;
+  if (!(next > 0) || !(fast > 1e10 * next)) return "";
+  return detail::format("a pole at about {} is more than 1e10 times faster than the others (at most {} in magnitude): a "
+                        "leading denominator coefficient is zero up to rounding; drop it (order {})",
+                        -a(1), next, g.order() - 1);
+}
+
 }  // namespace ctid

@@ -46,4 +46,10 @@ class TransferFunction {
   double delay_ = 0.0;
 };
 
+/// Why a user-given transfer function cannot be simulated meaningfully, or "" when it can: a pole more than
+/// 1e10 times faster than every other (non-zero) pole is parasitic, the trace of a leading denominator
+/// coefficient that is zero up to rounding (den [1e-20, 1, 2] is 1/(s + 2) with a pole at -1e20); its
+/// discretisation is meaningless. Model-file readers and the Python constructor refuse such models.
+std::string parasitic_pole_problem(const TransferFunction& g);
+
 }  // namespace ctid
