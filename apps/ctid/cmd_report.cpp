@@ -33,14 +33,33 @@ Result<M> bare_result(const M& model, const IdData& d, const Eigen::VectorXd& yh
   return r;
 }
 
+// A linear result file is reported as strictly as `ctid validate` scores it: its parameters and covariance must be
+// sound (finite, of the right size, positive semi-definite, no zero standard deviation unless the fit was exact),
+// else exit 3; a model that diverges on the record is not drawn (exit 1).
+template <class R>
+void check_linear_result(const R& r, const MisoModel& m, const IdData& d, const std::string& path) {
+  FitReport f;  // only the rules about parameters and covariance (the record may be another one)
+  if (r.fit.nrmse < 1e-6) {
+    f.n_samples = 1;
+    f.nrmse = r.fit.nrmse;
+    f.fit_percent = 100;
+  }
+  if (const std::string why = usability_problem(Summary{}, r.parameters, f); !why.empty())
+    throw InputError(path + ": " + why + " (its uncertainty bands would be meaningless)");
+  if (d.nu() != m.nu())
+    throw UsageError(detail::format("the model has {} inputs; {} inputs were selected", m.nu(), d.nu()));
+  require_finite_simulation(lsim(m, d), d, unstable_poles(m));
+}
+
 int run(const ReportArgs& a) {
   if (a.out.empty()) throw UsageError("give the report file with --out REPORT.html");
   check_outputs({a.out}, {a.data.path, a.result}, a.force);
-  std::ifstream in(a.result);
-  if (!in) throw InputError("cannot open " + a.result);
-  std::stringstream buf;
-  buf << in.rdbuf();
-  const std::string text = buf.str();
+  std::string text;
+  try {
+    text = read_text_file(a.result);
+  } catch (const FileError& e) {
+    throw InputError(e.what());
+  }
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text);
@@ -61,9 +80,13 @@ int run(const ReportArgs& a) {
   std::string html;
   try {
     if (type == "transfer_function") {
-      html = html_report(d, parse_result_json(text, a.result), o);
+      const Result<TransferFunction> r = parse_result_json(text, a.result);
+      check_linear_result(r, MisoModel{{r.model}}, d, a.result);
+      html = html_report(d, r, o);
     } else if (type == "miso") {
-      html = html_report(d, parse_miso_result_json(text, a.result), o);
+      const Result<MisoModel> r = parse_miso_result_json(text, a.result);
+      check_linear_result(r, r.model, d, a.result);
+      html = html_report(d, r, o);
     } else if (type == "narx") {
       const NarxModel m = parse_narx_json(text, a.result);
       const NarxModel p = m.process();

@@ -55,7 +55,13 @@ def _terms(cls, terms):
 
 
 def _columns(a, name):
-    a = _np.asarray(a, dtype=float)
+    a = _np.asarray(a)
+    if _np.iscomplexobj(a):
+        raise InvalidArgument(f"IdData.from_arrays: {name} is complex ({a.dtype}); give real signals (e.g. the real part "
+                              "and the imaginary part as two channels)")
+    if a.dtype.kind in "mM":
+        raise InvalidArgument(f"IdData.from_arrays: {name} holds {a.dtype} values (dates or durations); give numbers")
+    a = a.astype(float)
     if a.ndim == 1:
         a = a.reshape(-1, 1)
     if a.ndim != 2:
@@ -71,7 +77,7 @@ def _from_arrays(cls, u, y, ts=None, t=None, t0=0.0, input_names=None, output_na
     u = _np.zeros((y.shape[0], 0)) if u is None else _columns(u, "u")
     if (ts is None) == (t is None):
         raise InvalidArgument("IdData.from_arrays: give either ts (uniform sampling) or t (sample times)")
-    d = IdData(u, y, float(ts), float(t0)) if t is None else IdData.from_times(u, y, _np.asarray(t, dtype=float).ravel())
+    d = IdData(u, y, float(ts), float(t0)) if t is None else IdData.from_times(u, y, _seconds(t, "t"))
     if input_names is not None:
         d.input_names = list(input_names)
     if output_names is not None:
@@ -81,11 +87,25 @@ def _from_arrays(cls, u, y, ts=None, t=None, t0=0.0, input_names=None, output_na
     return d
 
 
+def _seconds(t, name):
+    """Sample times in seconds: numbers as they are; numpy/pandas timedelta or datetime values converted from their
+    unit (datetimes relative to the first sample), never read as raw nanosecond counts. Complex values are refused."""
+    a = _np.asarray(t)
+    if a.dtype.kind == "M":
+        a = a - a.ravel()[0]
+    if a.dtype.kind == "m":
+        return (a / _np.timedelta64(1, "ns")).astype(float).ravel() * 1e-9
+    if _np.iscomplexobj(a):
+        raise InvalidArgument(f"IdData.from_arrays: {name} is complex; sample times are real seconds")
+    return a.astype(float).ravel()
+
+
 def _from_pandas(cls, frame, inputs, outputs, ts=None, time=None, intersample=None):
-    """A record from the columns of a pandas DataFrame (time: a column of sample times, or ts)."""
-    t = None if time is None else frame[time].to_numpy(dtype=float)
-    return _from_arrays(cls, frame[list(inputs)].to_numpy(dtype=float) if inputs else None,
-                        frame[list(outputs)].to_numpy(dtype=float), ts=ts, t=t,
+    """A record from the columns of a pandas DataFrame (time: a column of sample times in seconds, or of
+    timedelta / datetime values, converted to seconds; or ts)."""
+    t = None if time is None else _seconds(frame[time].to_numpy(), time)
+    return _from_arrays(cls, frame[list(inputs)].to_numpy() if inputs else None,
+                        frame[list(outputs)].to_numpy(), ts=ts, t=t,
                         input_names=inputs, output_names=outputs, intersample=intersample)
 
 

@@ -180,3 +180,18 @@ def test_ctrl_c_stops_a_delay_grid_within_a_second():
     timer.join()
     assert time.monotonic() - t0 < 1.5
     assert r.summary.termination == "interrupted" and not r.usable()
+
+
+def test_data_loading_traps_are_errors_or_right():
+    # Issue 13: a time vector of another length, complex signals, and pandas time columns.
+    u, y = np.ones(10), np.arange(10.0)
+    with pytest.raises(ctid.InvalidArgument, match="time vector has 9 samples but y has 10"):
+        ctid.IdData.from_arrays(u, y, t=np.arange(9.0))
+    with pytest.raises(ctid.InvalidArgument, match="complex"):
+        ctid.IdData.from_arrays(u + 1j, y, ts=1.0)
+    pd = pytest.importorskip("pandas")
+    frame = pd.DataFrame({"t": pd.to_timedelta(np.arange(10) * 0.5, unit="s"), "u": u, "y": y})
+    d = ctid.IdData.from_pandas(frame, ["u"], ["y"], time="t")
+    assert d.ts == pytest.approx(0.5, rel=1e-12)  # seconds, not nanoseconds
+    frame["t"] = pd.Timestamp("2026-01-01") + frame["t"]
+    assert ctid.IdData.from_pandas(frame, ["u"], ["y"], time="t").ts == pytest.approx(0.5, rel=1e-12)

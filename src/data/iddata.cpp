@@ -48,6 +48,9 @@ IdData::IdData(Eigen::MatrixXd u, Eigen::MatrixXd y, Eigen::VectorXd t)
 
 IdData IdData::from_times(Eigen::MatrixXd u, Eigen::MatrixXd y, Eigen::VectorXd t) {
   const Eigen::Index N = t.size();
+  CTID_REQUIRE(N == y.rows() && (u.cols() == 0 || N == u.rows()),
+               "IdData: the time vector has {} samples but y has {} (and u {}); give one time per sample", N, y.rows(),
+               u.rows());
   if (N > 1 && t.allFinite()) {
     const double h = (t(N - 1) - t(0)) / double(N - 1);
     bool uniform = h > 0;

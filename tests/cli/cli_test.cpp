@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <random>
 #include <sys/wait.h>
 
 #include <gtest/gtest.h>
@@ -769,4 +770,158 @@ TEST(Cli, RobustnessCampaignBadInputs) {
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.args << "\n" << r.err;
     EXPECT_FALSE(fs::exists(out)) << c.args;
   }
+}
+
+// Issue 13: no crash, no lost file, no wrong answer that says "converged". Each case asserts the exit code, the
+// key words of the one line on stderr, and that nothing the user gave was changed.
+TEST(Cli, TrustCampaign) {
+  const std::string base = " --time time --input force --output position ";
+  // Pure noise: no model (the F test of the fit), exit 1.
+  std::string noise = "time,force,position\n";
+  {
+    std::mt19937 rng(5);
+    std::normal_distribution<double> n01;
+    for (int i = 0; i < 1000; ++i) noise += detail::format("{},{},{}\n", 0.01 * i, n01(rng) > 0 ? 1 : -1, n01(rng));
+  }
+  const std::string noise_csv = write("tr_noise.csv", noise);
+  const std::string mat = test::temp_path("tr_data.mat");
+  {
+    const CsvTable t = read_csv(good_csv());
+    write_mat(mat, {{"t", t.values.col(0)}, {"u", t.values.col(1)}, {"y", t.values.col(2)}});
+  }
+  const std::string upper = test::temp_path("TR_DATA.MAT");
+  fs::copy_file(mat, upper, fs::copy_options::overwrite_existing);
+  const std::string bom = write("tr_bom.csv", "\xEF\xBB\xBF" + read_text_file(good_csv()).substr(read_text_file(good_csv()).find('\n') + 1));
+  const std::string dupcols = write("tr_dupcols.csv", "time,force,force\n0,1,2\n0.1,2,3\n0.2,1,2\n");
+  const std::string ctrl = write("tr_ctrl.json", R"({"type": "transfer_function", "num": [1], "den": [1]})");
+  const std::string narx = write("tr_narx.json", R"J({"type": "narx", "ts": 0.01, "terms": [{"name": "y(k-1)", "value": 0.5}]})J");
+  const std::string parasitic = write("tr_parasitic.json", R"({"type": "transfer_function", "num": [1], "den": [1e-20, 1, 2]})");
+  const std::string dir = test::temp_path("tr_dir");
+  fs::create_directories(dir);
+  struct Case {
+    std::string args;
+    int code;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      // Crashes of before: no input selection with a .mat file (default: every variable but time and output).
+      {"fit " + mat + " --time t --output y --nf 2 --nb 1 --set tau=0.3", 0, ""},
+      {"fit " + upper + " --time t --input u --output y --nf 2 --nb 1 --set tau=0.3", 0, ""},
+      // Non-regular files and files that are not text tables.
+      {"fit /dev/zero --ts 1", 3, "'/dev/zero': it is a character device, not a data file"},
+      {"fit " + dir + " --ts 1", 3, "it is a directory, not a data file"},
+      {"fit " + dupcols + " --time time", 3, "column name 'force' appears twice (fields 2 and 3)"},
+      {"fit " + good_csv() + base + "--input force", 2, "inputs 'force' and 'force' are the same column"},
+      {"fit " + good_csv() + " --time time --input position --output position", 2, "both as an input and as the output"},
+      // A BOM on a header-less file: the first row is data, the fit is that of the clean file.
+      {"fit " + bom + " --time 1 --input 2 --output 3 --nf 2 --nb 1 --set tau=0.3", 0, ""},
+      // Caps on grids and searches.
+      {"fit " + good_csv() + base + "--method srivc --delay --set delay_grid=1e8", 2, "delay_grid must be in [0, 10000]"},
+      {"fit " + good_csv() + base + "--set tau_grid=1e9", 2, "tau_grid_size must be in [2, 1000]"},
+      {"order " + good_csv() + base + "--nb 1:100 --nf 1:100 --nk 0:100", 2, "more than the limit of 2000"},
+      // Flags that do not apply.
+      {"fit " + good_csv() + base + "--method srivc --reference force", 2, "--reference needs --closed-loop-controller"},
+      {"fit " + good_csv() + base + "--method srivc --responses r", 2, "--responses writes FSF responses"},
+      {"fit " + good_csv() + base + "--method modal --nf 2 --set shifts=1,2 --delay", 2, "--delay (delay estimation) needs"},
+      {"fit " + good_csv() + base + "--method srivc --narx " + narx, 2, "--narx gives KIA its NARX model"},
+      {"fit " + good_csv() + base + "--method physical --via bogus", 2, "--via must be fsf, frequency or raw (got 'bogus')"},
+      {"fit " + good_csv() + base + "--method narx --nf 2", 2, "--nf sets transfer-function orders"},
+      {"fit " + good_csv() + base + "--set tau=0.3 --set tau=0.4", 2, "--set tau is given twice"},
+      {"fit " + good_csv() + base + "--closed-loop-controller " + ctrl + " --method oe", 2, "needs --method srivc"},
+      // A fit the data cannot tell from no model.
+      {"fit " + noise_csv + base + "--method tfest --nf 2", 1, "the data cannot tell this model from no model"},
+      // A user-given model with a parasitic pole.
+      {"simulate " + parasitic + " " + good_csv() + " --time time --input force", 3, "zero up to rounding"},
+  };
+  for (const Case& c : cases) {
+    const CliRun r = ctid_run(c.args, "timeout 120 ");
+    EXPECT_EQ(r.code, c.code) << c.args << "\n" << r.err;
+    if (c.code != 0) {
+      EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << "\nstderr: " << r.err;
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.args << "\n" << r.err;
+    }
+  }
+  // The BOM file gives the clean file's numbers: a1 = 1.2 of 3/(s^2 + 1.2 s + 4) to the LSSVF accuracy (1e-2).
+  const CliRun b = ctid_run("fit " + bom + " --time 1 --input 2 --output 3 --nf 2 --nb 1 --set tau=0.3");
+  const CliRun g = ctid_run("fit " + good_csv() + base + "--nf 2 --nb 1 --set tau=0.3");
+  auto params = [](const std::string& out) { return out.substr(out.find("a1"), out.find("filter time") - out.find("a1")); };
+  EXPECT_EQ(params(b.out), params(g.out)) << b.out << g.out;
+}
+
+// Issue 13: outputs are checked against every input file and each other before the fit; special files and
+// symlinks are never replaced.
+TEST(Cli, OutputFilesNeverReplaceWhatTheUserGave) {
+  const std::string base = " --time time --input force --output position --nf 2 --nb 1 --set tau=0.3 ";
+  const std::string narx = write("os_narx.json", R"J({"type": "narx", "ts": 0.01, "terms": [{"name": "y(k-1)", "value": 0.5}]})J");
+  const std::string narx_text = read_text_file(narx);
+  CliRun r = ctid_run("fit " + good_csv() + " --time time --input force --output position --method kia --narx " + narx +
+                      " --json " + narx + " --force");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("it is the input file"), std::string::npos) << r.err;
+  EXPECT_EQ(read_text_file(narx), narx_text);
+  const std::string x = test::temp_path("os_x.out");
+  fs::remove(x);
+  r = ctid_run("fit " + good_csv() + base + "--json " + x + " --report " + x);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("two outputs of this command name the same file"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(x));
+  r = ctid_run("fit " + good_csv() + base + "--json /nonexistent_dir/x.json");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("does not exist"), std::string::npos) << r.err;
+  // A special file is refused even with --force (as root this would have replaced /dev/null).
+  r = ctid_run("fit " + good_csv() + base + "--json /dev/null --force");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("it is a character device, not a regular file"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_character_file("/dev/null"));
+  // A symlink is written through: the link stays, its target gets the result.
+  const std::string target = test::temp_path("os_target.json"), link = test::temp_path("os_link.json");
+  fs::remove(link);
+  write("os_target.json", "old");
+  fs::create_symlink(target, link);
+  r = ctid_run("fit " + good_csv() + base + "--json " + link + " --force");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_NE(read_text_file(target).find("\"method\""), std::string::npos);
+  // A symlink to the data file is the data file.
+  const std::string data_link = test::temp_path("os_data_link.csv");
+  fs::remove(data_link);
+  fs::create_symlink(good_csv(), data_link);
+  const std::string data_text = read_text_file(good_csv());
+  r = ctid_run("fit " + good_csv() + base + "--json " + data_link + " --force");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(read_text_file(good_csv()), data_text);
+}
+
+// Issue 13: `ctid report` refuses what `ctid validate` would: a covariance that is not positive semi-definite or
+// of the wrong size (exit 3), a model that diverges on the record (exit 1).
+TEST(Cli, ReportRefusesUnsoundResults) {
+  const std::string base = " --time time --input force --output position ";
+  const std::string json = test::temp_path("rr_fit.json");
+  fs::remove(json);
+  ASSERT_EQ(ctid_run("fit " + good_csv() + base + "--method srivc --nf 2 --nb 1 --json " + json).code, 0);
+  nlohmann::json j = nlohmann::json::parse(read_text_file(json));
+  auto report = [&](const nlohmann::json& v, const std::string& name) {
+    const std::string p = write(name, v.dump());
+    const std::string out = test::temp_path(name + ".html");
+    fs::remove(out);
+    CliRun r = ctid_run("report " + p + " " + good_csv() + base + "--out " + out);
+    EXPECT_EQ(r.code == 0, fs::exists(out)) << name;
+    return r;
+  };
+  EXPECT_EQ(report(j, "rr_ok.json").code, 0);
+  nlohmann::json bad = j;
+  bad["covariance"][0][1] = bad["covariance"][1][0] = 1e3;  // |correlation| far above 1
+  CliRun r = report(bad, "rr_notpsd.json");
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find("not positive semi-definite"), std::string::npos) << r.err;
+  bad = j;
+  bad["covariance"] = nlohmann::json::array({nlohmann::json::array({1.0})});
+  r = report(bad, "rr_size.json");
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find("is 1 x 1 for 3 parameters"), std::string::npos) << r.err;
+  bad = j;
+  bad["model"]["den"] = nlohmann::json::array({1.0, -500.0, 4.0});
+  r = report(bad, "rr_diverge.json");
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("the model diverges"), std::string::npos) << r.err;
 }
