@@ -137,12 +137,6 @@ Result<TransferFunction> refine(const IdData& data, const TfOrders& o, const Tra
   } else {
     internal::set_termination(r.summary, lm);
   }
-  if (!r.model.is_stable() && std::isfinite(lm.cost))
-    r.diagnostics.warnings.push_back(detail::format("the model is not asymptotically stable (poles {}): its response to "
-                                                    "a bounded input can grow without bound",
-                                                    tf_detail::poles_text(r.model)));
-  tf_detail::check_cancellation(r);
-  tf_detail::warn_poles_beyond_bandwidth(r, data);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
@@ -169,17 +163,50 @@ void check_common(const IdData& data, const TfOrders& o, const OeOptions& opt, c
                data.duration());
   CTID_REQUIRE_OPTION(!(opt.estimate_delay && o.nb > o.nf), "{}: delay estimation needs a strictly proper model (nb <= nf)",
                       who);
+  CTID_REQUIRE(!opt.estimate_delay || opt.srivc.delay_max < data.duration(),
+               "{}: delay_max = {} s is not shorter than the record ({} s)", who, opt.srivc.delay_max, data.duration());
+  CTID_REQUIRE(!opt.estimate_delay || opt.srivc.delay_min < data.duration(),
+               "{}: delay_min = {} s is not shorter than the record ({} s)", who, opt.srivc.delay_min, data.duration());
+  CTID_REQUIRE_OPTION(!opt.initial || opt.initial->order() == o.nf, "{}: the initial model has order {} but nf = {}", who,
+                      opt.initial ? opt.initial->order() : 0, o.nf);
+}
+
+// The options in the normalised units of n (tf_common.hpp): values, bounds and fixed values by parameter name,
+// delays and starting models.
+OeOptions normalised(const OeOptions& o, const tf_detail::TfNormalisation& n, const TfOrders& orders) {
+  OeOptions s = o;
+  if (s.initial) s.initial = n.to_normalised(*s.initial, orders);
+  for (auto& [k, v] : s.fixed) v *= n.factor(k, orders);
+  for (auto& [k, b] : s.bounds) {
+    b.first *= n.factor(k, orders);
+    b.second *= n.factor(k, orders);
+  }
+  s.delay /= n.c;
+  if (s.srivc.initial) s.srivc.initial = n.to_normalised(*s.srivc.initial, orders);
+  s.srivc.delay /= n.c;
+  s.srivc.delay_min /= n.c;
+  if (s.srivc.delay_max >= 0) s.srivc.delay_max /= n.c;
+  return s;
+}
+
+// Runs `fit` (oe or tfest in the units of its record) on the normalised record and maps the result back.
+template <class F>
+Result<TransferFunction> in_normalised_units(const IdData& data, const TfOrders& orders, const OeOptions& options, F&& fit) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const tf_detail::TfNormalisation n = tf_detail::TfNormalisation::of(data);
+  Result<TransferFunction> r = fit(n.data(data), normalised(options, n, orders), t0);
+  n.restore(r, orders);
+  tf_detail::finish_tf_result(r, data);
+  r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
 }
 
 double base_delay(const IdData& data, const TfOrders& o, const OeOptions& opt) {
   return opt.delay + (o.nk > 0 ? o.nk * data.ts() : 0.0);
 }
 
-}  // namespace
-
-Result<TransferFunction> oe(const IdData& data, const TfOrders& orders, const OeOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
-  check_common(data, orders, options, "oe");
+Result<TransferFunction> oe_in_units(const IdData& data, const TfOrders& orders, const OeOptions& options,
+                                     std::chrono::steady_clock::time_point t0) {
   TransferFunction start;
   if (options.estimate_delay) {
     // A delay is only found reliably by a search over its range (the cost has local minima
@@ -189,8 +216,6 @@ Result<TransferFunction> oe(const IdData& data, const TfOrders& orders, const Oe
     if (options.initial) so.initial = TransferFunction(options.initial->num(), options.initial->den());
     start = starting_model(srivc(data, orders, so).model, data);
   } else if (options.initial) {
-    CTID_REQUIRE_OPTION(options.initial->order() == orders.nf, "oe: the initial model has order {} but nf = {}",
-                        options.initial->order(), orders.nf);
     start = *options.initial;
     if (!options.estimate_delay && start.io_delay() == 0.0) start.set_io_delay(base_delay(data, orders, options));
   } else {
@@ -203,9 +228,8 @@ Result<TransferFunction> oe(const IdData& data, const TfOrders& orders, const Oe
   return refine(data, orders, start, options, t0);
 }
 
-Result<TransferFunction> tfest(const IdData& data, const TfOrders& orders, const OeOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
-  check_common(data, orders, options, "tfest");
+Result<TransferFunction> tfest_in_units(const IdData& data, const TfOrders& orders, const OeOptions& options,
+                                        std::chrono::steady_clock::time_point t0) {
   SrivcOptions so = options.srivc;
   so.delay = options.delay;
   so.estimate_delay = options.estimate_delay;
@@ -215,6 +239,24 @@ Result<TransferFunction> tfest(const IdData& data, const TfOrders& orders, const
   r.diagnostics.scalars["srivc_iterations"] = s.summary.iterations;
   r.diagnostics.scalars["srivc_fit_percent"] = s.fit.fit_percent;
   return r;
+}
+
+}  // namespace
+
+// oe and tfest estimate in normalised time and amplitude units (issue 13: the result does not depend on the
+// units of the record) and map the result back.
+Result<TransferFunction> oe(const IdData& data, const TfOrders& orders, const OeOptions& options) {
+  check_common(data, orders, options, "oe");
+  return in_normalised_units(data, orders, options, [&](const IdData& d, const OeOptions& o, auto t0) {
+    return oe_in_units(d, orders, o, t0);
+  });
+}
+
+Result<TransferFunction> tfest(const IdData& data, const TfOrders& orders, const OeOptions& options) {
+  check_common(data, orders, options, "tfest");
+  return in_normalised_units(data, orders, options, [&](const IdData& d, const OeOptions& o, auto t0) {
+    return tfest_in_units(d, orders, o, t0);
+  });
 }
 
 }  // namespace ctid

@@ -219,10 +219,10 @@ Eigen::VectorXd initial_theta(const IdData& d, const TfOrders& o, double delay, 
 
 }  // namespace
 
-Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const SrivcOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  orders.validate(/*allow_biproper=*/true);
-  options.validate();
+namespace {
+// SISO SRIVC in the units of `data` (srivc() calls it on the normalised record).
+// The checks of srivc()'s inputs, in the user's units (messages name seconds).
+void check_srivc_inputs(const IdData& data, const TfOrders& orders, const SrivcOptions& options) {
   CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "srivc: needs one input and one output (data has {} inputs, {} outputs)",
                data.nu(), data.ny());
   CTID_REQUIRE(orders.nk == 0 || data.is_uniform(), "srivc: nk = {} needs uniformly sampled data", orders.nk);
@@ -235,6 +235,15 @@ Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const
                "srivc: delay_max = {} s is not shorter than the record ({} s)", options.delay_max, data.duration());
   CTID_REQUIRE(!options.estimate_delay || options.delay_min < data.duration(),
                "srivc: delay_min = {} s is not shorter than the record ({} s)", options.delay_min, data.duration());
+  CTID_REQUIRE_OPTION(!options.initial || options.initial->order() == orders.nf,
+                      "srivc: the initial model has order {} but nf = {}", options.initial ? options.initial->order() : 0,
+                      orders.nf);
+}
+
+Result<TransferFunction> srivc_in_units(const IdData& data, const TfOrders& orders, const SrivcOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const int p = orders.nf + orders.nb;
+  const double base_delay = options.delay + (orders.nk > 0 ? orders.nk * data.ts() : 0.0);
 
   double delay = base_delay;
   Eigen::VectorXd theta;
@@ -329,8 +338,27 @@ Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const
     r.summary.termination = Termination::Interrupted;
     r.summary.message = detail::format("interrupted after {} iterations", run.iterations);
   }
-  tf_detail::check_cancellation(r);
-  tf_detail::warn_poles_beyond_bandwidth(r, data);
+  r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+}  // namespace
+
+Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const SrivcOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  orders.validate(/*allow_biproper=*/true);
+  options.validate();
+  check_srivc_inputs(data, orders, options);
+  // The estimation runs in normalised time and amplitude units, so that its result does not depend on the
+  // units of the record (issue 13); the result is mapped back.
+  const tf_detail::TfNormalisation n = tf_detail::TfNormalisation::of(data);
+  SrivcOptions o = options;
+  if (o.initial) o.initial = n.to_normalised(*o.initial, orders);
+  o.delay /= n.c;
+  o.delay_min /= n.c;
+  if (o.delay_max >= 0) o.delay_max /= n.c;
+  Result<TransferFunction> r = srivc_in_units(n.data(data), orders, o);
+  n.restore(r, orders);
+  tf_detail::finish_tf_result(r, data);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

@@ -2,6 +2,7 @@
 #include "estimate/tf_common.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <cmath>
 #include <complex>
@@ -10,6 +11,7 @@
 
 #include "ctid/core/check.hpp"
 #include "ctid/core/types.hpp"
+#include "ctid/estimate/lssvf.hpp"
 #include <limits>
 
 #include "ctid/simulate/lsim.hpp"
@@ -67,6 +69,88 @@ bool warn_poles_beyond_bandwidth(Result<TransferFunction>& r, const IdData& d) {
       return true;
     }
   return false;
+}
+
+TfNormalisation TfNormalisation::of(const IdData& d) {
+  TfNormalisation n;
+  auto rms = [](const Eigen::VectorXd& v) { return std::sqrt(v.squaredNorm() / std::max<Eigen::Index>(1, v.size())); };
+  const Eigen::VectorXd y = d.y().col(0), u = d.u().col(0);
+  const double ru = rms(u), ry = rms(y);
+  if (ru > 0 && std::isfinite(ru)) n.su = ru;
+  if (ry > 0 && std::isfinite(ry)) n.sy = ry;
+  const Eigen::Index N = y.size();
+  if (N >= 3) {
+    double dy2 = 0;
+    for (Eigen::Index k = 1; k < N; ++k) {
+      const double dv = (y(k) - y(k - 1)) / (d.time(static_cast<int>(k)) - d.time(static_cast<int>(k - 1)));
+      dy2 += dv * dv;
+    }
+    const double wc = std::sqrt(dy2 / double(N - 1)) / rms((y.array() - y.mean()).matrix());
+    if (wc > 0 && std::isfinite(wc)) n.c = 1.0 / wc;
+  }
+  return n;
+}
+
+IdData TfNormalisation::data(const IdData& d) const {
+  IdData s = d.is_uniform() ? IdData(d.u() / su, d.y() / sy, d.ts() / c, d.t0() / c)
+                            : IdData(d.u() / su, d.y() / sy, Eigen::VectorXd(d.times() / c));
+  for (int i = 0; i < d.nu(); ++i) s.set_intersample(i, d.intersample(i));
+  s.set_input_names(d.input_names());
+  s.set_output_names(d.output_names());
+  return s;
+}
+
+double TfNormalisation::factor(const std::string& name, const TfOrders& o) const {
+  if (name == "delay") return 1.0 / c;
+  if (name.size() < 2 || (name[0] != 'a' && name[0] != 'b')) return 1.0;
+  for (size_t i = 1; i < name.size(); ++i)
+    if (!std::isdigit(static_cast<unsigned char>(name[i]))) return 1.0;
+  const int k = std::stoi(name.substr(1));
+  if (name[0] == 'a') return std::pow(c, k);
+  return std::pow(c, o.nf - o.nb + 1 + k) * su / sy;
+}
+
+TransferFunction TfNormalisation::to_normalised(const TransferFunction& g, const TfOrders& o) const {
+  Eigen::VectorXd p = params_of(g, o);
+  const std::vector<std::string> names = tf_parameter_names(o);
+  for (Eigen::Index i = 0; i < p.size(); ++i) p(i) *= factor(names[static_cast<size_t>(i)], o);
+  return tf_of(p, o, g.io_delay() / c);
+}
+
+void TfNormalisation::restore(Result<TransferFunction>& r, const TfOrders& o) const {
+  ParameterSet& p = r.parameters;
+  Eigen::VectorXd f(p.size());
+  for (int i = 0; i < p.size(); ++i) f(i) = 1.0 / factor(p.names[static_cast<size_t>(i)], o);
+  p.values = p.values.cwiseProduct(f);
+  if (p.covariance.rows() == p.size() && p.covariance.cols() == p.size())
+    p.covariance = f.asDiagonal() * p.covariance * f.asDiagonal();
+  if (p.std.size() == p.size()) p.std = p.std.cwiseProduct(f.cwiseAbs());
+  Eigen::VectorXd coef = params_of(r.model, o);
+  const std::vector<std::string> names = tf_parameter_names(o);
+  for (Eigen::Index i = 0; i < coef.size(); ++i) coef(i) /= factor(names[static_cast<size_t>(i)], o);
+  r.model = tf_of(coef, o, r.model.io_delay() * c);
+  const double v = sy * sy, lv = std::log(v) * r.fit.n_samples;
+  r.fit.mse *= v;
+  r.fit.fpe *= v;
+  r.fit.aic += lv;
+  r.fit.aicc += lv;
+  r.fit.bic += lv;
+  auto& sc = r.diagnostics.scalars;
+  if (sc.count("delay")) sc["delay"] *= c;
+  if (sc.count("noise_variance")) sc["noise_variance"] *= v;
+  auto& vs = r.diagnostics.vectors;
+  if (vs.count("delay_grid")) vs["delay_grid"] *= c;
+  if (vs.count("delay_grid_mse")) vs["delay_grid_mse"] *= v;
+  sc["time_scale"] = c;
+}
+
+void finish_tf_result(Result<TransferFunction>& r, const IdData& d) {
+  if (!r.model.is_stable() && r.summary.succeeded())
+    r.diagnostics.warnings.push_back(detail::format("the model is not asymptotically stable (poles {}): its response to "
+                                                    "a bounded input can grow without bound",
+                                                    poles_text(r.model)));
+  check_cancellation(r);
+  warn_poles_beyond_bandwidth(r, d);
 }
 
 TransferFunction stabilized(const TransferFunction& tf) {

@@ -43,6 +43,28 @@ double nyquist(const IdData& d);
 /// resolve it (a lower order likely describes them as well). Returns whether there was one.
 bool warn_poles_beyond_bandwidth(Result<TransferFunction>& r, const IdData& d);
 
+/// Time and amplitude normalisation of a SISO transfer-function estimation (issue 13: results must not depend
+/// on the units of time, input and output). With t' = t / c, u' = u / su, y' = y / sy, the model
+/// G(s) = B(s)/A(s) (A monic of degree n, B with nb coefficients b_j of s^(nb-1-j)) becomes
+/// G'(s') = (su/sy) G(s'/c): a_k' = a_k c^k, b_j' = b_j c^(n-nb+1+j) su/sy, delay' = delay / c.
+/// c = 1/w_c with w_c = rms(dy/dt) / rms(y - mean y) (a characteristic frequency of the output, so the
+/// normalised coefficients are of order one); su, sy are the RMS values of u and y.
+struct TfNormalisation {
+  double c = 1.0, su = 1.0, sy = 1.0;
+  static TfNormalisation of(const IdData& d);
+  /// The normalised record (times / c, u / su, y / sy; names and intersample kept).
+  IdData data(const IdData& d) const;
+  /// normalised value = original value * factor(name) for a parameter a<k>, b<j> or "delay" (1 otherwise).
+  double factor(const std::string& name, const TfOrders& o) const;
+  TransferFunction to_normalised(const TransferFunction& g, const TfOrders& o) const;
+  /// Maps a result of the normalised problem back to the user's units: model, parameters, covariance, fit
+  /// measures, delay and noise diagnostics.
+  void restore(Result<TransferFunction>& r, const TfOrders& o) const;
+};
+/// The checks every SISO transfer-function result gets in the user's units: pole-zero cancellation,
+/// poles beyond the data's bandwidth, and a warning for a model that is not asymptotically stable.
+void finish_tf_result(Result<TransferFunction>& r, const IdData& d);
+
 /// Near-unidentifiability check of a successful transfer-function estimate with parameters named a1..an,
 /// b0..b(nb-1) and a covariance: a pole p and a zero z whose difference is within the 99 % confidence region
 /// of its own uncertainty (linearised: dp/da_k = -p^{n-k}/A'(p), dz/db_j = -z^{m-j}/B'(z)) cancel, i.e. the

@@ -96,3 +96,55 @@ TEST(NumericalRobustness, NearPoleZeroCancellation) {
     }
   }
 }
+
+// Issue 13 property test: every linear SISO estimator gives the same model whatever the units of time, input and
+// output. Random stable systems of order 1-4 (poles in [-2, -0.2], complex pairs with damping >= 0.2), 1500
+// samples at Ts = 0.05 s of a PRBS with 30 dB output noise; then the same record with time scaled so that Ts is
+// log-uniform in [1e-6, 1e3] s and u, y scaled by factors log-uniform in [1e-30, 1e30]. The estimates, mapped
+// back (a_k c^k, b_j c^(n-nb+1+j) ku/ky), agree with the unscaled fit to 1e-6 relative: the estimators work in
+// normalised units (estimate/tf_common.hpp), so only rounding differs (measured: <= 1e-9).
+TEST(NumericalRobustness, EstimatesDoNotDependOnUnitsOfTimeAndAmplitude) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  for (int trial = 0; trial < 8; ++trial) {
+    const int n = 1 + trial % 4, nb = 1 + static_cast<int>(U(rng) * n);
+    Eigen::VectorXcd poles(n);
+    for (int i = 0; i < n; ++i) {
+      const double w = 0.2 + 1.8 * U(rng);
+      if (i + 1 < n && U(rng) < 0.5) {
+        const double zeta = 0.2 + 0.7 * U(rng);
+        poles(i) = std::complex<double>(-zeta * w, w * std::sqrt(1 - zeta * zeta));
+        poles(i + 1) = std::conj(poles(i));
+        ++i;
+      } else {
+        poles(i) = -w;
+      }
+    }
+    Eigen::VectorXd num = Eigen::VectorXd::Zero(nb);
+    for (int j = 0; j < nb; ++j) num(j) = 0.5 + U(rng);
+    const TransferFunction g(Polynomial(num), Polynomial::from_roots(poles));
+    const int N = 1500;
+    const Eigen::VectorXd u = prbs(N, {.register_length = 9, .clock_period = 4});
+    const IdData d(u, add_noise_snr(lsim(g, u, time_grid(0.05, N)), 30.0, 100 + trial), 0.05);
+    const double c = std::pow(10.0, -6 + 9 * U(rng)) / 0.05, ku = std::pow(10.0, -30 + 60 * U(rng)),
+                 ky = std::pow(10.0, -30 + 60 * U(rng));
+    const IdData s(d.u() * ku, d.y() * ky, 0.05 * c);
+    const TfOrders o{nb, n, 0};
+    for (const char* m : {"srivc", "tfest", "oe", "lssvf", "ivsvf"}) {
+      auto fit = [&](const IdData& x) {
+        const std::string w = m;
+        return w == "srivc" ? srivc(x, o) : w == "tfest" ? tfest(x, o) : w == "oe" ? oe(x, o) : w == "lssvf" ? lssvf(x, o) : ivsvf(x, o);
+      };
+      const auto a = fit(d), b = fit(s);
+      EXPECT_EQ(a.usable(), b.usable()) << m << " trial " << trial << ": " << a.why_not_usable() << " / " << b.why_not_usable();
+      EXPECT_EQ(a.summary.termination, b.summary.termination) << m << " trial " << trial;
+      for (int i = 0; i < a.parameters.size(); ++i) {
+        const std::string& name = a.parameters.names[static_cast<size_t>(i)];
+        const int k = std::stoi(name.substr(1));
+        const double f = name[0] == 'a' ? std::pow(c, k) : std::pow(c, n - nb + 1 + k) * ku / ky;
+        EXPECT_NEAR(b.parameters.values(i) * f, a.parameters.values(i), 1e-6 * std::abs(a.parameters.values(i)))
+            << m << " trial " << trial << " n " << n << " nb " << nb << " " << name << " c " << c << " ku " << ku << " ky " << ky;
+      }
+    }
+  }
+}
