@@ -195,3 +195,43 @@ def test_data_loading_traps_are_errors_or_right():
     assert d.ts == pytest.approx(0.5, rel=1e-12)  # seconds, not nanoseconds
     frame["t"] = pd.Timestamp("2026-01-01") + frame["t"]
     assert ctid.IdData.from_pandas(frame, ["u"], ["y"], time="t").ts == pytest.approx(0.5, rel=1e-12)
+
+
+def test_unstable_plant_in_open_loop_and_fixed_integrator():
+    # Issue 13: tfest on 1/(s - 0.5) (400 samples at 20 ms, 1 % noise) returned a stable a1 = 1.3e-12, "converged".
+    # Output error now fits the unstable pole (measured a1 = -0.4993); SRIVC says why it cannot and names tfest.
+    rng = np.random.default_rng(1)
+    n, ts = 400, 0.02
+    u = ctid.prbs(n, register_length=7, clock_period=3)
+    y = ctid.TransferFunction([1.0], [1.0, -0.5]).simulate(u, ctid.time_grid(ts, n))
+    d = ctid.IdData.from_arrays(u, y + 0.01 * np.std(y) * rng.standard_normal(n), ts=ts)
+    r = ctid.tfest(d, 1, 1)
+    assert r.usable(), r.why_not_usable()
+    assert r.parameters["a1"] == pytest.approx(-0.5, abs=0.01)
+    assert any("not asymptotically stable" in w for w in r.diagnostics.warnings)
+    s = ctid.srivc(d, 1, 1)
+    assert not s.usable() and "use tfest or oe" in s.why_not_usable()
+    # An integrating plant 2/(s (s + 1)) with the pole at 0 fixed (fix.a2=0 was refused as "starting model
+    # unstable"): b0 = 2 and a1 = 1 within 1 % (measured 1.998, 0.999).
+    n = 2000
+    u = ctid.prbs(n, register_length=9, clock_period=5)
+    u = u - np.mean(u)
+    y = ctid.TransferFunction([2.0], [1.0, 1.0, 0.0]).simulate(u, ctid.time_grid(ts, n))
+    d = ctid.IdData.from_arrays(u, y + 0.02 * np.std(y) * rng.standard_normal(n), ts=ts)
+    r = ctid.tfest(d, 1, 2, fixed={"a2": 0.0})
+    assert r.usable(), r.why_not_usable()
+    assert r.parameters["b0"] == pytest.approx(2.0, rel=0.01)
+    assert r.parameters["a1"] == pytest.approx(1.0, rel=0.01)
+
+
+def test_delay_bounds_hold_in_the_output_error_refinement(plant):
+    # Issue 13: tfest --delay with delay_max = 30 returned a delay of 415 s. The refinement keeps
+    # [delay_min, delay_max]: a record delayed by 0.3 s, searched in [0, 0.1], ends at the bound 0.1.
+    g, d = plant
+    y = d.y[:, 0]
+    k = 15  # 0.3 s at 20 ms: the output lags the input by 0.3 s more
+    delayed = ctid.IdData.from_arrays(d.u[:, 0], np.r_[np.zeros(k), y[:-k]], ts=0.02)
+    r = ctid.tfest(delayed, 1, 2, estimate_delay=True, srivc={"delay_max": 1.0})
+    assert r.parameters["delay"] == pytest.approx(0.3, abs=0.02)
+    r = ctid.tfest(delayed, 1, 2, estimate_delay=True, srivc={"delay_max": 0.1})
+    assert 0.0 <= r.parameters["delay"] <= 0.1 + 1e-12

@@ -4,6 +4,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <sstream>
 #include <string_view>
@@ -50,6 +51,21 @@ std::vector<std::string> split(const std::string& line, char delim) {
     else cur += c;
   }
   out.push_back(trim(cur));
+  return out;
+}
+
+// A field as it may appear in a one-line message: control and non-ASCII bytes as \xNN, at most 40 characters.
+std::string printable(const std::string& s) {
+  std::string out;
+  for (unsigned char c : s) {
+    if (out.size() >= 40) return out + "...";
+    if (c >= 0x20 && c < 0x7f) out += static_cast<char>(c);
+    else {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02X", c);
+      out += hex;
+    }
+  }
   return out;
 }
 
@@ -123,7 +139,7 @@ CsvTable parse_csv(const std::string& text_in, const std::string& source, const 
       }
       if (!parse_number(f[i], r[i]))
         throw FileError(detail::format("{}:{}: column '{}' (field {}): cannot read '{}' as a number", source, lineno,
-                                       t.names[i], i + 1, f[i]));
+                                       printable(t.names[i]), i + 1, printable(f[i])));
       if (!std::isfinite(r[i]))
         throw FileError(detail::format("{}:{}: column '{}' (field {}): value '{}' is not finite", source, lineno,
                                        t.names[i], i + 1, f[i]));
