@@ -45,13 +45,13 @@ LinearSolution StreamingLeastSquares::solve(double tol) {
   s.n_rows = rows_;
   // Rescale weights so that their sum equals the effective sample size (Kish); with
   // equal weights this is the ordinary LS covariance.
-  const double neff = sumw2_ > 0 ? sumw_ * sumw_ / sumw2_ : 0.0;
-  const double c = sumw_ > 0 ? neff / sumw_ : 1.0;
+  const double neff = m_.sumw2 > 0 ? m_.sumw * m_.sumw / m_.sumw2 : 0.0;
+  const double c = m_.sumw > 0 ? neff / m_.sumw : 1.0;
   const Eigen::MatrixXd Ra = buf_.topRows(p_ + 1) * std::sqrt(c);
   const Eigen::MatrixXd R = Ra.topLeftCorner(p_, p_);
   const Eigen::VectorXd z = Ra.col(p_).head(p_);
   s.rss = Ra(p_, p_) * Ra(p_, p_);
-  s.tss = c * ym2_;
+  s.tss = c * m_.m2;
   s.condition = scaled_condition(R);
   s.rank_deficient = !(s.condition < 1.0 / tol);
   if (s.rank_deficient) {
@@ -85,8 +85,8 @@ LinearSolution GramLeastSquares::solve(double tol) {
   LinearSolution s;
   s.n_rows = rows_;
   Eigen::MatrixXd G = g_.selfadjointView<Eigen::Lower>();
-  const double neff = sumw2_ > 0 ? sumw_ * sumw_ / sumw2_ : 0.0;
-  const double c = sumw_ > 0 ? neff / sumw_ : 1.0;
+  const double neff = m_.sumw2 > 0 ? m_.sumw * m_.sumw / m_.sumw2 : 0.0;
+  const double c = m_.sumw > 0 ? neff / m_.sumw : 1.0;
   G *= c;
   const Eigen::MatrixXd Gxx = G.topLeftCorner(p_, p_);
   const Eigen::VectorXd gxy = G.col(p_).head(p_);
@@ -101,7 +101,7 @@ LinearSolution GramLeastSquares::solve(double tol) {
   const Eigen::VectorXd ts = ldlt.solve(gxy.cwiseQuotient(d));
   s.theta = ts.cwiseQuotient(d);
   s.rss = std::max(0.0, G(p_, p_) - gxy.dot(s.theta));
-  s.tss = c * ym2_;
+  s.tss = c * m_.m2;
   s.sigma2 = neff > p_ ? s.rss / (neff - p_) : std::numeric_limits<double>::quiet_NaN();
   if (!s.rank_deficient) {
     const Eigen::MatrixXd inv = ldlt.solve(Eigen::MatrixXd::Identity(p_, p_));

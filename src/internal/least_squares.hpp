@@ -25,6 +25,22 @@ struct LinearSolution {
   long long n_rows = 0;
 };
 
+/// Weights and targets of the rows added so far: sum w, sum w^2, and the weighted mean and sum of squared
+/// deviations of the targets (West 1979), from which the total sum of squares is known without cancellation.
+struct TargetMoments {
+  double sumw = 0.0, sumw2 = 0.0, mean = 0.0, m2 = 0.0;
+  void add(double y, double w) {
+    const double wn = sumw + w;
+    if (wn > 0) {
+      const double delta = y - mean;
+      mean += delta * w / wn;
+      m2 += w * delta * (y - mean);
+    }
+    sumw = wn;
+    sumw2 += w * w;
+  }
+};
+
 class StreamingLeastSquares {
  public:
   explicit StreamingLeastSquares(int p, int block = 1024);
@@ -33,7 +49,7 @@ class StreamingLeastSquares {
     const double sw = std::sqrt(w);
     for (int j = 0; j < p_; ++j) buf_(fill_, j) = sw * x[j];
     buf_(fill_, p_) = sw * y;
-    track_target(y, w);
+    m_.add(y, w);
     ++rows_;
     if (++fill_ == buf_.rows()) compress();
   }
@@ -47,18 +63,7 @@ class StreamingLeastSquares {
   Eigen::Index fill_;
   Eigen::HouseholderQR<Eigen::MatrixXd> qr_;
   long long rows_ = 0;
-  double sumw_ = 0.0, sumw2_ = 0.0;
-  double ymean_ = 0.0, ym2_ = 0.0;  // weighted mean and sum of squared deviations of the targets (West 1979)
-  void track_target(double y, double w) {
-    const double wn = sumw_ + w;
-    if (wn > 0) {
-      const double delta = y - ymean_;
-      ymean_ += delta * w / wn;
-      ym2_ += w * delta * (y - ymean_);
-    }
-    sumw_ = wn;
-    sumw2_ += w * w;
-  }
+  TargetMoments m_;
 };
 
 /// Weighted least squares by accumulating the augmented Gram matrix [X y]^T W [X y]
@@ -75,7 +80,7 @@ class GramLeastSquares {
     double* r = &buf_(0, fill_);
     for (int j = 0; j < p_; ++j) r[j] = sw * x[j];
     r[p_] = sw * y;
-    track_target(y, w);
+    m_.add(y, w);
     ++rows_;
     if (++fill_ == buf_.cols()) flush();
   }
@@ -89,18 +94,7 @@ class GramLeastSquares {
   Eigen::MatrixXd buf_;  // (p+1) x block, one weighted row per column
   Eigen::Index fill_ = 0;
   long long rows_ = 0;
-  double sumw_ = 0.0, sumw2_ = 0.0;
-  double ymean_ = 0.0, ym2_ = 0.0;  // weighted mean and sum of squared deviations of the targets (West 1979)
-  void track_target(double y, double w) {
-    const double wn = sumw_ + w;
-    if (wn > 0) {
-      const double delta = y - ymean_;
-      ymean_ += delta * w / wn;
-      ym2_ += w * delta * (y - ymean_);
-    }
-    sumw_ = wn;
-    sumw2_ += w * w;
-  }
+  TargetMoments m_;
 };
 
 /// Above this column-scaled condition number the Gram solution loses more than about
