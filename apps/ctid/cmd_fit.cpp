@@ -491,8 +491,6 @@ int run(const FitArgs& a) {
   if (a.method == "modal") return run_modal(a, d);
   if (a.method == "narx" || a.method == "kia") return run_narx_or_kia(a.method, d, a.sets, a.narx, a.json, a.report);
   TfOrders orders = all[0];
-  if (a.delay && (a.method == "lssvf" || a.method == "ivsvf" || a.method == "rls-svf"))
-    throw UsageError("--delay (delay estimation) needs --method srivc, oe or tfest");
   auto sets = parse_sets(a.sets);
   Result<TransferFunction> r;
   try {

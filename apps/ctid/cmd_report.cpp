@@ -2,9 +2,7 @@
 // record — transfer-function results with their covariance, NARX and NDE model files (the fit statistics
 // are recomputed on DATA).
 #include <cstdio>
-#include <fstream>
 #include <functional>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 

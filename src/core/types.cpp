@@ -18,10 +18,11 @@ std::string usability_problem(const Summary& summary, const ParameterSet& p, con
   if (!summary.succeeded())
     return summary.message.empty() ? std::string("the estimator ended with '") + to_string(summary.termination) + "'"
                                    : summary.message;
-  for (int i = 0; i < p.size(); ++i)
-    if (!std::isfinite(p.values(i)))
-      return detail::format("parameter {} is not finite ({})", i < static_cast<int>(p.names.size()) ? p.names[i] : "#" + std::to_string(i),
-                            p.values(i));
+  auto name = [&](Eigen::Index i) {
+    return i < static_cast<Eigen::Index>(p.names.size()) ? p.names[static_cast<size_t>(i)] : "#" + std::to_string(i);
+  };
+  for (Eigen::Index i = 0; i < p.values.size(); ++i)
+    if (!std::isfinite(p.values(i))) return detail::format("parameter {} is not finite ({})", name(i), p.values(i));
   if (fit.n_samples > 0 && !(fit.fit_percent > 0))
     return std::isfinite(fit.fit_percent)
                ? detail::format("the model's output fits the data worse than the output's mean does (fit {} %)",
@@ -46,7 +47,6 @@ std::string usability_problem(const Summary& summary, const ParameterSet& p, con
   if (p.covariance.size() == 0) return "";
   if (p.covariance.rows() != n || p.covariance.cols() != n)
     return detail::format("the parameter covariance is {} x {} for {} parameters", p.covariance.rows(), p.covariance.cols(), n);
-  auto name = [&](Eigen::Index i) { return i < static_cast<Eigen::Index>(p.names.size()) ? p.names[static_cast<size_t>(i)] : "#" + std::to_string(i); };
   auto is_fixed = [&](Eigen::Index i) { return i < static_cast<Eigen::Index>(p.fixed.size()) && p.fixed[static_cast<size_t>(i)]; };
   std::vector<Eigen::Index> free;
   for (Eigen::Index i = 0; i < n; ++i)

@@ -144,8 +144,8 @@ Result<TransferFunction> refine(const IdData& data, const TfOrders& o, const Tra
 // The starting model of the refinement: the equation-error (SRIVC) model as it is when it simulates better than
 // its stabilised copy (an unstable plant recorded in open loop), else the stabilised copy.
 TransferFunction starting_model(const TransferFunction& s, const IdData& data) {
-  const TransferFunction st = tf_detail::stabilized(s);
   if (s.is_stable()) return s;
+  const TransferFunction st = tf_detail::stabilized(s);
   const Eigen::VectorXd y = data.y().col(0);
   const double raw = (y - lsim(s, data, 0)).squaredNorm(), stab = (y - lsim(st, data, 0)).squaredNorm();
   return std::isfinite(raw) && raw < stab ? s : st;
