@@ -554,7 +554,7 @@ void setup_fit(CLI::App& app) {
                  "stride, quadrature=simpson|trapezoid, window=START,LENGTH (samples), frequencies=w1,.. (generated input); "
                  "narx: degree, ylag, ulag, umin, constant, max_terms, err_tolerance, criterion=none|aic|aicc|bic|fpe, "
                  "noise_terms (NARMAX e lags), noise_max; kia: the narx settings or --narx FILE, y_order, u_order, points, "
-                 "max (rad/s), seed, gls_order, err_threshold (%), zoh, refine (0: KIA only), quadratic=y^2,y*Dy, cubic=y^3, qpoints, qmax, qgls_order, "
+                 "max (rad/s, <= pi/Ts; default 1.25/Ts), seed, gls_order, err_threshold (%), zoh, refine (0: KIA only), quadratic=y^2,y*Dy, cubic=y^3, qpoints, qmax (default 0.55/Ts), qgls_order, "
                  "qerr_threshold");
   app.add_flag("--delay", a->delay,
                "Estimate a (non-integer) input delay (srivc, oe, tfest): grid search over [delay_min, delay_max], then "

@@ -179,6 +179,26 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
   for (int i = 0; i < r.parameters.size(); ++i)
     std::printf("  %-10s %14.6g   ERR %8.4f %%\n", r.parameters.names[i].c_str(), r.parameters.values(i), err(i));
   std::printf("simulated output fit: %.2f %%   (hold factor %s)\n", r.fit.fit_percent, lo.zoh ? "on" : "off");
+  // Kernel invariance means the equation reproduces its NARX model. One that simulates to less than half of the
+  // NARX model's free-run fit on the same record did not (candidate terms that cannot express it, or sampling too
+  // slow for invariance): not usable unless the output-error refinement below repairs it.
+  if (sim.ok()) {
+    bool escaped = false;
+    const int L = narx.max_lag();
+    const Eigen::VectorXd yn = narx.simulate(d.u().col(0), d.y().col(0).head(L), &escaped);
+    const double narx_fit =
+        escaped || d.size() <= L + 2 ? -INFINITY
+                                     : fit_report_or_inf(d.y().col(0).tail(d.size() - L), yn.tail(d.size() - L), 0).fit_percent;
+    std::printf("NARX model's free-run fit on the same record: %.2f %%\n", narx_fit);
+    if (narx_fit > 0 && r.fit.fit_percent < 0.5 * narx_fit) {
+      r.summary.termination = Termination::Unidentifiable;
+      r.summary.message = detail::format(
+          "the continuous-time equation does not reproduce its NARX model (simulated fit {} % against the NARX "
+          "model's {} %): its candidate terms cannot express the NARX kernels (y_order, u_order, quadratic, cubic), "
+          "or the sampling is too slow for kernel invariance",
+          std::round(r.fit.fit_percent * 100) / 100, std::round(narx_fit * 100) / 100);
+    }
+  }
   if (refine) {
     // Output-error refinement of the coefficients (nde_oe): consistent under output noise.
     const Result<NdeModel> oe = nde_oe(d, r.model);

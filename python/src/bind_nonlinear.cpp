@@ -118,7 +118,8 @@ void bind_nonlinear(py::module_& m) {
       .def(py::init<>())
       .def_readwrite("region", &KiaPointOptions::region)
       .def_readwrite("count", &KiaPointOptions::count)
-      .def_readwrite("max", &KiaPointOptions::max)
+      .def_readwrite("max", &KiaPointOptions::max,
+                     "rad/s, at most pi/T of the NARX model; 0 (default): 1.25/T (linear stage), 0.55/T (quadratic, cubic)")
       .def_readwrite("grid", &KiaPointOptions::grid)
       .def_readwrite("seed", &KiaPointOptions::seed);
   py::class_<KiaLinearOptions>(m, "KiaLinearOptions")

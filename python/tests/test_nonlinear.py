@@ -22,6 +22,10 @@ def test_narx_kia_and_refinement_reconstruct_bl33(bl33):
         assert q.model.normalized().coefficient(name) == pytest.approx(c, rel=0.01), name
         assert refined.model.coefficient(name) == pytest.approx(c, rel=1e-3), name
     assert "y*Dy" in repr(refined.model)
+    # The point range defaults to 1.25/T (500 rad/s at T = 2.5 ms); beyond pi/T = 1256.6 rad/s it is refused.
+    assert ctid.kia_linear(r.model, y_order=2, u_order=0, points=dict(max=500)).parameters.values.tolist() == lin.parameters.values.tolist()
+    with pytest.raises(ValueError, match="Nyquist frequency pi/T = 1256.6"):
+        ctid.kia_linear(r.model, points=dict(max=2000))
 
 
 def test_gfrf_and_harmonic_probing(bl33):

@@ -4,8 +4,9 @@
 
 #include <algorithm>
 #include <chrono>
-#include <limits>
 #include <cmath>
+#include <limits>
+#include <numbers>
 #include <random>
 
 #include "ctid/core/check.hpp"
@@ -120,6 +121,20 @@ Gls gls(const Eigen::MatrixXcd& P, const Eigen::VectorXcd& z, const Eigen::Vecto
 void check_points(const KiaPointOptions& p) {
   CTID_REQUIRE(p.count >= 1, "kia: the number of points must be >= 1 (got {})", p.count);
   CTID_REQUIRE(std::isfinite(p.max) && p.max > 0, "kia: the point range must be > 0 rad/s (got {})", p.max);
+}
+
+// The point range for a NARX model sampled at T: max = 0 gives default_max_T / T (the paper's range in units of
+// its sampling rate: 500 rad/s and 220 rad/s at T = 2.5 ms, BL 33); a range beyond the Nyquist frequency pi/T is
+// refused: there e^{sT} aliases and the kernels are not invariant (BL section 4, "fast enough sampling").
+KiaPointOptions in_band(KiaPointOptions p, double T, double default_max_T, const char* who, const char* key) {
+  CTID_REQUIRE_OPTION(std::isfinite(p.max) && p.max >= 0, "{}: the point range {} must be >= 0 rad/s (0: automatic; "
+                      "got {})", who, key, p.max);
+  if (p.max == 0) p.max = default_max_T / T;
+  CTID_REQUIRE_OPTION(p.max * T <= std::numbers::pi, "{}: the point range {} = {} rad/s lies beyond the Nyquist frequency pi/T = {} "
+                      "rad/s of the NARX model (T = {} s), where its kernels are not those of a continuous-time model; "
+                      "give {} <= {} or 0 (automatic: {} rad/s)", who, key, p.max, std::numbers::pi / T, T, key, std::numbers::pi / T,
+                      default_max_T / T);
+  return p;
 }
 }  // namespace
 
@@ -263,7 +278,7 @@ Result<NdeModel> extended(const NdeModel& base, const std::vector<NdeTerm>& cand
 Result<NdeModel> kia_linear(const NarxModel& narx, const KiaLinearOptions& o) {
   const auto t_start = std::chrono::steady_clock::now();
   o.validate();
-  const std::vector<cd> s = kia_points(o.points);
+  const std::vector<cd> s = kia_points(in_band(o.points, narx.ts(), 1.25, "kia_linear", "max"));
   const Eigen::Index n = static_cast<Eigen::Index>(s.size());
   Eigen::VectorXcd z(n), v(n);
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -296,9 +311,10 @@ Result<NdeModel> kia_quadratic(const NarxModel& narx, const NdeModel& linear_in,
   const NdeModel linear = linear_in.normalized();
   for (const auto& t : linear.terms())
     CTID_REQUIRE(t.degree() == 1, "kia_quadratic: the linear model has a nonlinear term {}", t.name());
-  KiaPointOptions second = o.points;
-  second.seed = o.points.seed + 7919;
-  const std::vector<cd> s1 = kia_points(o.points), s2 = kia_points(second);
+  const KiaPointOptions first = in_band(o.points, narx.ts(), 0.55, "kia_quadratic", "qmax");
+  KiaPointOptions second = first;
+  second.seed = first.seed + 7919;
+  const std::vector<cd> s1 = kia_points(first), s2 = kia_points(second);
   const Eigen::Index n = static_cast<Eigen::Index>(s1.size());
   const Polynomial A = linear.a();
   Eigen::VectorXcd z(n), v(n);
@@ -341,7 +357,7 @@ Result<NdeModel> kia_cubic(const NarxModel& narx, const NdeModel& model_in, cons
     CTID_REQUIRE(t.degree() <= 2, "kia_cubic: the model already has a term of degree {} ({})", t.degree(), t.name());
   std::vector<cd> S[3];
   for (int k = 0; k < 3; ++k) {
-    KiaPointOptions p = o.points;
+    KiaPointOptions p = in_band(o.points, narx.ts(), 0.55, "kia_cubic", "qmax");
     p.seed = o.points.seed + 7919u * static_cast<unsigned>(k);
     S[k] = kia_points(p);
   }

@@ -485,6 +485,16 @@ TEST(Cli, NarxKiaAndGfrf) {
   for (const char* s : {"Dy", "D^2y", "u", "y^2", "y*Dy"})
     EXPECT_NEAR(read_nde_json(nde).coefficient(s), truth.coefficient(s), 0.05 * std::abs(truth.coefficient(s))) << s;
   fs::remove(nde);
+  // An equation that does not reproduce its NARX model is not usable: pruning at ERR 30 % keeps y + a D^2y = 0
+  // (no input term; its fit is -123 % against the NARX model's 99.98 %, both printed).
+  r = ctid_run("fit " + data + " --ts 0.0025 --method kia --narx " + narx + " --set err_threshold=30 --set refine=0");
+  EXPECT_EQ(r.code, 1) << r.out << r.err;
+  EXPECT_NE(r.err.find("does not reproduce its NARX model"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("NARX model's free-run fit on the same record: 99.9"), std::string::npos) << r.out;
+  // Points beyond the Nyquist frequency pi/T = 1256.6 rad/s: refused with the bound (the default is 1.25/T = 500).
+  r = ctid_run("fit " + data + " --ts 0.0025 --method kia --narx " + narx + " --set max=2000");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("beyond the Nyquist frequency pi/T = 1256.6"), std::string::npos) << r.err;
   r = ctid_run("fit " + data + " --ts 0.0025 --method kia --narx " + narx + " --set quadratic=y^2,y*Dy --json " + nde);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("refined by output error"), std::string::npos) << r.out;

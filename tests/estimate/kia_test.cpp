@@ -16,6 +16,7 @@
 #include "ctid/estimate/nde_oe.hpp"
 #include "ctid/io/load.hpp"
 #include "ctid/simulate/lsim.hpp"
+#include "test_util.hpp"
 
 using namespace ctid;
 
@@ -99,6 +100,17 @@ TEST(Kia, PointsAndBadInputs) {
   EXPECT_THROW(kia_points({.count = 0}), InvalidArgument);
   EXPECT_THROW(kia_linear(bl34(), {.y_order = 0}), InvalidOptions);
   EXPECT_THROW(kia_quadratic(bl34(), NdeModel(), {.candidates = {NdeTerm::parse("y")}}), InvalidOptions);
+  // The automatic point range is the paper's in units of T: 1.25/T = 500 rad/s and 0.55/T = 220 rad/s at
+  // T = 2.5 ms, so the defaults and the explicit values give identical estimates.
+  const auto automatic = kia_linear(bl34(), {.zoh = false}), explicit500 = kia_linear(bl34(), {.points = {.max = 500}, .zoh = false});
+  EXPECT_EQ(automatic.parameters.values, explicit500.parameters.values);
+  const std::vector<NdeTerm> q = {NdeTerm::parse("y^2")};
+  EXPECT_EQ(kia_quadratic(bl34(), automatic.model, {.candidates = q}).parameters.values,
+            kia_quadratic(bl34(), automatic.model, {.candidates = q, .points = {.count = 70, .max = 220}}).parameters.values);
+  // Beyond the Nyquist frequency pi/T = 1256.6 rad/s the kernels alias: refused, naming the bound.
+  EXPECT_NE(test::error_of([] { kia_linear(bl34(), {.points = {.max = 1300}}); }).find("Nyquist frequency pi/T = 1256.6"),
+            std::string::npos);
+  EXPECT_THROW(kia_quadratic(bl34(), automatic.model, {.candidates = q, .points = {.max = -1}}), InvalidOptions);
 }
 
 namespace {

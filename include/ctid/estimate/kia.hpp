@@ -29,19 +29,21 @@ enum class KiaRegion {
 struct KiaPointOptions {
   KiaRegion region = KiaRegion::Axes;
   int count = 500;        ///< points (linear stage) or point pairs (quadratic stage)
-  double max = 500.0;     ///< rad/s
+  double max = 0.0;       ///< rad/s, at most the Nyquist frequency pi/T of the NARX model; 0: automatic, the
+                          ///< paper's range in units of its sampling rate (500 and 220 rad/s at T = 2.5 ms):
+                          ///< 1.25/T for the linear stage, 0.55/T for the quadratic and cubic stages
   bool grid = false;      ///< evenly spaced instead of uniformly random
   unsigned seed = 1;
 };
 
 /// The s-points of a region; for pairs call twice with different seeds (as kia_quadratic does).
-/// Throws InvalidArgument for count < 1 or max <= 0.
+/// Throws InvalidArgument for count < 1 or max <= 0 (the estimators resolve max = 0 from T first).
 std::vector<std::complex<double>> kia_points(const KiaPointOptions& options);
 
 struct KiaLinearOptions {
   int y_order = 2;             ///< candidates D^1 y .. D^{y_order} y (y itself has coefficient 1)
   int u_order = 0;             ///< candidates u .. D^{u_order} u
-  KiaPointOptions points;      ///< default: 500 points on both axes in (0, 500] rad/s (the paper's)
+  KiaPointOptions points;      ///< default: 500 points on both axes in (0, 1.25/T] rad/s (the paper's 500 rad/s)
   int gls_order = 10;          ///< filter order G; 0: plain least squares; -1: the smallest G <= 12 whose
                                ///< converged fit explains >= 99.99 % (sum of ERR; the paper: order 10, 99.992 %)
   int max_iterations = 100;
@@ -55,12 +57,12 @@ struct KiaLinearOptions {
 /// parameters: the implicit-form coefficients of the retained candidate terms (names "Dy", "D^2y", "u", ...);
 /// diagnostics.vectors "err" (ERR % of each parameter at convergence, forward selection), "first_iteration"
 /// (plain least squares); scalars "gls_iterations", "gls_order", "err_sum". Throws InvalidArgument for a
-/// NARX model without linear input terms.
+/// NARX model without linear input terms or a point range beyond the Nyquist frequency.
 Result<NdeModel> kia_linear(const NarxModel& narx, const KiaLinearOptions& options = {});
 
 struct KiaQuadraticOptions {
   std::vector<NdeTerm> candidates;  ///< degree-2 terms, e.g. y^2, y*Dy, Dy^2, y*u
-  KiaPointOptions points{.count = 70, .max = 220.0};  ///< point pairs (the paper: 35 real + 35 imaginary in (0, 220))
+  KiaPointOptions points{.count = 70};  ///< point pairs in (0, 0.55/T] (the paper: 35 real + 35 imaginary in (0, 220))
   int gls_order = 3;                ///< filter F(s_1 + s_2) order; 0: plain least squares
   int max_iterations = 100;
   double tolerance = 1e-8;
@@ -71,12 +73,12 @@ struct KiaQuadraticOptions {
 
 /// Quadratic stage with the linear part fixed: returns linear + retained quadratic terms (normalised), with
 /// parameters, "err" and "first_iteration" for the quadratic coefficients. Throws InvalidArgument for
-/// candidates that are not of degree 2 or an empty candidate list.
+/// candidates that are not of degree 2, an empty candidate list or a point range beyond the Nyquist frequency.
 Result<NdeModel> kia_quadratic(const NarxModel& narx, const NdeModel& linear, const KiaQuadraticOptions& options);
 
 struct KiaCubicOptions {
   std::vector<NdeTerm> candidates;  ///< degree-3 terms, e.g. y^3, y^2*Dy
-  KiaPointOptions points{.count = 70, .max = 220.0};  ///< point triples (s_1, s_2, s_3), each from its own seed
+  KiaPointOptions points{.count = 70};  ///< point triples (s_1, s_2, s_3), each from its own seed; range as quadratic
   int gls_order = 3;                ///< filter F(s_1 + s_2 + s_3) order; 0: plain least squares
   int max_iterations = 100;
   double tolerance = 1e-8;
