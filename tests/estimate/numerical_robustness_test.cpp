@@ -5,7 +5,11 @@
 #include <gtest/gtest.h>
 
 #include "ctid/data/input_design.hpp"
+#include "ctid/estimate/fsf.hpp"
 #include "ctid/estimate/lssvf.hpp"
+#include "ctid/estimate/modal.hpp"
+#include "ctid/estimate/physical.hpp"
+#include "ctid/estimate/rls_svf.hpp"
 #include "ctid/estimate/oe.hpp"
 #include "ctid/estimate/srivc.hpp"
 #include "ctid/simulate/lsim.hpp"
@@ -146,5 +150,82 @@ TEST(NumericalRobustness, EstimatesDoNotDependOnUnitsOfTimeAndAmplitude) {
             << m << " trial " << trial << " n " << n << " nb " << nb << " " << name << " c " << c << " ku " << ku << " ky " << ky;
       }
     }
+  }
+}
+
+// The same property for the other linear estimators, whose options carry units: FSF (T, s), modal functions
+// (shifts, s), RLS-SVF (tau, s; p0, the prior variance of theta_tau) and physical fits (initial values). Given in
+// the scaled record's units, they give the same model to 1e-6 relative (measured: <= 1e-9), usable or not alike.
+// Random stable systems of order 1-4 as above, a level sequence held 100 samples (modal functions need
+// constant-input windows), time scaled so that Ts is log-uniform in [1e-6, 1e3] s; u and y scaled by factors
+// log-uniform in [1e-30, 1e30] — by one common factor k for RLS-SVF, where P(0) = p0 I weighs theta_tau's
+// denominator and numerator parts alike and p0 is then given as p0 / k^2 (docs/methods/johansson.md).
+TEST(NumericalRobustness, EstimatorsWithOptionsInUnitsAgreeWhenTheOptionsAreScaled) {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  const double ts = 0.05;
+  const int N = 1600;
+  Eigen::VectorXd u(N);
+  const double levels[4] = {1, 2, -1, -2};
+  for (int i = 0; i < N; ++i) u(i) = levels[(i / 100 + i / 300) % 4];
+  for (int trial = 0; trial < 8; ++trial) {
+    const int n = 1 + trial % 4;
+    Eigen::VectorXd poles(n);
+    for (int i = 0; i < n; ++i) poles(i) = -(0.3 + 1.7 * U(rng));
+    const Polynomial den = Polynomial::from_roots(poles.cast<std::complex<double>>());
+    const TransferFunction g(Polynomial{den.coefficients()(n)}, den);  // unit DC gain
+    const IdData d(u, add_noise_snr(lsim(g, u, time_grid(ts, N)), 30.0, 200 + trial), ts);
+    const double c = std::pow(10.0, -6 + 9 * U(rng)) / ts, ku = std::pow(10.0, -30 + 60 * U(rng)),
+                 ky = std::pow(10.0, -30 + 60 * U(rng)), k = std::pow(10.0, -30 + 60 * U(rng));
+    const IdData s(d.u() * ku, d.y() * ky, ts * c), sk(d.u() * k, d.y() * k, ts * c);
+    const std::string at = "trial " + std::to_string(trial) + " n " + std::to_string(n);
+    // a_j / a_0 c^j and b_j / a_0 c^(n-nb+1+j) ku / ky: the scaled model's coefficients in the original units.
+    auto same_model = [&](const TransferFunction& ma, const TransferFunction& mb, double kk, const std::string& who) {
+      const Eigen::VectorXd da = ma.den().coefficients(), db = mb.den().coefficients();
+      const Eigen::VectorXd na = ma.num().coefficients(), nb = mb.num().coefficients();
+      ASSERT_EQ(da.size(), db.size());
+      ASSERT_EQ(na.size(), nb.size());
+      for (Eigen::Index j = 1; j < da.size(); ++j)
+        EXPECT_NEAR(db(j) / db(0) * std::pow(c, double(j)), da(j) / da(0), 1e-6 * std::abs(da(j) / da(0))) << who << " " << at;
+      const Eigen::Index off = da.size() - na.size();
+      for (Eigen::Index j = 0; j < na.size(); ++j)
+        EXPECT_NEAR(nb(j) / db(0) * std::pow(c, double(off + j)) * kk, na(j) / da(0), 1e-6 * std::abs(na(j) / da(0)))
+            << who << " " << at;
+    };
+    // FSF: its parameters are frequency samples of G (units y/u).
+    const auto fa = fsf(d, {.T = 600 * ts, .n = 21}), fb = fsf(s, {.T = 600 * ts * c, .n = 21});
+    EXPECT_EQ(fa.usable(), fb.usable()) << at;
+    for (int i = 0; i < fa.parameters.size(); ++i)
+      EXPECT_NEAR(fb.parameters.values(i) * ku / ky, fa.parameters.values(i), 1e-6 * fa.parameters.values.cwiseAbs().maxCoeff())
+          << "fsf " << at << " " << fa.parameters.names[static_cast<size_t>(i)];
+    // Modal functions, discrete basis, uniform shifts i * 10 Ts.
+    Eigen::VectorXd shifts(n);
+    for (int i = 0; i < n; ++i) shifts(i) = (i + 1) * 10 * ts;
+    const auto ma = modal_fit(d, 1, {.shifts = shifts, .basis = ModalBasis::Discrete}),
+               mb = modal_fit(s, 1, {.shifts = shifts * c, .basis = ModalBasis::Discrete});
+    EXPECT_EQ(ma.usable(), mb.usable()) << at << ": " << ma.why_not_usable() << " / " << mb.why_not_usable();
+    same_model(ma.model, mb.model, ku / ky, "modal_fit");
+    // RLS-SVF on theta_tau (nb = nf, nothing fixed).
+    RlsSvf ra({n, n, 0}, {.tau = 0.3}), rb({n, n, 0}, {.tau = 0.3 * c, .p0 = 1e4 / (k * k)});
+    for (int i = 0; i < N; ++i) {
+      ra.update(d.time(i), d.u()(i, 0), d.y()(i, 0));
+      rb.update(sk.time(i), sk.u()(i, 0), sk.y()(i, 0));
+    }
+    same_model(ra.model(), rb.model(), 1.0, "rls-svf");
+    // Physical: k / (s^n + c1 s^(n-1) + .. + cn), started 20 % off the truth (scaled alike).
+    std::string expr = "k/(s^" + std::to_string(n);
+    std::vector<PhysicalParameter> pa{{"k", 1.2 * den.coefficients()(n)}}, pb{{"k", 1.2 * den.coefficients()(n) / std::pow(c, n) * ky / ku}};
+    std::vector<std::string> names{"k"};
+    for (int j = 1; j <= n; ++j) {
+      const std::string cj = "c" + std::to_string(j);
+      expr += " + " + cj + (j < n ? "*s^" + std::to_string(n - j) : "");
+      names.push_back(cj);
+      pa.push_back({cj, 1.2 * den.coefficients()(j)});
+      pb.push_back({cj, 1.2 * den.coefficients()(j) / std::pow(c, j)});
+    }
+    const PhysicalModel pm(expr + ")", names);
+    const auto qa = fit_physical_raw(pm, pa, d), qb = fit_physical_raw(pm, pb, s);
+    EXPECT_EQ(qa.usable(), qb.usable()) << at << ": " << qa.why_not_usable() << " / " << qb.why_not_usable();
+    same_model(qa.model, qb.model, ku / ky, "physical");
   }
 }
