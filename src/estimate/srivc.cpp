@@ -371,13 +371,11 @@ void SrivcMisoOptions::validate() const {
                         i + 1, delays[i]);
 }
 
-Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& orders, const SrivcMisoOptions& opt) {
+namespace {
+Result<MisoModel> srivc_miso_in_units(const IdData& data, const std::vector<TfOrders>& orders, const SrivcMisoOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
   opt.validate();
   const int K = data.nu();
-  CTID_REQUIRE(data.ny() == 1, "srivc_miso: needs one output (data has {})", data.ny());
-  CTID_REQUIRE(K >= 1 && static_cast<int>(orders.size()) == K, "srivc_miso: {} inputs but {} sets of orders", K,
-               orders.size());
   CTID_REQUIRE_OPTION(opt.delays.empty() || static_cast<int>(opt.delays.size()) == K,
                       "srivc_miso: {} delays for {} inputs", opt.delays.size(), K);
   int p = 0;
@@ -511,6 +509,55 @@ Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& or
   return r;
 }
 
+// g(s'/c) * gain as a transfer function in s' (a known controller in normalised units).
+TransferFunction time_scaled(const TransferFunction& g, double c, double gain) {
+  const int n = g.den().degree();
+  auto scaled = [&](const Polynomial& p, double k) {
+    Eigen::VectorXd q = p.coefficients();
+    const int m = p.degree();
+    for (int i = 0; i <= m; ++i) q(i) *= k * std::pow(c, n - (m - i));
+    return q;
+  };
+  return TransferFunction(scaled(g.num(), gain), scaled(g.den(), 1.0), g.io_delay() / c);
+}
+}  // namespace
+
+Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& orders, const SrivcMisoOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  CTID_REQUIRE(data.ny() == 1, "srivc_miso: needs one output (data has {})", data.ny());
+  CTID_REQUIRE(data.nu() >= 1 && static_cast<int>(orders.size()) == data.nu(), "srivc_miso: {} inputs but {} sets of orders",
+               data.nu(), orders.size());
+  // As srivc: estimated in normalised units (time / c, each input by its RMS, y by its RMS), mapped back.
+  const tf_detail::TfNormalisation n = tf_detail::TfNormalisation::of(data);
+  std::vector<tf_detail::TfNormalisation> per_input;  // c, the input's RMS, sy
+  Eigen::MatrixXd u = data.u();
+  for (int i = 0; i < data.nu(); ++i) {
+    const double rms = std::sqrt(u.col(i).squaredNorm() / std::max<Eigen::Index>(1, u.rows()));
+    per_input.push_back({n.c, rms > 0 && std::isfinite(rms) ? rms : 1.0, n.sy});
+    u.col(i) /= per_input.back().su;
+  }
+  IdData scaled_u = data.is_uniform() ? IdData(u, data.y(), data.ts(), data.t0()) : IdData(u, data.y(), data.times());
+  for (int i = 0; i < data.nu(); ++i) scaled_u.set_intersample(i, data.intersample(i));
+  scaled_u.set_input_names(data.input_names());
+  scaled_u.set_output_names(data.output_names());
+  SrivcMisoOptions o = opt;
+  for (double& dl : o.delays) dl /= n.c;
+  Result<MisoModel> r = srivc_miso_in_units(tf_detail::TfNormalisation{n.c, 1.0, n.sy}.data(scaled_u), orders, o);
+  // Parameters "a<k>" (common denominator), "u<i>.a<k>", "u<i>.b<j>".
+  Eigen::VectorXd f(r.parameters.size());
+  for (int k = 0; k < r.parameters.size(); ++k) {
+    const std::string& name = r.parameters.names[static_cast<size_t>(k)];
+    const size_t dot = name.find('.');
+    const int i = dot == std::string::npos ? 0 : std::stoi(name.substr(1, dot - 1)) - 1;
+    f(k) = per_input[static_cast<size_t>(i)].factor(dot == std::string::npos ? name : name.substr(dot + 1), orders[i]);
+  }
+  n.restore_common(r.parameters, f, r.fit, r.diagnostics);
+  for (int i = 0; i < r.model.nu(); ++i)
+    r.model.channels[i] = per_input[static_cast<size_t>(i)].from_normalised(r.model.channels[i], orders[i]);
+  r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
 void ClosedLoopOptions::validate() const {
   CTID_REQUIRE_OPTION(max_iterations >= 1, "srivc_closed_loop: max_iterations must be >= 1 (got {})", max_iterations);
   CTID_REQUIRE_OPTION(tolerance > 0 && std::isfinite(tolerance), "srivc_closed_loop: tolerance must be > 0 (got {})",
@@ -519,13 +566,12 @@ void ClosedLoopOptions::validate() const {
                       controller.io_delay());
 }
 
-Result<TransferFunction> srivc_closed_loop(const IdData& data, const Eigen::VectorXd& reference, const TfOrders& orders,
-                                           const ClosedLoopOptions& opt) {
+namespace {
+Result<TransferFunction> srivc_closed_loop_in_units(const IdData& data, const Eigen::VectorXd& reference,
+                                                    const TfOrders& orders, const ClosedLoopOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
   orders.validate(/*allow_biproper=*/false);
   opt.validate();
-  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "srivc_closed_loop: needs one input and one output (data has {} inputs, {} outputs)",
-               data.nu(), data.ny());
   CTID_REQUIRE(reference.size() == data.size(), "srivc_closed_loop: the reference has {} samples but the data have {}",
                reference.size(), data.size());
   CTID_REQUIRE(reference.allFinite(), "srivc_closed_loop: the reference contains NaN or Inf");
@@ -579,6 +625,24 @@ Result<TransferFunction> srivc_closed_loop(const IdData& data, const Eigen::Vect
   r.summary.iterations = std::min(it, opt.max_iterations);
   set_termination(r, run.rank_deficient, converged, opt.tolerance, opt.max_iterations,
                   "the closed-loop instrument matrix is singular; the reference does not excite every parameter");
+  r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+}  // namespace
+
+Result<TransferFunction> srivc_closed_loop(const IdData& data, const Eigen::VectorXd& reference, const TfOrders& orders,
+                                           const ClosedLoopOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "srivc_closed_loop: needs one input and one output (data has {} inputs, {} outputs)",
+               data.nu(), data.ny());
+  // As srivc: estimated in normalised units and mapped back. The controller maps y to u: C'(s') = (sy/su) C(s'/c);
+  // the reference has the units of u (added at the plant input) or of y (a setpoint).
+  const tf_detail::TfNormalisation n = tf_detail::TfNormalisation::of(data);
+  ClosedLoopOptions o = opt;
+  o.controller = time_scaled(opt.controller, n.c, n.sy / n.su);
+  const Eigen::VectorXd r_scaled = reference / (opt.reference_at_plant_input ? n.su : n.sy);
+  Result<TransferFunction> r = srivc_closed_loop_in_units(n.data(data), r_scaled, orders, o);
+  n.restore(r, orders);
   tf_detail::check_cancellation(r);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;

@@ -117,28 +117,34 @@ TransferFunction TfNormalisation::to_normalised(const TransferFunction& g, const
   return tf_of(p, o, g.io_delay() / c);
 }
 
+TransferFunction TfNormalisation::from_normalised(const TransferFunction& g, const TfOrders& o) const {
+  return TfNormalisation{1.0 / c, 1.0 / su, 1.0 / sy}.to_normalised(g, o);
+}
+
 void TfNormalisation::restore(Result<TransferFunction>& r, const TfOrders& o) const {
-  ParameterSet& p = r.parameters;
-  Eigen::VectorXd f(p.size());
-  for (int i = 0; i < p.size(); ++i) f(i) = 1.0 / factor(p.names[static_cast<size_t>(i)], o);
+  Eigen::VectorXd f(r.parameters.size());
+  for (int i = 0; i < r.parameters.size(); ++i) f(i) = factor(r.parameters.names[static_cast<size_t>(i)], o);
+  restore_common(r.parameters, f, r.fit, r.diagnostics);
+  r.model = from_normalised(r.model, o);
+}
+
+void TfNormalisation::restore_common(ParameterSet& p, const Eigen::VectorXd& factors, FitReport& fit,
+                                     Diagnostics& dg) const {
+  const Eigen::VectorXd f = factors.cwiseInverse();
   p.values = p.values.cwiseProduct(f);
   if (p.covariance.rows() == p.size() && p.covariance.cols() == p.size())
     p.covariance = f.asDiagonal() * p.covariance * f.asDiagonal();
   if (p.std.size() == p.size()) p.std = p.std.cwiseProduct(f.cwiseAbs());
-  Eigen::VectorXd coef = params_of(r.model, o);
-  const std::vector<std::string> names = tf_parameter_names(o);
-  for (Eigen::Index i = 0; i < coef.size(); ++i) coef(i) /= factor(names[static_cast<size_t>(i)], o);
-  r.model = tf_of(coef, o, r.model.io_delay() * c);
-  const double v = sy * sy, lv = std::log(v) * r.fit.n_samples;
-  r.fit.mse *= v;
-  r.fit.fpe *= v;
-  r.fit.aic += lv;
-  r.fit.aicc += lv;
-  r.fit.bic += lv;
-  auto& sc = r.diagnostics.scalars;
+  const double v = sy * sy, lv = std::log(v) * fit.n_samples;
+  fit.mse *= v;
+  fit.fpe *= v;
+  fit.aic += lv;
+  fit.aicc += lv;
+  fit.bic += lv;
+  auto& sc = dg.scalars;
   if (sc.count("delay")) sc["delay"] *= c;
   if (sc.count("noise_variance")) sc["noise_variance"] *= v;
-  auto& vs = r.diagnostics.vectors;
+  auto& vs = dg.vectors;
   if (vs.count("delay_grid")) vs["delay_grid"] *= c;
   if (vs.count("delay_grid_mse")) vs["delay_grid_mse"] *= v;
   sc["time_scale"] = c;

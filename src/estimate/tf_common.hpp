@@ -57,9 +57,15 @@ struct TfNormalisation {
   /// normalised value = original value * factor(name) for a parameter a<k>, b<j> or "delay" (1 otherwise).
   double factor(const std::string& name, const TfOrders& o) const;
   TransferFunction to_normalised(const TransferFunction& g, const TfOrders& o) const;
+  /// The inverse of to_normalised: a model of the normalised problem in the user's units.
+  TransferFunction from_normalised(const TransferFunction& g, const TfOrders& o) const;
   /// Maps a result of the normalised problem back to the user's units: model, parameters, covariance, fit
   /// measures, delay and noise diagnostics.
   void restore(Result<TransferFunction>& r, const TfOrders& o) const;
+  /// The parts of restore() that do not depend on the model type: parameter values, standard deviations and
+  /// covariance divided by the factors f (normalised = original * f), fit measures and the diagnostics
+  /// "delay", "noise_variance", "delay_grid", "delay_grid_mse"; sets the diagnostic "time_scale" = c.
+  void restore_common(ParameterSet& p, const Eigen::VectorXd& f, FitReport& fit, Diagnostics& dg) const;
 };
 /// The checks every SISO transfer-function result gets in the user's units: pole-zero cancellation,
 /// poles beyond the data's bandwidth, and a warning for a model that is not asymptotically stable.
