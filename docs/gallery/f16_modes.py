@@ -49,7 +49,7 @@ def main(data_dir, out_dir):
         _, g_val = spectra(d, 5, 9)
         r = ctid.tf_from_frequency((w, g), ORDER + 1, ORDER)  # biproper: acceleration over force
         if not r.usable():
-            print(f"level {level}: not usable ({r.summary.message})")
+            print(f"level {level}: not usable ({r.why_not_usable()})")
             continue
         p = r.model.poles()
         p = p[p.imag > 0]

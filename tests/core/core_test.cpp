@@ -93,6 +93,14 @@ TEST(Core, UsabilityRulesNameTheCause) {
   r.fit.nrmse = std::sqrt(1 - 0.02);
   r.fit.fit_percent = 100 * (1 - r.fit.nrmse);
   EXPECT_TRUE(r.usable()) << r.why_not_usable();
+  // Collinear estimates (correlation 1 - 1e-15: smallest eigenvalue of the correlation matrix below 1e-13 of the
+  // largest) name the parameters; a real but high correlation (1 - 1e-9) is fine.
+  r = base();
+  r.parameters.covariance = Eigen::Matrix2d{{1.0, 1.0 - 1e-15}, {1.0 - 1e-15, 1.0}} * 0.01;
+  EXPECT_NE(r.why_not_usable().find("do not determine a1, b0 separately: their estimates are collinear"), std::string::npos)
+      << r.why_not_usable();
+  r.parameters.covariance = Eigen::Matrix2d{{1.0, 1.0 - 1e-9}, {1.0 - 1e-9, 1.0}} * 0.01;
+  EXPECT_TRUE(r.usable()) << r.why_not_usable();
   // Noise-free exact fit: zero covariance is the truth, not a singular information matrix.
   r = base();
   r.fit.nrmse = 1e-9;

@@ -63,7 +63,9 @@ struct Diagnostics {
 ///  4. where a covariance was computed (non-empty): it is finite and positive semi-definite over the
 ///     free parameters, and every free parameter's standard deviation is finite and > 0 (zero or
 ///     non-finite means a singular information matrix: the data do not determine that parameter);
-///     zero is accepted only for an exact fit (nrmse < 1e-6: noise-free data);
+///     zero is accepted only for an exact fit (nrmse < 1e-6: noise-free data); and the estimates are not
+///     collinear: the correlation matrix's smallest eigenvalue is at least 1e-13 of its largest (otherwise
+///     a combination of parameters is not determined by the data, e.g. the scale of k/(m s^2 + c s + k));
 ///  5. the free parameters are jointly significant: where a fit was computed, the overall F test
 ///     F = (R^2/d) / ((1-R^2)/(N-d)), R^2 = 1 - nrmse^2, reaches its 95 % point (otherwise the data
 ///     cannot tell the model from no model, as for a fit to pure noise).
