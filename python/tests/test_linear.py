@@ -235,3 +235,25 @@ def test_delay_bounds_hold_in_the_output_error_refinement(plant):
     assert r.parameters["delay"] == pytest.approx(0.3, abs=0.02)
     r = ctid.tfest(delayed, 1, 2, estimate_delay=True, srivc={"delay_max": 0.1})
     assert 0.0 <= r.parameters["delay"] <= 0.1 + 1e-12
+
+
+def test_units_do_not_matter_and_useless_fits_say_why(plant):
+    # Issue 13, as the C++ property test and CLI cases: the same record in nanoseconds and 1e20 output units
+    # gives the same model after rescaling (1e-6 relative; SRIVC and tfest work in normalised units).
+    g, d = plant
+    c, ky = 1e-9, 1e20
+    s = ctid.IdData.from_arrays(d.u[:, 0], d.y[:, 0] * ky, ts=0.02 * c)
+    for fit in (ctid.srivc, ctid.tfest):
+        a, b = fit(d, 1, 2), fit(s, 1, 2)
+        assert a.usable() and b.usable(), (a.why_not_usable(), b.why_not_usable())
+        assert b.parameters["a1"] * c == pytest.approx(a.parameters["a1"], rel=1e-6)
+        assert b.parameters["a2"] * c**2 == pytest.approx(a.parameters["a2"], rel=1e-6)
+        assert b.parameters["b0"] * c**2 / ky == pytest.approx(a.parameters["b0"], rel=1e-6)
+    # Pure noise: the F test refuses the fit (the CLI exits 1 with the same words).
+    rng = np.random.default_rng(5)
+    noise = ctid.IdData.from_arrays(np.sign(rng.standard_normal(1000)), rng.standard_normal(1000), ts=0.01)
+    r = ctid.tfest(noise, 2, 2)
+    assert not r.usable() and "cannot tell this model from no model" in r.why_not_usable()
+    # A leading denominator coefficient that is zero up to rounding is refused (it simulated to ~1e-30).
+    with pytest.raises(ctid.InvalidArgument, match="zero up to rounding"):
+        ctid.TransferFunction([1.0], [1e-20, 1.0, 2.0])
