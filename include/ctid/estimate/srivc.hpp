@@ -42,7 +42,9 @@ struct SrivcOptions {
 };
 
 /// SISO SRIVC. orders.nb may be nf + 1 (biproper). Throws InvalidArgument for data that
-/// are not SISO or too short, InvalidOptions for bad options.
+/// are not SISO or too short, InvalidOptions for bad options. Like srivc_miso and
+/// srivc_closed_loop it estimates in normalised time and amplitude units and maps the result
+/// back, so the estimate does not depend on the units of the record (docs/guide.md).
 Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const SrivcOptions& options = {});
 
 struct SrivcMisoOptions {
