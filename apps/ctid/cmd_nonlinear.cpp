@@ -88,11 +88,11 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
     write_report(report, d, r, "narx", set_list, "");
     return r.usable() ? kOk : kNotUsable;
   }
-  // kia: the NARX model from --narx, or identified here.
-  KiaLinearOptions lo;
-  KiaQuadraticOptions qo;
-  bool refine = true;
-  KiaCubicOptions co;
+  // kia: the NARX model from --narx, or identified here; then the library's workflow (kia()).
+  KiaOptions ko;
+  KiaLinearOptions& lo = ko.linear;
+  KiaQuadraticOptions& qo = ko.quadratic;
+  KiaCubicOptions& co = ko.cubic;
   lo.zoh = qo.zoh = co.zoh = d.intersample(0) == Intersample::Zoh;
   consume_sets(sets, [&](const std::string& k, const std::string& v) {
     if (k == "y_order") lo.y_order = to_int(k, v);
@@ -103,7 +103,7 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
     else if (k == "gls_order") lo.gls_order = to_int(k, v);
     else if (k == "err_threshold") lo.err_threshold = to_double(k, v);
     else if (k == "zoh") lo.zoh = qo.zoh = co.zoh = to_int(k, v) != 0;
-    else if (k == "refine") refine = to_int(k, v) != 0;
+    else if (k == "refine") ko.refine = to_int(k, v) != 0;
     else if (k == "quadratic") {
       try {
         for (const auto& t : split(v)) qo.candidates.push_back(NdeTerm::parse(t));
@@ -141,85 +141,37 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
     throw UsageError("--set " + sets.begin()->first + ": not a setting of kia (settings: y_order, u_order, points, max, "
                      "seed, gls_order, err_threshold, zoh, refine, quadratic=y^2,y*Dy, cubic=y^3, qpoints, qmax, qgls_order, "
                      "qerr_threshold, and the narx settings)");
-  Result<NdeModel> r;
+  KiaRun run;
   try {
-    r = kia_linear(narx, lo);
-    // Each higher stage returns its own coefficients; prepend the earlier stages' to the table.
-    auto stack = [&](const Result<NdeModel>& before, Result<NdeModel> next) {
-      next.parameters.names.insert(next.parameters.names.begin(), before.parameters.names.begin(),
-                                   before.parameters.names.end());
-      Eigen::VectorXd v(before.parameters.size() + next.parameters.values.size());
-      v << before.parameters.values, next.parameters.values;
-      next.parameters.values = v;
-      next.parameters.std = Eigen::VectorXd::Constant(v.size(), NAN);
-      next.parameters.fixed.assign(v.size(), false);
-      Eigen::VectorXd e(v.size());
-      e << before.diagnostics.vectors.at("err"), next.diagnostics.vectors.at("err");
-      next.diagnostics.vectors["err"] = e;
-      return next;
-    };
-    if (!qo.candidates.empty()) r = stack(r, kia_quadratic(narx, r.model, qo));
-    if (!co.candidates.empty()) r = stack(r, kia_cubic(narx, r.model, co));
+    run = kia(d, narx, ko);
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }
-  // Validation: simulate the NDE on the record's input.
-  Eigen::VectorXd t(d.size());
-  for (int i = 0; i < d.size(); ++i) t(i) = d.time(i) - d.t0();
-  const NdeSimulation sim = r.model.simulate(d.u().col(0), t, d.intersample(0));
-  if (!sim.ok()) {
-    r.summary.termination = sim.termination;
-    r.summary.message = "the NDE simulation failed: " + sim.message;
-    r.fit = fit_report_or_inf(d.y().col(0), Eigen::VectorXd::Constant(d.size(), NAN), r.parameters.size());
-  } else {
-    r.fit = fit_report_or_inf(d.y().col(0), sim.y, r.parameters.size());
+  const Result<NdeModel>& k = run.reconstructed;
+  std::printf("NDE: %s\n", k.model.to_string(5).c_str());
+  const Eigen::VectorXd& err = k.diagnostics.vectors.at("err");
+  for (int i = 0; i < k.parameters.size(); ++i)
+    std::printf("  %-10s %14.6g   ERR %8.4f %%\n", k.parameters.names[i].c_str(), k.parameters.values(i), err(i));
+  std::printf("simulated output fit: %.2f %%   (hold factor %s)\n", k.fit.fit_percent, lo.zoh ? "on" : "off");
+  std::printf("NARX model's free-run fit on the same record: %.2f %%\n", run.narx_fit_percent);
+  if (run.refined && run.refined->usable()) {
+    const Result<NdeModel>& oe = *run.refined;
+    std::printf("refined by output error (%d iterations): %s\n", oe.summary.iterations, oe.model.to_string(5).c_str());
+    for (int i = 0; i < oe.parameters.size(); ++i)
+      std::printf("  %-10s %14.6g +- %.3g%s\n", oe.parameters.names[i].c_str(), oe.parameters.values(i),
+                  oe.parameters.std(i), oe.parameters.fixed[static_cast<size_t>(i)] ? "  (reference)" : "");
+    for (const auto& w : oe.diagnostics.warnings) std::printf("  note: %s\n", w.c_str());
+    std::printf("simulated output fit: %.2f %%\n", oe.fit.fit_percent);
+  } else if (run.refined) {
+    std::fprintf(stderr, "ctid: warning: the output-error refinement failed (%s); keeping the KIA model\n",
+                 run.refined->why_not_usable().c_str());
   }
-  std::printf("NDE: %s\n", r.model.to_string(5).c_str());
-  const Eigen::VectorXd& err = r.diagnostics.vectors.at("err");
-  for (int i = 0; i < r.parameters.size(); ++i)
-    std::printf("  %-10s %14.6g   ERR %8.4f %%\n", r.parameters.names[i].c_str(), r.parameters.values(i), err(i));
-  std::printf("simulated output fit: %.2f %%   (hold factor %s)\n", r.fit.fit_percent, lo.zoh ? "on" : "off");
-  // Kernel invariance means the equation reproduces its NARX model. One that simulates to less than half of the
-  // NARX model's free-run fit on the same record did not (candidate terms that cannot express it, or sampling too
-  // slow for invariance): not usable unless the output-error refinement below repairs it.
-  if (sim.ok()) {
-    bool escaped = false;
-    const int L = narx.max_lag();
-    const Eigen::VectorXd yn = narx.simulate(d.u().col(0), d.y().col(0).head(L), &escaped);
-    const double narx_fit =
-        escaped || d.size() <= L + 2 ? -INFINITY
-                                     : fit_report_or_inf(d.y().col(0).tail(d.size() - L), yn.tail(d.size() - L), 0).fit_percent;
-    std::printf("NARX model's free-run fit on the same record: %.2f %%\n", narx_fit);
-    if (narx_fit > 0 && r.fit.fit_percent < 0.5 * narx_fit) {
-      r.summary.termination = Termination::Unidentifiable;
-      r.summary.message = detail::format(
-          "the continuous-time equation does not reproduce its NARX model (simulated fit {} % against the NARX "
-          "model's {} %): its candidate terms cannot express the NARX kernels (y_order, u_order, quadratic, cubic), "
-          "or the sampling is too slow for kernel invariance",
-          std::round(r.fit.fit_percent * 100) / 100, std::round(narx_fit * 100) / 100);
-    }
-  }
-  if (refine) {
-    // Output-error refinement of the coefficients (nde_oe): consistent under output noise.
-    const Result<NdeModel> oe = nde_oe(d, r.model);
-    if (oe.usable()) {
-      std::printf("refined by output error (%d iterations): %s\n", oe.summary.iterations, oe.model.to_string(5).c_str());
-      for (int i = 0; i < oe.parameters.size(); ++i)
-        std::printf("  %-10s %14.6g +- %.3g%s\n", oe.parameters.names[i].c_str(), oe.parameters.values(i),
-                    oe.parameters.std(i), oe.parameters.fixed[static_cast<size_t>(i)] ? "  (reference)" : "");
-      for (const auto& w : oe.diagnostics.warnings) std::printf("  note: %s\n", w.c_str());
-      std::printf("simulated output fit: %.2f %%\n", oe.fit.fit_percent);
-      r = oe;
-    } else {
-      std::fprintf(stderr, "ctid: warning: the output-error refinement failed (%s); keeping the KIA model\n",
-                   oe.why_not_usable().c_str());
-    }
-  }
+  const Result<NdeModel>& r = run.result();
   if (!json.empty()) {
     write_result_json(json, r, "kia");
     std::printf("wrote %s\n", json.c_str());
   }
-  write_report(report, d, r, refine ? "kia+oe" : "kia", set_list, narx_file);
+  write_report(report, d, r, ko.refine ? "kia+oe" : "kia", set_list, narx_file);
   if (!r.usable()) {
     std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", r.why_not_usable().c_str());
     return kNotUsable;

@@ -48,3 +48,4 @@
 #include "ctid/validate/crlb.hpp"
 #include "ctid/validate/metrics.hpp"
 #include "ctid/validate/residuals.hpp"
+#include "ctid/validate/uncertainty.hpp"

@@ -15,9 +15,10 @@ from . import _ctid
 from ._ctid import (  # noqa: F401  (re-exported)
     CorrelationTest, DeadbeatObserver, FileError, FrequencyData, FsfModel, IdData, InputGenerator, InvalidArgument,
     InvalidOptions, MisoModel, ModalModel, ModalWindow, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm,
-    NonlinearCorrelationTests, PhysicalModel, TransferFunction, add_noise_snr, fit_percent, html_report,
-    input_residual_crosscorrelation, load, narx_candidates, narx_noise_candidates, nonlinear_correlation_tests,
-    one_sided_dft, piecewise_constant_windows, prbs, read_narx_json, read_nde_json, residual_autocorrelation, time_grid,
+    NonlinearCorrelationTests, PhysicalModel, TransferFunction, add_noise_snr, fit_percent, frequency_grid, html_report,
+    input_residual_crosscorrelation, load, magnitude_band, narx_candidates, narx_noise_candidates,
+    nonlinear_correlation_tests, one_sided_dft, piecewise_constant_windows, prbs, read_narx_json, read_nde_json,
+    residual_autocorrelation, response_horizon, time_grid,
 )
 
 __version__ = _ctid.__version__
@@ -284,6 +285,17 @@ def kia_cubic(narx, model, **options):
     if "candidates" in options:
         options["candidates"] = _terms(NdeTerm, options["candidates"])
     return _ctid.kia_cubic(narx, model, _options(_ctid.KiaCubicOptions, "kia_cubic", options))
+
+
+def kia(data, narx, **options):
+    """The whole Kernel Invariance workflow (as `ctid fit --method kia`): stages, stacking, the check that the
+    equation reproduces its NARX model, and the output-error refinement. Options: KiaOptions, e.g.
+    linear=dict(y_order=2), quadratic=dict(candidates=['y^2', 'y*Dy']), cubic=dict(candidates=['y^3']), refine=True.
+    Returns a KiaRun; its result() is the answer."""
+    for stage in ("quadratic", "cubic"):
+        if isinstance(options.get(stage), dict) and "candidates" in options[stage]:
+            options[stage] = dict(options[stage], candidates=_terms(NdeTerm, options[stage]["candidates"]))
+    return _ctid.kia(data, narx, _options(_ctid.KiaOptions, "kia", options))
 
 
 def nde_oe(data, initial, **options):

@@ -4,8 +4,8 @@ Every function draws on `ax` (or new axes) and returns the axes it drew on.
 """
 import numpy as np
 
-from . import FsfModel, InvalidArgument, MisoModel, TransferFunction, input_residual_crosscorrelation, \
-    residual_autocorrelation, simulate
+from . import FsfModel, InvalidArgument, MisoModel, TransferFunction, frequency_grid, input_residual_crosscorrelation, \
+    magnitude_band, residual_autocorrelation, response_horizon, simulate
 
 
 def _axes(ax, n=1):
@@ -51,23 +51,6 @@ def residuals(data, model, max_lag=25, ax=None):
     return axes
 
 
-def _tf_samples(result, n=200, seed=0):
-    """Transfer functions drawn from the parameter covariance of a transfer-function result."""
-    p = result.parameters
-    g = result.model
-    if p.covariance.size == 0 or not np.all(np.isfinite(p.covariance)):
-        return []
-    idx = {name: i for i, name in enumerate(p.names)}
-    draws = np.random.default_rng(seed).multivariate_normal(p.values, p.covariance, size=n, check_valid="ignore")
-    out = []
-    for v in draws:
-        den = np.concatenate(([1.0], [v[idx[f"a{i}"]] if f"a{i}" in idx else c
-                                      for i, c in enumerate(g.den[1:], start=1)]))
-        num = np.array([v[idx[f"b{j}"]] if f"b{j}" in idx else c for j, c in enumerate(g.num)])
-        out.append(TransferFunction(num, den, g.delay))
-    return out
-
-
 def bode(model, w=None, confidence=True, ax=None):
     """Bode magnitude (dB) and phase (deg); with confidence=True a band of +-2 std (FSF: from the
     parameter covariance exactly; transfer-function results: 2.5-97.5 % of 200 draws from it)."""
@@ -76,9 +59,7 @@ def bode(model, w=None, confidence=True, ax=None):
     if w is None:
         if isinstance(m, (TransferFunction, MisoModel)):
             poles = np.concatenate([g.poles() for g in m.channels]) if isinstance(m, MisoModel) else m.poles()
-            mag = np.abs(poles) if poles.size else np.array([1.0])
-            mag = mag[mag > 0] if np.any(mag > 0) else np.array([1.0])
-            w = np.logspace(np.log10(mag.min()) - 2, np.log10(mag.max()) + 2, 400)
+            w = frequency_grid(poles, 0.0, 400)  # the report's grid
         elif isinstance(m, FsfModel):
             w = np.linspace(0.5 * 2 * np.pi / m.T, np.pi / m.delta * 0.95, 400)
         else:
@@ -93,10 +74,9 @@ def bode(model, w=None, confidence=True, ax=None):
             band = 2 * np.hypot(s.real, s.imag)
             lo, hi = np.maximum(np.abs(h) - band, 1e-300), np.abs(h) + band
         elif isinstance(m, TransferFunction) and hasattr(model, "parameters"):
-            draws = _tf_samples(model)
-            if draws:
-                mags = np.array([np.abs(g.freqresp(w)) for g in draws])
-                lo, hi = np.percentile(mags, 2.5, axis=0), np.percentile(mags, 97.5, axis=0)
+            band = magnitude_band(model, w)  # the report's band: 2.5-97.5 % of 200 seeded draws
+            if band is not None:
+                lo, hi = band
         if lo is not None:
             axes[0].fill_between(w, 20 * np.log10(lo), 20 * np.log10(hi), alpha=0.25, lw=0)
     axes[0].set_ylabel("magnitude (dB)")
@@ -112,10 +92,7 @@ def _response(kind, model, t, ax):
         if isinstance(m, FsfModel):
             t = np.linspace(0, m.T, 400)
         elif isinstance(m, (TransferFunction, MisoModel)):
-            poles = np.concatenate([g.poles() for g in m.channels]) if isinstance(m, MisoModel) else m.poles()
-            re = np.abs(np.real(poles))
-            re = re[re > 0]
-            t = np.linspace(0, 8 / re.min() if re.size else 10.0, 400)
+            t = np.linspace(0, response_horizon(m.channels if isinstance(m, MisoModel) else [m], 10.0), 400)
         else:
             raise InvalidArgument(f"{kind}: give t for a {type(m).__name__}")
     y = m.step(t) if kind == "step" else m.impulse(t)

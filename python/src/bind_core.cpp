@@ -140,6 +140,20 @@ void bind_core(py::module_& m) {
       .def_readonly("u2_e2", &NonlinearCorrelationTests::u2_e2)
       .def("passed", &NonlinearCorrelationTests::passed);
   m.def("nonlinear_correlation_tests", &nonlinear_correlation_tests, py::arg("u"), py::arg("e"), py::arg("max_lag") = 20);
+
+  // Response views shared with the HTML report (validate/uncertainty.hpp).
+  m.def("frequency_grid", &frequency_grid, py::arg("poles"), py::arg("w_max") = 0.0, py::arg("n") = 300,
+        "n log-spaced rad/s from two decades below the slowest to two above the fastest pole magnitude (<= w_max).");
+  m.def("response_horizon", &response_horizon, py::arg("models"), py::arg("fallback"),
+        "8 slowest stable time constants plus the largest delay of the transfer functions (s); fallback otherwise.");
+  m.def(
+      "magnitude_band",
+      [](const Result<TransferFunction>& r, const Eigen::VectorXd& w, double level, int draws, unsigned seed) {
+        const MagnitudeBand b = magnitude_band(r, w, level, draws, seed);
+        return b.empty() ? py::object(py::none()) : py::object(py::make_tuple(b.lower, b.upper));
+      },
+      py::arg("result"), py::arg("w"), py::arg("level") = 0.95, py::arg("draws") = 200, py::arg("seed") = 1,
+      "(lower, upper) of |G(jw)| over draws from the parameter covariance, or None when the result has none.");
 }
 
 }  // namespace ctid::python

@@ -164,6 +164,23 @@ void bind_nonlinear(py::module_& m) {
   m.def("nde_oe", [](const IdData& d, const NdeModel& initial, const NdeOeOptions& o) {
           return interruptible([&] { return nde_oe(d, initial, o); });
         }, py::arg("data"), py::arg("initial"), py::arg("options") = NdeOeOptions{});
+
+  py::class_<KiaOptions>(m, "KiaOptions")
+      .def(py::init<>())
+      .def_readwrite("linear", &KiaOptions::linear)
+      .def_readwrite("quadratic", &KiaOptions::quadratic)
+      .def_readwrite("cubic", &KiaOptions::cubic)
+      .def_readwrite("refine", &KiaOptions::refine)
+      .def_readwrite("refinement", &KiaOptions::refinement);
+  py::class_<KiaRun>(m, "KiaRun", "The KIA workflow's stages: reconstructed, narx_fit_percent, refined, result().")
+      .def_readonly("reconstructed", &KiaRun::reconstructed)
+      .def_readonly("narx_fit_percent", &KiaRun::narx_fit_percent)
+      .def_readonly("refined", &KiaRun::refined)
+      .def("result", &KiaRun::result, py::return_value_policy::reference_internal,
+           "The refinement when it is usable, the reconstructed equation otherwise.");
+  m.def("kia", [](const IdData& d, const NarxModel& narx, const KiaOptions& o) {
+          return interruptible([&] { return kia(d, narx, o); }, OnInterrupt::Raise);
+        }, py::arg("data"), py::arg("narx"), py::arg("options") = KiaOptions{});
 }
 
 }  // namespace ctid::python

@@ -11,6 +11,8 @@
 
 #include "ctid/core/check.hpp"
 #include "ctid/estimate/gfrf.hpp"
+#include "ctid/simulate/lsim.hpp"
+#include "ctid/validate/metrics.hpp"
 
 namespace ctid {
 
@@ -387,6 +389,59 @@ Result<NdeModel> kia_cubic(const NarxModel& narx, const NdeModel& model_in, cons
   std::vector<int> keep;
   const Gls g = fit_and_prune(P, z, v, o.gls_order, o.max_iterations, o.tolerance, o.err_threshold, keep);
   return extended(model, o.candidates, keep, g, t_start);
+}
+
+KiaRun kia(const IdData& d, const NarxModel& narx, const KiaOptions& o) {
+  CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "kia: needs one input and one output (the data have {} and {})", d.nu(), d.ny());
+  CTID_REQUIRE(std::abs(narx.ts() - d.ts()) <= 1e-9 * d.ts(),
+               "kia: the NARX model was identified at Ts = {} s, the data have {} s", narx.ts(), d.ts());
+  KiaRun run;
+  Result<NdeModel>& r = run.reconstructed;
+  r = kia_linear(narx, o.linear);
+  // Each higher stage returns its own coefficients; the earlier stages' are prepended to its table.
+  auto stack = [](const Result<NdeModel>& before, Result<NdeModel> next) {
+    next.parameters.names.insert(next.parameters.names.begin(), before.parameters.names.begin(),
+                                 before.parameters.names.end());
+    Eigen::VectorXd v(before.parameters.size() + next.parameters.values.size());
+    v << before.parameters.values, next.parameters.values;
+    next.parameters.values = v;
+    next.parameters.std = Eigen::VectorXd::Constant(v.size(), NAN);
+    next.parameters.fixed.assign(static_cast<size_t>(v.size()), false);
+    Eigen::VectorXd e(v.size());
+    e << before.diagnostics.vectors.at("err"), next.diagnostics.vectors.at("err");
+    next.diagnostics.vectors["err"] = e;
+    return next;
+  };
+  if (!o.quadratic.candidates.empty()) r = stack(r, kia_quadratic(narx, r.model, o.quadratic));
+  if (!o.cubic.candidates.empty()) r = stack(r, kia_cubic(narx, r.model, o.cubic));
+  // The equation's simulated output on the record.
+  const Eigen::VectorXd t = (d.times().array() - d.t0()).matrix();
+  const NdeSimulation sim = r.model.simulate(d.u().col(0), t, d.intersample(0));
+  if (!sim.ok()) {
+    r.summary.termination = sim.termination;
+    r.summary.message = "the NDE simulation failed: " + sim.message;
+    r.fit = fit_report_or_inf(d.y().col(0), Eigen::VectorXd::Constant(d.size(), NAN), r.parameters.size());
+  } else {
+    r.fit = fit_report_or_inf(d.y().col(0), sim.y, r.parameters.size());
+  }
+  // Kernel invariance means the equation reproduces its NARX model.
+  const int L = narx.max_lag();
+  if (d.size() > L + 2) {
+    bool escaped = false;
+    const Eigen::VectorXd yn = narx.simulate(d.u().col(0), d.y().col(0).head(L), &escaped);
+    if (!escaped)
+      run.narx_fit_percent = fit_report_or_inf(d.y().col(0).tail(d.size() - L), yn.tail(d.size() - L), 0).fit_percent;
+  }
+  if (sim.ok() && run.narx_fit_percent > 0 && r.fit.fit_percent < 0.5 * run.narx_fit_percent) {
+    r.summary.termination = Termination::Unidentifiable;
+    r.summary.message = detail::format(
+        "the continuous-time equation does not reproduce its NARX model (simulated fit {} % against the NARX "
+        "model's {} %): its candidate terms cannot express the NARX kernels (y_order, u_order, quadratic, cubic), "
+        "or the sampling is too slow for kernel invariance",
+        std::round(r.fit.fit_percent * 100) / 100, std::round(run.narx_fit_percent * 100) / 100);
+  }
+  if (o.refine) run.refined = nde_oe(d, r.model, o.refinement);
+  return run;
 }
 
 }  // namespace ctid

@@ -169,34 +169,6 @@ TransferFunction stabilized(const TransferFunction& tf) {
   return TransferFunction(tf.num(), Polynomial::from_roots(p), tf.io_delay());
 }
 
-std::vector<TfCoefficient> tf_coefficients(const TransferFunction& g, const ParameterSet& p) {
-  const Eigen::VectorXd& den = g.den().coefficients();
-  const Eigen::VectorXd& num = g.num().coefficients();
-  if (den.size() == 0 || den(0) != 1.0) return {};
-  std::vector<TfCoefficient> map(static_cast<size_t>(p.size()));
-  for (int i = 0; i < p.size(); ++i) {
-    const std::string& n = p.names[static_cast<size_t>(i)];
-    if (n.size() < 2 || n.size() > 7 || (n[0] != 'a' && n[0] != 'b') ||
-        n.find_first_not_of("0123456789", 1) != std::string::npos)
-      continue;  // e.g. "delay"
-    const int k = std::stoi(n.substr(1));
-    const Eigen::VectorXd& c = n[0] == 'a' ? den : num;
-    if (k < (n[0] == 'a' ? 1 : 0) || k >= c.size() ||
-        std::abs(c(k) - p.values(i)) > 1e-9 * std::max(1.0, std::abs(c(k))))
-      return {};
-    map[static_cast<size_t>(i)] = {n[0], k};
-  }
-  return map;
-}
-
-TransferFunction with_coefficients(const TransferFunction& g, const std::vector<TfCoefficient>& map,
-                                   const Eigen::VectorXd& v) {
-  Eigen::VectorXd num = g.num().coefficients(), den = g.den().coefficients();
-  for (size_t i = 0; i < map.size(); ++i)
-    if (map[i].poly) (map[i].poly == 'a' ? den : num)(map[i].index) = v(static_cast<Eigen::Index>(i));
-  return TransferFunction(num, den, g.io_delay());
-}
-
 }  // namespace ctid::tf_detail
 
 namespace ctid::tf_detail {

@@ -9,6 +9,7 @@
 #include "ctid/data/iddata.hpp"
 #include "ctid/estimate/orders.hpp"
 #include "ctid/model/transfer_function.hpp"
+#include "ctid/validate/uncertainty.hpp"
 
 namespace ctid::tf_detail {
 
@@ -20,20 +21,6 @@ TransferFunction tf_of(const Eigen::VectorXd& p, const TfOrders& o, double delay
 double output_error_mse(const TransferFunction& g, const IdData& d);
 /// Mirror unstable poles into the left half plane (prefilters and auxiliary models must be stable).
 TransferFunction stabilized(const TransferFunction& tf);
-
-/// Which transfer-function coefficient each parameter of p is: for a parameter named a<k> (denominator
-/// coefficient k, descending, of a monic denominator) or b<k> (numerator coefficient k) whose value equals
-/// that coefficient of g, {'a' or 'b', k}; other names (e.g. "delay") get {0, -1} and are held at g's value.
-/// Returns an empty vector when g's denominator is not monic or a name a<k>/b<k> does not match g (another
-/// parameterisation, e.g. physical parameters).
-struct TfCoefficient {
-  char poly = 0;  // 'a' (denominator), 'b' (numerator) or 0 (not a coefficient)
-  int index = -1;
-};
-std::vector<TfCoefficient> tf_coefficients(const TransferFunction& g, const ParameterSet& p);
-/// g with the coefficients named by map (from tf_coefficients) set to v.
-TransferFunction with_coefficients(const TransferFunction& g, const std::vector<TfCoefficient>& map,
-                                   const Eigen::VectorXd& v);
 
 /// "p1, p2, ..." (6 significant digits, complex poles as re+imj).
 std::string poles_text(const TransferFunction& g);

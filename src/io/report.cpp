@@ -8,7 +8,6 @@
 #include <cmath>
 #include <complex>
 #include <numbers>
-#include <random>
 #include <sstream>
 
 #include "ctid/core/check.hpp"
@@ -16,7 +15,7 @@
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/validate/metrics.hpp"
 #include "ctid/validate/residuals.hpp"
-#include "estimate/tf_common.hpp"
+#include "ctid/validate/uncertainty.hpp"
 
 namespace ctid {
 
@@ -380,23 +379,6 @@ void validation(Page& page, const IdData& d, const Eigen::VectorXd& yhat, const 
   }
 }
 
-// Log-spaced angular frequencies two decades around the magnitudes of the given poles.
-Eigen::VectorXd frequency_grid(const Eigen::VectorXcd& poles, double w_max_limit, int n = 300) {
-  double lo = INFINITY, hi = 0;
-  for (const auto& p : poles)
-    if (std::abs(p) > 0) {
-      lo = std::min(lo, std::abs(p));
-      hi = std::max(hi, std::abs(p));
-    }
-  if (!(hi > 0)) lo = hi = 1.0;
-  double a = std::log10(lo) - 2, b = std::log10(hi) + 2;
-  if (w_max_limit > 0) b = std::min(b, std::log10(w_max_limit));
-  if (b <= a) a = b - 3;
-  Eigen::VectorXd w(n);
-  for (int i = 0; i < n; ++i) w(i) = std::pow(10.0, a + (b - a) * i / (n - 1));
-  return w;
-}
-
 // Bode magnitude and (unwrapped) phase of one or more responses hs = {(label, H(jw))} on the grid w; the
 // 95 % magnitude band (lo_mag, hi_mag) goes with a single response.
 void bode(Page& page, const Eigen::VectorXd& w, const std::vector<std::pair<std::string, Eigen::VectorXcd>>& hs,
@@ -430,13 +412,9 @@ void bode(Page& page, const Eigen::VectorXd& w, const std::vector<std::pair<std:
 // Step and impulse responses of the given channels over 8 slowest time constants (+ delay).
 void time_responses(Page& page, const std::vector<std::pair<std::string, TransferFunction>>& gs, double fallback) {
   page.section("Step and impulse responses");
-  double slow = INFINITY, delay = 0;
-  for (const auto& [label, g] : gs) {
-    for (const auto& p : g.poles())
-      if (p.real() < 0) slow = std::min(slow, -p.real());
-    delay = std::max(delay, g.io_delay());
-  }
-  const double horizon = std::isfinite(slow) ? 8.0 / slow + delay : fallback;
+  std::vector<TransferFunction> models;
+  for (const auto& [label, g] : gs) models.push_back(g);
+  const double horizon = response_horizon(models, fallback);
   const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(400, 0.0, horizon);
   std::vector<Series> step, impulse;
   for (const auto& [label, g] : gs) {
@@ -461,32 +439,8 @@ std::string html_report(const IdData& d, const Result<TransferFunction>& r, cons
   const Eigen::VectorXd w = frequency_grid(r.model.poles(), nyquist(d));
   const Eigen::VectorXcd h = r.model.frequency_response(w);
   // 95 % band of |G| from 200 draws of the parameter covariance (seeded: the report is reproducible).
-  Eigen::VectorXd lo, hi;
-  const int P = r.parameters.size();
-  const std::vector<tf_detail::TfCoefficient> map = tf_detail::tf_coefficients(r.model, r.parameters);
-  if (P > 0 && r.parameters.covariance.rows() == P && r.parameters.covariance.allFinite() && !map.empty()) {
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(r.parameters.covariance);
-    const Eigen::MatrixXd L = es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
-    std::mt19937 rng(1);
-    std::normal_distribution<double> n01;
-    const int K = 200;
-    Eigen::MatrixXd mags(K, w.size());
-    for (int k = 0; k < K; ++k) {
-      Eigen::VectorXd z(P);
-      for (auto& v : z) v = n01(rng);
-      const TransferFunction g = tf_detail::with_coefficients(r.model, map, r.parameters.values + L * z);
-      mags.row(k) = g.frequency_response(w).cwiseAbs().transpose();
-    }
-    lo.resize(w.size());
-    hi.resize(w.size());
-    for (Eigen::Index j = 0; j < w.size(); ++j) {
-      std::vector<double> c(mags.col(j).data(), mags.col(j).data() + K);
-      std::sort(c.begin(), c.end());
-      lo(j) = c[static_cast<size_t>(0.025 * K)];
-      hi(j) = c[static_cast<size_t>(0.975 * K) - 1];
-    }
-  }
-  bode(page, w, {{"G(jw)", h}}, lo.size() ? &lo : nullptr, hi.size() ? &hi : nullptr);
+  const MagnitudeBand band = magnitude_band(r, w);
+  bode(page, w, {{"G(jw)", h}}, band.empty() ? nullptr : &band.lower, band.empty() ? nullptr : &band.upper);
   time_responses(page, {{"G", r.model}}, d.duration());
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }

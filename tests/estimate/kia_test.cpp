@@ -138,15 +138,27 @@ Eigen::MatrixXd end_to_end(unsigned seed, double snr_db) {
   const auto cand = narx_candidates(2, 6, 6);
   const FrolsOptions fo{.max_terms = 20, .criterion = InformationCriterion::Aic};
   const NarxModel narx = (snr_db > 0 ? narmax(d, cand, {.frols = fo}) : frols(d, cand, fo)).model.process();
-  const auto lin = kia_linear(narx, {.y_order = 2, .u_order = 0});  // hold factor on: the data were held
-  const auto q = kia_quadratic(narx, lin.model, {.candidates = {NdeTerm::parse("y^2"), NdeTerm::parse("y*Dy")}});
-  const auto refined = nde_oe(d, q.model);
+  // The library workflow (what the CLI and Python run): linear stage (hold factor on: the data were held),
+  // quadratic stage, simulation, the NARX-fidelity check and the output-error refinement.
+  KiaOptions ko;
+  ko.linear = {.y_order = 2, .u_order = 0};
+  ko.quadratic.candidates = {NdeTerm::parse("y^2"), NdeTerm::parse("y*Dy")};
+  const KiaRun run = kia(d, narx, ko);
+  EXPECT_TRUE(std::isfinite(run.narx_fit_percent));
+  if (snr_db <= 0) {  // noise-free: the equation reproduces its NARX model (fits measured 99.9 % and 99.98 %)
+    EXPECT_TRUE(run.reconstructed.usable()) << run.reconstructed.why_not_usable();
+    EXPECT_GT(run.reconstructed.fit.fit_percent, 0.9 * run.narx_fit_percent);
+  }
+  EXPECT_EQ(run.reconstructed.parameters.size(), 5);  // Dy, D^2y, u, then y^2, y*Dy stacked
+  EXPECT_TRUE(run.refined.has_value());
+  const Result<NdeModel>& refined = *run.refined;
   EXPECT_TRUE(refined.usable()) << refined.why_not_usable();
-  const NdeModel kia = q.model.normalized();
+  EXPECT_EQ(&run.result(), &refined);
+  const NdeModel equation = run.reconstructed.model.normalized();
   Eigen::MatrixXd e(2, 5);
   int i = 0;
   for (const char* s : {"Dy", "D^2y", "u", "y^2", "y*Dy"}) {
-    e(0, i) = std::abs(kia.coefficient(s) / truth.coefficient(s) - 1);
+    e(0, i) = std::abs(equation.coefficient(s) / truth.coefficient(s) - 1);
     e(1, i++) = std::abs(refined.model.coefficient(s) / truth.coefficient(s) - 1);
   }
   return e;

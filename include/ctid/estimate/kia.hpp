@@ -11,9 +11,13 @@
 #pragma once
 
 #include <complex>
+#include <limits>
+#include <optional>
 #include <vector>
 
 #include "ctid/core/types.hpp"
+#include "ctid/data/iddata.hpp"
+#include "ctid/estimate/nde_oe.hpp"
 #include "ctid/model/narx.hpp"
 #include "ctid/model/nde.hpp"
 
@@ -92,5 +96,34 @@ struct KiaCubicOptions {
 /// quadratic terms' contribution through H_1 and H_2, C: minus the six orderings of first-order products;
 /// NdeModel::h3). Returns model + the retained cubic terms (normalised).
 Result<NdeModel> kia_cubic(const NarxModel& narx, const NdeModel& model, const KiaCubicOptions& options);
+
+/// The whole workflow from a record and the NARX model identified from it (what `ctid fit --method kia` and
+/// Python's ctid.kia run): the linear stage, the quadratic and cubic stages when they have candidates, stacked
+/// into one equation; its simulation on the record; the check that it reproduces its NARX model; and the
+/// output-error refinement (nde_oe, consistent under output noise), which replaces the equation when usable.
+struct KiaOptions {
+  KiaLinearOptions linear;
+  KiaQuadraticOptions quadratic;  ///< no candidates: no quadratic stage
+  KiaCubicOptions cubic;          ///< no candidates: no cubic stage
+  bool refine = true;             ///< refine the reconstructed equation by output error on the record
+  NdeOeOptions refinement;
+};
+
+struct KiaRun {
+  /// The reconstructed equation: every stage's coefficients (no standard deviations), diagnostics.vectors "err"
+  /// (ERR % of each), fit = its simulated output on the record. Not usable when the simulation fails, or when its
+  /// fit is below half of the NARX model's free-run fit on the same record: then it does not reproduce its NARX
+  /// model (candidate terms that cannot express the kernels, or sampling too slow for kernel invariance).
+  Result<NdeModel> reconstructed;
+  /// The NARX model's free-run fit (%) on the record after its first max_lag samples; -Inf when it escapes.
+  double narx_fit_percent = -std::numeric_limits<double>::infinity();
+  std::optional<Result<NdeModel>> refined;  ///< the output-error refinement (options.refine), usable or not
+  /// The answer: the refinement when it is usable, the reconstructed equation otherwise.
+  const Result<NdeModel>& result() const { return refined && refined->usable() ? *refined : reconstructed; }
+};
+
+/// Throws InvalidArgument for a record that is not SISO, a NARX model identified at another sampling period,
+/// and the stages' errors (kia_linear, kia_quadratic, kia_cubic).
+KiaRun kia(const IdData& data, const NarxModel& narx, const KiaOptions& options = {});
 
 }  // namespace ctid

@@ -1,0 +1,52 @@
+// ctid — what every view of an estimated transfer function needs besides the model: which parameter is which
+// coefficient, the frequency grid and time horizon of its responses, and the band of its frequency response
+// from the parameter covariance. One implementation for the HTML report (io/report) and Python (ctid.plot).
+#pragma once
+
+#include <Eigen/Dense>
+#include <vector>
+
+#include "ctid/core/types.hpp"
+#include "ctid/model/transfer_function.hpp"
+
+namespace ctid {
+
+/// The transfer-function coefficient a parameter is: poly 'a' (denominator, index k of a monic denominator in
+/// descending powers, k >= 1) or 'b' (numerator, index k), or poly 0 for a parameter that is not a coefficient
+/// (e.g. "delay").
+struct TfCoefficient {
+  char poly = 0;
+  int index = -1;
+};
+
+/// For each parameter named a<k> or b<k> whose value equals that coefficient of g, where it sits in g; other
+/// names (e.g. "delay") get poly 0. Returns an empty vector when g's denominator is not monic or a name a<k>/b<k>
+/// does not match g (another parameterisation, e.g. physical parameters).
+std::vector<TfCoefficient> tf_coefficients(const TransferFunction& g, const ParameterSet& p);
+
+/// g with the coefficients named by map (from tf_coefficients) set to the values v (one per parameter).
+TransferFunction with_coefficients(const TransferFunction& g, const std::vector<TfCoefficient>& map, const Eigen::VectorXd& v);
+
+/// n log-spaced angular frequencies (rad/s) from two decades below the smallest to two decades above the largest
+/// nonzero pole magnitude (1 rad/s when there is none), ending at w_max when w_max > 0 (e.g. the Nyquist
+/// frequency of the data). Throws InvalidArgument for n < 2.
+Eigen::VectorXd frequency_grid(const Eigen::VectorXcd& poles, double w_max = 0.0, int n = 300);
+
+/// Time horizon (s) of step and impulse plots: 8 times the slowest stable time constant of the models plus their
+/// largest delay; `fallback` when none has a stable pole.
+double response_horizon(const std::vector<TransferFunction>& models, double fallback);
+
+/// Pointwise band of |G(jw)|: lower and upper are empty when it cannot be computed.
+struct MagnitudeBand {
+  Eigen::VectorXd lower, upper;
+  bool empty() const { return lower.size() == 0; }
+};
+
+/// The central `level` band of |G(jw)| at w over `draws` transfer functions whose estimated coefficients are drawn
+/// from N(values, covariance) of r (fixed parameters and non-coefficients held; a seeded generator, so the band is
+/// reproducible). Empty when r has no finite covariance of its parameters' size or none of its parameters is a
+/// coefficient of its model (e.g. physical parameters). Throws InvalidArgument for level outside (0, 1) or draws < 10.
+MagnitudeBand magnitude_band(const Result<TransferFunction>& r, const Eigen::VectorXd& w, double level = 0.95,
+                             int draws = 200, unsigned seed = 1);
+
+}  // namespace ctid
