@@ -1,0 +1,149 @@
+// El-Shafey (1987): poles from a free-response data matrix with Newton's characteristic polynomial and the
+// deflation by a known generator (ES-C9, ES 4.50-4.62), and Prony's method for comparison.
+#include "ctid/estimate/modal.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <numbers>
+
+#include "ctid/core/check.hpp"
+#include "estimate/modal_common.hpp"
+
+namespace ctid {
+
+using namespace modal_detail;
+
+Polynomial newton_characteristic_polynomial(const Eigen::MatrixXd& M) {
+  CTID_REQUIRE(M.rows() == M.cols() && M.rows() >= 1, "newton_characteristic_polynomial: needs a square matrix (got {}x{})",
+               M.rows(), M.cols());
+  const int n = static_cast<int>(M.rows());
+  Eigen::VectorXd T(n + 1);  // T(k) = trace(M^k)
+  Eigen::MatrixXd Mk = Eigen::MatrixXd::Identity(n, n);
+  for (int k = 1; k <= n; ++k) {
+    Mk = Mk * M;
+    T(k) = Mk.trace();
+  }
+  // c(k) = coefficient of s^{n-k} (c(0) = 1): c_k = -(c_{k-1} T_1 + c_{k-2} T_2 + ... + c_1 T_{k-1} + T_k) / k.
+  Eigen::VectorXd c = Eigen::VectorXd::Zero(n + 1);
+  c(0) = 1.0;
+  for (int k = 1; k <= n; ++k) {
+    double s = T(k);
+    for (int i = 1; i < k; ++i) s += c(k - i) * T(i);
+    c(k) = -s / k;
+  }
+  return Polynomial(c);
+}
+
+namespace {
+// Deflate the augmented polynomial by the generator's: least squares on the coefficients of
+// P_a = P * P_c with P monic of degree deg(P_a) - deg(P_c) (ES 4.56-4.62).
+Polynomial deflate(const Polynomial& Pa, const Polynomial& Pc) {
+  const int na = Pa.degree(), ncg = Pc.degree(), n = na - ncg;
+  const Eigen::VectorXd pc = Pc.monic().coefficients(), pa = Pa.monic().coefficients();
+  // pa = conv([1, x_1..x_n], pc): unknowns x (coefficients of s^{n-1} .. s^0).
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(na + 1, n);
+  Eigen::VectorXd b = pa;
+  for (int i = 0; i <= ncg; ++i) b(i) -= pc(i);  // the leading 1 times pc
+  for (int k = 0; k < n; ++k)
+    for (int i = 0; i <= ncg; ++i) A(k + 1 + i, k) += pc(i);
+  const Eigen::VectorXd x = A.colPivHouseholderQr().solve(b);
+  Eigen::VectorXd c(n + 1);
+  c << 1.0, x;
+  return Polynomial(c);
+}
+}  // namespace
+
+void FreeResponseOptions::validate() const {
+  CTID_REQUIRE_OPTION(shifts.size() >= 1, "free_response_poles: at least one shift is needed");
+  for (Eigen::Index i = 0; i < shifts.size(); ++i)
+    for (Eigen::Index k = 0; k < i; ++k)
+      CTID_REQUIRE_OPTION(shifts(i) != shifts(k), "free_response_poles: shifts {} and {} are equal ({} s)", k + 1, i + 1,
+                          shifts(i));
+  CTID_REQUIRE_OPTION(std::isfinite(interval) && interval > 0, "free_response_poles: interval must be > 0 (got {} s)",
+                      interval);
+  CTID_REQUIRE_OPTION(std::isfinite(spacing) && spacing > 0, "free_response_poles: spacing must be > 0 (got {} s)",
+                      spacing);
+  CTID_REQUIRE_OPTION(pairs >= shifts.size(), "free_response_poles: {} instant pairs for {} shifts (need at least one "
+                      "pair per shift)", pairs, shifts.size());
+  CTID_REQUIRE_OPTION(generator.degree() < shifts.size(), "free_response_poles: the generator polynomial has degree {} "
+                      "but the augmented order is only {}", generator.degree(), shifts.size());
+}
+
+PoleEstimate free_response_poles(const Eigen::VectorXd& y, double Ts, const FreeResponseOptions& o) {
+  o.validate();
+  CTID_REQUIRE(std::isfinite(Ts) && Ts > 0, "free_response_poles: Ts must be > 0 (got {})", Ts);
+  CTID_REQUIRE(y.allFinite(), "free_response_poles: the response has non-finite samples");
+  const int n = static_cast<int>(o.shifts.size()), N = static_cast<int>(y.size());
+  Eigen::VectorXi lag(n);
+  for (int i = 0; i < n; ++i) lag(i) = samples_of(o.shifts(i), Ts, "shift T_" + std::to_string(i + 1));
+  const int i0 = samples_of(o.start, Ts, "start"), K = samples_of(o.interval, Ts, "interval"),
+            step = samples_of(o.spacing, Ts, "spacing");
+  const int last = i0 + (o.pairs - 1) * step + K;
+  CTID_REQUIRE(i0 - lag.maxCoeff() >= 0 && last - lag.minCoeff() <= N - 1,
+               "free_response_poles: the shifted instants span samples [{}, {}] but the record has samples [0, {}]",
+               i0 - lag.maxCoeff(), last - lag.minCoeff(), N - 1);
+  const Eigen::VectorXd wq = quadrature_weights(K, Ts, o.quadrature);
+  Eigen::MatrixXd Y(n, o.pairs), Z(n, o.pairs);
+  for (int k = 0; k < o.pairs; ++k) {
+    const int a = i0 + k * step;
+    for (int i = 0; i < n; ++i) {
+      Y(i, k) = y(a + K - lag(i)) - y(a - lag(i));
+      Z(i, k) = wq.dot(y.segment(a - lag(i), K + 1));
+    }
+  }
+  PoleEstimate r;
+  const Eigen::MatrixXd ZZ = Z * Z.transpose();
+  r.condition = condition_2(ZZ);
+  r.lambda = ZZ.transpose().colPivHouseholderQr().solve(Z * Y.transpose()).transpose();  // Y Z^T (Z Z^T)^{-1}
+  r.all_poles = Eigen::EigenSolver<Eigen::MatrixXd>(r.lambda, false).eigenvalues();
+  r.augmented = newton_characteristic_polynomial(r.lambda);
+  r.characteristic = o.generator.degree() > 0 ? deflate(r.augmented, o.generator) : r.augmented;
+  r.poles = r.characteristic.degree() > 0 ? r.characteristic.roots() : Eigen::VectorXcd(0);
+  if (r.condition > 1e12)
+    r.warnings.push_back(detail::format("Z Z^T is nearly singular (condition {}): the response does not excite {} modes "
+                                        "in the chosen instants, or the shifts are badly placed", r.condition, n));
+  return r;
+}
+
+PoleEstimate prony(const Eigen::VectorXd& y, double Ts, const PronyOptions& o) {
+  CTID_REQUIRE(std::isfinite(Ts) && Ts > 0, "prony: Ts must be > 0 (got {})", Ts);
+  CTID_REQUIRE(o.order >= 1 && o.spacing >= 1 && o.equations >= o.order && o.start >= 0,
+               "prony: needs order >= 1, spacing >= 1, equations >= order, start >= 0 (got {}, {}, {}, {})", o.order,
+               o.spacing, o.equations, o.start);
+  const long long last = o.start + static_cast<long long>(o.order + o.equations - 1) * o.spacing;
+  CTID_REQUIRE(last < y.size(), "prony: needs samples up to index {} but the record has {}", last, y.size());
+  CTID_REQUIRE(y.allFinite(), "prony: the response has non-finite samples");
+  const int n = o.order;
+  Eigen::MatrixXd R(o.equations, n);
+  Eigen::VectorXd b(o.equations);
+  for (int e = 0; e < o.equations; ++e) {
+    const int m = e + n;  // y(m) + sum_k p_k y(m - k) = 0
+    for (int k = 1; k <= n; ++k) R(e, k - 1) = y(o.start + (m - k) * o.spacing);
+    b(e) = -y(o.start + m * o.spacing);
+  }
+  PoleEstimate r;
+  r.condition = condition_2(R.transpose() * R);
+  const Eigen::VectorXd pk = R.colPivHouseholderQr().solve(b);
+  Eigen::VectorXd c(n + 1);
+  c << 1.0, pk;
+  const Eigen::VectorXcd z = Polynomial(c).roots();
+  const double T = o.spacing * Ts;
+  r.poles.resize(n);
+  for (int k = 0; k < n; ++k) r.poles(k) = std::log(z(k)) / T;
+  // prod (s - s_k), real part (the poles come in conjugate pairs up to round-off).
+  Eigen::VectorXcd e = Eigen::VectorXcd::Zero(n + 1);
+  e(0) = 1.0;
+  for (int k = 0; k < n; ++k)
+    for (int i = k + 1; i >= 1; --i) e(i) -= r.poles(k) * e(i - 1);
+  r.characteristic = Polynomial(Eigen::VectorXd(e.real()));
+  r.all_poles = r.poles;
+  r.augmented = r.characteristic;
+  r.warnings.push_back(detail::format("Prony: imaginary parts are only determined modulo 2 pi / T = {} rad/s; a mode "
+                                      "faster than pi / T = {} rad/s aliases into (-{}, {}]",
+                                      2 * std::numbers::pi / T, std::numbers::pi / T, std::numbers::pi / T,
+                                      std::numbers::pi / T));
+  return r;
+}
+
+}  // namespace ctid
