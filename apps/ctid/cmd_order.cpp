@@ -1,4 +1,4 @@
-// ctid order DATA --nb 1:2 --nf 3:5 [--nk 0:0] [--rank yic|rt2|aic|bic]
+// ctid order DATA --nb 1:2 --nf 3:5 [--nk 0:0] [--rank yic|rt2|aic|bic] [--json OUT.json [--force]]
 #include <cstdio>
 #include <functional>
 
@@ -10,7 +10,8 @@ extern std::function<int()> g_run;
 namespace {
 struct OrderArgs {
   DataArgs data;
-  std::string nb = "1:2", nf = "1:3", nk = "0:0", rank = "yic";
+  std::string nb = "1:2", nf = "1:3", nk = "0:0", rank = "yic", json;
+  bool force = false;
 };
 
 OrderRange parse_range(const std::string& flag, const std::string& s) {
@@ -41,6 +42,7 @@ int run(const OrderArgs& a) {
     throw UsageError(e.what());
   }
   const OrderRange nb = parse_range("--nb", a.nb), nf = parse_range("--nf", a.nf), nk = parse_range("--nk", a.nk);
+  check_outputs({a.json}, {a.data.path}, a.force);
   const IdData d = a.data.load(true);
   if (d.nu() != 1 || d.ny() != 1) throw UsageError("order selection needs one --input and one --output");
   std::vector<OrderCandidate> c;
@@ -54,6 +56,10 @@ int run(const OrderArgs& a) {
   for (const auto& k : c)
     std::printf("%4d  %2d %2d %2d %10.3f %9.4f %11.1f %11.1f %8.2f  %s\n", ++i, k.orders.nb, k.orders.nf, k.orders.nk, k.yic,
                 k.rt2, k.aic, k.bic, k.fit_percent, k.termination.c_str());
+  if (!a.json.empty()) {
+    write_text_file(a.json, order_selection_to_json(c, o.rank_by, interrupt_requested()));
+    std::printf("wrote %s\n", a.json.c_str());
+  }
   if (interrupt_requested()) {
     std::fprintf(stderr, "ctid: interrupted after %zu of the structures; the table ranks those fitted\n", c.size());
     return kNotUsable;
@@ -70,6 +76,8 @@ void setup_order(CLI::App& app) {
   app.add_option("--nf", a->nf, "Model orders: N or MIN:MAX")->capture_default_str();
   app.add_option("--nk", a->nk, "Input delays in samples: N or MIN:MAX")->capture_default_str();
   app.add_option("--rank", a->rank, "Ranking criterion: yic, rt2, aic or bic")->capture_default_str();
+  app.add_option("--json", a->json, "Write the ranked candidates to this JSON file");
+  app.add_flag("--force", a->force, "Overwrite an existing output file");
   app.callback([a] { g_run = [a] { return run(*a); }; });
 }
 

@@ -21,6 +21,16 @@ OrderCriterion order_criterion_from_string(const std::string& s) {
   throw InvalidArgument(detail::format("unknown order criterion '{}' (use yic, rt2, aic or bic)", s));
 }
 
+const char* to_string(OrderCriterion c) {
+  switch (c) {
+    case OrderCriterion::Yic: return "yic";
+    case OrderCriterion::Rt2: return "rt2";
+    case OrderCriterion::Aic: return "aic";
+    case OrderCriterion::Bic: return "bic";
+  }
+  return "yic";
+}
+
 std::vector<OrderCandidate> select_order(const IdData& data, OrderRange nb, OrderRange nf, OrderRange nk,
                                          const OrderSelectionOptions& options) {
   auto check = [](OrderRange r, int lo, const char* name) {

@@ -362,4 +362,17 @@ void write_result_json(const std::string& path, const Result<TransferFunction>& 
   write_text_file(path, result_to_json(r, method) + "\n");
 }
 
+std::string order_selection_to_json(const std::vector<OrderCandidate>& candidates, OrderCriterion rank_by,
+                                    bool interrupted, int indent) {
+  json list = json::array();
+  for (const OrderCandidate& c : candidates)
+    list.push_back({{"nb", c.orders.nb},      {"nf", c.orders.nf},   {"nk", c.orders.nk},
+                    {"yic", num(c.yic)},      {"rt2", num(c.rt2)},   {"aic", num(c.aic)},
+                    {"bic", num(c.bic)},      {"fit_percent", num(c.fit_percent)},
+                    {"usable", c.usable},     {"termination", c.termination}});
+  const json j = {{"type", "order_selection"}, {"rank_by", to_string(rank_by)}, {"interrupted", interrupted},
+                  {"candidates", list}};
+  return j.dump(indent) + "\n";
+}
+
 }  // namespace ctid

@@ -218,6 +218,18 @@ TEST(Cli, SrivcTfestWithDelayAndOrderSelection) {
   const CliRun o = ctid_run("order " + csv14 + " --time t --nb 1:2 --nf 1:3 --nk 13:14");
   ASSERT_EQ(o.code, 0) << o.err;
   EXPECT_NE(o.out.find("   1   1  2 14"), std::string::npos) << o.out;  // rank 1 is [1 2 14]
+  // The same ranking as JSON (issue 14: every command that computes something can write its result).
+  const std::string oj = test::temp_path("order.json");
+  fs::remove(oj);
+  ASSERT_EQ(ctid_run("order " + csv14 + " --time t --nb 1:2 --nf 1:3 --nk 13:14 --rank bic --json " + oj).code, 0);
+  const nlohmann::json ord = nlohmann::json::parse(read_text_file(oj));
+  EXPECT_EQ(ord.at("type"), "order_selection");
+  EXPECT_EQ(ord.at("rank_by"), "bic");
+  ASSERT_EQ(ord.at("candidates").size(), 12u);  // nb 1:2 x nf 1:3 (all with nb <= nf + 1) x nk 13:14
+  EXPECT_EQ(ord.at("candidates")[0].at("nf"), 2);
+  EXPECT_EQ(ord.at("candidates")[0].at("nk"), 14);
+  EXPECT_EQ(ord.at("candidates")[0].at("usable"), true);
+  EXPECT_EQ(ctid_run("order " + csv14 + " --time t --nf 2 --json " + oj).code, 2);  // exists, no --force
   EXPECT_EQ(ctid_run("order " + csv + " --time t --nf 3:1").code, 2);
   EXPECT_EQ(ctid_run("order " + csv + " --time t --nf x").code, 2);
   const CliRun bad = ctid_run("fit " + csv + " --time t --method srivc --delay --set delay_min=2 --set delay_max=1");

@@ -19,6 +19,8 @@ namespace ctid {
 enum class OrderCriterion { Yic, Rt2, Aic, Bic };
 /// "yic", "rt2", "aic", "bic"; throws InvalidArgument otherwise.
 OrderCriterion order_criterion_from_string(const std::string& s);
+/// The name order_criterion_from_string reads ("yic", "rt2", "aic", "bic").
+const char* to_string(OrderCriterion c);
 
 struct OrderCandidate {
   TfOrders orders;

@@ -12,6 +12,7 @@
 #include <variant>
 
 #include "ctid/core/types.hpp"
+#include "ctid/estimate/order_selection.hpp"
 #include "ctid/model/fsf.hpp"
 #include "ctid/model/miso.hpp"
 #include "ctid/model/narx.hpp"
@@ -56,6 +57,11 @@ std::string result_to_json(const Result<NdeModel>& result, const std::string& me
 void write_result_json(const std::string& path, const Result<NdeModel>& result, const std::string& method);
 /// Read a NARX (or NDE) model from a bare model object or a result envelope. Throws FileError naming the
 /// file and the problem (wrong type, a malformed or unknown term name with its position, a missing member).
+/// Order selection (ctid order --json): {"type": "order_selection", "rank_by": "yic", "interrupted": false,
+/// "candidates": [{"nb", "nf", "nk", "yic", "rt2", "aic", "bic", "fit_percent", "usable", "termination"}, ...]} in
+/// rank order (non-finite numbers as null).
+std::string order_selection_to_json(const std::vector<OrderCandidate>& candidates, OrderCriterion rank_by,
+                                    bool interrupted, int indent = 2);
 NarxModel read_narx_json(const std::string& path);
 NdeModel read_nde_json(const std::string& path);
 NarxModel parse_narx_json(const std::string& text, const std::string& source = "<json>");
