@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <optional>
 #include <sstream>
 
 #include "common.hpp"
@@ -87,9 +88,12 @@ struct PolesArgs {
   int order = 0;
   std::vector<double> generator;
   std::vector<std::string> sets;
+  std::string json;
+  bool force = false;
 };
 
 int run_poles(PolesArgs a) {
+  check_outputs({a.json}, {a.data.path}, a.force);
   if (a.order < 1) throw UsageError("--order must be >= 1");
   if (a.data.outputs.empty()) {
     try {
@@ -173,11 +177,18 @@ int run_poles(PolesArgs a) {
   if (g.order()) std::printf("  before deflation by the generator: %s\n", dm.augmented.to_string("s", 6).c_str());
   if (p_spacing < 0) p_spacing = whole_samples("shifts", shifts[0]);
   if (p_equations < 0) p_equations = (d.size() - 1 - p_start) / std::max(1, p_spacing) - n_aug + 1;
+  std::optional<PoleEstimate> pr;
+  std::string prony_error;
   try {
-    const PoleEstimate pr = prony(y, Ts, {.order = n_aug, .spacing = p_spacing, .equations = p_equations, .start = p_start});
-    print(detail::format("Prony (order {}, T = {} samples, {} equations):", n_aug, p_spacing, p_equations).c_str(), pr);
+    pr = prony(y, Ts, {.order = n_aug, .spacing = p_spacing, .equations = p_equations, .start = p_start});
+    print(detail::format("Prony (order {}, T = {} samples, {} equations):", n_aug, p_spacing, p_equations).c_str(), *pr);
   } catch (const InvalidArgument& e) {
+    prony_error = e.what();
     std::printf("Prony: not computed (%s)\n", e.what());
+  }
+  if (!a.json.empty()) {
+    write_text_file(a.json, poles_to_json(dm, pr ? &*pr : nullptr, prony_error, a.order, Ts));
+    std::printf("wrote %s\n", a.json.c_str());
   }
   return kOk;
 }
@@ -292,6 +303,8 @@ void setup_poles(CLI::App& app) {
                  "KEY=VALUE: shifts=S1,..,Sn (samples; n + generator modes), start, interval, spacing (samples), pairs, "
                  "generator=w1,.. (same as --generator), quadrature=simpson|trapezoid, "
                  "prony_spacing, prony_equations, prony_start");
+  app.add_option("--json", a->json, "Write both estimates (poles, characteristic polynomials, conditions) to this JSON file");
+  app.add_flag("--force", a->force, "Overwrite an existing output file");
   app.callback([a] { g_run = [a] { return run_poles(*a); }; });
 }
 

@@ -375,4 +375,24 @@ std::string order_selection_to_json(const std::vector<OrderCandidate>& candidate
   return j.dump(indent) + "\n";
 }
 
+std::string poles_to_json(const PoleEstimate& dm, const PoleEstimate* prony, const std::string& prony_error, int order,
+                          double ts, int indent) {
+  auto estimate = [](const PoleEstimate& p) {
+    json poles = json::array();
+    for (const auto& z : p.poles) poles.push_back({{"re", num(z.real())}, {"im", num(z.imag())}});
+    return json{{"poles", poles},
+                {"characteristic", vec(p.characteristic.coefficients())},
+                {"augmented", vec(p.augmented.coefficients())},
+                {"condition", num(p.condition)},
+                {"warnings", p.warnings}};
+  };
+  const json j = {{"type", "poles"},
+                  {"order", order},
+                  {"ts", ts},
+                  {"data_matrix", estimate(dm)},
+                  {"prony", prony ? estimate(*prony) : json(nullptr)},
+                  {"prony_error", prony_error}};
+  return j.dump(indent) + "\n";
+}
+
 }  // namespace ctid

@@ -428,6 +428,20 @@ TEST(Cli, ModalFitPolesAndResponses) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("s^3 + 4 s^2 + 30 s + 52"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("Prony"), std::string::npos);
+  // --json: the same estimates as numbers. S3 = (s + 2)(s^2 + 2 s + 26): noise-free, the characteristic
+  // polynomial to 1e-6 (the printed text has 6 digits).
+  const std::string pj = test::temp_path("poles.json");
+  fs::remove(pj);
+  r = ctid_run("poles " + free + " --ts " + ts320() + " --order 3 --set shifts=20,40,60 --json " + pj);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json pjs = nlohmann::json::parse(read_text_file(pj));
+  EXPECT_EQ(pjs.at("type"), "poles");
+  const std::vector<double> cp = pjs.at("data_matrix").at("characteristic");
+  ASSERT_EQ(cp.size(), 4u);
+  const std::array<double, 4> s3{1, 4, 30, 52};
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(cp[i], s3[i], 1e-6 * 52) << i;
+  EXPECT_EQ(pjs.at("data_matrix").at("poles").size(), 3u);
+  EXPECT_FALSE(pjs.at("prony").is_null());
   // A response forced by sin 4t (ES Ex. 4.7): order 3 + 2 generator modes, deflated by s^2 + 16.
   Eigen::MatrixXd forced(600, 1);
   forced.col(0) = lsim(kS3.to_state_space(), InputGenerator::sinusoid(4.0, 1.0), time_grid(kTs320, 600));

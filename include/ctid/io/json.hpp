@@ -12,6 +12,7 @@
 #include <variant>
 
 #include "ctid/core/types.hpp"
+#include "ctid/estimate/modal.hpp"
 #include "ctid/estimate/order_selection.hpp"
 #include "ctid/model/fsf.hpp"
 #include "ctid/model/miso.hpp"
@@ -62,6 +63,11 @@ void write_result_json(const std::string& path, const Result<NdeModel>& result, 
 /// rank order (non-finite numbers as null).
 std::string order_selection_to_json(const std::vector<OrderCandidate>& candidates, OrderCriterion rank_by,
                                     bool interrupted, int indent = 2);
+/// Poles from a free response (ctid poles --json): {"type": "poles", "order": n, "ts": s, "data_matrix": E,
+/// "prony": E or null, "prony_error": "" or why Prony was not computed}, E = {"poles": [{"re", "im"}, ...],
+/// "characteristic": [descending coefficients], "augmented": [...], "condition": c, "warnings": [...]}.
+std::string poles_to_json(const PoleEstimate& data_matrix, const PoleEstimate* prony, const std::string& prony_error,
+                          int order, double ts, int indent = 2);
 NarxModel read_narx_json(const std::string& path);
 NdeModel read_nde_json(const std::string& path);
 NarxModel parse_narx_json(const std::string& text, const std::string& source = "<json>");
