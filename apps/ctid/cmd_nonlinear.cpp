@@ -130,8 +130,6 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
     } catch (const FileError& e) {
       throw InputError(e.what());
     }
-    if (std::abs(narx.ts() - d.ts()) > 1e-9 * d.ts())
-      throw UsageError(detail::format("{} was identified at Ts = {} s, the data have {} s", narx_file, narx.ts(), d.ts()));
   } else {
     const Result<NarxModel> r = run_narx(d, sets);
     print_narx(r);

@@ -358,8 +358,9 @@ Result<NdeModel> kia_cubic(const NarxModel& narx, const NdeModel& model_in, cons
   for (const auto& t : model.terms())
     CTID_REQUIRE(t.degree() <= 2, "kia_cubic: the model already has a term of degree {} ({})", t.degree(), t.name());
   std::vector<cd> S[3];
+  const KiaPointOptions points = in_band(o.points, narx.ts(), 0.55, "kia_cubic", "qmax");
   for (int k = 0; k < 3; ++k) {
-    KiaPointOptions p = in_band(o.points, narx.ts(), 0.55, "kia_cubic", "qmax");
+    KiaPointOptions p = points;
     p.seed = o.points.seed + 7919u * static_cast<unsigned>(k);
     S[k] = kia_points(p);
   }

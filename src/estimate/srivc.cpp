@@ -530,19 +530,15 @@ Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& or
   // As srivc: estimated in normalised units (time / c, each input by its RMS, y by its RMS), mapped back.
   const tf_detail::TfNormalisation n = tf_detail::TfNormalisation::of(data);
   std::vector<tf_detail::TfNormalisation> per_input;  // c, the input's RMS, sy
-  Eigen::MatrixXd u = data.u();
+  Eigen::RowVectorXd su(data.nu());
   for (int i = 0; i < data.nu(); ++i) {
-    const double rms = std::sqrt(u.col(i).squaredNorm() / std::max<Eigen::Index>(1, u.rows()));
-    per_input.push_back({n.c, rms > 0 && std::isfinite(rms) ? rms : 1.0, n.sy});
-    u.col(i) /= per_input.back().su;
+    const double rms = std::sqrt(data.u().col(i).squaredNorm() / std::max(1, data.size()));
+    su(i) = rms > 0 && std::isfinite(rms) ? rms : 1.0;
+    per_input.push_back({n.c, su(i), n.sy});
   }
-  IdData scaled_u = data.is_uniform() ? IdData(u, data.y(), data.ts(), data.t0()) : IdData(u, data.y(), data.times());
-  for (int i = 0; i < data.nu(); ++i) scaled_u.set_intersample(i, data.intersample(i));
-  scaled_u.set_input_names(data.input_names());
-  scaled_u.set_output_names(data.output_names());
   SrivcMisoOptions o = opt;
   for (double& dl : o.delays) dl /= n.c;
-  Result<MisoModel> r = srivc_miso_in_units(tf_detail::TfNormalisation{n.c, 1.0, n.sy}.data(scaled_u), orders, o);
+  Result<MisoModel> r = srivc_miso_in_units(n.data(data, su), orders, o);
   // Parameters "a<k>" (common denominator), "u<i>.a<k>", "u<i>.b<j>".
   Eigen::VectorXd f(r.parameters.size());
   for (int k = 0; k < r.parameters.size(); ++k) {

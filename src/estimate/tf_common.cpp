@@ -91,9 +91,12 @@ TfNormalisation TfNormalisation::of(const IdData& d) {
   return n;
 }
 
-IdData TfNormalisation::data(const IdData& d) const {
-  IdData s = d.is_uniform() ? IdData(d.u() / su, d.y() / sy, d.ts() / c, d.t0() / c)
-                            : IdData(d.u() / su, d.y() / sy, Eigen::VectorXd(d.times() / c));
+IdData TfNormalisation::data(const IdData& d) const { return data(d, Eigen::RowVectorXd::Constant(d.nu(), su)); }
+
+IdData TfNormalisation::data(const IdData& d, const Eigen::RowVectorXd& input_scales) const {
+  const Eigen::MatrixXd u = d.u().array().rowwise() / input_scales.array();
+  IdData s = d.is_uniform() ? IdData(u, d.y() / sy, d.ts() / c, d.t0() / c)
+                            : IdData(u, d.y() / sy, Eigen::VectorXd(d.times() / c));
   for (int i = 0; i < d.nu(); ++i) s.set_intersample(i, d.intersample(i));
   s.set_input_names(d.input_names());
   s.set_output_names(d.output_names());

@@ -41,6 +41,8 @@ struct TfNormalisation {
   static TfNormalisation of(const IdData& d);
   /// The normalised record (times / c, u / su, y / sy; names and intersample kept).
   IdData data(const IdData& d) const;
+  /// The same with input i divided by input_scales(i) instead of su (MISO: each input by its own RMS).
+  IdData data(const IdData& d, const Eigen::RowVectorXd& input_scales) const;
   /// normalised value = original value * factor(name) for a parameter a<k>, b<j> or "delay" (1 otherwise).
   double factor(const std::string& name, const TfOrders& o) const;
   TransferFunction to_normalised(const TransferFunction& g, const TfOrders& o) const;
