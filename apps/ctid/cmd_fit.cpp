@@ -29,6 +29,14 @@ struct FitArgs {
   std::set<std::string> given;  ///< long names of the options given on the command line
 };
 
+// A method of `ctid fit`: the library registry entries whose settings --set takes (estimate/methods.hpp; empty:
+// settings not yet in a table, listed in the --set help), and how it runs.
+struct FitMethod {
+  std::vector<std::string> library;
+  std::function<int(const FitArgs&, const IdData&)> run;
+};
+const std::map<std::string, FitMethod>& fit_methods();
+
 // Options that belong to some methods only: given to another, they are errors, never silently ignored.
 void reject_flags_that_do_not_apply(const FitArgs& a) {
   auto has = [&](const char* f) { return a.given.count(f) > 0; };
@@ -52,32 +60,17 @@ void reject_flags_that_do_not_apply(const FitArgs& a) {
       if (has(f)) refuse(f, "names a column of frequency data: it needs --frequency");
 }
 
-// Apply --set keys to LSSVF options; consumed keys are erased.
-void apply_svf_sets(std::map<std::string, std::string>& s, LssvfOptions& o) {
-  consume_sets(s, [&](const std::string& k, const std::string& v) {
-    if (k == "tau") o.tau = to_double(k, v);
-    else if (k == "alpha") o.alpha = to_double(k, v);
-    else if (k == "transient") o.transient_time = to_double(k, v);
-    else if (k == "tau_grid") o.tau_grid_size = to_int(k, v);
-    else if (k == "weights") {
-      if (v == "riemann") o.weights = SvfWeights::Riemann;
-      else if (v == "trapezoidal") o.weights = SvfWeights::Trapezoidal;
-      else throw UsageError("--set weights: use riemann or trapezoidal (got '" + v + "')");
-    } else if (k.rfind("fix.", 0) == 0) o.fixed[k.substr(4)] = to_double(k, v);
-    else return false;
-    return true;
-  });
-}
+using Settings = std::vector<std::pair<std::string, std::string>>;
 
 // Print, write the JSON file and the HTML report if asked, and map usability to the exit code.
 template <class M>
-int finish(const Result<M>& r, const std::string& method, const IdData& d, const FitArgs& a) {
+int finish(const Result<M>& r, const std::string& method, const IdData& d, const FitArgs& a, const Settings& settings) {
   print_result(r, method, d);
   if (!a.json.empty()) {
     write_result_json(a.json, r, method);
     std::printf("wrote %s\n", a.json.c_str());
   }
-  write_report(a.report, d, r, method, a.sets, a.data.path);
+  write_report(a.report, d, r, method, settings, a.data.path);
   if (!r.usable()) {
     std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", r.why_not_usable().c_str());
     return kNotUsable;
@@ -85,79 +78,35 @@ int finish(const Result<M>& r, const std::string& method, const IdData& d, const
   return kOk;
 }
 
-void reject_unknown(const std::map<std::string, std::string>& s, const std::string& method, const std::string& known) {
-  if (s.empty()) return;
-  throw UsageError("--set " + s.begin()->first + ": not a setting of " + method + " (settings: " + known + ")");
+// Bad orders, options or data for the method are usage errors of the command line (exit 2).
+template <class F>
+auto call_library(F&& f) {
+  try {
+    return f();
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
 }
 
-Result<TransferFunction> run_rls(const IdData& d, const TfOrders& orders, std::map<std::string, std::string> s) {
-  RlsSvfOptions o;
-  consume_sets(s, [&](const std::string& k, const std::string& v) {
-    if (k == "tau") o.tau = to_double(k, v);
-    else if (k == "p0") o.p0 = to_double(k, v);
-    else if (k == "forgetting") o.forgetting = to_double(k, v);
-    else if (k == "alpha") o.alpha = to_double(k, v);
-    else if (k == "regression_interval") o.regression_interval = to_double(k, v);
-    else if (k.rfind("fix.", 0) == 0) o.fixed[k.substr(4)] = to_double(k, v);
-    else return false;
-    return true;
+// One input, one output: [nb nf nk] from the flags (nb defaults to nf).
+TfOrders siso_orders(const FitArgs& a) {
+  const int nf = a.nf[0];
+  return {a.nb.empty() ? nf : a.nb[0], nf, a.nk[0]};
+}
+
+// A single-input transfer-function estimator: its options from the table (--delay is estimate_delay), the fit,
+// the output.
+template <class O>
+int run_tf(const FitArgs& a, const IdData& d, Result<TransferFunction> (*estimator)(const IdData&, const TfOrders&, const O&)) {
+  O o;
+  if constexpr (requires { o.estimate_delay; }) o.estimate_delay = a.delay;
+  apply_sets(a.method, a.sets, o);
+  const TfOrders orders = siso_orders(a);
+  const Result<TransferFunction> r = call_library([&] {
+    orders.validate();
+    return estimator(d, orders, o);
   });
-  reject_unknown(s, "rls-svf", "tau, p0, forgetting, alpha, regression_interval, fix.NAME");
-  if (d.nu() != 1 || d.ny() != 1) throw UsageError("rls-svf needs one --input and one --output");
-  if (orders.nk > 0) throw UsageError("rls-svf: --nk must be 0 (delay the input column instead)");
-  o.input_intersample = d.intersample(0);
-  const auto start = std::chrono::steady_clock::now();
-  RlsSvf rls(orders, o);
-  for (int k = 0; k < d.size(); ++k) rls.update(d.time(k), d.u()(k, 0), d.y()(k, 0));
-  Result<TransferFunction> r;
-  r.model = rls.model();
-  r.parameters.names = tf_parameter_names(orders);
-  r.parameters.values = rls.parameters();
-  r.parameters.std = Eigen::VectorXd::Constant(orders.n_parameters(), std::numeric_limits<double>::quiet_NaN());
-  r.parameters.fixed.assign(orders.n_parameters(), false);
-  for (int i = 0; i < orders.n_parameters(); ++i) r.parameters.fixed[i] = o.fixed.count(r.parameters.names[i]) > 0;
-  r.diagnostics.scalars["tau"] = o.tau;
-  r.summary.iterations = static_cast<int>(rls.n_updates());
-  r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  r.fit = fit_report_or_inf(d.y().col(0), lsim(r.model, d, 0), orders.n_parameters() - static_cast<int>(o.fixed.size()));
-  if (!r.model.is_stable()) r.diagnostics.warnings.push_back("the estimated model is unstable");
-  return r;
-}
-
-// Settings shared by srivc / oe / tfest.
-bool apply_srivc_set(const std::string& k, const std::string& v, SrivcOptions& o) {
-  if (k == "max_iterations") o.max_iterations = to_int(k, v);
-  else if (k == "tolerance") o.tolerance = to_double(k, v);
-  else if (k == "delay") o.delay = to_double(k, v);
-  else if (k == "delay_min") o.delay_min = to_double(k, v);
-  else if (k == "delay_max") o.delay_max = to_double(k, v);
-  else if (k == "delay_grid") o.delay_grid = to_int(k, v);
-  else return false;
-  return true;
-}
-
-Result<TransferFunction> run_oe(const IdData& d, const TfOrders& orders, std::map<std::string, std::string> sets,
-                                bool delay, bool tf_est) {
-  OeOptions o;
-  o.estimate_delay = delay;
-  consume_sets(sets, [&](const std::string& k, const std::string& v) {
-    if (k == "max_iterations") o.max_iterations = to_int(k, v);
-    else if (k == "tolerance") o.tolerance = to_double(k, v);
-    else if (k == "delay") o.delay = to_double(k, v);
-    else if (k.rfind("fix.", 0) == 0) o.fixed[k.substr(4)] = to_double(k, v);
-    else if (k.rfind("lower.", 0) == 0) {
-      auto& b = o.bounds.try_emplace(k.substr(6), -INFINITY, INFINITY).first->second;
-      b.first = to_double(k, v);
-    } else if (k.rfind("upper.", 0) == 0) {
-      auto& b = o.bounds.try_emplace(k.substr(6), -INFINITY, INFINITY).first->second;
-      b.second = to_double(k, v);
-    } else if (k == "delay_min" || k == "delay_max" || k == "delay_grid") return apply_srivc_set(k, v, o.srivc);
-    else return false;
-    return true;
-  });
-  reject_unknown(sets, tf_est ? "tfest" : "oe",
-                 "max_iterations, tolerance, delay, delay_min, delay_max, delay_grid, fix.NAME, lower.NAME, upper.NAME");
-  return tf_est ? tfest(d, orders, o) : oe(d, orders, o);
+  return finish(r, a.method, d, a, settings_of(o));
 }
 
 // Closed-loop SRIVC: the reference column is loaded with the data and split off.
@@ -179,23 +128,10 @@ int run_closed_loop(const FitArgs& a) {
   const Eigen::VectorXd r = both.u().col(1);
   ClosedLoopOptions o;
   o.controller = std::get<TransferFunction>(c);
-  auto sets = parse_sets(a.sets);
-  consume_sets(sets, [&](const std::string& k, const std::string& v) {
-    if (k == "max_iterations") o.max_iterations = to_int(k, v);
-    else if (k == "tolerance") o.tolerance = to_double(k, v);
-    else if (k == "setpoint") o.reference_at_plant_input = to_int(k, v) == 0;
-    else return false;
-    return true;
-  });
-  reject_unknown(sets, "srivc (closed loop)", "max_iterations, tolerance, setpoint (1: u = C (r - y))");
-  Result<TransferFunction> r2;
-  try {
-    const int nf = a.nf[0];
-    r2 = srivc_closed_loop(d, r, {a.nb.empty() ? nf : a.nb[0], nf, a.nk[0]}, o);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
-  return finish(r2, "clsrivc", d, a);
+  o.reference_intersample = both.intersample(1);
+  apply_sets("srivc_closed_loop", a.sets, o);
+  const Result<TransferFunction> r2 = call_library([&] { return srivc_closed_loop(d, r, siso_orders(a), o); });
+  return finish(r2, "clsrivc", d, a, settings_of(o));
 }
 
 // Frequency-response data: columns w, re, im (G) or the spectra U and Y.
@@ -227,24 +163,8 @@ int run_frequency(const FitArgs& a) {
   }
   FrequencyFitOptions o;
   o.estimate_delay = a.delay;
-  auto sets = parse_sets(a.sets);
-  consume_sets(sets, [&](const std::string& k, const std::string& v) {
-    if (k == "max_iterations") o.max_iterations = to_int(k, v);
-    else if (k == "tolerance") o.tolerance = to_double(k, v);
-    else if (k == "sk_iterations") o.sk_iterations = to_int(k, v);
-    else if (k == "delay") o.delay = to_double(k, v);
-    else if (k == "refine") o.refine = to_int(k, v) != 0;
-    else return false;
-    return true;
-  });
-  reject_unknown(sets, "frequency-domain tfest", "max_iterations, tolerance, sk_iterations, delay, refine");
-  Result<TransferFunction> r;
-  try {
-    const int nf = a.nf[0];
-    r = tf_from_frequency(fd, {a.nb.empty() ? nf : a.nb[0], nf, a.nk[0]}, o);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
+  apply_sets("tf_from_frequency", a.sets, o);
+  const Result<TransferFunction> r = call_library([&] { return tf_from_frequency(fd, siso_orders(a), o); });
   std::printf("method: tfest (frequency data)   frequencies: %d   from %.4g to %.4g rad/s\n", fd.size(), fd.w()(0),
               fd.w()(fd.size() - 1));
   std::printf("model:  G(s) = %s\n", r.model.to_string(6).c_str());
@@ -258,25 +178,9 @@ int run_frequency(const FitArgs& a) {
   return r.usable() ? kOk : kNotUsable;
 }
 
-// Gawthrop & Wang: FSF compression settings shared by --method fsf and --method physical.
-FsfOptions fsf_options(std::map<std::string, std::string>& sets, bool* unstable) {
-  FsfOptions o;
-  o.T = 0;
-  consume_sets(sets, [&](const std::string& k, const std::string& v) {
-    if (k == "T") o.T = to_double(k, v);
-    else if (k == "n") o.n = to_int(k, v);
-    else if (k == "a") o.a = to_double(k, v);
-    else if (k == "b") o.b = to_double(k, v);
-    else if (k == "unstable" && unstable) *unstable = to_int(k, v) != 0;
-    else return false;
-    return true;
-  });
+// Gawthrop & Wang: the FSF window needs its settling time (the library's validate() checks the rest).
+void require_fsf_window(const FsfOptions& o) {
   if (o.T == 0) throw UsageError("the FSF window needs --set T=SECONDS (settling time of the, possibly shifted, system)");
-  if (unstable && *unstable && !(o.a > 0))
-    throw UsageError(detail::format("the plant is declared unstable: give a window a > 0 larger than its fastest unstable "
-                                    "pole (got a = {})",
-                                    o.a));
-  return o;
 }
 
 void write_fsf_responses(const std::string& prefix, const FsfModel& f) {
@@ -301,17 +205,11 @@ void write_fsf_responses(const std::string& prefix, const FsfModel& f) {
 }
 
 int run_fsf(const FitArgs& a, const IdData& d) {
-  auto sets = parse_sets(a.sets);
-  bool unstable = false;
-  const FsfOptions o = fsf_options(sets, &unstable);
-  reject_unknown(sets, "fsf", "T, n, a, b, unstable");
-  Result<FsfModel> r;
-  try {
-    r = fsf(d, o);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
-  const int code = finish(r, "fsf", d, a);
+  FsfOptions o;
+  apply_sets("fsf", a.sets, o);
+  require_fsf_window(o);
+  const Result<FsfModel> r = call_library([&] { return fsf(d, o); });
+  const int code = finish(r, "fsf", d, a, settings_of(o));
   if (!a.responses.empty()) write_fsf_responses(a.responses, r.model);
   return code;
 }
@@ -343,53 +241,62 @@ int run_physical(const FitArgs& a, const IdData& d) {
     for (const auto& s : symbols) used = used || n == s;
     if (!used) throw UsageError(detail::format("--param {}: '{}' does not appear in the model \"{}\"", n, n, a.model_expr));
   }
-  auto sets = parse_sets(a.sets);
+  // Per-parameter constraints, in the vocabulary of oe: fixed.NAME=VALUE, bounds.NAME=LOWER,UPPER.
+  std::vector<std::string> method_sets;
+  Settings constraints;
+  for (const auto& [k, v] : parse_sets(a.sets)) {
+    const bool fix = k.rfind("fixed.", 0) == 0, bound = k.rfind("bounds.", 0) == 0;
+    if (!fix && !bound) {
+      method_sets.push_back(k + "=" + v);
+      continue;
+    }
+    const std::string name = k.substr(k.find('.') + 1);
+    auto q = std::find_if(ps.begin(), ps.end(), [&](const PhysicalParameter& p) { return p.name == name; });
+    if (q == ps.end()) throw UsageError("--set " + k + ": '" + name + "' is not a --param");
+    const auto value = call_library([&] {
+      return fix ? std::pair{options_detail::parse_real("physical", k, v), 0.0} : options_detail::parse_bounds("physical", k, v);
+    });
+    if (fix) {
+      q->fixed = true;
+      q->initial = value.first;
+    } else {
+      std::tie(q->lower, q->upper) = value;
+    }
+    constraints.emplace_back(k, v);
+  }
+  FsfOptions fo;
   PhysicalFitOptions po;
-  consume_sets(sets, [&](const std::string& k, const std::string& v) {
-    if (k == "max_iterations") po.max_iterations = to_int(k, v);
-    else if (k == "tolerance") po.tolerance = to_double(k, v);
-    else if (k.rfind("lower.", 0) == 0 || k.rfind("upper.", 0) == 0 || k.rfind("fix.", 0) == 0) {
-      const auto dot = k.find('.');
-      const std::string name = k.substr(dot + 1);
-      bool found = false;
-      for (auto& q : ps)
-        if (q.name == name) {
-          found = true;
-          if (k[0] == 'l') q.lower = to_double(k, v);
-          else if (k[0] == 'u') q.upper = to_double(k, v);
-          else { q.fixed = true; q.initial = to_double(k, v); }
-        }
-      if (!found) throw UsageError("--set " + k + ": '" + name + "' is not a --param");
-    } else return false;
-    return true;
-  });
-  Result<TransferFunction> r;
-  try {
+  apply_sets("physical", method_sets, fo, po);
+  if (a.via == "raw")
+    for (const auto& s : method_sets)
+      for (const char* k : {"T=", "n=", "b=", "weights=", "step_points="})
+        if (s.rfind(k, 0) == 0)
+          throw UsageError("--set " + s + ": --via raw fits the record itself (its settings: a, unstable, max_iterations, "
+                           "tolerance, fixed.NAME, bounds.NAME)");
+  Result<TransferFunction> r = call_library([&] {
     const PhysicalModel model(a.model_expr, names);
     if (a.via == "raw") {
-      double wa = 0;
-      bool unstable = false;
-      consume_sets(sets, [&](const std::string& k, const std::string& v) {
-        if (k == "a") wa = to_double(k, v);
-        else if (k == "unstable") unstable = to_int(k, v) != 0;
-        else return false;
-        return true;
-      });
-      if (unstable && !(wa > 0)) throw UsageError("the plant is declared unstable: give a window a > 0");
-      reject_unknown(sets, "physical (raw)", "a, unstable, max_iterations, tolerance, lower.NAME, upper.NAME, fix.NAME");
-      r = fit_physical_raw(model, ps, d, wa, po);
-    } else {
-      bool unstable = false;
-      const FsfOptions fo = fsf_options(sets, &unstable);
-      reject_unknown(sets, "physical", "T, n, a, b, unstable, max_iterations, tolerance, lower.NAME, upper.NAME, fix.NAME");
-      const Result<FsfModel> c = fsf(d, fo);
-      r = a.via == "frequency" ? fit_physical_frequency(model, ps, c.model, po) : fit_physical_step(model, ps, c.model, po);
-      for (const auto& w : c.diagnostics.warnings) r.diagnostics.warnings.push_back("fsf: " + w);
+      CTID_REQUIRE_OPTION(!fo.unstable || fo.a > 0, "physical: the plant is declared unstable: give a window a > 0 (got a = {})",
+                          fo.a);
+      return fit_physical_raw(model, ps, d, fo.a, po);
     }
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
-  return finish(r, "physical-" + a.via, d, a);
+    require_fsf_window(fo);
+    const Result<FsfModel> c = fsf(d, fo);
+    Result<TransferFunction> q =
+        a.via == "frequency" ? fit_physical_frequency(model, ps, c.model, po) : fit_physical_step(model, ps, c.model, po);
+    for (const auto& w : c.diagnostics.warnings) q.diagnostics.warnings.push_back("fsf: " + w);
+    return q;
+  });
+  Settings settings = a.via == "raw" ? Settings{{"a", options_detail::format_real(fo.a)}} : settings_of(fo);
+  for (auto& s : settings_of(po)) settings.push_back(s);
+  for (auto& s : constraints) settings.push_back(s);
+  return finish(r, "physical-" + a.via, d, a, settings);
+}
+
+// Settings left after the modal parser took its own (modal's settings are not yet in a table).
+void reject_unknown(const std::map<std::string, std::string>& s, const std::string& method, const std::string& known) {
+  if (s.empty()) return;
+  throw UsageError("--set " + s.begin()->first + ": not a setting of " + method + " (settings: " + known + ")");
 }
 
 // El-Shafey: modal functions (generated input with --set frequencies, or piecewise-constant input).
@@ -427,7 +334,7 @@ int run_modal(const FitArgs& a, const IdData& d0) {
     throw UsageError(e.what());
   }
   if (nk > 0) r.model.set_io_delay(nk * d0.ts());
-  return finish(r, "modal", d0, a);
+  return finish(r, "modal", d0, a, raw_settings(a.sets));
 }
 
 int run(const FitArgs& a) {
@@ -467,76 +374,71 @@ int run(const FitArgs& a) {
       throw UsageError(detail::format("{} estimates single-input models; use --method srivc for {} inputs", a.method, d.nu()));
     if (a.delay) throw UsageError("--delay is available for single-input models");
     SrivcMisoOptions o;
-    auto sets = parse_sets(a.sets);
-    consume_sets(sets, [&](const std::string& k, const std::string& v) {
-      if (k == "max_iterations") o.max_iterations = to_int(k, v);
-      else if (k == "tolerance") o.tolerance = to_double(k, v);
-      else if (k == "common_denominator") o.common_denominator = to_int(k, v) != 0;
-      else return false;
-      return true;
-    });
-    reject_unknown(sets, "srivc (MISO)", "max_iterations, tolerance, common_denominator");
-    Result<MisoModel> r;
-    try {
-      r = srivc_miso(d, all, o);
-    } catch (const InvalidArgument& e) {
-      throw UsageError(e.what());
-    }
-    return finish(r, "srivc", d, a);
+    apply_sets("srivc_miso", a.sets, o);
+    const Result<MisoModel> r = call_library([&] { return srivc_miso(d, all, o); });
+    return finish(r, "srivc", d, a, settings_of(o));
   }
-  if (a.method == "fsf" || a.method == "physical") {
-    if (d.nu() != 1) throw UsageError(detail::format("{} needs one input (selected {})", a.method, d.nu()));
-    return a.method == "fsf" ? run_fsf(a, d) : run_physical(a, d);
-  }
-  if (a.method == "modal") return run_modal(a, d);
-  if (a.method == "narx" || a.method == "kia") return run_narx_or_kia(a.method, d, a.sets, a.narx, a.json, a.report);
-  TfOrders orders = all[0];
-  auto sets = parse_sets(a.sets);
-  Result<TransferFunction> r;
-  try {
-    orders.validate();
-    if (a.method == "lssvf") {
-      LssvfOptions o;
-      apply_svf_sets(sets, o);
-      reject_unknown(sets, "lssvf", "tau, alpha, transient, weights, tau_grid, fix.NAME");
-      r = lssvf(d, orders, o);
-    } else if (a.method == "ivsvf") {
-      IvsvfOptions o;
-      apply_svf_sets(sets, o.svf);
-      consume_sets(sets, [&](const std::string& k, const std::string& v) {
-        if (k == "max_iterations") o.max_iterations = to_int(k, v);
-        else if (k == "tolerance") o.tolerance = to_double(k, v);
-        else return false;
-        return true;
-      });
-      reject_unknown(sets, "ivsvf", "tau, alpha, transient, weights, tau_grid, fix.NAME, max_iterations, tolerance");
-      r = ivsvf(d, orders, o);
-    } else if (a.method == "srivc") {
-      SrivcOptions o;
-      o.estimate_delay = a.delay;
-      consume_sets(sets, [&](const std::string& k, const std::string& v) { return apply_srivc_set(k, v, o); });
-      reject_unknown(sets, "srivc", "max_iterations, tolerance, delay, delay_min, delay_max, delay_grid");
-      r = srivc(d, orders, o);
-    } else if (a.method == "oe" || a.method == "tfest") {
-      r = run_oe(d, orders, sets, a.delay, a.method == "tfest");
-    } else {
-      r = run_rls(d, orders, sets);
-    }
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
-  return finish(r, a.method, d, a);
+  return fit_methods().at(a.method).run(a, d);
+}
+
+const std::map<std::string, FitMethod>& fit_methods() {
+  static const std::map<std::string, FitMethod> m = {
+      {"lssvf", {{"lssvf"}, [](const FitArgs& a, const IdData& d) { return run_tf(a, d, &lssvf); }}},
+      {"ivsvf", {{"ivsvf"}, [](const FitArgs& a, const IdData& d) { return run_tf(a, d, &ivsvf); }}},
+      {"rls-svf", {{"rls_svf"}, [](const FitArgs& a, const IdData& d) { return run_tf(a, d, &rls_svf); }}},
+      {"srivc",
+       {{"srivc", "srivc_miso", "srivc_closed_loop"}, [](const FitArgs& a, const IdData& d) { return run_tf(a, d, &srivc); }}},
+      {"oe", {{"oe", "tf_from_frequency"}, [](const FitArgs& a, const IdData& d) { return run_tf(a, d, &oe); }}},
+      {"tfest", {{"tfest", "tf_from_frequency"}, [](const FitArgs& a, const IdData& d) { return run_tf(a, d, &tfest); }}},
+      {"fsf", {{"fsf"}, run_fsf}},
+      {"physical", {{"physical"}, run_physical}},
+      {"modal", {{}, run_modal}},
+      {"narx",
+       {{},
+        [](const FitArgs& a, const IdData& d) { return run_narx_or_kia(a.method, d, a.sets, a.narx, a.json, a.report); }}},
+      {"kia",
+       {{},
+        [](const FitArgs& a, const IdData& d) { return run_narx_or_kia(a.method, d, a.sets, a.narx, a.json, a.report); }}},
+  };
+  return m;
 }
 
 }  // namespace
 
+
+namespace {
+std::shared_ptr<FitArgs> g_fit_args;  // read by fit_method_help after a --help
+}  // namespace
+
+std::string fit_method_help(const CLI::App& fit) {
+  if (!g_fit_args || fit.count("--method") == 0) return "";
+  const auto it = fit_methods().find(g_fit_args->method);
+  if (it == fit_methods().end()) return "";
+  if (it->second.library.empty())
+    return "\n" + g_fit_args->method + ": its settings are listed under --set above (not yet in a settings table).\n";
+  std::string out;
+  static const std::map<std::string, std::string> when = {
+      {"srivc_miso", " (several --input columns)"},
+      {"srivc_closed_loop", " (with --closed-loop-controller)"},
+      {"tf_from_frequency", " (with --frequency)"}};
+  for (const auto& name : it->second.library) {
+    const MethodInfo& m = method_info(name);
+    out += "\n" + m.name + ": " + m.summary + (when.count(name) ? when.at(name) : "") + "\n" + settings_help(m);
+  }
+  return out;
+}
+
 void setup_fit(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
   app.add_option("DATA", a->data.path, "CSV/.dat table (header row optional) or .mat file")->required();
+  std::vector<std::string> names;
+  for (const auto& [name, m] : fit_methods()) names.push_back(name);
   app.add_option("--method", a->method,
-                 "Estimator: srivc, tfest, oe, lssvf, ivsvf, rls-svf, fsf, physical, modal, narx or kia")
-      ->check(CLI::IsMember({"lssvf", "ivsvf", "rls-svf", "srivc", "oe", "tfest", "fsf", "physical", "modal", "narx", "kia"}))
+                 "Estimator: srivc, tfest, oe, lssvf, ivsvf, rls-svf, fsf, physical, modal, narx or kia (with --help: "
+                 "its settings)")
+      ->check(CLI::IsMember(names))
       ->capture_default_str();
+  g_fit_args = a;
   a->data.add_to(app, true);
   app.add_option("--nb", a->nb, "Number of numerator coefficients (default: nf); one per input with several inputs (1,2)")
       ->delimiter(',');
@@ -545,23 +447,20 @@ void setup_fit(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--nk", a->nk, "Input delay in samples; per input allowed")->delimiter(',')->capture_default_str();
   app.add_option("--set", a->sets,
-                 "Method setting KEY=VALUE (repeatable). lssvf/ivsvf: tau (s, 0 = automatic), alpha, transient (s), "
-                 "weights=riemann|trapezoidal, fix.NAME=value (e.g. fix.a2=4); ivsvf also max_iterations, tolerance; "
-                 "rls-svf: tau, p0, forgetting, alpha, regression_interval, fix.NAME; srivc: max_iterations, tolerance, "
-                 "delay (s), delay_min, delay_max, delay_grid; oe/tfest: the same plus fix.NAME, lower.NAME, upper.NAME; "
-                 "fsf/physical: T (s), n (odd), a, b, unstable=1; physical also lower.NAME, upper.NAME, fix.NAME; modal: "
+                 "Method setting NAME=VALUE (repeatable); 'ctid fit --method M --help' lists M's settings with units, "
+                 "ranges and defaults (the same names as the C++ options and the Python keywords). modal: "
                  "shifts=S1,..,Sn (samples) or shift_times (s), basis=fourier|walsh|discrete, functions, iv (samples), "
                  "stride, quadrature=simpson|trapezoid, window=START,LENGTH (samples), frequencies=w1,.. (generated input); "
                  "narx: degree, ylag, ulag, umin, constant, max_terms, err_tolerance, criterion=none|aic|aicc|bic|fpe, "
                  "noise_terms (NARMAX e lags), noise_max; kia: the narx settings or --narx FILE, y_order, u_order, points, "
-                 "max (rad/s, <= pi/Ts; default 1.25/Ts), seed, gls_order, err_threshold (%), zoh, refine (0: KIA only), quadratic=y^2,y*Dy, cubic=y^3, qpoints, qmax (default 0.55/Ts), qgls_order, "
-                 "qerr_threshold");
+                 "max (rad/s, <= pi/Ts; default 1.25/Ts), seed, gls_order, err_threshold (%), zoh, refine (0: KIA only), "
+                 "quadratic=y^2,y*Dy, cubic=y^3, qpoints, qmax (default 0.55/Ts), qgls_order, qerr_threshold");
   app.add_flag("--delay", a->delay,
                "Estimate a (non-integer) input delay (srivc, oe, tfest): grid search over [delay_min, delay_max], then "
                "refinement");
   app.add_option("--closed-loop-controller", a->controller,
                  "Closed-loop data: JSON file of the known controller C(s) (transfer_function); with --reference");
-  app.add_option("--reference", a->reference, "Closed-loop data: the reference column (added at the plant input unless --set setpoint=1)");
+  app.add_option("--reference", a->reference, "Closed-loop data: the reference column (added at the plant input unless --set reference_at_plant_input=0: then u = C (r - y))");
   app.add_flag("--frequency", a->frequency,
                "DATA holds frequency-response data: columns --w (rad/s), --re, --im of G(jw), or the spectra --u-re --u-im "
                "--y-re --y-im");

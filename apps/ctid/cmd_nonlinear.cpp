@@ -85,7 +85,7 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
       write_result_json(json, r, "narx");
       std::printf("wrote %s\n", json.c_str());
     }
-    write_report(report, d, r, "narx", set_list, "");
+    write_report(report, d, r, "narx", raw_settings(set_list), "");
     return r.usable() ? kOk : kNotUsable;
   }
   // kia: the NARX model from --narx, or identified here; then the library's workflow (kia()).
@@ -169,7 +169,7 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
     write_result_json(json, r, "kia");
     std::printf("wrote %s\n", json.c_str());
   }
-  write_report(report, d, r, ko.refine ? "kia+oe" : "kia", set_list, narx_file);
+  write_report(report, d, r, ko.refine ? "kia+oe" : "kia", raw_settings(set_list), narx_file);
   if (!r.usable()) {
     std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", r.why_not_usable().c_str());
     return kNotUsable;

@@ -84,21 +84,64 @@ void print_result(const Result<TransferFunction>& r, const std::string& method, 
 void print_result(const Result<MisoModel>& r, const std::string& method, const IdData& data);
 void print_result(const Result<FsfModel>& r, const std::string& method, const IdData& data);
 
-/// --report: write the HTML report of r on d (nothing when path is empty). `sets` are shown as the method
+/// Applies --set KEY=VALUE pairs to options structs through their tables (estimate/options.hpp): each key goes
+/// to the first struct whose table has it. An unknown key, or a value that does not parse, is a UsageError naming
+/// `method` and the closest valid setting. Ranges are checked by the estimator (validate()).
+template <class... O>
+void apply_sets(const std::string& method, const std::vector<std::string>& sets, O&... o) {
+  for (const auto& [key, value] : parse_sets(sets)) {
+    bool done = false;
+    try {
+      (
+          [&] {
+            if (!done && option_table<O>().find(key)) {
+              option_table<O>().set(o, key, value);
+              done = true;
+            }
+          }(),
+          ...);
+    } catch (const InvalidOptions& e) {
+      throw UsageError(e.what());
+    }
+    if (done) continue;
+    std::vector<std::string> names;
+    (
+        [&] {
+          for (const auto& n : option_table<O>().names()) names.push_back(n);
+        }(),
+        ...);
+    const std::string near = closest_name(key, names);
+    throw UsageError("--set " + key + ": not a setting of " + method +
+                     (near.empty() ? std::string() : "; did you mean '" + near + "'?") +
+                     " (ctid fit --method " + method + " --help lists them)");
+  }
+}
+/// The settings of options structs as NAME/VALUE text pairs (for the report).
+template <class... O>
+std::vector<std::pair<std::string, std::string>> settings_of(const O&... o) {
+  std::vector<std::pair<std::string, std::string>> s;
+  (
+      [&] {
+        for (auto& p : option_table<O>().settings(o)) s.push_back(std::move(p));
+      }(),
+      ...);
+  return s;
+}
+/// --set pairs as given (methods without a table yet).
+std::vector<std::pair<std::string, std::string>> raw_settings(const std::vector<std::string>& sets);
+
+/// --report: write the HTML report of r on d (nothing when path is empty), with `settings` as the method
 /// settings. A report that cannot be made (e.g. multi-channel data) is a UsageError; a write failure an
 /// InputError.
 template <class M>
 void write_report(const std::string& path, const IdData& d, const Result<M>& r, const std::string& method,
-                  const std::vector<std::string>& sets, const std::string& source) {
+                  const std::vector<std::pair<std::string, std::string>>& settings, const std::string& source) {
   if (path.empty()) return;
   ReportOptions o;
   o.method = method;
   o.title = "ctid " + method + " fit";
   o.data_source = source;
-  for (const auto& s : sets) {
-    const auto eq = s.find('=');
-    o.settings.emplace_back(s.substr(0, eq), eq == std::string::npos ? "" : s.substr(eq + 1));
-  }
+  o.settings = settings;
   std::string html;
   try {
     html = html_report(d, r, o);
@@ -130,6 +173,9 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
                     const std::string& report);
 
 void setup_fit(CLI::App& app);
+/// After `ctid fit --method M --help`: M's settings (names, units, ranges, defaults) from the library's registry;
+/// "" without --method.
+std::string fit_method_help(const CLI::App& fit);
 void setup_gfrf(CLI::App& app);
 void setup_poles(CLI::App& app);
 void setup_response(CLI::App& app);

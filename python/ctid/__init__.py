@@ -9,6 +9,8 @@ brief report. Bad input raises ``ctid.InvalidArgument`` / ``ctid.InvalidOptions`
 ``summary.termination`` says why and ``usable()`` is False. Ctrl-C stops a long estimation: the
 result comes back with termination ``"interrupted"``.
 """
+import difflib as _difflib
+
 import numpy as _np
 
 from . import _ctid
@@ -16,7 +18,7 @@ from ._ctid import (  # noqa: F401  (re-exported)
     CorrelationTest, DeadbeatObserver, FileError, FrequencyData, FsfModel, IdData, InputGenerator, InvalidArgument,
     InvalidOptions, MisoModel, ModalModel, ModalWindow, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm,
     NonlinearCorrelationTests, PhysicalModel, TransferFunction, add_noise_snr, fit_percent, frequency_grid, html_report,
-    input_residual_crosscorrelation, load, magnitude_band, narx_candidates, narx_noise_candidates,
+    input_residual_crosscorrelation, load, magnitude_band, methods, settings, narx_candidates, narx_noise_candidates,
     nonlinear_correlation_tests, one_sided_dft, piecewise_constant_windows, prbs, read_narx_json, read_nde_json,
     residual_autocorrelation, response_horizon, time_grid,
 )
@@ -35,8 +37,18 @@ def _enum(enum_cls, value, who, key):
 
 
 def _options(cls, who, kwargs):
-    """An options struct of type cls from keyword arguments (nested structs from dicts, enums from names)."""
+    """An options struct of type cls from keyword arguments. Structs with a settings table (``cls._names``) convert
+    each value in C++ by the setting's kind; the others take nested structs from dicts and enums from names."""
     o = cls()
+    names = getattr(cls, "_names", None)
+    if names is not None:
+        for key, value in kwargs.items():
+            if key not in names:
+                near = _difflib.get_close_matches(key, names, n=1, cutoff=0.6)
+                hint = f"; did you mean '{near[0]}'?" if near else ""
+                raise TypeError(f"{who}: unknown option '{key}'{hint} (options: {', '.join(names)})")
+            setattr(o, key, value)
+        return o
     for key, value in kwargs.items():
         if key.startswith("_") or not hasattr(o, key):
             known = sorted(k for k in dir(o) if not k.startswith("_"))
@@ -193,7 +205,8 @@ def lssvf(data, nb, nf, nk=0, **options):
 
 
 def ivsvf(data, nb, nf, nk=0, **options):
-    """Johansson's regression with instrumental variables (options: IvsvfOptions; svf=dict(...))."""
+    """Johansson's regression with instrumental variables (options: IvsvfOptions: the LSSVF settings, max_iterations,
+    tolerance)."""
     return _ctid.ivsvf(data, nb, nf, nk, _options(_ctid.IvsvfOptions, "ivsvf", options))
 
 
@@ -210,6 +223,12 @@ def oe(data, nb, nf, nk=0, **options):
 def tfest(data, nb, nf, nk=0, **options):
     """SRIVC start, then output-error refinement (options: OeOptions)."""
     return _ctid.tfest(data, nb, nf, nk, _options(_ctid.OeOptions, "tfest", options))
+
+
+def rls_svf(data, nb, nf, nk=0, **options):
+    """Johansson's recursive least squares on filtered signals, run once over the record: the final estimate, its
+    simulation fit, no standard deviations (options: RlsSvfOptions; ctid.settings("rls_svf") lists them)."""
+    return _ctid.rls_svf(data, nb, nf, nk, _options(_ctid.RlsSvfOptions, "rls_svf", options))
 
 
 def srivc_miso(data, orders, **options):
@@ -373,9 +392,10 @@ def fit_physical_raw(model, parameters, data, a=0.0, **options):
                                   _options(_ctid.PhysicalFitOptions, "fit_physical_raw", options))
 
 
-def rls_svf(nb, nf, **options):
+def rls_svf_recursive(nb, nf, **options):
     """Johansson (1986) recursive least squares on filtered signals: an RlsSvf to feed with update() or run()
-    (options: RlsSvfOptions: tau, forgetting, alpha, fixed, ...)."""
+    sample by sample (options: RlsSvfOptions: tau, forgetting, alpha, fixed, ...). ctid.rls_svf(data, ..) runs it
+    once over a record and returns the usual result."""
     return _ctid.RlsSvf(nb, nf, _options(_ctid.RlsSvfOptions, "rls_svf", options))
 
 

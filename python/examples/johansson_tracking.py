@@ -21,7 +21,7 @@ y[2000:] = tail + y[1999] * np.exp(-0.5 * (t[2000:] - t[1999]))
 batch = ctid.lssvf(ctid.IdData.from_arrays(u[:2000], y[:2000], ts=ts), 1, 1, tau=0.5)
 print("LSSVF on the first 20 s:", batch.model)
 
-rls = ctid.rls_svf(1, 1, tau=0.5, forgetting=0.995)
+rls = ctid.rls_svf_recursive(1, 1, tau=0.5, forgetting=0.995)
 history = rls.run(t, u, y)
 b0 = history[:, 1]
 settled = np.argmax(np.abs(b0[2000:] - 2.0) < 0.1) * ts

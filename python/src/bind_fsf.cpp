@@ -5,13 +5,7 @@
 namespace ctid::python {
 
 void bind_fsf(py::module_& m) {
-  py::class_<FsfOptions>(m, "FsfOptions")
-      .def(py::init<>())
-      .def_readwrite("T", &FsfOptions::T)
-      .def_readwrite("n", &FsfOptions::n)
-      .def_readwrite("a", &FsfOptions::a)
-      .def_readwrite("b", &FsfOptions::b)
-      .def_readwrite("weights", &FsfOptions::weights);
+  bind_options<FsfOptions>(m, "FsfOptions");
   py::class_<FsfModel>(m, "FsfModel", "Frequency-sampling-filter model (GW 2005): N samples per window, n filters.")
       .def_property_readonly("delta", &FsfModel::delta)
       .def_property_readonly("N", &FsfModel::N)

@@ -23,56 +23,14 @@ void def_tf_estimator(py::module_& m, const char* name, Estimator<Options> f, co
 void bind_linear(py::module_& m) {
   py::enum_<SvfWeights>(m, "SvfWeights").value("Riemann", SvfWeights::Riemann).value("Trapezoidal", SvfWeights::Trapezoidal);
 
-  py::class_<LssvfOptions>(m, "LssvfOptions")
-      .def(py::init<>())
-      .def_readwrite("tau", &LssvfOptions::tau)
-      .def_readwrite("weights", &LssvfOptions::weights)
-      .def_readwrite("alpha", &LssvfOptions::alpha)
-      .def_readwrite("transient_time", &LssvfOptions::transient_time)
-      .def_readwrite("fixed", &LssvfOptions::fixed)
-      .def_readwrite("data_filter", &LssvfOptions::data_filter)
-      .def_readwrite("tau_grid_size", &LssvfOptions::tau_grid_size);
-  py::class_<IvsvfOptions>(m, "IvsvfOptions")
-      .def(py::init<>())
-      .def_readwrite("svf", &IvsvfOptions::svf)
-      .def_readwrite("max_iterations", &IvsvfOptions::max_iterations)
-      .def_readwrite("tolerance", &IvsvfOptions::tolerance);
-  py::class_<SrivcOptions>(m, "SrivcOptions")
-      .def(py::init<>())
-      .def_readwrite("max_iterations", &SrivcOptions::max_iterations)
-      .def_readwrite("tolerance", &SrivcOptions::tolerance)
-      .def_readwrite("initial", &SrivcOptions::initial)
-      .def_readwrite("delay", &SrivcOptions::delay)
-      .def_readwrite("estimate_delay", &SrivcOptions::estimate_delay)
-      .def_readwrite("delay_min", &SrivcOptions::delay_min)
-      .def_readwrite("delay_max", &SrivcOptions::delay_max)
-      .def_readwrite("delay_grid", &SrivcOptions::delay_grid);
-  py::class_<OeOptions>(m, "OeOptions")
-      .def(py::init<>())
-      .def_readwrite("max_iterations", &OeOptions::max_iterations)
-      .def_readwrite("tolerance", &OeOptions::tolerance)
-      .def_readwrite("initial", &OeOptions::initial)
-      .def_readwrite("fixed", &OeOptions::fixed)
-      .def_readwrite("bounds", &OeOptions::bounds)
-      .def_readwrite("estimate_delay", &OeOptions::estimate_delay)
-      .def_readwrite("delay", &OeOptions::delay)
-      .def_readwrite("srivc", &OeOptions::srivc);
+  bind_options<LssvfOptions>(m, "LssvfOptions");
+  bind_options<IvsvfOptions>(m, "IvsvfOptions");
+  bind_options<SrivcOptions>(m, "SrivcOptions");
+  bind_options<OeOptions>(m, "OeOptions");
+  bind_options<RlsSvfOptions>(m, "RlsSvfOptions");
 
-  py::class_<SrivcMisoOptions>(m, "SrivcMisoOptions")
-      .def(py::init<>())
-      .def_readwrite("max_iterations", &SrivcMisoOptions::max_iterations)
-      .def_readwrite("tolerance", &SrivcMisoOptions::tolerance)
-      .def_readwrite("common_denominator", &SrivcMisoOptions::common_denominator)
-      .def_readwrite("delays", &SrivcMisoOptions::delays);
-  py::class_<ClosedLoopOptions>(m, "ClosedLoopOptions")
-      .def(py::init<>())
-      .def_readwrite("controller", &ClosedLoopOptions::controller)
-      .def_readwrite("reference_at_plant_input", &ClosedLoopOptions::reference_at_plant_input)
-      .def_property(
-          "reference_intersample", [](const ClosedLoopOptions& o) { return to_string(o.reference_intersample); },
-          [](ClosedLoopOptions& o, const std::string& s) { o.reference_intersample = intersample_from_string(s); })
-      .def_readwrite("max_iterations", &ClosedLoopOptions::max_iterations)
-      .def_readwrite("tolerance", &ClosedLoopOptions::tolerance);
+  bind_options<SrivcMisoOptions>(m, "SrivcMisoOptions");
+  bind_options<ClosedLoopOptions>(m, "ClosedLoopOptions");
   py::class_<FrequencyData>(m, "FrequencyData", "G(jw) at angular frequencies w (rad/s).")
       .def(py::init<Eigen::VectorXd, Eigen::VectorXcd>(), py::arg("w"), py::arg("response"))
       .def_static("from_spectra", &FrequencyData::from_spectra, py::arg("w"), py::arg("U"), py::arg("Y"),
@@ -80,15 +38,7 @@ void bind_linear(py::module_& m) {
       .def_property_readonly("w", &FrequencyData::w)
       .def_property_readonly("response", &FrequencyData::response)
       .def("__len__", &FrequencyData::size);
-  py::class_<FrequencyFitOptions>(m, "FrequencyFitOptions")
-      .def(py::init<>())
-      .def_readwrite("sk_iterations", &FrequencyFitOptions::sk_iterations)
-      .def_readwrite("refine", &FrequencyFitOptions::refine)
-      .def_readwrite("max_iterations", &FrequencyFitOptions::max_iterations)
-      .def_readwrite("tolerance", &FrequencyFitOptions::tolerance)
-      .def_readwrite("estimate_delay", &FrequencyFitOptions::estimate_delay)
-      .def_readwrite("delay", &FrequencyFitOptions::delay)
-      .def_readwrite("require_stable", &FrequencyFitOptions::require_stable);
+  bind_options<FrequencyFitOptions>(m, "FrequencyFitOptions");
   py::enum_<OrderCriterion>(m, "OrderCriterion")
       .value("Yic", OrderCriterion::Yic)
       .value("Rt2", OrderCriterion::Rt2)
@@ -128,6 +78,8 @@ void bind_linear(py::module_& m) {
   def_tf_estimator<SrivcOptions>(m, "srivc", &srivc, "Simplified refined instrumental variables (SISO).");
   def_tf_estimator<OeOptions>(m, "oe", &oe, "Continuous-time output error (Levenberg-Marquardt).");
   def_tf_estimator<OeOptions>(m, "tfest", &tfest, "SRIVC start, then output-error refinement.");
+  def_tf_estimator<RlsSvfOptions>(m, "rls_svf", &rls_svf,
+                                  "Recursive least squares on filtered signals run once over the record (final estimate).");
   m.def(
       "srivc_miso",
       [](const IdData& d, const std::vector<std::tuple<int, int, int>>& orders, const SrivcMisoOptions& o) {

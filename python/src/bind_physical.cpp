@@ -35,11 +35,7 @@ std::vector<PhysicalParameter> parameters_of(const py::dict& spec) {
 void bind_physical(py::module_& m) {
   py::class_<PhysicalModel>(m, "PhysicalModel", "G(s; Theta) from an expression such as 'k/(s*(J*s + b))'.")
       .def(py::init<const std::string&, std::vector<std::string>>(), py::arg("expression"), py::arg("parameters"));
-  py::class_<PhysicalFitOptions>(m, "PhysicalFitOptions")
-      .def(py::init<>())
-      .def_readwrite("max_iterations", &PhysicalFitOptions::max_iterations)
-      .def_readwrite("tolerance", &PhysicalFitOptions::tolerance)
-      .def_readwrite("step_points", &PhysicalFitOptions::step_points);
+  bind_options<PhysicalFitOptions>(m, "PhysicalFitOptions");
   m.def("fit_physical_step", [](const PhysicalModel& pm, const py::dict& p, const FsfModel& c, const PhysicalFitOptions& o) {
           const auto ps = parameters_of(p);
           return interruptible([&] { return fit_physical_step(pm, ps, c, o); });
@@ -56,15 +52,6 @@ void bind_physical(py::module_& m) {
         }, py::arg("model"), py::arg("parameters"), py::arg("data"), py::arg("a") = 0.0,
         py::arg("options") = PhysicalFitOptions{});
 
-  py::class_<RlsSvfOptions>(m, "RlsSvfOptions")
-      .def(py::init<>())
-      .def_readwrite("tau", &RlsSvfOptions::tau)
-      .def_readwrite("p0", &RlsSvfOptions::p0)
-      .def_readwrite("forgetting", &RlsSvfOptions::forgetting)
-      .def_readwrite("alpha", &RlsSvfOptions::alpha)
-      .def_readwrite("regression_interval", &RlsSvfOptions::regression_interval)
-      .def_readwrite("fixed", &RlsSvfOptions::fixed)
-      .def_readwrite("theta0", &RlsSvfOptions::theta0);
   py::class_<RlsSvf>(m, "RlsSvf", "Johansson (1986) recursive least squares on filtered signals (one sample at a time).")
       .def(py::init([](int nb, int nf, const RlsSvfOptions& o) { return RlsSvf(TfOrders{nb, nf, 0}, o); }),
            py::arg("nb"), py::arg("nf"), py::arg("options") = RlsSvfOptions{})

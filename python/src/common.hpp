@@ -80,7 +80,55 @@ void def_report(py::module_& m) {
       "Write the self-contained HTML report of a result on a record (plots, residual tests, parameters).");
 }
 
+/// A setting's value from Python, converted by the setting's kind (estimate/options.hpp): numbers, 0/1 or
+/// bool, a choice by name (or an enumeration member), a sequence of numbers, a dict of numbers, a dict of
+/// (lower, upper) pairs, a TransferFunction or None.
+OptionValue option_value_from_python(py::handle v, const OptionInfo& info, const std::string& method);
+
+/// Binds options struct O as Python class `name` from its table: one property per setting (same name, typed
+/// get/set, the table's doc with unit and range), `_names` (the setting names, in table order) and a repr
+/// listing every setting.
+template <class O>
+py::class_<O> bind_options(py::module_& m, const char* name) {
+  const OptionTable<O>& t = option_table<O>();
+  static const std::string doc = [&] {
+    std::string s = "Settings of " + t.method() + " (the same names, units and defaults as the C++ struct and the CLI's --set):";
+    for (const auto& i : t.info())
+      s += "\n  " + i.name + (i.unit.empty() ? "" : " (" + i.unit + ")") + ": " + i.doc + "; default " +
+           (i.default_value.empty() ? "none" : i.default_value) + (i.range.empty() ? "" : "; " + i.range);
+    return s;
+  }();
+  py::class_<O> c(m, name, doc.c_str());
+  c.def(py::init<>());
+  py::list names;
+  for (const auto& f : t.fields()) {
+    const std::string n = f.info.name;
+    names.append(n);
+    c.def_property(
+        f.info.name.c_str(), py::cpp_function([n](const O& o) { return option_table<O>().field(n).get(o); }),
+        py::cpp_function(
+            [n](O& o, py::handle v) {
+              const OptionTable<O>& tt = option_table<O>();
+              tt.set_value(o, n, option_value_from_python(v, tt.field(n).info, tt.method()));
+            },
+            py::is_method(c)),
+        f.info.doc.c_str());
+  }
+  c.attr("_names") = names;
+  c.def("__repr__", [name = std::string(name)](const O& o) {
+    std::string s = name + "(";
+    bool first = true;
+    for (const auto& [k, v] : option_table<O>().settings(o)) {
+      s += (first ? "" : ", ") + k + "=" + v;
+      first = false;
+    }
+    return s + ")";
+  });
+  return c;
+}
+
 void bind_core(py::module_& m);
+void bind_registry(py::module_& m);
 void bind_linear(py::module_& m);
 void bind_fsf(py::module_& m);
 void bind_nonlinear(py::module_& m);

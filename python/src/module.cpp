@@ -21,6 +21,7 @@ PYBIND11_MODULE(_ctid, m) {
   });
   m.attr("__version__") = ctid::version();
   ctid::python::bind_core(m);
+  ctid::python::bind_registry(m);
   ctid::python::bind_linear(m);
   ctid::python::bind_fsf(m);
   ctid::python::bind_nonlinear(m);

@@ -28,8 +28,8 @@ def test_srivc_recovers_the_plant_and_reports(plant):
 @pytest.mark.parametrize("method", ["lssvf", "ivsvf", "oe", "tfest"])
 def test_every_linear_estimator_with_keyword_options(plant, method):
     g, d = plant
-    kwargs = {"lssvf": {"tau": 0.2}, "ivsvf": {"max_iterations": 10, "svf": {"tau": 0.2}},
-              "oe": {"max_iterations": 50}, "tfest": {"srivc": {"max_iterations": 20}}}[method]
+    kwargs = {"lssvf": {"tau": 0.2}, "ivsvf": {"max_iterations": 10, "tau": 0.2},
+              "oe": {"max_iterations": 50}, "tfest": {"start_max_iterations": 20}}[method]
     r = getattr(ctid, method)(d, 1, 2, **kwargs)
     assert r.usable(), r.summary.message
     tol = 0.1 if method == "lssvf" else 0.02  # LSSVF is biased by the output noise
@@ -211,7 +211,7 @@ def test_unstable_plant_in_open_loop_and_fixed_integrator():
     assert any("not asymptotically stable" in w for w in r.diagnostics.warnings)
     s = ctid.srivc(d, 1, 1)
     assert not s.usable() and "use tfest or oe" in s.why_not_usable()
-    # An integrating plant 2/(s (s + 1)) with the pole at 0 fixed (fix.a2=0 was refused as "starting model
+    # An integrating plant 2/(s (s + 1)) with the pole at 0 fixed (fixed.a2=0 was refused as "starting model
     # unstable"): b0 = 2 and a1 = 1 within 1 % (measured 1.998, 0.999).
     n = 2000
     u = ctid.prbs(n, register_length=9, clock_period=5)
@@ -231,9 +231,9 @@ def test_delay_bounds_hold_in_the_output_error_refinement(plant):
     y = d.y[:, 0]
     k = 15  # 0.3 s at 20 ms: the output lags the input by 0.3 s more
     delayed = ctid.IdData.from_arrays(d.u[:, 0], np.r_[np.zeros(k), y[:-k]], ts=0.02)
-    r = ctid.tfest(delayed, 1, 2, estimate_delay=True, srivc={"delay_max": 1.0})
+    r = ctid.tfest(delayed, 1, 2, estimate_delay=True, delay_max=1.0)
     assert r.parameters["delay"] == pytest.approx(0.3, abs=0.02)
-    r = ctid.tfest(delayed, 1, 2, estimate_delay=True, srivc={"delay_max": 0.1})
+    r = ctid.tfest(delayed, 1, 2, estimate_delay=True, delay_max=0.1)
     assert 0.0 <= r.parameters["delay"] <= 0.1 + 1e-12
 
 

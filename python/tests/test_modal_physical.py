@@ -115,7 +115,7 @@ def test_recursive_johansson_tracks_a_first_order_plant():
     g = ctid.TransferFunction([2.0], [1.0, 0.5])
     t = ctid.time_grid(0.01, 4000)
     u = ctid.prbs(4000, register_length=8, clock_period=10)
-    est = ctid.rls_svf(1, 1, tau=0.5)
+    est = ctid.rls_svf_recursive(1, 1, tau=0.5)
     history = est.run(t, u, g.simulate(u, t))
     assert history.shape == (4000, 2)
     np.testing.assert_allclose(est.parameters(), [0.5, 2.0], rtol=1e-3)  # noise-free: a1 = 0.5, b0 = 2

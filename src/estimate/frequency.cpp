@@ -14,12 +14,22 @@
 
 namespace ctid {
 
-void FrequencyFitOptions::validate() const {
-  CTID_REQUIRE_OPTION(sk_iterations >= 1, "tf_from_frequency: sk_iterations must be >= 1 (got {})", sk_iterations);
-  CTID_REQUIRE_OPTION(max_iterations >= 1, "tf_from_frequency: max_iterations must be >= 1 (got {})", max_iterations);
-  CTID_REQUIRE_OPTION(tolerance > 0, "tf_from_frequency: tolerance must be > 0 (got {})", tolerance);
-  CTID_REQUIRE_OPTION(std::isfinite(delay) && delay >= 0, "tf_from_frequency: delay must be >= 0 (got {} s)", delay);
+template <>
+const OptionTable<FrequencyFitOptions>& option_table<FrequencyFitOptions>() {
+  using O = FrequencyFitOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("tf_from_frequency")
+          .integer("sk_iterations", &O::sk_iterations, "", at_least(1), "Sanathanan-Koerner iterations")
+          .flag("refine", &O::refine, "output-error refinement after Sanathanan-Koerner")
+          .integer("max_iterations", &O::max_iterations, "", at_least(1), "Levenberg-Marquardt iterations of the refinement")
+          .real("tolerance", &O::tolerance, "", above(0), "relative cost decrease that stops the refinement")
+          .flag("estimate_delay", &O::estimate_delay, "add an input delay (s) to the refinement (parameter delay)")
+          .real("delay", &O::delay, "s", at_least(0), "fixed or initial input delay")
+          .flag("require_stable", &O::require_stable, "keep the refinement among stable models");
+  return t;
 }
+
+void FrequencyFitOptions::validate() const { option_table<FrequencyFitOptions>().check(*this); }
 
 namespace {
 using cd = std::complex<double>;

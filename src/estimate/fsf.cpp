@@ -20,15 +20,28 @@ namespace ctid {
 
 using cd = std::complex<double>;
 
+template <>
+const OptionTable<FsfOptions>& option_table<FsfOptions>() {
+  using O = FsfOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("fsf")
+          .real("T", &O::T, "s", above(0), "settling time of the (shifted) system; T/Ts must be a whole number")
+          .integer("n", &O::n, "", at_least(1), "number of frequency-sampling filters, odd, <= T/Ts")
+          .real("a", &O::a, "1/s", at_least(0), "exponential window e^{-at}; > every unstable pole's real part")
+          .real("b", &O::b, "1/s", at_least(0), "residual weighting e^{bt}, <= a (b > 0 is risky, see the method page)")
+          .reals("weights", &O::weights, "", at_least(0), "per-sample residual weights; none: 1")
+          .flag("unstable", &O::unstable, "the plant is unstable: then the window a must be > 0");
+  return t;
+}
+
 void FsfOptions::validate() const {
-  CTID_REQUIRE_OPTION(std::isfinite(T) && T > 0, "fsf: T (settling time) must be > 0 (got {} s)", T);
-  CTID_REQUIRE_OPTION(n >= 1 && n % 2 == 1, "fsf: the number of filters n must be odd and >= 1 (got {})", n);
-  CTID_REQUIRE_OPTION(std::isfinite(a) && a >= 0, "fsf: the window exponent a must be >= 0 (got {})", a);
-  CTID_REQUIRE_OPTION(std::isfinite(b) && b >= 0, "fsf: the weighting exponent b must be >= 0 (got {})", b);
+  option_table<FsfOptions>().check(*this);
+  CTID_REQUIRE_OPTION(n % 2 == 1, "fsf: the number of filters n must be odd and >= 1 (got {})", n);
   CTID_REQUIRE_OPTION(b <= a, "fsf: b = {} must not exceed a = {} (e^{(b-a)t} must not grow)", b, a);
-  for (Eigen::Index i = 0; i < weights.size(); ++i)
-    CTID_REQUIRE_OPTION(std::isfinite(weights(i)) && weights(i) >= 0, "fsf: weight {} must be finite and >= 0 (got {})", i,
-                        weights(i));
+  CTID_REQUIRE_OPTION(!unstable || a > 0,
+                      "fsf: the plant is declared unstable: give a window a > 0 larger than its fastest unstable pole "
+                      "(got a = {})",
+                      a);
 }
 
 namespace {

@@ -17,15 +17,39 @@
 
 namespace ctid {
 
+template <>
+const OptionTable<LssvfOptions>& option_table<LssvfOptions>() {
+  using O = LssvfOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("lssvf")
+          .real("tau", &O::tau, "s", or_special(above(0), 0, "automatic"),
+                "filter time constant of z = 1/(1 + p tau); 0: best simulation fit over a grid from 2 Ts to duration/20")
+          .choice("weights", &O::weights, {{"riemann", SvfWeights::Riemann}, {"trapezoidal", SvfWeights::Trapezoidal}},
+                  "sample weights of the criterion int e^2 dt (RJ 44, 59-61)")
+          .real("alpha", &O::alpha, "1/s", at_least(0), "exponential weighting rate: criterion weight e^{2 alpha t}")
+          .real("transient_time", &O::transient_time, "s", at_least(0),
+                "seconds at the start left out of the criterion (filter and system transients)")
+          .named_reals("fixed", &O::fixed, "known coefficients held fixed, by parameter name (fixed.a2=4)")
+          .model("data_filter", &O::data_filter, "extra filter F(s) applied to input and output (stable, proper, no delay)")
+          .integer("tau_grid_size", &O::tau_grid_size, "", between(2, O::kMaxTauGrid),
+                   "number of tau candidates of the automatic choice");
+  return t;
+}
+
+template <>
+const OptionTable<IvsvfOptions>& option_table<IvsvfOptions>() {
+  using O = IvsvfOptions;
+  static const OptionTable<O> t = OptionTable<O>("ivsvf")
+                                      .include(&O::svf, option_table<LssvfOptions>())
+                                      .integer("max_iterations", &O::max_iterations, "", at_least(1),
+                                               "instrument/estimate refinements after the LS start")
+                                      .real("tolerance", &O::tolerance, "", above(0),
+                                            "stop when the relative parameter change is below");
+  return t;
+}
+
 void LssvfOptions::validate() const {
-  CTID_REQUIRE_OPTION(std::isfinite(tau) && tau >= 0, "lssvf: tau must be > 0, or 0 for automatic (got {})", tau);
-  CTID_REQUIRE_OPTION(std::isfinite(alpha) && alpha >= 0, "lssvf: alpha must be >= 0 (got {})", alpha);
-  CTID_REQUIRE_OPTION(std::isfinite(transient_time) && transient_time >= 0,
-                      "lssvf: transient_time must be >= 0 (got {} s)", transient_time);
-  CTID_REQUIRE_OPTION(tau_grid_size >= 2 && tau_grid_size <= kMaxTauGrid, "lssvf: tau_grid_size must be in [2, {}] (got {})",
-                      kMaxTauGrid, tau_grid_size);
-  for (const auto& [name, v] : fixed)
-    CTID_REQUIRE_OPTION(std::isfinite(v), "lssvf: fixed value of {} must be finite (got {})", name, v);
+  option_table<LssvfOptions>().check(*this);
   if (data_filter) {
     CTID_REQUIRE_OPTION(data_filter->is_stable(), "lssvf: data_filter must be stable (got {})", data_filter->to_string());
     CTID_REQUIRE_OPTION(data_filter->io_delay() == 0.0, "lssvf: data_filter must have no delay (got {} s)",
@@ -35,8 +59,7 @@ void LssvfOptions::validate() const {
 
 void IvsvfOptions::validate() const {
   svf.validate();
-  CTID_REQUIRE_OPTION(max_iterations >= 1, "ivsvf: max_iterations must be >= 1 (got {})", max_iterations);
-  CTID_REQUIRE_OPTION(tolerance > 0 && std::isfinite(tolerance), "ivsvf: tolerance must be > 0 (got {})", tolerance);
+  option_table<IvsvfOptions>().check(*this);
 }
 
 std::vector<std::string> tf_parameter_names(const TfOrders& o) {

@@ -17,13 +17,26 @@
 
 namespace ctid {
 
+template <>
+const OptionTable<OeOptions>& option_table<OeOptions>() {
+  using O = OeOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("oe")
+          .integer("max_iterations", &O::max_iterations, "", at_least(1), "Levenberg-Marquardt iterations")
+          .real("tolerance", &O::tolerance, "", above(0), "relative cost decrease / parameter change that stops the search")
+          .model("initial", &O::initial, "starting model; none: LSSVF with an automatic filter (oe) or SRIVC (tfest)")
+          .named_reals("fixed", &O::fixed, "parameters held at a value, by name (fixed.a1=2, fixed.delay=0.1)")
+          .named_bounds("bounds", &O::bounds, "parameter bounds by name (bounds.a1=0,inf); the delay is always >= 0")
+          .flag("estimate_delay", &O::estimate_delay, "add the input delay (s) as a parameter named delay")
+          .real("delay", &O::delay, "s", at_least(0), "initial or fixed input delay, added to nk Ts")
+          .include(&O::srivc, option_table<SrivcOptions>(), {"delay_min", "delay_max", "delay_grid"})
+          .include(&O::srivc, option_table<SrivcOptions>(), {"max_iterations", "tolerance"},
+                   {{"max_iterations", "start_max_iterations"}, {"tolerance", "start_tolerance"}});
+  return t;
+}
+
 void OeOptions::validate() const {
-  CTID_REQUIRE_OPTION(max_iterations >= 1, "oe: max_iterations must be >= 1 (got {})", max_iterations);
-  CTID_REQUIRE_OPTION(tolerance > 0 && std::isfinite(tolerance), "oe: tolerance must be > 0 (got {})", tolerance);
-  CTID_REQUIRE_OPTION(std::isfinite(delay) && delay >= 0, "oe: delay must be >= 0 (got {} s)", delay);
-  for (const auto& [k, v] : fixed) CTID_REQUIRE_OPTION(std::isfinite(v), "oe: fixed value of {} must be finite (got {})", k, v);
-  for (const auto& [k, b] : bounds)
-    CTID_REQUIRE_OPTION(!(b.first > b.second), "oe: bounds of {} are empty ([{}, {}])", k, b.first, b.second);
+  option_table<OeOptions>().check(*this);
   srivc.validate();
 }
 
@@ -133,7 +146,7 @@ Result<TransferFunction> refine(const IdData& data, const TfOrders& o, const Tra
   if (!std::isfinite(lm.cost)) {
     r.summary.termination = Termination::NumericalFailure;
     r.summary.message = "the simulation of the starting model overflows on this record (its poles are far in the right "
-                        "half plane); fix or bound the coefficients (--set fix.NAME, lower.NAME, upper.NAME)";
+                        "half plane); fix or bound the coefficients (--set fixed.NAME=VALUE, bounds.NAME=LOWER,UPPER)";
   } else {
     internal::set_termination(r.summary, lm);
   }

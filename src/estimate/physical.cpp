@@ -13,11 +13,19 @@
 
 namespace ctid {
 
-void PhysicalFitOptions::validate() const {
-  CTID_REQUIRE_OPTION(max_iterations >= 1, "physical: max_iterations must be >= 1 (got {})", max_iterations);
-  CTID_REQUIRE_OPTION(tolerance > 0, "physical: tolerance must be > 0 (got {})", tolerance);
-  CTID_REQUIRE_OPTION(step_points >= 2, "physical: step_points must be >= 2 (got {})", step_points);
+template <>
+const OptionTable<PhysicalFitOptions>& option_table<PhysicalFitOptions>() {
+  using O = PhysicalFitOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("physical")
+          .integer("max_iterations", &O::max_iterations, "", at_least(1), "Levenberg-Marquardt iterations")
+          .real("tolerance", &O::tolerance, "", above(0), "relative cost decrease that stops the search")
+          .integer("step_points", &O::step_points, "", at_least(2),
+                   "samples of the compressed step response on [0, T] (route via fsf)");
+  return t;
 }
+
+void PhysicalFitOptions::validate() const { option_table<PhysicalFitOptions>().check(*this); }
 
 namespace {
 

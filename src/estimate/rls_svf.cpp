@@ -2,24 +2,39 @@
 // (RJ 74-79; SEEDS-SPEC RJ-A6, RJ-A7). See include/ctid/estimate/rls_svf.hpp.
 #include "ctid/estimate/rls_svf.hpp"
 
+#include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "ctid/core/check.hpp"
+#include "ctid/estimate/lssvf.hpp"
+#include "ctid/simulate/lsim.hpp"
+#include "ctid/validate/metrics.hpp"
 #include "estimate/svf_common.hpp"
 
 namespace ctid {
 
-void RlsSvfOptions::validate() const {
-  CTID_REQUIRE_OPTION(std::isfinite(tau) && tau > 0, "rls_svf: tau must be > 0 (got {})", tau);
-  CTID_REQUIRE_OPTION(std::isfinite(p0) && p0 > 0, "rls_svf: p0 must be > 0 (got {})", p0);
-  CTID_REQUIRE_OPTION(forgetting > 0 && forgetting <= 1, "rls_svf: forgetting must be in (0, 1] (got {})", forgetting);
-  CTID_REQUIRE_OPTION(std::isfinite(alpha) && alpha >= 0, "rls_svf: alpha must be >= 0 (got {})", alpha);
-  CTID_REQUIRE_OPTION(std::isfinite(regression_interval) && regression_interval >= 0,
-                      "rls_svf: regression_interval must be >= 0 (got {})", regression_interval);
-  for (const auto& [name, v] : fixed)
-    CTID_REQUIRE_OPTION(std::isfinite(v), "rls_svf: fixed value of {} must be finite (got {})", name, v);
-  CTID_REQUIRE_OPTION(theta0.allFinite(), "rls_svf: theta0 must be finite");
+template <>
+const OptionTable<RlsSvfOptions>& option_table<RlsSvfOptions>() {
+  using O = RlsSvfOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("rls_svf")
+          .real("tau", &O::tau, "s", above(0), "filter time constant of z = 1/(1 + p tau)")
+          .real("p0", &O::p0, "", above(0), "initial covariance P(0) = p0 I")
+          .real("forgetting", &O::forgetting, "", above_at_most(0, 1), "forgetting factor lambda per regression update")
+          .real("alpha", &O::alpha, "1/s", at_least(0), "exponential weighting rate: lambda times e^{-2 alpha dt}")
+          .real("regression_interval", &O::regression_interval, "s", at_least(0),
+                "time between regression updates; 0: every sample")
+          .choice("input_intersample", &O::input_intersample,
+                  {{"zoh", Intersample::Zoh}, {"foh", Intersample::Foh}, {"bl", Intersample::BandLimited}},
+                  "intersample behaviour of the input in the filters (a fit to a record takes the record's)")
+          .named_reals("fixed", &O::fixed, "known coefficients held fixed, by parameter name (fixed.a2=4)")
+          .reals("theta0", &O::theta0, "", OptionRange{},
+                 "initial parameters [a1..an, b0..]; none: 0");
+  return t;
 }
+
+void RlsSvfOptions::validate() const { option_table<RlsSvfOptions>().check(*this); }
 
 RlsSvf::RlsSvf(const TfOrders& orders, const RlsSvfOptions& options)
     : orders_((orders.validate(), orders)),
@@ -190,6 +205,30 @@ void CoefficientTracker::update(double t, double u, double y) {
     estimate_ = sign_ * theta_(j_);
     updated_ = true;
   }
+}
+
+Result<TransferFunction> rls_svf(const IdData& d, const TfOrders& orders, const RlsSvfOptions& options) {
+  CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "rls_svf: needs one input and one output (got {} and {})", d.nu(), d.ny());
+  CTID_REQUIRE(orders.nk == 0, "rls_svf: nk must be 0 (got {}; delay the input column instead)", orders.nk);
+  const auto start = std::chrono::steady_clock::now();
+  RlsSvfOptions o = options;
+  o.input_intersample = d.intersample(0);
+  RlsSvf rls(orders, o);
+  for (int k = 0; k < d.size(); ++k) rls.update(d.time(k), d.u()(k, 0), d.y()(k, 0));
+  Result<TransferFunction> r;
+  r.model = rls.model();
+  r.parameters.names = tf_parameter_names(orders);
+  r.parameters.values = rls.parameters();
+  r.parameters.std = Eigen::VectorXd::Constant(orders.n_parameters(), std::numeric_limits<double>::quiet_NaN());
+  r.parameters.fixed.assign(orders.n_parameters(), false);
+  for (int i = 0; i < orders.n_parameters(); ++i) r.parameters.fixed[i] = options.fixed.count(r.parameters.names[i]) > 0;
+  r.diagnostics.scalars["tau"] = options.tau;
+  r.summary.iterations = static_cast<int>(rls.n_updates());
+  r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.fit = fit_report_or_inf(d.y().col(0), lsim(r.model, d, 0),
+                            orders.n_parameters() - static_cast<int>(options.fixed.size()));
+  if (!r.model.is_stable()) r.diagnostics.warnings.push_back("the estimated model is unstable");
+  return r;
 }
 
 }  // namespace ctid

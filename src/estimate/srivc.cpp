@@ -17,17 +17,30 @@
 
 namespace ctid {
 
+template <>
+const OptionTable<SrivcOptions>& option_table<SrivcOptions>() {
+  using O = SrivcOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("srivc")
+          .integer("max_iterations", &O::max_iterations, "", at_least(1), "IV iterations")
+          .real("tolerance", &O::tolerance, "", above(0),
+                "stop when max_i |change of theta_i| / max(|theta_i|, 1e-8) is below")
+          .model("initial", &O::initial, "starting model of the same orders; none: LSSVF with an automatic filter")
+          .real("delay", &O::delay, "s", at_least(0), "input delay added to nk Ts (the start of the search when estimated)")
+          .flag("estimate_delay", &O::estimate_delay,
+                "estimate a non-integer input delay: grid search over [delay_min, delay_max], then refinement")
+          .real("delay_min", &O::delay_min, "s", at_least(0), "lower end of the delay search")
+          .real("delay_max", &O::delay_max, "s", or_special(at_least(0), -1, "10 % of the record"),
+                "upper end of the delay search")
+          .integer("delay_grid", &O::delay_grid, "", or_special(between(1, O::kMaxDelayGrid), 0, "one per sample period, at most 200"),
+                   "grid points of the delay search");
+  return t;
+}
+
 void SrivcOptions::validate() const {
-  CTID_REQUIRE_OPTION(max_iterations >= 1, "srivc: max_iterations must be >= 1 (got {})", max_iterations);
-  CTID_REQUIRE_OPTION(tolerance > 0 && std::isfinite(tolerance), "srivc: tolerance must be > 0 (got {})", tolerance);
-  CTID_REQUIRE_OPTION(std::isfinite(delay) && delay >= 0, "srivc: delay must be >= 0 (got {} s)", delay);
-  CTID_REQUIRE_OPTION(std::isfinite(delay_min) && delay_min >= 0, "srivc: delay_min must be >= 0 (got {} s)", delay_min);
-  CTID_REQUIRE_OPTION(std::isfinite(delay_max), "srivc: delay_max must be finite (got {})", delay_max);
+  option_table<SrivcOptions>().check(*this);
   CTID_REQUIRE_OPTION(delay_max < 0 || delay_max >= delay_min, "srivc: the delay range [{}, {}] s is empty", delay_min,
                       delay_max);
-  CTID_REQUIRE_OPTION(delay_grid >= 0 && delay_grid <= kMaxDelayGrid,
-                      "srivc: delay_grid must be in [0, {}] points (got {}); a finer grid adds nothing the refinement "
-                      "does not", kMaxDelayGrid, delay_grid);
 }
 
 
@@ -363,13 +376,20 @@ Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const
   return r;
 }
 
-void SrivcMisoOptions::validate() const {
-  CTID_REQUIRE_OPTION(max_iterations >= 1, "srivc_miso: max_iterations must be >= 1 (got {})", max_iterations);
-  CTID_REQUIRE_OPTION(tolerance > 0 && std::isfinite(tolerance), "srivc_miso: tolerance must be > 0 (got {})", tolerance);
-  for (std::size_t i = 0; i < delays.size(); ++i)
-    CTID_REQUIRE_OPTION(std::isfinite(delays[i]) && delays[i] >= 0, "srivc_miso: delay of input {} must be >= 0 (got {} s)",
-                        i + 1, delays[i]);
+template <>
+const OptionTable<SrivcMisoOptions>& option_table<SrivcMisoOptions>() {
+  using O = SrivcMisoOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("srivc_miso")
+          .integer("max_iterations", &O::max_iterations, "", at_least(1), "sweeps over all channels")
+          .real("tolerance", &O::tolerance, "", above(0), "stop when the relative change of every parameter is below")
+          .flag("common_denominator", &O::common_denominator,
+                "1: y = (sum_i B_i u_i)/A with one A; 0: y = sum_i B_i/A_i u_i (backfitting)")
+          .reals("delays", &O::delays, "s", at_least(0), "per-input delays added to nk Ts (none: zero)");
+  return t;
 }
+
+void SrivcMisoOptions::validate() const { option_table<SrivcMisoOptions>().check(*this); }
 
 namespace {
 Result<MisoModel> srivc_miso_in_units(const IdData& data, const std::vector<TfOrders>& orders, const SrivcMisoOptions& opt) {
@@ -554,10 +574,24 @@ Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& or
   return r;
 }
 
+template <>
+const OptionTable<ClosedLoopOptions>& option_table<ClosedLoopOptions>() {
+  using O = ClosedLoopOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("srivc_closed_loop")
+          .model("controller", &O::controller, "the known controller C(s) (proper, no delay)")
+          .flag("reference_at_plant_input", &O::reference_at_plant_input,
+                "1: u = r - C y (reference added at the plant input); 0: u = C (r - y) (a setpoint)")
+          .choice("reference_intersample", &O::reference_intersample,
+                  {{"zoh", Intersample::Zoh}, {"foh", Intersample::Foh}, {"bl", Intersample::BandLimited}},
+                  "intersample behaviour of the reference")
+          .integer("max_iterations", &O::max_iterations, "", at_least(1), "IV iterations")
+          .real("tolerance", &O::tolerance, "", above(0), "stop when the relative parameter change is below");
+  return t;
+}
+
 void ClosedLoopOptions::validate() const {
-  CTID_REQUIRE_OPTION(max_iterations >= 1, "srivc_closed_loop: max_iterations must be >= 1 (got {})", max_iterations);
-  CTID_REQUIRE_OPTION(tolerance > 0 && std::isfinite(tolerance), "srivc_closed_loop: tolerance must be > 0 (got {})",
-                      tolerance);
+  option_table<ClosedLoopOptions>().check(*this);
   CTID_REQUIRE_OPTION(controller.io_delay() == 0.0, "srivc_closed_loop: the controller must have no delay (got {} s)",
                       controller.io_delay());
 }

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <optional>
 #include <random>
+#include <set>
 #include <sys/wait.h>
 
 #include <gtest/gtest.h>
@@ -151,8 +152,8 @@ TEST(Cli, BadInputGivesOneLineAndTheDocumentedExitCode) {
       {"fit " + nonincr + base, 3, "nonincr.csv:4: time column 'time' is not strictly increasing (0.1 after 0.2)"},
       {"fit " + good_csv() + base + "--nf 0", 2, "nf (model order) must be >= 1 (got 0)"},
       {"fit " + good_csv() + base + "--nf -2", 2, "nf (model order) must be >= 1 (got -2)"},
-      {"fit " + good_csv() + base + "--set tau=-0.5", 2, "tau must be > 0, or 0 for automatic (got -0.5)"},
-      {"fit " + good_csv() + base + "--method rls-svf --set tau=0", 2, "tau must be > 0 (got 0)"},
+      {"fit " + good_csv() + base + "--set tau=-0.5", 2, "tau must be > 0, or 0 (automatic) (got -0.5 s)"},
+      {"fit " + good_csv() + base + "--method rls-svf --set tau=0", 2, "tau must be > 0 (got 0 s)"},
       {"fit " + good_csv() + base + "--set bogus=1", 2, "--set bogus: not a setting of lssvf"},
       {"fit " + good_csv() + base + "--method magic", 2, "magic"},
       {"fit " + good_csv() + " --input force --output position", 2, "--time COLUMN or --ts SECONDS"},
@@ -852,8 +853,9 @@ TEST(Cli, TrustCampaign) {
       // A BOM on a header-less file: the first row is data, the fit is that of the clean file.
       {"fit " + bom + " --time 1 --input 2 --output 3 --nf 2 --nb 1 --set tau=0.3", 0, ""},
       // Caps on grids and searches.
-      {"fit " + good_csv() + base + "--method srivc --delay --set delay_grid=1e8", 2, "delay_grid must be in [0, 10000]"},
-      {"fit " + good_csv() + base + "--set tau_grid=1e9", 2, "tau_grid_size must be in [2, 1000]"},
+      {"fit " + good_csv() + base + "--method srivc --delay --set delay_grid=1e8", 2, "delay_grid must be in [1, 10000], or 0"},
+      {"fit " + good_csv() + base + "--set tau_grid_size=1e9", 2, "tau_grid_size must be in [2, 1000] (got 1000000000)"},
+      {"fit " + good_csv() + base + "--set tau_grid=20", 2, "not a setting of lssvf; did you mean 'tau_grid_size'?"},
       {"order " + good_csv() + base + "--nb 1:100 --nf 1:100 --nk 0:100", 2, "more than the limit of 2000"},
       // Flags that do not apply.
       {"fit " + good_csv() + base + "--method srivc --reference force", 2, "--reference needs --closed-loop-controller"},
@@ -965,4 +967,51 @@ TEST(Cli, ReportRefusesUnsoundResults) {
   r = report(bad, "rr_diverge.json");
   EXPECT_EQ(r.code, 1) << r.err;
   EXPECT_NE(r.err.find("the model diverges"), std::string::npos) << r.err;
+}
+
+// Issue 14 (item 3): `ctid fit --method M --help` lists every setting of the library's registry entries of M
+// (estimate/methods.hpp) with its default and unit, and every one of them is accepted by --set under that name
+// (set to its own default, the fit must not stop with a usage error naming it).
+TEST(Cli, MethodHelpListsEveryRegisteredSettingAndSetAcceptsIt) {
+  const std::map<std::string, std::vector<std::string>> cli_methods = {
+      {"lssvf", {"lssvf"}}, {"ivsvf", {"ivsvf"}}, {"rls-svf", {"rls_svf"}},
+      {"srivc", {"srivc", "srivc_miso", "srivc_closed_loop"}}, {"oe", {"oe", "tf_from_frequency"}},
+      {"tfest", {"tfest", "tf_from_frequency"}}, {"fsf", {"fsf"}}, {"physical", {"physical"}}};
+  std::set<std::string> covered;
+  for (const auto& [cli, entries] : cli_methods) {
+    const CliRun h = ctid_run("fit --method " + cli + " --help");
+    ASSERT_EQ(h.code, 0) << cli << "\n" << h.err;
+    for (const auto& name : entries) {
+      covered.insert(name);
+      const MethodInfo& m = method_info(name);
+      EXPECT_NE(h.out.find("settings of " + name), std::string::npos) << cli;
+      for (const auto& s : m.settings) {
+        const auto at = h.out.find("\n  " + s.name + " ", h.out.find("settings of " + name));
+        ASSERT_NE(at, std::string::npos) << cli << ": " << name << "." << s.name << " missing from the help";
+        const std::string line = h.out.substr(at + 1, h.out.find('\n', at + 1) - at - 1);
+        const std::string d = s.default_value.empty() ? "none" : s.default_value;
+        EXPECT_NE(line.find("default " + d), std::string::npos) << line;
+        if (!s.unit.empty()) EXPECT_NE(line.find(s.unit), std::string::npos) << line;
+      }
+    }
+  }
+  // Every registry entry is reachable from some CLI method.
+  for (const auto& m : methods()) EXPECT_TRUE(covered.count(m.name)) << m.name << " is not reachable from ctid fit";
+
+  // --set accepts each single-input setting under its registry name (given its default value: a named or model
+  // setting gets a valid example instead). The fit may still fail for reasons of the data, never "not a setting".
+  const std::string base = " --time time --input force --output position --nf 2 --nb 1 ";
+  for (const auto& [cli, name] : std::vector<std::pair<std::string, std::string>>{
+           {"lssvf", "lssvf"}, {"ivsvf", "ivsvf"}, {"rls-svf", "rls_svf"}, {"srivc", "srivc"}, {"oe", "oe"}, {"tfest", "tfest"}}) {
+    for (const auto& s : method_info(name).settings) {
+      std::string value = s.default_value.empty() ? "none" : s.default_value;
+      std::string key = s.name;
+      if (s.kind == OptionKind::NamedReals) key += ".a1", value = "1.2";
+      if (s.kind == OptionKind::NamedBounds) key += ".a1", value = "0,10";
+      if (s.kind == OptionKind::Model) value = s.name == "data_filter" ? "1/0.01,1" : "3/1,1.2,4";
+      const CliRun r = ctid_run("fit " + good_csv() + base + "--method " + cli + " --set " + key + "=" + value);
+      EXPECT_EQ(r.err.find("not a setting"), std::string::npos) << cli << " " << key << ": " << r.err;
+      EXPECT_NE(r.code, 2) << cli << " --set " << key << "=" << value << ": " << r.err;
+    }
+  }
 }

@@ -13,6 +13,7 @@
 #include "ctid/data/frequency_data.hpp"
 #include "ctid/estimate/orders.hpp"
 #include "ctid/model/transfer_function.hpp"
+#include "ctid/estimate/options.hpp"
 
 namespace ctid {
 
@@ -29,6 +30,9 @@ struct FrequencyFitOptions {
   bool require_stable = true;
   void validate() const;
 };
+/// The settings of FrequencyFitOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
+template <>
+const OptionTable<FrequencyFitOptions>& option_table<FrequencyFitOptions>();
 
 /// Fit G(s) = e^{-sT} B(s)/A(s) with orders.nb numerator and orders.nf denominator
 /// coefficients (orders.nk must be 0). Throws InvalidArgument when there are fewer real

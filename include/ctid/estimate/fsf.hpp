@@ -16,6 +16,7 @@
 #include "ctid/core/types.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/model/fsf.hpp"
+#include "ctid/estimate/options.hpp"
 
 namespace ctid {
 
@@ -25,8 +26,12 @@ struct FsfOptions {
   double a = 0.0;     ///< exponential window e^{-at} (1/s), >= 0; choose a > max Re(poles) for unstable plants
   double b = 0.0;     ///< residual weighting e^{bt} (1/s), 0 <= b <= a; b > 0 is risky (see the method page)
   Eigen::VectorXd weights;  ///< optional per-sample residual weights (>= 0, length N_data); empty: 1
+  bool unstable = false;    ///< the plant is declared unstable: validate() then requires a > 0
   void validate() const;
 };
+/// The settings of FsfOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
+template <>
+const OptionTable<FsfOptions>& option_table<FsfOptions>();
 
 /// Fit an FSF model to one input and one output (uniform Ts). Throws InvalidArgument /
 /// InvalidOptions for: even n, n > N, T not a whole multiple of Ts (to 1e-9) or longer than

@@ -22,6 +22,7 @@
 #include "ctid/core/types.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/estimate/orders.hpp"
+#include "ctid/estimate/options.hpp"
 #include "ctid/model/transfer_function.hpp"
 
 namespace ctid {
@@ -51,6 +52,9 @@ struct LssvfOptions {
   /// Throws InvalidOptions naming the field.
   void validate() const;
 };
+/// The settings of LssvfOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
+template <>
+const OptionTable<LssvfOptions>& option_table<LssvfOptions>();
 
 struct IvsvfOptions {
   LssvfOptions svf;            ///< filter, weights and fixed coefficients (as for LSSVF)
@@ -58,6 +62,9 @@ struct IvsvfOptions {
   double tolerance = 1e-7;     ///< stop when the relative parameter change is below
   void validate() const;
 };
+/// The settings of IvsvfOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
+template <>
+const OptionTable<IvsvfOptions>& option_table<IvsvfOptions>();
 
 /// LSSVF on one input and one output. Throws InvalidArgument for data with other
 /// channel counts, irregular data with nk > 0, or too few samples for the free

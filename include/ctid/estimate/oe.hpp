@@ -17,6 +17,7 @@
 #include "ctid/core/types.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/estimate/orders.hpp"
+#include "ctid/estimate/options.hpp"
 #include "ctid/estimate/srivc.hpp"
 #include "ctid/model/transfer_function.hpp"
 
@@ -36,6 +37,9 @@ struct OeOptions {
   SrivcOptions srivc;            ///< options of the SRIVC start (tfest); its delay search is used when estimate_delay
   void validate() const;
 };
+/// The settings of OeOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
+template <>
+const OptionTable<OeOptions>& option_table<OeOptions>();
 
 /// Output-error estimate of a SISO transfer function. Throws InvalidArgument /
 /// InvalidOptions for bad data or options (incl. unknown parameter names).

@@ -13,6 +13,7 @@
 #include "ctid/data/iddata.hpp"
 #include "ctid/model/fsf.hpp"
 #include "ctid/model/physical_model.hpp"
+#include "ctid/estimate/options.hpp"
 
 namespace ctid {
 
@@ -30,6 +31,9 @@ struct PhysicalFitOptions {
   int step_points = 1000;   ///< samples of the compressed step response on [0, T] (step route)
   void validate() const;
 };
+/// The settings of PhysicalFitOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
+template <>
+const OptionTable<PhysicalFitOptions>& option_table<PhysicalFitOptions>();
 
 /// Fit to the compressed step response of `compressed` (whose shift a is applied to the
 /// model). `parameters` gives every parameter of `model` (same names, any order). Throws

@@ -17,8 +17,10 @@
 
 #include <Eigen/Dense>
 
+#include "ctid/core/types.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/estimate/orders.hpp"
+#include "ctid/estimate/options.hpp"
 #include "ctid/model/transfer_function.hpp"
 #include "ctid/signal/svf.hpp"
 
@@ -35,6 +37,9 @@ struct RlsSvfOptions {
   Eigen::VectorXd theta0;           ///< initial parameter values [a1..an, b0..]; empty = 0
   void validate() const;
 };
+/// The settings of RlsSvfOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
+template <>
+const OptionTable<RlsSvfOptions>& option_table<RlsSvfOptions>();
 
 /// Recursive LSSVF. With no fixed coefficient and nb = nf, the recursion runs on
 /// theta_tau exactly as RJ 59-60 (P(0) = p0 I on theta_tau); otherwise on the free
@@ -75,6 +80,12 @@ class RlsSvf {
   Eigen::VectorXd Pphi_, row_, psi_;
   long long n_updates_ = 0;
 };
+
+/// The recursion run once over a whole record (one input, one output, nk = 0): the final estimate as a result,
+/// with the simulation fit on the record and no standard deviations (P is not a covariance under forgetting or
+/// unknown noise). The input's intersample behaviour is the record's. The CLI's `fit --method rls-svf` and Python's ctid.rls_svf. Throws InvalidArgument for data
+/// that are not SISO or nk > 0, InvalidOptions for bad options.
+Result<TransferFunction> rls_svf(const IdData& data, const TfOrders& orders, const RlsSvfOptions& options = {});
 
 struct CoefficientTrackerOptions {
   double tau = 0.5;                  ///< filter time constant (s)

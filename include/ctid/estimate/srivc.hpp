@@ -19,6 +19,7 @@
 #include "ctid/core/types.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/estimate/orders.hpp"
+#include "ctid/estimate/options.hpp"
 #include "ctid/model/miso.hpp"
 #include "ctid/model/transfer_function.hpp"
 
@@ -40,6 +41,9 @@ struct SrivcOptions {
   static constexpr int kMaxDelayGrid = 10000;
   void validate() const;
 };
+/// The settings of SrivcOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
+template <>
+const OptionTable<SrivcOptions>& option_table<SrivcOptions>();
 
 /// SISO SRIVC. orders.nb may be nf + 1 (biproper). Throws InvalidArgument for data that
 /// are not SISO or too short, InvalidOptions for bad options. Like srivc_miso and
@@ -57,6 +61,9 @@ struct SrivcMisoOptions {
   std::vector<double> delays;
   void validate() const;
 };
+/// The settings of SrivcMisoOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
+template <>
+const OptionTable<SrivcMisoOptions>& option_table<SrivcMisoOptions>();
 
 struct ClosedLoopOptions {
   /// The known controller C(s) (proper, no delay).
@@ -68,6 +75,9 @@ struct ClosedLoopOptions {
   double tolerance = 1e-7;
   void validate() const;
 };
+/// The settings of ClosedLoopOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
+template <>
+const OptionTable<ClosedLoopOptions>& option_table<ClosedLoopOptions>();
 
 /// Closed-loop SRIVC (CLSRIVC; Gilson, Garnier, Young & Van den Hof 2008, "Instrumental
 /// variable methods for closed-loop continuous-time model identification", in Garnier & Wang

@@ -1,0 +1,144 @@
+// The options tables (estimate/options.hpp) and the method registry (estimate/methods.hpp), issue 14 item 3.
+#include <functional>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "ctid/ctid.hpp"
+
+using namespace ctid;
+
+namespace {
+std::string message_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InvalidOptions& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+// Text forms: numbers, whole numbers written as 1e3, flags, choices, lists, named values, bounds, transfer
+// functions "NUM/DEN" (descending powers); each set lands in the struct's member.
+TEST(Options, TextFormsSetTheMembers) {
+  OeOptions o;
+  const auto& t = option_table<OeOptions>();
+  t.set(o, "max_iterations", "1e3");
+  t.set(o, "tolerance", "2.5e-9");
+  t.set(o, "estimate_delay", "yes");
+  t.set(o, "fixed.a2", "4");
+  t.set(o, "bounds.a1", "0,inf");
+  t.set(o, "initial", "3/1,1.2,4");
+  t.set(o, "delay_max", "0.5");              // from the nested SRIVC options, same name
+  t.set(o, "start_max_iterations", "7");     // the nested SRIVC's max_iterations, renamed
+  EXPECT_EQ(o.max_iterations, 1000);
+  EXPECT_EQ(o.tolerance, 2.5e-9);
+  EXPECT_TRUE(o.estimate_delay);
+  EXPECT_EQ(o.fixed.at("a2"), 4.0);
+  EXPECT_EQ(o.bounds.at("a1").first, 0.0);
+  EXPECT_EQ(o.bounds.at("a1").second, std::numeric_limits<double>::infinity());
+  ASSERT_TRUE(o.initial.has_value());
+  EXPECT_EQ(o.initial->den().coefficients(), (Eigen::VectorXd{{1.0, 1.2, 4.0}}));
+  EXPECT_EQ(o.initial->num().coefficients(), (Eigen::VectorXd{{3.0}}));
+  EXPECT_EQ(o.srivc.delay_max, 0.5);
+  EXPECT_EQ(o.srivc.max_iterations, 7);
+  EXPECT_EQ(o.max_iterations, 1000);  // untouched by the renamed nested field
+
+  LssvfOptions l;
+  option_table<LssvfOptions>().set(l, "weights", "trapezoidal");
+  EXPECT_EQ(l.weights, SvfWeights::Trapezoidal);
+  // Formatting reads back what was set (report settings).
+  const auto s = t.settings(o);
+  auto value = [&](const std::string& k) {
+    for (const auto& [n, v] : s)
+      if (n == k) return v;
+    return std::string("?");
+  };
+  EXPECT_EQ(value("initial"), "3/1,1.2,4");
+  EXPECT_EQ(value("bounds"), "a1=0,inf");
+  EXPECT_EQ(value("start_max_iterations"), "7");
+}
+
+// Errors name the method, the setting, the admissible range and the value; an unknown key names the closest.
+TEST(Options, ErrorsNameTheSettingTheRangeAndTheClosestName) {
+  LssvfOptions l;
+  const auto& t = option_table<LssvfOptions>();
+  EXPECT_EQ(message_of([&] { t.set(l, "tau_grid", "5"); }).find("lssvf: 'tau_grid' is not a setting; did you mean 'tau_grid_size'?"), 0u);
+  EXPECT_NE(message_of([&] { t.set(l, "transient", "1"); }).find("did you mean 'transient_time'?"), std::string::npos);
+  EXPECT_NE(message_of([&] { t.set(l, "alhpa", "1"); }).find("did you mean 'alpha'?"), std::string::npos);
+  EXPECT_EQ(message_of([&] { t.set(l, "tau", "fast"); }), "lssvf: tau must be a number (got 'fast')");
+  EXPECT_EQ(message_of([&] { t.set(l, "tau_grid_size", "2.5"); }), "lssvf: tau_grid_size must be a whole number (got '2.5')");
+  EXPECT_EQ(message_of([&] { t.set(l, "weights", "simpson"); }),
+            "lssvf: weights must be one of riemann, trapezoidal (got 'simpson')");
+  EXPECT_EQ(message_of([&] { t.set(l, "fixed", "3"); }).find("lssvf: fixed must be given per name"), 0u);
+  l.tau = -0.5;
+  EXPECT_EQ(message_of([&] { l.validate(); }), "lssvf: tau must be > 0, or 0 (automatic) (got -0.5 s)");
+  l.tau = 0;
+  l.tau_grid_size = 1;
+  EXPECT_EQ(message_of([&] { l.validate(); }), "lssvf: tau_grid_size must be in [2, 1000] (got 1)");
+  RlsSvfOptions r;
+  r.forgetting = 1.5;
+  EXPECT_EQ(message_of([&] { r.validate(); }), "rls_svf: forgetting must be in (0, 1] (got 1.5)");
+  OeOptions o;
+  o.bounds["a1"] = {2, 1};
+  EXPECT_EQ(message_of([&] { o.validate(); }), "oe: bounds.a1 must be lower <= upper (got 2,1)");
+  o.bounds.clear();
+  o.tolerance = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(message_of([&] { o.validate(); }), "oe: tolerance must be > 0 (got inf)");
+  SrivcOptions so;
+  EXPECT_NE(message_of([&] { option_table<SrivcOptions>().set(so, "initial", "1,2"); }).find("NUM/DEN"), std::string::npos);
+  // A nested struct's setting is checked under the outer method's name.
+  IvsvfOptions iv;
+  iv.svf.alpha = -1;
+  EXPECT_EQ(message_of([&] { option_table<IvsvfOptions>().check(iv); }), "ivsvf: alpha must be >= 0 (got -1 1/s)");
+  EXPECT_EQ(closest_name("xyz_unrelated", {"tau", "alpha"}), "");
+}
+
+// The registry: names unique, every setting documented with its default, and the defaults are those of a
+// default-constructed options struct (read through the table, checked here against the struct members).
+TEST(Options, RegistryListsEachMethodOnceWithDocumentedDefaults) {
+  std::set<std::string> names;
+  for (const auto& m : methods()) {
+    EXPECT_TRUE(names.insert(m.name).second) << m.name;
+    EXPECT_FALSE(m.summary.empty());
+    EXPECT_FALSE(m.settings.empty()) << m.name;
+    std::set<std::string> settings;
+    for (const auto& s : m.settings) {
+      EXPECT_TRUE(settings.insert(s.name).second) << m.name << "." << s.name;
+      EXPECT_FALSE(s.doc.empty()) << m.name << "." << s.name;
+    }
+  }
+  auto default_of = [](const std::string& method, const std::string& name) {
+    for (const auto& s : method_info(method).settings)
+      if (s.name == name) return s.default_value;
+    return std::string("?");
+  };
+  EXPECT_EQ(default_of("srivc", "max_iterations"), std::to_string(SrivcOptions{}.max_iterations));
+  EXPECT_EQ(default_of("oe", "tolerance"), "1e-12");
+  EXPECT_EQ(default_of("lssvf", "tau_grid_size"), "12");
+  EXPECT_EQ(default_of("fsf", "n"), "21");
+  EXPECT_EQ(default_of("physical", "step_points"), "1000");
+  EXPECT_EQ(default_of("tfest", "start_max_iterations"), "50");
+  EXPECT_EQ(default_of("srivc_closed_loop", "reference_at_plant_input"), "1");
+  EXPECT_NE(std::string(settings_help(method_info("srivc"))).find("delay_max"), std::string::npos);
+  EXPECT_EQ(message_of([] { method_info("srvic"); }).find("'srvic' is not a method; did you mean 'srivc'?"), 0u);
+}
+
+// The same table drives validate(): a struct accepted by every field's range passes, one outside fails.
+TEST(Options, ValidateUsesTheTableAndKeepsCrossFieldRules) {
+  FsfOptions f;
+  f.T = 8;
+  f.validate();
+  f.n = 20;
+  EXPECT_NE(message_of([&] { f.validate(); }).find("must be odd"), std::string::npos);
+  f.n = 21;
+  f.unstable = true;
+  EXPECT_NE(message_of([&] { f.validate(); }).find("declared unstable"), std::string::npos);
+  f.a = 2;
+  f.validate();
+  SrivcOptions s;
+  s.delay_min = 2;
+  s.delay_max = 1;
+  EXPECT_NE(message_of([&] { s.validate(); }).find("the delay range [2, 1] s is empty"), std::string::npos);
+}
