@@ -60,7 +60,7 @@ void reject_flags_that_do_not_apply(const FitArgs& a) {
       if (has(f)) refuse(f, "names a column of frequency data: it needs --frequency");
 }
 
-using Settings = std::vector<std::pair<std::string, std::string>>;
+
 
 // Print, write the JSON file and the HTML report if asked, and map usability to the exit code.
 template <class M>
@@ -394,10 +394,10 @@ const std::map<std::string, FitMethod>& fit_methods() {
       {"physical", {{"physical"}, run_physical}},
       {"modal", {{}, run_modal}},
       {"narx",
-       {{},
+       {{"narx"},
         [](const FitArgs& a, const IdData& d) { return run_narx_or_kia(a.method, d, a.sets, a.narx, a.json, a.report); }}},
       {"kia",
-       {{},
+       {{"kia", "narx"},
         [](const FitArgs& a, const IdData& d) { return run_narx_or_kia(a.method, d, a.sets, a.narx, a.json, a.report); }}},
   };
   return m;
@@ -423,7 +423,10 @@ std::string fit_method_help(const CLI::App& fit) {
       {"tf_from_frequency", " (with --frequency)"}};
   for (const auto& name : it->second.library) {
     const MethodInfo& m = method_info(name);
-    out += "\n" + m.name + ": " + m.summary + (when.count(name) ? when.at(name) : "") + "\n" + settings_help(m);
+    const std::string note = when.count(name)                             ? when.at(name)
+                             : name == "narx" && g_fit_args->method == "kia" ? " (the NARX model fitted first, unless --narx FILE)"
+                                                                            : "";
+    out += "\n" + m.name + ": " + m.summary + note + "\n" + settings_help(m);
   }
   return out;
 }
@@ -450,11 +453,7 @@ void setup_fit(CLI::App& app) {
                  "Method setting NAME=VALUE (repeatable); 'ctid fit --method M --help' lists M's settings with units, "
                  "ranges and defaults (the same names as the C++ options and the Python keywords). modal: "
                  "shifts=S1,..,Sn (samples) or shift_times (s), basis=fourier|walsh|discrete, functions, iv (samples), "
-                 "stride, quadrature=simpson|trapezoid, window=START,LENGTH (samples), frequencies=w1,.. (generated input); "
-                 "narx: degree, ylag, ulag, umin, constant, max_terms, err_tolerance, criterion=none|aic|aicc|bic|fpe, "
-                 "noise_terms (NARMAX e lags), noise_max; kia: the narx settings or --narx FILE, y_order, u_order, points, "
-                 "max (rad/s, <= pi/Ts; default 1.25/Ts), seed, gls_order, err_threshold (%), zoh, refine (0: KIA only), "
-                 "quadratic=y^2,y*Dy, cubic=y^3, qpoints, qmax (default 0.55/Ts), qgls_order, qerr_threshold");
+                 "stride, quadrature=simpson|trapezoid, window=START,LENGTH (samples), frequencies=w1,.. (generated input)");
   app.add_flag("--delay", a->delay,
                "Estimate a (non-integer) input delay (srivc, oe, tfest): grid search over [delay_min, delay_max], then "
                "refinement");

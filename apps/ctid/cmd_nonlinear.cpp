@@ -12,23 +12,6 @@ namespace ctid::cli {
 extern std::function<int()> g_run;
 
 namespace {
-std::vector<std::string> split(const std::string& v) {
-  std::vector<std::string> out;
-  std::stringstream ss(v);
-  std::string item;
-  while (std::getline(ss, item, ',')) out.push_back(item);
-  return out;
-}
-
-InformationCriterion criterion_of(const std::string& v) {
-  if (v == "none") return InformationCriterion::None;
-  if (v == "aic") return InformationCriterion::Aic;
-  if (v == "aicc") return InformationCriterion::Aicc;
-  if (v == "bic") return InformationCriterion::Bic;
-  if (v == "fpe") return InformationCriterion::Fpe;
-  throw UsageError("--set criterion: use none, aic, aicc, bic or fpe (got '" + v + "')");
-}
-
 void print_narx(const Result<NarxModel>& r) {
   std::printf("selected terms (in order of selection) with their error reduction ratio:\n");
   const Eigen::VectorXd& err = r.diagnostics.vectors.at("err");
@@ -39,32 +22,13 @@ void print_narx(const Result<NarxModel>& r) {
 }
 }  // namespace
 
-// Consumes the NARX settings; noise_terms > 0 selects NARMAX.
-Result<NarxModel> run_narx(const IdData& d, std::map<std::string, std::string>& sets) {
-  int degree = 2, ylag = 2, ulag = 2, umin = 1, elag = 0, noise_max = 5;
-  bool constant = true;
-  FrolsOptions fo{.criterion = InformationCriterion::Aic};
-  consume_sets(sets, [&](const std::string& k, const std::string& v) {
-    if (k == "degree") degree = to_int(k, v);
-    else if (k == "ylag") ylag = to_int(k, v);
-    else if (k == "ulag") ulag = to_int(k, v);
-    else if (k == "umin") umin = to_int(k, v);
-    else if (k == "constant") constant = to_int(k, v) != 0;
-    else if (k == "max_terms") fo.max_terms = to_int(k, v);
-    else if (k == "err_tolerance") fo.err_tolerance = to_double(k, v);
-    else if (k == "criterion") fo.criterion = criterion_of(v);
-    else if (k == "noise_terms") elag = to_int(k, v);
-    else if (k == "noise_max") noise_max = to_int(k, v);
-    else return false;
-    return true;
-  });
-  if (ylag < 1) throw UsageError(detail::format("--set ylag={}: a NARX model needs past outputs (ylag >= 1)", ylag));
-  if (elag < 0) throw UsageError("--set noise_terms must be >= 0");
+// The library's NARX workflow (narx()) with the settings of its table.
+Result<NarxModel> run_narx(const IdData& d, const NarxOptions& o) {
   try {
-    const std::vector<NarxTerm> cand = narx_candidates(degree, ylag, ulag, constant, umin);
-    std::printf("candidates: %zu (degree %d, ylag %d, ulag %d)\n", cand.size(), degree, ylag, ulag);
-    if (elag == 0) return frols(d, cand, fo);
-    return narmax(d, cand, {.frols = fo, .noise_candidates = narx_noise_candidates(elag, 2, 2), .max_noise_terms = noise_max});
+    o.validate();
+    std::printf("candidates: %zu (degree %d, ylag %d, ulag %d)\n",
+                narx_candidates(o.degree, o.ylag, o.ulag, o.constant, o.umin).size(), o.degree, o.ylag, o.ulag);
+    return narx(d, o);
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }
@@ -74,55 +38,23 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
                     const std::string& narx_file, const std::string& json,
                     const std::string& report) {
   if (d.nu() != 1 || d.ny() != 1) throw UsageError(method + " needs one --input and one --output");
-  auto sets = parse_sets(set_list);
+  NarxOptions no;
   if (method == "narx") {
-    const Result<NarxModel> r = run_narx(d, sets);
-    if (!sets.empty())
-      throw UsageError("--set " + sets.begin()->first + ": not a setting of narx (settings: degree, ylag, ulag, umin, "
-                       "constant, max_terms, err_tolerance, criterion, noise_terms, noise_max)");
+    apply_sets("narx", set_list, no);
+    const Result<NarxModel> r = run_narx(d, no);
     print_narx(r);
     if (!json.empty()) {
       write_result_json(json, r, "narx");
       std::printf("wrote %s\n", json.c_str());
     }
-    write_report(report, d, r, "narx", raw_settings(set_list), "");
+    write_report(report, d, r, "narx", settings_of(no), "");
     return r.usable() ? kOk : kNotUsable;
   }
-  // kia: the NARX model from --narx, or identified here; then the library's workflow (kia()).
+  // kia: the NARX model from --narx, or identified here with the narx settings; then the library's workflow (kia()).
   KiaOptions ko;
-  KiaLinearOptions& lo = ko.linear;
-  KiaQuadraticOptions& qo = ko.quadratic;
-  KiaCubicOptions& co = ko.cubic;
-  lo.zoh = qo.zoh = co.zoh = d.intersample(0) == Intersample::Zoh;
-  consume_sets(sets, [&](const std::string& k, const std::string& v) {
-    if (k == "y_order") lo.y_order = to_int(k, v);
-    else if (k == "u_order") lo.u_order = to_int(k, v);
-    else if (k == "points") lo.points.count = to_int(k, v);
-    else if (k == "max") lo.points.max = to_double(k, v);
-    else if (k == "seed") lo.points.seed = qo.points.seed = co.points.seed = static_cast<unsigned>(to_int(k, v));
-    else if (k == "gls_order") lo.gls_order = to_int(k, v);
-    else if (k == "err_threshold") lo.err_threshold = to_double(k, v);
-    else if (k == "zoh") lo.zoh = qo.zoh = co.zoh = to_int(k, v) != 0;
-    else if (k == "refine") ko.refine = to_int(k, v) != 0;
-    else if (k == "quadratic") {
-      try {
-        for (const auto& t : split(v)) qo.candidates.push_back(NdeTerm::parse(t));
-      } catch (const InvalidArgument& e) {
-        throw UsageError(std::string("--set quadratic: ") + e.what());
-      }
-    } else if (k == "cubic") {
-      try {
-        for (const auto& t : split(v)) co.candidates.push_back(NdeTerm::parse(t));
-      } catch (const InvalidArgument& e) {
-        throw UsageError(std::string("--set cubic: ") + e.what());
-      }
-    } else if (k == "qpoints") qo.points.count = to_int(k, v);
-    else if (k == "qmax") qo.points.max = to_double(k, v);
-    else if (k == "qgls_order") qo.gls_order = to_int(k, v);
-    else if (k == "qerr_threshold") qo.err_threshold = to_double(k, v);
-    else return false;
-    return true;
-  });
+  ko.linear.zoh = ko.quadratic.zoh = ko.cubic.zoh = d.intersample(0) == Intersample::Zoh;
+  if (narx_file.empty()) apply_sets("kia", set_list, ko, no);
+  else apply_sets("kia", set_list, ko);
   NarxModel narx;
   if (!narx_file.empty()) {
     try {
@@ -131,14 +63,10 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
       throw InputError(e.what());
     }
   } else {
-    const Result<NarxModel> r = run_narx(d, sets);
+    const Result<NarxModel> r = run_narx(d, no);
     print_narx(r);
     narx = r.model.process();
   }
-  if (!sets.empty())
-    throw UsageError("--set " + sets.begin()->first + ": not a setting of kia (settings: y_order, u_order, points, max, "
-                     "seed, gls_order, err_threshold, zoh, refine, quadratic=y^2,y*Dy, cubic=y^3, qpoints, qmax, qgls_order, "
-                     "qerr_threshold, and the narx settings)");
   KiaRun run;
   try {
     run = kia(d, narx, ko);
@@ -150,7 +78,7 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
   const Eigen::VectorXd& err = k.diagnostics.vectors.at("err");
   for (int i = 0; i < k.parameters.size(); ++i)
     std::printf("  %-10s %14.6g   ERR %8.4f %%\n", k.parameters.names[i].c_str(), k.parameters.values(i), err(i));
-  std::printf("simulated output fit: %.2f %%   (hold factor %s)\n", k.fit.fit_percent, lo.zoh ? "on" : "off");
+  std::printf("simulated output fit: %.2f %%   (hold factor %s)\n", k.fit.fit_percent, ko.linear.zoh ? "on" : "off");
   std::printf("NARX model's free-run fit on the same record: %.2f %%\n", run.narx_fit_percent);
   if (run.refined && run.refined->usable()) {
     const Result<NdeModel>& oe = *run.refined;
@@ -169,7 +97,10 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
     write_result_json(json, r, "kia");
     std::printf("wrote %s\n", json.c_str());
   }
-  write_report(report, d, r, ko.refine ? "kia+oe" : "kia", raw_settings(set_list), narx_file);
+  Settings settings = settings_of(ko);
+  if (narx_file.empty())
+    for (auto& x : settings_of(no)) settings.push_back(x);
+  write_report(report, d, r, ko.refine ? "kia+oe" : "kia", settings, narx_file);
   if (!r.usable()) {
     std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", r.why_not_usable().c_str());
     return kNotUsable;

@@ -84,6 +84,9 @@ void print_result(const Result<TransferFunction>& r, const std::string& method, 
 void print_result(const Result<MisoModel>& r, const std::string& method, const IdData& data);
 void print_result(const Result<FsfModel>& r, const std::string& method, const IdData& data);
 
+/// Method settings as NAME/VALUE text pairs (the report's "settings" section).
+using Settings = std::vector<std::pair<std::string, std::string>>;
+
 /// Applies --set KEY=VALUE pairs to options structs through their tables (estimate/options.hpp): each key goes
 /// to the first struct whose table has it. An unknown key, or a value that does not parse, is a UsageError naming
 /// `method` and the closest valid setting. Ranges are checked by the estimator (validate()).

@@ -281,39 +281,37 @@ def frols(data, candidates, **options):
 
 
 def narmax(data, candidates, **options):
-    """NARMAX by FROLS and extended least squares (options: NarmaxOptions; frols=dict(...))."""
-    if "noise_candidates" in options:
-        options["noise_candidates"] = _terms(NarxTerm, options["noise_candidates"])
+    """NARMAX by FROLS and extended least squares (options: NarmaxOptions: the FROLS settings, noise_candidates,
+    max_noise_terms, iterations, tolerance)."""
     return _ctid.narmax(data, _terms(NarxTerm, candidates), _options(_ctid.NarmaxOptions, "narmax", options))
 
 
+def narx(data, **options):
+    """The NARX workflow of `ctid fit --method narx`: candidates from degree, ylag, ulag, umin, constant; FROLS with
+    an information criterion (criterion='aic' by default); NARMAX when noise_terms > 0 (options: NarxOptions)."""
+    return _ctid.narx(data, _options(_ctid.NarxOptions, "narx", options))
+
+
 def kia_linear(narx, **options):
-    """Kernel Invariance Algorithm, linear stage (options: KiaLinearOptions; points=dict(...))."""
+    """Kernel Invariance Algorithm, linear stage (options: KiaLinearOptions: y_order, u_order, points, max, ...)."""
     return _ctid.kia_linear(narx, _options(_ctid.KiaLinearOptions, "kia_linear", options))
 
 
 def kia_quadratic(narx, linear, **options):
     """Kernel Invariance Algorithm, quadratic stage (options: KiaQuadraticOptions; candidates=['y^2', ...])."""
-    if "candidates" in options:
-        options["candidates"] = _terms(NdeTerm, options["candidates"])
     return _ctid.kia_quadratic(narx, linear, _options(_ctid.KiaQuadraticOptions, "kia_quadratic", options))
 
 
 def kia_cubic(narx, model, **options):
     """Kernel Invariance Algorithm, cubic stage (options: KiaCubicOptions; candidates=['y^3', ...])."""
-    if "candidates" in options:
-        options["candidates"] = _terms(NdeTerm, options["candidates"])
     return _ctid.kia_cubic(narx, model, _options(_ctid.KiaCubicOptions, "kia_cubic", options))
 
 
 def kia(data, narx, **options):
     """The whole Kernel Invariance workflow (as `ctid fit --method kia`): stages, stacking, the check that the
-    equation reproduces its NARX model, and the output-error refinement. Options: KiaOptions, e.g.
-    linear=dict(y_order=2), quadratic=dict(candidates=['y^2', 'y*Dy']), cubic=dict(candidates=['y^3']), refine=True.
+    equation reproduces its NARX model, and the output-error refinement. Options: KiaOptions with the CLI's names,
+    e.g. y_order=2, quadratic=['y^2', 'y*Dy'], cubic=['y^3'], qpoints=70, refine=True (ctid.settings('kia')).
     Returns a KiaRun; its result() is the answer."""
-    for stage in ("quadratic", "cubic"):
-        if isinstance(options.get(stage), dict) and "candidates" in options[stage]:
-            options[stage] = dict(options[stage], candidates=_terms(NdeTerm, options[stage]["candidates"]))
     return _ctid.kia(data, narx, _options(_ctid.KiaOptions, "kia", options))
 
 

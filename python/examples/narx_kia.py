@@ -14,7 +14,7 @@ t = ctid.time_grid(0.0025, 1000)
 y = ctid.add_noise_snr(truth.simulate(u, t, rtol=1e-11).y, 20.0, 7)
 data = ctid.IdData.from_arrays(u, y, ts=0.0025)
 
-narx = ctid.narmax(data, ctid.narx_candidates(2, 6, 6), frols={"max_terms": 20, "criterion": "aic"})
+narx = ctid.narmax(data, ctid.narx_candidates(2, 6, 6), max_terms=20, criterion="aic")
 process = narx.model.process()
 print("NARX:", process)
 lin = ctid.kia_linear(process, y_order=2, u_order=0)

@@ -21,7 +21,6 @@ void def_tf_estimator(py::module_& m, const char* name, Estimator<Options> f, co
 }  // namespace
 
 void bind_linear(py::module_& m) {
-  py::enum_<SvfWeights>(m, "SvfWeights").value("Riemann", SvfWeights::Riemann).value("Trapezoidal", SvfWeights::Trapezoidal);
 
   bind_options<LssvfOptions>(m, "LssvfOptions");
   bind_options<IvsvfOptions>(m, "IvsvfOptions");

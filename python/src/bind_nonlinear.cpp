@@ -53,28 +53,15 @@ void bind_nonlinear(py::module_& m) {
   def_report<NarxModel>(m);
   m.def("read_narx_json", &read_narx_json, py::arg("path"));
 
-  py::enum_<InformationCriterion>(m, "InformationCriterion")
-      .value("None", InformationCriterion::None)
-      .value("Aic", InformationCriterion::Aic)
-      .value("Aicc", InformationCriterion::Aicc)
-      .value("Bic", InformationCriterion::Bic)
-      .value("Fpe", InformationCriterion::Fpe);
-  py::class_<FrolsOptions>(m, "FrolsOptions")
-      .def(py::init<>())
-      .def_readwrite("max_terms", &FrolsOptions::max_terms)
-      .def_readwrite("err_tolerance", &FrolsOptions::err_tolerance)
-      .def_readwrite("criterion", &FrolsOptions::criterion)
-      .def_readwrite("block_rows", &FrolsOptions::block_rows);
-  py::class_<NarmaxOptions>(m, "NarmaxOptions")
-      .def(py::init<>())
-      .def_readwrite("frols", &NarmaxOptions::frols)
-      .def_readwrite("noise_candidates", &NarmaxOptions::noise_candidates)
-      .def_readwrite("max_noise_terms", &NarmaxOptions::max_noise_terms)
-      .def_readwrite("iterations", &NarmaxOptions::iterations)
-      .def_readwrite("tolerance", &NarmaxOptions::tolerance);
+  bind_options<FrolsOptions>(m, "FrolsOptions");
+  bind_options<NarmaxOptions>(m, "NarmaxOptions");
   m.def("frols", [](const IdData& d, const std::vector<NarxTerm>& c, const FrolsOptions& o) {
           return interruptible([&] { return frols(d, c, o); });
         }, py::arg("data"), py::arg("candidates"), py::arg("options") = FrolsOptions{});
+  bind_options<NarxOptions>(m, "NarxOptions");
+  m.def("narx", [](const IdData& d, const NarxOptions& o) { return interruptible([&] { return narx(d, o); }); },
+        py::arg("data"), py::arg("options") = NarxOptions{},
+        "The NARX workflow: candidates from degree and lags, FROLS with a criterion (AIC), NARMAX when noise_terms > 0.");
   m.def("narmax", [](const IdData& d, const std::vector<NarxTerm>& c, const NarmaxOptions& o) {
           return interruptible([&] { return narmax(d, c, o); });
         }, py::arg("data"), py::arg("candidates"), py::arg("options") = NarmaxOptions{});
@@ -109,69 +96,20 @@ void bind_nonlinear(py::module_& m) {
   def_report<NdeModel>(m);
   m.def("read_nde_json", &read_nde_json, py::arg("path"));
 
-  py::enum_<KiaRegion>(m, "KiaRegion")
-      .value("Axes", KiaRegion::Axes)
-      .value("RealAxis", KiaRegion::RealAxis)
-      .value("ImaginaryAxis", KiaRegion::ImaginaryAxis)
-      .value("Complex", KiaRegion::Complex);
-  py::class_<KiaPointOptions>(m, "KiaPointOptions")
-      .def(py::init<>())
-      .def_readwrite("region", &KiaPointOptions::region)
-      .def_readwrite("count", &KiaPointOptions::count)
-      .def_readwrite("max", &KiaPointOptions::max,
-                     "rad/s, at most pi/T of the NARX model; 0 (default): 1.25/T (linear stage), 0.55/T (quadratic, cubic)")
-      .def_readwrite("grid", &KiaPointOptions::grid)
-      .def_readwrite("seed", &KiaPointOptions::seed);
-  py::class_<KiaLinearOptions>(m, "KiaLinearOptions")
-      .def(py::init<>())
-      .def_readwrite("y_order", &KiaLinearOptions::y_order)
-      .def_readwrite("u_order", &KiaLinearOptions::u_order)
-      .def_readwrite("points", &KiaLinearOptions::points)
-      .def_readwrite("gls_order", &KiaLinearOptions::gls_order)
-      .def_readwrite("max_iterations", &KiaLinearOptions::max_iterations)
-      .def_readwrite("tolerance", &KiaLinearOptions::tolerance)
-      .def_readwrite("err_threshold", &KiaLinearOptions::err_threshold)
-      .def_readwrite("zoh", &KiaLinearOptions::zoh);
-  py::class_<KiaQuadraticOptions>(m, "KiaQuadraticOptions")
-      .def(py::init<>())
-      .def_readwrite("candidates", &KiaQuadraticOptions::candidates)
-      .def_readwrite("points", &KiaQuadraticOptions::points)
-      .def_readwrite("gls_order", &KiaQuadraticOptions::gls_order)
-      .def_readwrite("max_iterations", &KiaQuadraticOptions::max_iterations)
-      .def_readwrite("tolerance", &KiaQuadraticOptions::tolerance)
-      .def_readwrite("err_threshold", &KiaQuadraticOptions::err_threshold)
-      .def_readwrite("zoh", &KiaQuadraticOptions::zoh);
-  py::class_<KiaCubicOptions>(m, "KiaCubicOptions")
-      .def(py::init<>())
-      .def_readwrite("candidates", &KiaCubicOptions::candidates)
-      .def_readwrite("points", &KiaCubicOptions::points)
-      .def_readwrite("gls_order", &KiaCubicOptions::gls_order)
-      .def_readwrite("max_iterations", &KiaCubicOptions::max_iterations)
-      .def_readwrite("tolerance", &KiaCubicOptions::tolerance)
-      .def_readwrite("err_threshold", &KiaCubicOptions::err_threshold)
-      .def_readwrite("zoh", &KiaCubicOptions::zoh);
+  bind_options<KiaPointOptions>(m, "KiaPointOptions");
+  bind_options<KiaLinearOptions>(m, "KiaLinearOptions");
+  bind_options<KiaQuadraticOptions>(m, "KiaQuadraticOptions");
+  bind_options<KiaCubicOptions>(m, "KiaCubicOptions");
   m.def("kia_linear", &kia_linear, py::arg("narx"), py::arg("options") = KiaLinearOptions{});
   m.def("kia_quadratic", &kia_quadratic, py::arg("narx"), py::arg("linear"), py::arg("options"));
   m.def("kia_cubic", &kia_cubic, py::arg("narx"), py::arg("model"), py::arg("options"));
 
-  py::class_<NdeOeOptions>(m, "NdeOeOptions")
-      .def(py::init<>())
-      .def_readwrite("max_iterations", &NdeOeOptions::max_iterations)
-      .def_readwrite("tolerance", &NdeOeOptions::tolerance)
-      .def_readwrite("estimate_initial_state", &NdeOeOptions::estimate_initial_state)
-      .def_readwrite("fixed", &NdeOeOptions::fixed)
-      .def_readwrite("rtol", &NdeOeOptions::rtol);
+  bind_options<NdeOeOptions>(m, "NdeOeOptions");
   m.def("nde_oe", [](const IdData& d, const NdeModel& initial, const NdeOeOptions& o) {
           return interruptible([&] { return nde_oe(d, initial, o); });
         }, py::arg("data"), py::arg("initial"), py::arg("options") = NdeOeOptions{});
 
-  py::class_<KiaOptions>(m, "KiaOptions")
-      .def(py::init<>())
-      .def_readwrite("linear", &KiaOptions::linear)
-      .def_readwrite("quadratic", &KiaOptions::quadratic)
-      .def_readwrite("cubic", &KiaOptions::cubic)
-      .def_readwrite("refine", &KiaOptions::refine)
-      .def_readwrite("refinement", &KiaOptions::refinement);
+  bind_options<KiaOptions>(m, "KiaOptions");
   py::class_<KiaRun>(m, "KiaRun", "The KIA workflow's stages: reconstructed, narx_fit_percent, refined, result().")
       .def_readonly("reconstructed", &KiaRun::reconstructed)
       .def_readonly("narx_fit_percent", &KiaRun::narx_fit_percent)

@@ -39,6 +39,13 @@ OptionValue option_value_from_python(py::handle v, const OptionInfo& info, const
         return py::cast<std::vector<double>>(v);
       case OptionKind::NamedReals: return py::cast<std::map<std::string, double>>(v);
       case OptionKind::NamedBounds: return py::cast<std::map<std::string, std::pair<double, double>>>(v);
+      case OptionKind::Names: {
+        if (py::isinstance<py::str>(v)) return bad("a list of names");
+        std::vector<std::string> out;
+        for (py::handle x : py::reinterpret_borrow<py::iterable>(v))
+          out.push_back(py::isinstance<py::str>(x) ? py::cast<std::string>(x) : py::cast<std::string>(x.attr("name")));
+        return out;
+      }
       case OptionKind::Model:
         if (v.is_none()) return std::optional<TransferFunction>{};
         return std::optional<TransferFunction>(py::cast<TransferFunction>(v));

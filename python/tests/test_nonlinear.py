@@ -23,16 +23,16 @@ def test_narx_kia_and_refinement_reconstruct_bl33(bl33):
         assert refined.model.coefficient(name) == pytest.approx(c, rel=1e-3), name
     assert "y*Dy" in repr(refined.model)
     # The library workflow gives the same equation and refinement as the stages above, and prefers the refinement.
-    run = ctid.kia(d, r.model, linear=dict(y_order=2, u_order=0), quadratic=dict(candidates=["y^2", "y*Dy"]))
+    run = ctid.kia(d, r.model, y_order=2, u_order=0, quadratic=["y^2", "y*Dy"])
     assert run.reconstructed.usable() and run.refined.usable()
     assert run.reconstructed.model.normalized().coefficient("y^2") == pytest.approx(
         q.model.normalized().coefficient("y^2"), rel=1e-12)
     assert run.result().model.coefficient("y*Dy") == pytest.approx(refined.model.coefficient("y*Dy"), rel=1e-9)
     assert run.narx_fit_percent < 0  # this NARX model escapes in free run (above): the fidelity check is skipped
     # The point range defaults to 1.25/T (500 rad/s at T = 2.5 ms); beyond pi/T = 1256.6 rad/s it is refused.
-    assert ctid.kia_linear(r.model, y_order=2, u_order=0, points=dict(max=500)).parameters.values.tolist() == lin.parameters.values.tolist()
+    assert ctid.kia_linear(r.model, y_order=2, u_order=0, max=500).parameters.values.tolist() == lin.parameters.values.tolist()
     with pytest.raises(ValueError, match="Nyquist frequency pi/T = 1256.6"):
-        ctid.kia_linear(r.model, points=dict(max=2000))
+        ctid.kia_linear(r.model, max=2000)
 
 
 def test_gfrf_and_harmonic_probing(bl33):
@@ -66,7 +66,7 @@ def test_nonlinear_models_have_freqresp_and_step(bl33):
 
 def test_narmax_options_nested_and_enum_errors(bl33):
     _, d = bl33
-    r = ctid.narmax(d, ctid.narx_candidates(1, 2, 2), frols={"max_terms": 4}, iterations=3)
+    r = ctid.narmax(d, ctid.narx_candidates(1, 2, 2), max_terms=4, iterations=3)
     assert r.summary.termination in ("completed", "converged")
     with pytest.raises(ValueError, match="criterion.*aic"):
         ctid.frols(d, ctid.narx_candidates(1, 2, 2), criterion="akaike")

@@ -21,6 +21,8 @@ def _python_default_matches(kind, text, value):
         return (text == "none" and len(value) == 0) or list(value) == [float(x) for x in text.split(",")]
     if kind in ("values by name", "bounds by name"):
         return text == "" and value == {}
+    if kind == "list of names":
+        return (text == "none" and list(value) == []) or list(value) == text.split(",")
     if kind == "transfer function":
         return (text == "none" and value is None) or isinstance(value, ctid.TransferFunction)
     raise AssertionError(kind)
@@ -50,13 +52,20 @@ def test_every_setting_is_a_keyword_of_its_function_and_round_trips():
             for s in ctid.settings(method):
                 if s["name"] not in cls._names:
                     continue
-                value = s["range"].split("|")[-1] if s["kind"] == "choice" else examples[s["kind"]]
+                if s["kind"] == "choice":
+                    value = s["range"].split("|")[-1]
+                elif s["kind"] == "list of names":
+                    value = ["e(k-1)"] if "noise" in s["name"] else ["y^2"]
+                else:
+                    value = examples[s["kind"]]
                 o = ctid._options(cls, method, {s["name"]: value})
                 got = getattr(o, s["name"])
                 if s["kind"] == "transfer function":
                     assert got.den == pytest.approx([0.1, 1.0]) or got.den == pytest.approx([1.0, 10.0])
                 elif s["kind"] == "bounds by name":
                     assert got == {"a1": (0.0, 10.0)}
+                elif s["kind"] == "list of names":
+                    assert list(got) == value
                 elif s["kind"] == "list of reals":
                     assert list(got) == [0.5, 1.5]
                 else:

@@ -19,12 +19,24 @@
 
 namespace ctid {
 
-void FrolsOptions::validate() const {
-  CTID_REQUIRE_OPTION(max_terms >= 1, "frols: max_terms must be >= 1 (got {})", max_terms);
-  CTID_REQUIRE_OPTION(std::isfinite(err_tolerance) && err_tolerance >= 0 && err_tolerance < 1,
-                      "frols: err_tolerance must be in [0, 1) (got {})", err_tolerance);
-  CTID_REQUIRE_OPTION(block_rows >= 16, "frols: block_rows must be >= 16 (got {})", block_rows);
+template <>
+const OptionTable<FrolsOptions>& option_table<FrolsOptions>() {
+  using O = FrolsOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("frols")
+          .integer("max_terms", &O::max_terms, "", at_least(1), "upper bound on the number of selected terms")
+          .real("err_tolerance", &O::err_tolerance, "", OptionRange{0, 1, false, true, {}, {}},
+                "stop when 1 - sum(ERR) <= err_tolerance (0: only max_terms and the criterion)")
+          .choice("criterion", &O::criterion,
+                  {{"none", InformationCriterion::None}, {"aic", InformationCriterion::Aic},
+                   {"aicc", InformationCriterion::Aicc}, {"bic", InformationCriterion::Bic},
+                   {"fpe", InformationCriterion::Fpe}},
+                  "model size: the number of terms minimising it along the greedy pass (none: all selected)")
+          .integer("block_rows", &O::block_rows, "", at_least(16), "rows of candidate columns generated at a time (memory)");
+  return t;
 }
+
+void FrolsOptions::validate() const { option_table<FrolsOptions>().check(*this); }
 
 namespace {
 // Candidate columns for rows [k0, k0 + rows) into the columns of B.
@@ -273,11 +285,55 @@ Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& cand, c
   return frols_signals({y, u, e}, data.ts(), cand, o);
 }
 
+template <>
+const OptionTable<NarmaxOptions>& option_table<NarmaxOptions>() {
+  using O = NarmaxOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("narmax")
+          .include(&O::frols, option_table<FrolsOptions>())
+          .terms("noise_candidates", &O::noise_candidates, "noise candidate terms (each with an e(k-i) factor)")
+          .integer("max_noise_terms", &O::max_noise_terms, "", at_least(0), "noise terms allowed on top of max_terms")
+          .integer("iterations", &O::iterations, "", at_least(1), "extended least-squares iterations")
+          .real("tolerance", &O::tolerance, "", at_least(0),
+                "stop when the process terms repeat and their coefficients change less (relative)");
+  return t;
+}
+
+template <>
+const OptionTable<NarxOptions>& option_table<NarxOptions>() {
+  using O = NarxOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("narx")
+          .integer("degree", &O::degree, "", between(1, 10), "polynomial degree of the candidate terms")
+          .integer("ylag", &O::ylag, "samples", at_least(1), "output lags y(k-1) .. y(k-ylag)")
+          .integer("ulag", &O::ulag, "samples", at_least(0), "input lags u(k-umin) .. u(k-ulag)")
+          .integer("umin", &O::umin, "samples", at_least(0), "smallest input lag (0: direct feed-through)")
+          .flag("constant", &O::constant, "include the constant term")
+          .integer("noise_terms", &O::noise_terms, "samples", at_least(0),
+                   "NARMAX residual lags e(k-1 .. k-noise_terms); 0: NARX by FROLS")
+          .include(&O::narmax, option_table<NarmaxOptions>(),
+                   {"max_terms", "err_tolerance", "criterion", "block_rows", "max_noise_terms", "iterations", "tolerance"},
+                   {{"iterations", "narmax_iterations"}, {"tolerance", "narmax_tolerance"}});
+  return t;
+}
+
+void NarxOptions::validate() const {
+  option_table<NarxOptions>().check(*this);
+  narmax.validate();
+}
+
+Result<NarxModel> narx(const IdData& data, const NarxOptions& o) {
+  o.validate();
+  const std::vector<NarxTerm> candidates = narx_candidates(o.degree, o.ylag, o.ulag, o.constant, o.umin);
+  if (o.noise_terms == 0) return frols(data, candidates, o.narmax.frols);
+  NarmaxOptions n = o.narmax;
+  n.noise_candidates = narx_noise_candidates(o.noise_terms, 2, 2);
+  return narmax(data, candidates, n);
+}
+
 void NarmaxOptions::validate() const {
   frols.validate();
-  CTID_REQUIRE_OPTION(max_noise_terms >= 0, "narmax: max_noise_terms must be >= 0 (got {})", max_noise_terms);
-  CTID_REQUIRE_OPTION(iterations >= 1, "narmax: iterations must be >= 1 (got {})", iterations);
-  CTID_REQUIRE_OPTION(std::isfinite(tolerance) && tolerance >= 0, "narmax: tolerance must be >= 0 (got {})", tolerance);
+  option_table<NarmaxOptions>().check(*this);
   for (const auto& t : noise_candidates)
     CTID_REQUIRE_OPTION(t.has_noise(), "narmax: noise candidate {} has no e(k-i) factor", t.name());
 }

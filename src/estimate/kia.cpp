@@ -171,13 +171,94 @@ std::vector<std::complex<double>> kia_points(const KiaPointOptions& o) {
   return s;
 }
 
+template <>
+const OptionTable<KiaPointOptions>& option_table<KiaPointOptions>() {
+  using O = KiaPointOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("kia")
+          .choice("region", &O::region,
+                  {{"axes", KiaRegion::Axes}, {"real", KiaRegion::RealAxis}, {"imaginary", KiaRegion::ImaginaryAxis},
+                   {"complex", KiaRegion::Complex}},
+                  "where the s-points lie (axes: half on each positive axis)")
+          .integer("points", &O::count, "", at_least(1), "s-points (linear stage), pairs or triples (higher stages)")
+          .real("max", &O::max, "rad/s", or_special(above(0), 0, "automatic: 1.25/T linear, 0.55/T higher stages"),
+                "range of the s-points, at most the Nyquist frequency pi/T of the NARX model")
+          .flag("grid", &O::grid, "evenly spaced points instead of uniformly random ones")
+          .integer("seed", &O::seed, "", at_least(0), "seed of the random points");
+  return t;
+}
+
+namespace {
+// The settings every KIA stage shares, after its own (candidates or orders) and its points.
+template <class O>
+OptionTable<O>& stage_settings(OptionTable<O>& t) {
+  return t.include(&O::points, option_table<KiaPointOptions>())
+      .integer("gls_order", &O::gls_order, "", between(-1, 20),
+               "GLS filter order; 0: plain least squares; -1 (linear stage): the smallest order explaining 99.99 %")
+      .integer("gls_iterations", &O::max_iterations, "", at_least(1), "GLS iterations")
+      .real("gls_tolerance", &O::tolerance, "", above(0), "relative change of the coefficients that stops GLS")
+      .real("err_threshold", &O::err_threshold, "%", OptionRange{0, 100, false, true, {}, {}},
+            "prune terms with a smaller ERR after convergence, then re-estimate (0: keep all)")
+      .flag("zoh", &O::zoh, "divide the NARX kernels by the hold factor Z(s) (held input; the CLI takes it from the data)");
+}
+}  // namespace
+
+template <>
+const OptionTable<KiaLinearOptions>& option_table<KiaLinearOptions>() {
+  using O = KiaLinearOptions;
+  static const OptionTable<O> t = [] {
+    OptionTable<O> x("kia_linear");
+    x.integer("y_order", &O::y_order, "", at_least(1), "output derivatives D^1 y .. D^y_order y")
+        .integer("u_order", &O::u_order, "", at_least(0), "input derivatives u .. D^u_order u");
+    return stage_settings(x);
+  }();
+  return t;
+}
+
+template <>
+const OptionTable<KiaQuadraticOptions>& option_table<KiaQuadraticOptions>() {
+  using O = KiaQuadraticOptions;
+  static const OptionTable<O> t = [] {
+    OptionTable<O> x("kia_quadratic");
+    x.terms("candidates", &O::candidates, "degree-2 candidate terms, e.g. y^2,y*Dy,Dy^2,y*u");
+    return stage_settings(x);
+  }();
+  return t;
+}
+
+template <>
+const OptionTable<KiaCubicOptions>& option_table<KiaCubicOptions>() {
+  using O = KiaCubicOptions;
+  static const OptionTable<O> t = [] {
+    OptionTable<O> x("kia_cubic");
+    x.terms("candidates", &O::candidates, "degree-3 candidate terms, e.g. y^3,y^2*Dy");
+    return stage_settings(x);
+  }();
+  return t;
+}
+
+template <>
+const OptionTable<KiaOptions>& option_table<KiaOptions>() {
+  using O = KiaOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("kia")
+          .include(&O::linear, option_table<KiaLinearOptions>())
+          .include(&O::quadratic, option_table<KiaQuadraticOptions>(), {}, {{"candidates", "quadratic"}}, "q")
+          .include(&O::cubic, option_table<KiaCubicOptions>(), {}, {{"candidates", "cubic"}}, "c")
+          .flag("refine", &O::refine, "refine the reconstructed equation by output error on the record")
+          .include(&O::refinement, option_table<NdeOeOptions>(), {}, {}, "oe_");
+  return t;
+}
+
+void KiaOptions::validate() const {
+  linear.validate();
+  if (!quadratic.candidates.empty()) quadratic.validate();
+  if (!cubic.candidates.empty()) cubic.validate();
+  refinement.validate();
+}
+
 void KiaLinearOptions::validate() const {
-  CTID_REQUIRE_OPTION(y_order >= 1, "kia_linear: y_order must be >= 1 (got {})", y_order);
-  CTID_REQUIRE_OPTION(u_order >= 0, "kia_linear: u_order must be >= 0 (got {})", u_order);
-  CTID_REQUIRE_OPTION(gls_order >= -1 && gls_order <= 20, "kia_linear: gls_order must be in [-1, 20] (got {})", gls_order);
-  CTID_REQUIRE_OPTION(max_iterations >= 1, "kia_linear: max_iterations must be >= 1 (got {})", max_iterations);
-  CTID_REQUIRE_OPTION(std::isfinite(err_threshold) && err_threshold >= 0 && err_threshold < 100,
-                      "kia_linear: err_threshold must be in [0, 100) % (got {})", err_threshold);
+  option_table<KiaLinearOptions>().check(*this);
   CTID_REQUIRE_OPTION(points.count >= y_order + u_order + 1, "kia_linear: {} points for {} coefficients", points.count,
                       y_order + u_order + 1);
 }
@@ -186,11 +267,7 @@ void KiaQuadraticOptions::validate() const {
   CTID_REQUIRE_OPTION(!candidates.empty(), "kia_quadratic: no candidate terms");
   for (const auto& t : candidates)
     CTID_REQUIRE_OPTION(t.degree() == 2, "kia_quadratic: candidate {} is not of degree 2", t.name());
-  CTID_REQUIRE_OPTION(gls_order >= -1 && gls_order <= 20, "kia_quadratic: gls_order must be in [-1, 20] (got {})",
-                      gls_order);
-  CTID_REQUIRE_OPTION(max_iterations >= 1, "kia_quadratic: max_iterations must be >= 1 (got {})", max_iterations);
-  CTID_REQUIRE_OPTION(std::isfinite(err_threshold) && err_threshold >= 0 && err_threshold < 100,
-                      "kia_quadratic: err_threshold must be in [0, 100) % (got {})", err_threshold);
+  option_table<KiaQuadraticOptions>().check(*this);
   CTID_REQUIRE_OPTION(points.count >= static_cast<int>(candidates.size()), "kia_quadratic: {} point pairs for {} "
                       "coefficients", points.count, candidates.size());
 }
@@ -343,10 +420,7 @@ void KiaCubicOptions::validate() const {
   CTID_REQUIRE_OPTION(!candidates.empty(), "kia_cubic: no candidate terms");
   for (const auto& t : candidates)
     CTID_REQUIRE_OPTION(t.degree() == 3, "kia_cubic: candidate {} is not of degree 3", t.name());
-  CTID_REQUIRE_OPTION(gls_order >= -1 && gls_order <= 20, "kia_cubic: gls_order must be in [-1, 20] (got {})", gls_order);
-  CTID_REQUIRE_OPTION(max_iterations >= 1, "kia_cubic: max_iterations must be >= 1 (got {})", max_iterations);
-  CTID_REQUIRE_OPTION(std::isfinite(err_threshold) && err_threshold >= 0 && err_threshold < 100,
-                      "kia_cubic: err_threshold must be in [0, 100) % (got {})", err_threshold);
+  option_table<KiaCubicOptions>().check(*this);
   CTID_REQUIRE_OPTION(points.count >= static_cast<int>(candidates.size()), "kia_cubic: {} point triples for {} "
                       "coefficients", points.count, candidates.size());
 }
@@ -396,6 +470,7 @@ KiaRun kia(const IdData& d, const NarxModel& narx, const KiaOptions& o) {
   CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "kia: needs one input and one output (the data have {} and {})", d.nu(), d.ny());
   CTID_REQUIRE(std::abs(narx.ts() - d.ts()) <= 1e-9 * d.ts(),
                "kia: the NARX model was identified at Ts = {} s, the data have {} s", narx.ts(), d.ts());
+  o.validate();
   KiaRun run;
   Result<NdeModel>& r = run.reconstructed;
   r = kia_linear(narx, o.linear);

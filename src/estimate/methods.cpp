@@ -6,8 +6,11 @@
 #include "ctid/core/check.hpp"
 #include "ctid/core/error.hpp"
 #include "ctid/estimate/frequency.hpp"
+#include "ctid/estimate/frols.hpp"
 #include "ctid/estimate/fsf.hpp"
+#include "ctid/estimate/kia.hpp"
 #include "ctid/estimate/lssvf.hpp"
+#include "ctid/estimate/nde_oe.hpp"
 #include "ctid/estimate/oe.hpp"
 #include "ctid/estimate/physical.hpp"
 #include "ctid/estimate/rls_svf.hpp"
@@ -51,6 +54,17 @@ const std::vector<MethodInfo>& methods() {
       entry<FsfOptions, PhysicalFitOptions>("physical",
                                             "physical parameters of a transfer-function expression (via FSF or raw data)",
                                             {"FsfOptions", "PhysicalFitOptions"}),
+      entry<NarxOptions>("narx", "Billings & Li NARX workflow: candidates from degree and lags, FROLS with a criterion, "
+                                 "NARMAX with noise_terms > 0",
+                         {"NarxOptions"}),
+      entry<FrolsOptions>("frols", "FROLS/ERR selection among given NARX candidate terms", {"FrolsOptions"}),
+      entry<NarmaxOptions>("narmax", "NARMAX: FROLS with noise terms by extended least squares", {"NarmaxOptions"}),
+      entry<KiaOptions>("kia", "Kernel Invariance Algorithm: NDE from a NARX model (stages, stacking, OE refinement)",
+                        {"KiaOptions"}),
+      entry<KiaLinearOptions>("kia_linear", "KIA linear stage", {"KiaLinearOptions"}),
+      entry<KiaQuadraticOptions>("kia_quadratic", "KIA quadratic stage", {"KiaQuadraticOptions"}),
+      entry<KiaCubicOptions>("kia_cubic", "KIA cubic stage", {"KiaCubicOptions"}),
+      entry<NdeOeOptions>("nde_oe", "output-error refinement of a nonlinear differential equation", {"NdeOeOptions"}),
   };
   return all;
 }

@@ -12,13 +12,22 @@
 
 namespace ctid {
 
-void NdeOeOptions::validate() const {
-  CTID_REQUIRE_OPTION(max_iterations >= 1, "nde_oe: max_iterations must be >= 1 (got {})", max_iterations);
-  CTID_REQUIRE_OPTION(std::isfinite(tolerance) && tolerance > 0 && tolerance < 1,
-                      "nde_oe: tolerance must be in (0, 1) (got {})", tolerance);
-  CTID_REQUIRE_OPTION(std::isfinite(rtol) && rtol >= 1e-13 && rtol <= 1e-6,
-                      "nde_oe: rtol must be in [1e-13, 1e-6] (got {}); the Jacobian needs accurate simulations", rtol);
+template <>
+const OptionTable<NdeOeOptions>& option_table<NdeOeOptions>() {
+  using O = NdeOeOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("nde_oe")
+          .integer("max_iterations", &O::max_iterations, "", at_least(1), "Levenberg-Marquardt iterations")
+          .real("tolerance", &O::tolerance, "", OptionRange{0, 1, true, true, {}, {}},
+                "relative cost decrease or parameter change that stops the search")
+          .flag("estimate_initial_state", &O::estimate_initial_state,
+                "estimate [y, Dy, ..] at the first sample; 0: start from rest")
+          .names("fixed", &O::fixed, "term names whose coefficients are held (the reference term always is)")
+          .real("rtol", &O::rtol, "", between(1e-13, 1e-6), "relative tolerance of the simulations (the Jacobian needs accuracy)");
+  return t;
 }
+
+void NdeOeOptions::validate() const { option_table<NdeOeOptions>().check(*this); }
 
 Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOeOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();

@@ -23,6 +23,7 @@ const char* to_string(OptionKind k) {
     case OptionKind::NamedReals: return "values by name";
     case OptionKind::NamedBounds: return "bounds by name";
     case OptionKind::Model: return "transfer function";
+    case OptionKind::Names: return "list of names";
   }
   return "?";
 }
@@ -159,6 +160,22 @@ TransferFunction parse_tf(const std::string& method, const std::string& key, con
   } catch (const InvalidArgument& e) {
     throw InvalidOptions(detail::format("{}: {}: {}", method, key, e.what()));
   }
+}
+
+std::vector<std::string> parse_names(const std::string& text) {
+  std::vector<std::string> v;
+  if (trim(text).empty() || trim(text) == "none") return v;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) v.push_back(trim(item));
+  return v;
+}
+
+std::string format_names(const std::vector<std::string>& v) {
+  if (v.empty()) return "none";
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ",") + x;
+  return s;
 }
 
 std::string format_real(double v) {

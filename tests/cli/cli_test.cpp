@@ -782,7 +782,7 @@ TEST(Cli, RobustnessCampaignBadInputs) {
       {"fit " + ok + base + "--method lssvf --set tau=1e300", 2, "more than 1000 times the record"},
       {"fit " + ok + base + "--method tfest --nf 2 --delay --set delay_max=1e300", 2, "delay_max = 1e+300 s"},
       {"fit " + ok + base + "--method oe --set delay=1e9", 2, "is not shorter than the record"},
-      {"fit " + ok + base + "--method kia --set points=-3", 2, "-3 points"},
+      {"fit " + ok + base + "--method kia --set points=-3", 2, "points must be >= 1 (got -3)"},
       {"fit " + ok + " --ts -1 --input force --output position", 2, "--ts must be a positive"},
       // Damaged model files and expressions.
       {"simulate " + truncjson + " " + ok + " --time time --input force", 3, "not valid JSON"},
@@ -976,7 +976,8 @@ TEST(Cli, MethodHelpListsEveryRegisteredSettingAndSetAcceptsIt) {
   const std::map<std::string, std::vector<std::string>> cli_methods = {
       {"lssvf", {"lssvf"}}, {"ivsvf", {"ivsvf"}}, {"rls-svf", {"rls_svf"}},
       {"srivc", {"srivc", "srivc_miso", "srivc_closed_loop"}}, {"oe", {"oe", "tf_from_frequency"}},
-      {"tfest", {"tfest", "tf_from_frequency"}}, {"fsf", {"fsf"}}, {"physical", {"physical"}}};
+      {"tfest", {"tfest", "tf_from_frequency"}}, {"fsf", {"fsf"}}, {"physical", {"physical"}},
+      {"narx", {"narx"}}, {"kia", {"kia", "narx"}}};
   std::set<std::string> covered;
   for (const auto& [cli, entries] : cli_methods) {
     const CliRun h = ctid_run("fit --method " + cli + " --help");
@@ -995,8 +996,26 @@ TEST(Cli, MethodHelpListsEveryRegisteredSettingAndSetAcceptsIt) {
       }
     }
   }
-  // Every registry entry is reachable from some CLI method.
-  for (const auto& m : methods()) EXPECT_TRUE(covered.count(m.name)) << m.name << " is not reachable from ctid fit";
+  // Every registry entry is reachable from some CLI method: directly, or (the library's building blocks) through
+  // the workflow that runs it, where its settings are included: frols and narmax in narx, the KIA stages and
+  // nde_oe (prefixed oe_) in kia.
+  const std::map<std::string, std::pair<std::string, std::string>> through = {
+      {"frols", {"narx", ""}}, {"narmax", {"narx", ""}}, {"kia_linear", {"kia", ""}},
+      {"kia_quadratic", {"kia", "q"}}, {"kia_cubic", {"kia", "c"}}, {"nde_oe", {"kia", "oe_"}}};
+  for (const auto& m : methods()) {
+    if (covered.count(m.name)) continue;
+    ASSERT_TRUE(through.count(m.name)) << m.name << " is not reachable from ctid fit";
+    const auto& [parent, prefix] = through.at(m.name);
+    std::set<std::string> parent_names;
+    for (const auto& s : method_info(parent).settings) parent_names.insert(s.name);
+    for (const auto& s : m.settings) {
+      if (s.name == "candidates" || s.name == "noise_candidates") continue;  // quadratic=, cubic=; noise_terms
+      const std::string want = (m.name == "narmax" && (s.name == "iterations" || s.name == "tolerance"))
+                                   ? "narmax_" + s.name
+                                   : prefix + s.name;
+      EXPECT_TRUE(parent_names.count(want)) << m.name << "." << s.name << " not reachable as " << parent << "." << want;
+    }
+  }
 
   // --set accepts each single-input setting under its registry name (given its default value: a named or model
   // setting gets a valid example instead). The fit may still fail for reasons of the data, never "not a setting".

@@ -12,6 +12,7 @@
 #include <Eigen/Dense>
 
 #include "ctid/core/types.hpp"
+#include "ctid/estimate/options.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/model/narx.hpp"
 
@@ -57,5 +58,35 @@ struct NarmaxOptions {
 /// model.process() drops them for simulation. diagnostics.scalars: "narmax_iterations", "relative_change".
 Result<NarxModel> narmax(const IdData& data, const std::vector<NarxTerm>& process_candidates,
                          const NarmaxOptions& options = {});
+
+/// The NARX workflow (`ctid fit --method narx`, Python ctid.narx, C++ narx()): the polynomial candidates of
+/// narx_candidates(degree, ylag, ulag, constant, umin), then FROLS — model size by an information criterion,
+/// AIC by default — or, with noise_terms > 0, NARMAX with the noise candidates narx_noise_candidates(noise_terms,
+/// 2, 2).
+struct NarxOptions {
+  int degree = 2;         ///< polynomial degree of the candidates
+  int ylag = 2;           ///< output lags y(k-1) .. y(k-ylag), >= 1
+  int ulag = 2;           ///< input lags u(k-umin) .. u(k-ulag)
+  int umin = 1;           ///< smallest input lag (0: a direct feed-through term)
+  bool constant = true;   ///< include the constant term
+  int noise_terms = 0;    ///< NARMAX residual lags e(k-1..noise_terms); 0: NARX by FROLS
+  NarmaxOptions narmax = [] {
+    NarmaxOptions o;
+    o.frols.criterion = InformationCriterion::Aic;
+    return o;
+  }();                    ///< selection (narmax.frols, also for NARX) and NARMAX iterations; noise candidates from noise_terms
+  void validate() const;
+};
+
+/// Fits the NARX (or NARMAX) workflow on one SISO record. Throws InvalidArgument / InvalidOptions as frols/narmax.
+Result<NarxModel> narx(const IdData& data, const NarxOptions& options = {});
+
+/// The settings tables (estimate/options.hpp).
+template <>
+const OptionTable<FrolsOptions>& option_table<FrolsOptions>();
+template <>
+const OptionTable<NarmaxOptions>& option_table<NarmaxOptions>();
+template <>
+const OptionTable<NarxOptions>& option_table<NarxOptions>();
 
 }  // namespace ctid

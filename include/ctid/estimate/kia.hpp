@@ -20,6 +20,7 @@
 #include "ctid/estimate/nde_oe.hpp"
 #include "ctid/model/narx.hpp"
 #include "ctid/model/nde.hpp"
+#include "ctid/estimate/options.hpp"
 
 namespace ctid {
 
@@ -39,6 +40,8 @@ struct KiaPointOptions {
   bool grid = false;      ///< evenly spaced instead of uniformly random
   unsigned seed = 1;
 };
+template <>
+const OptionTable<KiaPointOptions>& option_table<KiaPointOptions>();
 
 /// The s-points of a region; for pairs call twice with different seeds (as kia_quadratic does).
 /// Throws InvalidArgument for count < 1 or max <= 0 (the estimators resolve max = 0 from T first).
@@ -56,6 +59,8 @@ struct KiaLinearOptions {
   bool zoh = true;             ///< divide the NARX kernel by the hold factor Z(s) (data sampled with a held input)
   void validate() const;
 };
+template <>
+const OptionTable<KiaLinearOptions>& option_table<KiaLinearOptions>();
 
 /// Linear stage: returns the linear NDE y + sum alpha_l D^l y - sum beta_l D^l u = 0 (normalised).
 /// parameters: the implicit-form coefficients of the retained candidate terms (names "Dy", "D^2y", "u", ...);
@@ -74,6 +79,8 @@ struct KiaQuadraticOptions {
   bool zoh = true;
   void validate() const;
 };
+template <>
+const OptionTable<KiaQuadraticOptions>& option_table<KiaQuadraticOptions>();
 
 /// Quadratic stage with the linear part fixed: returns linear + retained quadratic terms (normalised), with
 /// parameters, "err" and "first_iteration" for the quadratic coefficients. Throws InvalidArgument for
@@ -90,6 +97,8 @@ struct KiaCubicOptions {
   bool zoh = true;
   void validate() const;
 };
+template <>
+const OptionTable<KiaCubicOptions>& option_table<KiaCubicOptions>();
 
 /// Cubic stage (BL-D5 "higher orders proceed likewise"): with the linear and quadratic terms of `model`
 /// fixed, 6 A(s_1+s_2+s_3) H_3 + Q = sum_cubic gamma C is linear in the cubic coefficients gamma (Q: the
@@ -107,7 +116,10 @@ struct KiaOptions {
   KiaCubicOptions cubic;          ///< no candidates: no cubic stage
   bool refine = true;             ///< refine the reconstructed equation by output error on the record
   NdeOeOptions refinement;
+  void validate() const;
 };
+template <>
+const OptionTable<KiaOptions>& option_table<KiaOptions>();
 
 struct KiaRun {
   /// The reconstructed equation: every stage's coefficients (no standard deviations), diagnostics.vectors "err"

@@ -14,6 +14,7 @@
 #include "ctid/core/types.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/model/nde.hpp"
+#include "ctid/estimate/options.hpp"
 
 namespace ctid {
 
@@ -25,6 +26,8 @@ struct NdeOeOptions {
   double rtol = 1e-10;                 ///< relative tolerance of the simulations
   void validate() const;
 };
+template <>
+const OptionTable<NdeOeOptions>& option_table<NdeOeOptions>();
 
 /// Refine the coefficients of `initial` on SISO data (input held or linear between samples as the data's
 /// intersample says; BandLimited is treated as linear). The reference term — y, or the highest derivative

@@ -23,6 +23,7 @@
 #include <variant>
 #include <vector>
 
+#include "ctid/core/error.hpp"
 #include "ctid/model/transfer_function.hpp"
 
 namespace ctid {
@@ -37,6 +38,7 @@ enum class OptionKind {
   NamedReals,   ///< std::map<std::string, double>: NAME.KEY=V
   NamedBounds,  ///< std::map<std::string, std::pair<double, double>>: NAME.KEY=LO,HI
   Model,        ///< std::optional<TransferFunction> or TransferFunction: "NUM/DEN"
+  Names,        ///< std::vector<std::string> (e.g. model terms "y^2,y*Dy"): comma-separated
 };
 const char* to_string(OptionKind k);
 
@@ -71,7 +73,8 @@ struct OptionInfo {
 
 /// A setting's value, typed (Python reads and writes these).
 using OptionValue = std::variant<double, int, bool, std::string, std::vector<double>, std::map<std::string, double>,
-                                 std::map<std::string, std::pair<double, double>>, std::optional<TransferFunction>>;
+                                 std::map<std::string, std::pair<double, double>>, std::optional<TransferFunction>,
+                                 std::vector<std::string>>;
 
 /// The closest of `names` to `key` by edit distance ("" when none is within half of key's length + 2).
 std::string closest_name(const std::string& key, const std::vector<std::string>& names);
@@ -83,6 +86,8 @@ bool parse_flag(const std::string& method, const std::string& key, const std::st
 std::vector<double> parse_reals(const std::string& method, const std::string& key, const std::string& text);
 std::pair<double, double> parse_bounds(const std::string& method, const std::string& key, const std::string& text);
 TransferFunction parse_tf(const std::string& method, const std::string& key, const std::string& text);
+std::vector<std::string> parse_names(const std::string& text);
+std::string format_names(const std::vector<std::string>& v);
 std::string format_real(double v);
 std::string format_reals(const std::vector<double>& v);
 std::string format_tf(const TransferFunction& g);
@@ -121,12 +126,25 @@ class OptionTable {
                  if (!r.contains(o.*m)) options_detail::out_of_range(method, n, r.text(), options_detail::format_real(o.*m), u);
                });
   }
-  OptionTable& integer(const char* name, int O::*m, const char* unit, OptionRange r, const char* doc) {
+  /// A whole number (int or unsigned member; held as int in OptionValue).
+  template <class I>
+  OptionTable& integer(const char* name, I O::*m, const char* unit, OptionRange r, const char* doc) {
+    static_assert(std::is_integral_v<I>);
+    if constexpr (std::is_unsigned_v<I>) r.lo = std::max(r.lo, 0.0);
     const std::string n = name, u = unit;
     return add({n, OptionKind::Integer, u, r.text(), doc, {}, {}},
-               [m, n](O& o, const std::string& method, const std::string& t) { o.*m = options_detail::parse_int(method, n, t); },
-               [m](const O& o) { return std::to_string(o.*m); }, [m](const O& o) { return OptionValue(o.*m); },
-               [m](O& o, const std::string&, const OptionValue& v) { o.*m = std::get<int>(v); },
+               [m, n, r, u](O& o, const std::string& method, const std::string& t) {
+                 const int v = options_detail::parse_int(method, n, t);
+                 if (std::is_unsigned_v<I> && v < 0) options_detail::out_of_range(method, n, r.text(), t, u);
+                 o.*m = static_cast<I>(v);
+               },
+               [m](const O& o) { return std::to_string(o.*m); },
+               [m](const O& o) { return OptionValue(static_cast<int>(o.*m)); },
+               [m, n, r, u](O& o, const std::string& method, const OptionValue& v) {
+                 const int x = std::get<int>(v);
+                 if (std::is_unsigned_v<I> && x < 0) options_detail::out_of_range(method, n, r.text(), std::to_string(x), u);
+                 o.*m = static_cast<I>(x);
+               },
                [m, n, r, u](const O& o, const std::string& method) {
                  if (!r.contains(o.*m)) options_detail::out_of_range(method, n, r.text(), std::to_string(o.*m), u);
                });
@@ -267,15 +285,55 @@ class OptionTable {
                },
                nullptr);
   }
+  /// A list of names (comma-separated in text).
+  OptionTable& names(const char* name, std::vector<std::string> O::*m, const char* doc) {
+    const std::string n = name;
+    return add({n, OptionKind::Names, "", "", doc, {}, {}},
+               [m](O& o, const std::string&, const std::string& t) { o.*m = options_detail::parse_names(t); },
+               [m](const O& o) { return options_detail::format_names(o.*m); }, [m](const O& o) { return OptionValue(o.*m); },
+               [m](O& o, const std::string&, const OptionValue& v) { o.*m = std::get<std::vector<std::string>>(v); }, nullptr);
+  }
+  /// A list of model terms T (T::parse(text), t.name()), e.g. NDE terms "y^2,y*Dy"; a bad term is an InvalidOptions.
+  template <class T>
+  OptionTable& terms(const char* name, std::vector<T> O::*m, const char* doc) {
+    const std::string n = name;
+    auto from = [n](const std::string& method, const std::vector<std::string>& names) {
+      std::vector<T> out;
+      for (const auto& s : names) {
+        try {
+          out.push_back(T::parse(s));
+        } catch (const InvalidArgument& e) {
+          throw InvalidOptions(method + ": " + n + ": " + e.what());
+        }
+      }
+      return out;
+    };
+    auto to = [m](const O& o) {
+      std::vector<std::string> out;
+      for (const auto& t : o.*m) out.push_back(t.name());
+      return out;
+    };
+    return add({n, OptionKind::Names, "", "", doc, {}, {}},
+               [m, from](O& o, const std::string& method, const std::string& t) {
+                 o.*m = from(method, options_detail::parse_names(t));
+               },
+               [to](const O& o) { return options_detail::format_names(to(o)); }, [to](const O& o) { return OptionValue(to(o)); },
+               [m, from](O& o, const std::string& method, const OptionValue& v) {
+                 o.*m = from(method, std::get<std::vector<std::string>>(v));
+               },
+               nullptr);
+  }
   /// The fields of a nested options struct, reached under their own names (or `rename` old -> new);
   /// `only` (if not empty) limits which fields are included.
+  /// `prefix` is put before every name that `rename` does not give.
   template <class N>
   OptionTable& include(N O::*m, const OptionTable<N>& nested, std::vector<std::string> only = {},
-                       std::map<std::string, std::string> rename = {}) {
+                       std::map<std::string, std::string> rename = {}, const std::string& prefix = "") {
     for (const auto& f : nested.fields()) {
       if (!only.empty() && std::find(only.begin(), only.end(), f.info.name) == only.end()) continue;
       OptionInfo info = f.info;
       if (auto it = rename.find(info.name); it != rename.end()) info.name = it->second;
+      else info.name = prefix + info.name;
       const std::string inner = f.info.name, outer = info.name;
       Field g;
       g.info = info;
