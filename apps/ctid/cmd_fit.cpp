@@ -293,48 +293,33 @@ int run_physical(const FitArgs& a, const IdData& d) {
   return finish(r, "physical-" + a.via, d, a, settings);
 }
 
-// Settings left after the modal parser took its own (modal's settings are not yet in a table).
-void reject_unknown(const std::map<std::string, std::string>& s, const std::string& method, const std::string& known) {
-  if (s.empty()) return;
-  throw UsageError("--set " + s.begin()->first + ": not a setting of " + method + " (settings: " + known + ")");
-}
-
-// El-Shafey: modal functions (generated input with --set frequencies, or piecewise-constant input).
-int run_modal(const FitArgs& a, const IdData& d0) {
-  if (d0.nu() != 1) throw UsageError(detail::format("modal needs one input (selected {})", d0.nu()));
+// El-Shafey: modal functions (modal_fit). Besides the table's settings: shift_samples (the shifts in samples) and
+// frequencies=w1,.. (a generated input: the generator fitted to the measured input); --nk is the input delay.
+int run_modal(const FitArgs& a, const IdData& d) {
+  if (d.nu() != 1) throw UsageError(detail::format("modal needs one input (selected {})", d.nu()));
   if (a.nf.size() != 1 || a.nb.size() > 1 || a.nk.size() != 1) throw UsageError("modal: one --nb, --nf and --nk value");
   const int n = a.nf[0], nb = a.nb.empty() ? n : a.nb[0], nk = a.nk[0];
   if (nk < 0) throw UsageError("--nk must be >= 0");
-  auto sets = parse_sets(a.sets);
-  ModalSettings ms = modal_settings(sets, d0.ts());
-  reject_unknown(sets, "modal", "shifts (samples) or shift_times (s), basis=fourier|walsh|discrete, functions, iv "
-                                "(samples), stride, quadrature, window=START,LENGTH (samples), frequencies=w1,..");
-  if (ms.options.shifts.size() != n)
-    throw UsageError(detail::format("modal needs one shift per pole: --set shifts=S1,..,S{} (samples; got {} for --nf {})",
-                                    n, ms.options.shifts.size(), n));
-  // An input delay of nk samples: fit on the delayed input (zero before the record), report it as io_delay.
-  IdData d = d0;
+  std::map<std::string, std::string> own;
+  ModalOptions o = modal_options("modal", a.sets, d.ts(), {"frequencies"}, own);
+  if (o.shifts.size() != n)
+    throw UsageError(detail::format("modal needs one shift per pole: --set shifts=T1,..,T{} (s) or shift_samples=S1,..,S{} "
+                                    "(samples; got {} for --nf {})",
+                                    n, n, o.shifts.size(), n));
   if (nk > 0) {
-    Eigen::MatrixXd u = Eigen::MatrixXd::Zero(d0.size(), 1);
-    for (int i = nk; i < d0.size(); ++i) u(i, 0) = d0.u()(i - nk, 0);
-    d = IdData(u, d0.y(), d0.ts(), d0.t0());
-    d.set_intersample(0, d0.intersample(0));
+    if (o.delay > 0) throw UsageError("give the input delay once: --nk (samples) or --set delay (s)");
+    o.delay = nk * d.ts();
   }
-  if (!ms.basis_given) ms.options.basis = ms.frequencies.empty() ? ModalBasis::Walsh : ModalBasis::Fourier;
-  if (!ms.functions_given && ms.options.basis == ModalBasis::Walsh) ms.options.functions = 8;
-  Result<TransferFunction> r;
-  try {
-    if (!ms.frequencies.empty()) {
-      const InputGenerator g = generator_fitted_to_input(ms.frequencies, d);
-      r = modal_fit(d, nb, ms.options, &g);
-    } else {
-      r = modal_fit(d, nb, ms.options);
-    }
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
-  if (nk > 0) r.model.set_io_delay(nk * d0.ts());
-  return finish(r, "modal", d0, a, raw_settings(a.sets));
+  std::vector<double> frequencies;
+  if (own.count("frequencies")) frequencies = call_library([&] { return options_detail::parse_reals("modal", "frequencies", own.at("frequencies")); });
+  const Result<TransferFunction> r = call_library([&] {
+    if (frequencies.empty()) return modal_fit(d, nb, o);
+    const InputGenerator g = generator_fitted_to_input(frequencies, d);
+    return modal_fit(d, nb, o, &g);
+  });
+  Settings settings = settings_of(o);
+  if (!frequencies.empty()) settings.emplace_back("frequencies", own.at("frequencies"));
+  return finish(r, "modal", d, a, settings);
 }
 
 int run(const FitArgs& a) {
@@ -392,7 +377,7 @@ const std::map<std::string, FitMethod>& fit_methods() {
       {"tfest", {{"tfest", "tf_from_frequency"}, [](const FitArgs& a, const IdData& d) { return run_tf(a, d, &tfest); }}},
       {"fsf", {{"fsf"}, run_fsf}},
       {"physical", {{"physical"}, run_physical}},
-      {"modal", {{}, run_modal}},
+      {"modal", {{"modal"}, run_modal}},
       {"narx",
        {{"narx"},
         [](const FitArgs& a, const IdData& d) { return run_narx_or_kia(a.method, d, a.sets, a.narx, a.json, a.report); }}},
@@ -451,9 +436,9 @@ void setup_fit(CLI::App& app) {
   app.add_option("--nk", a->nk, "Input delay in samples; per input allowed")->delimiter(',')->capture_default_str();
   app.add_option("--set", a->sets,
                  "Method setting NAME=VALUE (repeatable); 'ctid fit --method M --help' lists M's settings with units, "
-                 "ranges and defaults (the same names as the C++ options and the Python keywords). modal: "
-                 "shifts=S1,..,Sn (samples) or shift_times (s), basis=fourier|walsh|discrete, functions, iv (samples), "
-                 "stride, quadrature=simpson|trapezoid, window=START,LENGTH (samples), frequencies=w1,.. (generated input)");
+                 "ranges and defaults (the same names as the C++ options and the Python keywords). modal also "
+                 "takes shift_samples=S1,..,Sn (the shifts in samples) and frequencies=w1,.. (rad/s: a generated input, its "
+                 "generator fitted to the measured input)");
   app.add_flag("--delay", a->delay,
                "Estimate a (non-integer) input delay (srivc, oe, tfest): grid search over [delay_min, delay_max], then "
                "refinement");

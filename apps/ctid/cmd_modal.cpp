@@ -28,57 +28,23 @@ int whole_samples(const std::string& key, double v) {
 }
 }  // namespace
 
-ModalSettings modal_settings(std::map<std::string, std::string>& sets, double Ts) {
-  ModalSettings m;
-  std::vector<double> shifts;
-  bool in_samples = false;
-  consume_sets(sets, [&](const std::string& k, const std::string& v) {
-    if (k == "shifts") {
-      shifts = to_list(k, v);
-      for (double& s : shifts) s = whole_samples(k, s) * Ts;
-      in_samples = true;
-    } else if (k == "shift_times") {
-      if (in_samples) throw UsageError("give either shifts (samples) or shift_times (seconds), not both");
-      shifts = to_list(k, v);
-    } else if (k == "basis") {
-      if (v == "fourier") m.options.basis = ModalBasis::Fourier;
-      else if (v == "walsh") m.options.basis = ModalBasis::Walsh;
-      else if (v == "discrete") m.options.basis = ModalBasis::Discrete;
-      else throw UsageError("--set basis: use fourier, walsh or discrete (got '" + v + "')");
-      m.basis_given = true;
-    } else if (k == "functions") {
-      m.options.functions = to_int(k, v);
-      m.functions_given = true;
-    }
-    else if (k == "iv") m.options.iv_shift = whole_samples(k, to_double(k, v)) * Ts;
-    else if (k == "stride") m.options.stride = to_int(k, v);
-    else if (k == "quadrature") {
-      if (v == "simpson") m.options.quadrature = Quadrature::Simpson;
-      else if (v == "trapezoid") m.options.quadrature = Quadrature::Trapezoid;
-      else throw UsageError("--set quadrature: use simpson or trapezoid (got '" + v + "')");
-    } else if (k == "window") {
-      const auto w = to_list(k, v);
-      if (w.size() != 2) throw UsageError("--set window=START,LENGTH (samples)");
-      m.options.windows = {{whole_samples(k, w[0]) * Ts, whole_samples(k, w[1]) * Ts}};
-    } else if (k == "frequencies") m.frequencies = to_list(k, v);
-    else return false;
-    return true;
-  });
-  m.options.shifts = Eigen::Map<const Eigen::VectorXd>(shifts.data(), static_cast<Eigen::Index>(shifts.size()));
-  return m;
-}
-
-InputGenerator generator_fitted_to_input(const std::vector<double>& frequencies, const IdData& d) {
-  InputGenerator g;
-  for (double w : frequencies) {
-    if (!(w >= 0)) throw UsageError(detail::format("--set frequencies: {} rad/s is not >= 0", w));
-    g = g + (w == 0 ? InputGenerator::constant(1.0) : InputGenerator::sinusoid(w, 1.0, 0.0));
+ModalOptions modal_options(const std::string& method, const std::vector<std::string>& sets, double Ts,
+                           const std::vector<std::string>& own, std::map<std::string, std::string>& own_values) {
+  ModalOptions o;
+  std::vector<std::string> rest;
+  std::vector<double> samples;
+  for (const auto& [k, v] : parse_sets(sets)) {
+    if (k == "shift_samples") samples = to_list(k, v);
+    else if (std::find(own.begin(), own.end(), k) != own.end()) own_values[k] = v;
+    else rest.push_back(k + "=" + v);
   }
-  Eigen::VectorXd t(d.size());
-  for (int i = 0; i < d.size(); ++i) t(i) = d.time(i) - d.t0();
-  const Eigen::MatrixXd X = g.basis(t);
-  const Eigen::VectorXd c = X.colPivHouseholderQr().solve(d.u().col(0));  // amplitudes from the measured input
-  return InputGenerator(g.A(), c, g.x0());
+  apply_sets(method, rest, o);
+  if (!samples.empty()) {
+    if (o.shifts.size() > 0) throw UsageError("give either shifts (seconds) or shift_samples (samples), not both");
+    o.shifts.resize(static_cast<Eigen::Index>(samples.size()));
+    for (std::size_t i = 0; i < samples.size(); ++i) o.shifts(static_cast<Eigen::Index>(i)) = whole_samples("shift_samples", samples[i]) * Ts;
+  }
+  return o;
 }
 
 namespace {
@@ -207,35 +173,29 @@ int run_response(const ResponseArgs& a) {
   const IdData d = a.data.load(true);
   if (d.nu() != 1 || d.ny() != 1) throw UsageError("response needs one --input and one --output");
   const double Ts = d.ts();
-  auto sets = parse_sets(a.sets);
+  std::map<std::string, std::string> own;
+  ModalOptions mo = modal_options("response --method modal", a.sets, Ts, {"period", "horizon", "harmonics", "window_start"}, own);
   double period = 0, horizon = 0, window_start = -1;
   std::vector<double> harmonics_d;
-  consume_sets(sets, [&](const std::string& k, const std::string& v) {
+  for (const auto& [k, v] : own) {
     if (k == "period") period = to_double(k, v);
     else if (k == "horizon") horizon = to_double(k, v);
     else if (k == "harmonics") harmonics_d = to_list(k, v);
-    else if (k == "window_start") window_start = to_double(k, v);
-    else return false;
-    return true;
-  });
-  ModalSettings ms = modal_settings(sets, Ts);
-  if (!sets.empty())
-    throw UsageError("--set " + sets.begin()->first + ": not a setting of response --method modal (settings: period, "
-                     "horizon, harmonics, window_start, shifts, shift_times, basis, functions, iv, quadrature)");
+    else window_start = to_double(k, v);
+  }
   if (!(period > 0)) throw UsageError("response --method modal needs --set period=SECONDS (level period for step/impulse, "
                                       "input period for frequency)");
-  if (ms.options.shifts.size() == 0) {  // default: shifts i T (step/impulse) or i Ts * period/(n+1) (frequency)
-    ms.options.shifts.resize(a.order);
+  if (mo.shifts.size() == 0) {  // default: shifts i T (step/impulse) or i Ts * period/(n+1) (frequency)
+    mo.shifts.resize(a.order);
     const double base = a.kind == "frequency" ? std::round(period / (a.order + 1) / Ts) * Ts : period;
-    for (int i = 0; i < a.order; ++i) ms.options.shifts(i) = (i + 1) * base;
+    for (int i = 0; i < a.order; ++i) mo.shifts(i) = (i + 1) * base;
   }
-  if (ms.options.shifts.size() != a.order)
-    throw UsageError(detail::format("{} shifts for --order {}", ms.options.shifts.size(), a.order));
-  if (!ms.basis_given) ms.options.basis = ModalBasis::Discrete;
-  const double Tn = ms.options.shifts.maxCoeff();
+  if (mo.shifts.size() != a.order) throw UsageError(detail::format("{} shifts for --order {}", mo.shifts.size(), a.order));
+  if (!mo.basis) mo.basis = ModalBasis::Discrete;
+  const double Tn = mo.shifts.maxCoeff();
   try {
     // p_0 from the constant-input windows (piecewise-constant input).
-    ModalOptions o = ms.options;
+    ModalOptions o = mo;
     o.max_order = 0;
     if (o.windows.empty()) o.windows = piecewise_constant_windows(d, Tn, Ts);
     if (o.windows.empty()) throw UsageError("the input never stays constant for longer than T_n: no validity windows");
@@ -243,7 +203,7 @@ int run_response(const ResponseArgs& a) {
     std::printf("modal parameters p_0:");
     for (int i = 0; i < a.order; ++i) std::printf(" %.6g", m.model.P()(0, i));
     std::printf("   (shifts");
-    for (int i = 0; i < a.order; ++i) std::printf(" %.6g", ms.options.shifts(i));
+    for (int i = 0; i < a.order; ++i) std::printf(" %.6g", mo.shifts(i));
     std::printf(" s)");
     std::printf("   (%zu windows, condition %.3g)\n", o.windows.size(), m.diagnostics.condition_number);
     if (a.kind == "frequency") {
@@ -251,7 +211,7 @@ int run_response(const ResponseArgs& a) {
       for (double x : harmonics_d.empty() ? std::vector<double>{1, 3, 5, 7, 9} : harmonics_d)
         h.push_back(whole_samples("harmonics", x));
       const HarmonicResponse r =
-          modal_frequency_response(d, m.model, period, h, window_start >= 0 ? window_start : Tn, ms.options.quadrature);
+          modal_frequency_response(d, m.model, period, h, window_start >= 0 ? window_start : Tn, mo.quadrature);
       const FrequencyData& f = r.response;
       Eigen::MatrixXd tab(f.size(), 5);
       for (int i = 0; i < f.size(); ++i) {
@@ -267,9 +227,9 @@ int run_response(const ResponseArgs& a) {
       const char* name = "step";
       if (a.kind == "impulse") {
         // Negative shifts -i T and Fourier functions on the first half of the horizon (ES 5.38-5.42).
-        const Eigen::VectorXd neg = -ms.options.shifts;
+        const Eigen::VectorXd neg = -mo.shifts;
         const double To = std::floor((hz - Tn) / 2 / Ts) * Ts;
-        g = modal_impulse_from_step(g, neg, To, std::max(6, 2 * ((a.order + 2) / 2)), ms.options.quadrature).impulse;
+        g = modal_impulse_from_step(g, neg, To, std::max(6, 2 * ((a.order + 2) / 2)), mo.quadrature).impulse;
         name = "impulse";
       }
       const int K = static_cast<int>(g.t.size());
@@ -321,8 +281,8 @@ void setup_response(CLI::App& app) {
   app.add_option("--order", a->order, "System order n")->required();
   app.add_option("--set", a->sets,
                  "KEY=VALUE: period (s; level period of a piecewise-constant input, or the input period for "
-                 "frequency), horizon (s), harmonics=1,3,5, window_start (s), shifts (samples), shift_times (s), "
-                 "basis, iv, quadrature");
+                 "frequency), horizon (s), harmonics=1,3,5, window_start (s), and the modal settings (ctid fit --method "
+                 "modal --help; basis default discrete), shift_samples (the shifts in samples)");
   app.add_option("--out", a->out, "Write the response to this CSV file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
   app.callback([a] { g_run = [a] { return run_response(*a); }; });

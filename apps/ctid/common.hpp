@@ -159,16 +159,11 @@ void write_report(const std::string& path, const IdData& d, const Result<M>& r, 
   std::printf("wrote %s\n", path.c_str());
 }
 
-/// Modal-function settings (El-Shafey) from --set: shifts (samples) or shift_times (s), basis,
-/// functions, iv (samples), stride, quadrature, window=START,LENGTH (samples), frequencies (rad/s).
-struct ModalSettings {
-  ModalOptions options;
-  std::vector<double> frequencies;  ///< a generated input: 0 = constant, w > 0 = sinusoid pair
-  bool basis_given = false, functions_given = false;
-};
-ModalSettings modal_settings(std::map<std::string, std::string>& sets, double Ts);
-/// The generator of the given frequencies with its coefficients c fitted to the measured input.
-InputGenerator generator_fitted_to_input(const std::vector<double>& frequencies, const IdData& d);
+/// Modal-function options (El-Shafey) from --set through their table, plus the CLI's shift_samples (the shifts
+/// counted in sampling periods of Ts; give it or shifts in seconds). Keys listed in `own` are not modal settings
+/// but the command's own: they are returned in `own_values` instead.
+ModalOptions modal_options(const std::string& method, const std::vector<std::string>& sets, double Ts,
+                           const std::vector<std::string>& own, std::map<std::string, std::string>& own_values);
 
 /// Billings & Li: fit --method narx | kia (cmd_nonlinear.cpp).
 int run_narx_or_kia(const std::string& method, const IdData& d, const std::vector<std::string>& sets,

@@ -17,7 +17,8 @@ from . import _ctid
 from ._ctid import (  # noqa: F401  (re-exported)
     CorrelationTest, DeadbeatObserver, FileError, FrequencyData, FsfModel, IdData, InputGenerator, InvalidArgument,
     InvalidOptions, MisoModel, ModalModel, ModalWindow, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm,
-    NonlinearCorrelationTests, PhysicalModel, TransferFunction, add_noise_snr, fit_percent, frequency_grid, html_report,
+    NonlinearCorrelationTests, PhysicalModel, TransferFunction, add_noise_snr, fit_percent, frequency_grid,
+    generator_fitted_to_input, html_report,
     input_residual_crosscorrelation, load, magnitude_band, methods, settings, narx_candidates, narx_noise_candidates,
     nonlinear_correlation_tests, one_sided_dft, piecewise_constant_windows, prbs, read_narx_json, read_nde_json,
     residual_autocorrelation, response_horizon, time_grid,
@@ -327,8 +328,12 @@ def modal_fit(data, nb, input=None, **options):
 
 
 def _modal_options(who, options):
+    """windows may be given as ModalWindow objects or (start, length) pairs (seconds); the setting is their flat list."""
     if "windows" in options:
-        options["windows"] = [w if isinstance(w, ModalWindow) else ModalWindow(*w) for w in options["windows"]]
+        flat = []
+        for w in options["windows"]:
+            flat += [w.start, w.length] if isinstance(w, ModalWindow) else list(w) if _np.ndim(w) else [w]
+        options["windows"] = flat
     return _options(_ctid.ModalOptions, who, options)
 
 

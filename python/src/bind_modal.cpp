@@ -16,16 +16,7 @@ void bind_modal(py::module_& m) {
            py::arg("length"))
       .def_readwrite("start", &ModalWindow::start)
       .def_readwrite("length", &ModalWindow::length);
-  py::class_<ModalOptions>(m, "ModalOptions")
-      .def(py::init<>())
-      .def_readwrite("shifts", &ModalOptions::shifts)
-      .def_readwrite("basis", &ModalOptions::basis)
-      .def_readwrite("max_order", &ModalOptions::max_order)
-      .def_readwrite("windows", &ModalOptions::windows)
-      .def_readwrite("functions", &ModalOptions::functions)
-      .def_readwrite("quadrature", &ModalOptions::quadrature)
-      .def_readwrite("stride", &ModalOptions::stride)
-      .def_readwrite("iv_shift", &ModalOptions::iv_shift);
+  bind_options<ModalOptions>(m, "ModalOptions");
   py::class_<InputGenerator>(m, "InputGenerator", "Known input generator u = c^T x_c, x_c' = A x_c (ES ch. 4).")
       .def(py::init<Eigen::MatrixXd, Eigen::VectorXd, Eigen::VectorXd>(), py::arg("A"), py::arg("c"), py::arg("x0"))
       .def_static("constant", &InputGenerator::constant, py::arg("level") = 1.0)
@@ -35,6 +26,8 @@ void bind_modal(py::module_& m) {
       .def("__add__", &InputGenerator::operator+)
       .def("modes", &InputGenerator::modes)
       .def("__call__", [](const InputGenerator& g, const Eigen::VectorXd& t) { return g(t); }, py::arg("t"));
+  m.def("generator_fitted_to_input", &generator_fitted_to_input, py::arg("frequencies"), py::arg("data"),
+        "The generator of the frequencies (rad/s; 0 = constant) with its coefficients fitted to the record's input.");
   m.def("modal_fit", [](const IdData& d, int nb, const ModalOptions& o, const InputGenerator* input) {
           return interruptible([&] { return modal_fit(d, nb, o, input); });
         }, py::arg("data"), py::arg("nb"), py::arg("options"), py::arg("input") = nullptr,

@@ -10,6 +10,7 @@
 #include "ctid/estimate/fsf.hpp"
 #include "ctid/estimate/kia.hpp"
 #include "ctid/estimate/lssvf.hpp"
+#include "ctid/estimate/modal.hpp"
 #include "ctid/estimate/nde_oe.hpp"
 #include "ctid/estimate/oe.hpp"
 #include "ctid/estimate/physical.hpp"
@@ -54,6 +55,9 @@ const std::vector<MethodInfo>& methods() {
       entry<FsfOptions, PhysicalFitOptions>("physical",
                                             "physical parameters of a transfer-function expression (via FSF or raw data)",
                                             {"FsfOptions", "PhysicalFitOptions"}),
+      entry<ModalOptions>("modal",
+                          "El-Shafey (1987) modal functions: transfer function from a generated or piecewise-constant input",
+                          {"ModalOptions"}),
       entry<NarxOptions>("narx", "Billings & Li NARX workflow: candidates from degree and lags, FROLS with a criterion, "
                                  "NARMAX with noise_terms > 0",
                          {"NarxOptions"}),

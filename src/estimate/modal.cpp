@@ -48,7 +48,52 @@ struct SampleWindow {
 
 }  // namespace
 
+template <>
+const OptionTable<ModalOptions>& option_table<ModalOptions>() {
+  using O = ModalOptions;
+  static const OptionTable<O> t = [] {
+    OptionTable<O> x("modal");
+    x.reals("shifts", &O::shifts, "s", above(0),
+            "T_1 < .. < T_n, one per system pole, whole multiples of Ts (the CLI also takes shift_samples)")
+        .choice("basis", &O::basis,
+                {{"automatic", std::optional<ModalBasis>()}, {"fourier", std::optional(ModalBasis::Fourier)},
+                 {"walsh", std::optional(ModalBasis::Walsh)}, {"discrete", std::optional(ModalBasis::Discrete)}},
+                "modal functions (automatic: Walsh for a piecewise-constant input, Fourier otherwise)")
+        .integer("max_order", &O::max_order, "", at_least(0), "estimate p_j, q_j for j = 0..max_order (> 0: Fourier or Walsh)")
+        .reals_via("windows", "s", at_least(0),
+                   "validity windows START,LENGTH[,START,LENGTH..] (none: automatic)",
+                   [](const O& o) {
+                     std::vector<double> v;
+                     for (const auto& w : o.windows) v.insert(v.end(), {w.start, w.length});
+                     return v;
+                   },
+                   [](O& o, const std::string& method, const std::vector<double>& v) {
+                     if (v.size() % 2 != 0)
+                       throw InvalidOptions(detail::format("{}: windows are pairs START,LENGTH (got {} values)", method, v.size()));
+                     o.windows.clear();
+                     for (std::size_t i = 0; i < v.size(); i += 2) o.windows.push_back({v[i], v[i + 1]});
+                   })
+        .integer("functions", &O::functions, "", at_least(0),
+                 "Fourier: 2m functions (even); Walsh: 2^k functions per window; 0: automatic (6 Fourier, 8 Walsh)")
+        .choice("quadrature", &O::quadrature, {{"simpson", Quadrature::Simpson}, {"trapezoid", Quadrature::Trapezoid}},
+                "integration rule of the Fourier/Walsh integrals (trapezoid reproduces the thesis)")
+        .integer("stride", &O::stride, "", at_least(1), "Discrete: every stride-th sample of a window is an equation")
+        .real("iv_shift", &O::iv_shift, "s", at_least(0), "Discrete: > 0 uses instruments y(t - T_i + iv_shift)")
+        .real("delay", &O::delay, "s", at_least(0), "input delay (a multiple of Ts), fitted on the delayed input");
+    return x;
+  }();
+  return t;
+}
+
+ModalOptions ModalOptions::resolved(bool piecewise_constant) const {
+  ModalOptions o = *this;
+  if (!o.basis) o.basis = piecewise_constant ? ModalBasis::Walsh : ModalBasis::Fourier;
+  if (o.functions == 0) o.functions = o.basis == ModalBasis::Walsh ? 8 : 6;
+  return o;
+}
+
 void ModalOptions::validate() const {
+  option_table<ModalOptions>().check(*this);
   CTID_REQUIRE_OPTION(shifts.size() >= 1, "modal: at least one shift is needed (one per system pole)");
   for (Eigen::Index i = 0; i < shifts.size(); ++i) {
     CTID_REQUIRE_OPTION(std::isfinite(shifts(i)) && shifts(i) > 0, "modal: shift {} must be > 0 (got {} s)", i + 1,
@@ -61,10 +106,10 @@ void ModalOptions::validate() const {
   CTID_REQUIRE_OPTION(basis != ModalBasis::Discrete || max_order == 0,
                       "modal: derivative orders j > 0 (max_order = {}) need the Fourier or Walsh basis: derivatives are "
                       "not measured", max_order);
-  if (basis == ModalBasis::Fourier)
+  if (basis == ModalBasis::Fourier && functions != 0)
     CTID_REQUIRE_OPTION(functions >= 2 && functions % 2 == 0, "modal: the number of Fourier functions must be even and "
                         ">= 2 (got {})", functions);
-  if (basis == ModalBasis::Walsh)
+  if (basis == ModalBasis::Walsh && functions != 0)
     CTID_REQUIRE_OPTION(functions >= 1 && (functions & (functions - 1)) == 0,
                         "modal: the number of Walsh functions must be a power of two (got {})", functions);
   CTID_REQUIRE_OPTION(stride >= 1, "modal: stride must be >= 1 (got {})", stride);
@@ -93,9 +138,12 @@ std::vector<ModalWindow> piecewise_constant_windows(const IdData& data, double s
   return out;
 }
 
-Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& input_basis, const ModalOptions& o) {
+Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& input_basis, const ModalOptions& options) {
   const auto t_start = std::chrono::steady_clock::now();
-  o.validate();
+  options.validate();
+  CTID_REQUIRE_OPTION(options.delay == 0.0, "modal: delay = {} s applies to modal_fit (delay the input of the record)",
+                      options.delay);
+  const ModalOptions o = options.resolved(false);
   CTID_REQUIRE(data.ny() == 1, "modal: needs one output (got {})", data.ny());
   CTID_REQUIRE(data.is_uniform(), "modal: needs uniformly sampled data");
   const double Ts = data.ts();
@@ -314,13 +362,38 @@ Result<TransferFunction> modal_transfer_function(const IdData& data, const Input
   return r;
 }
 
+namespace {
+Result<TransferFunction> modal_fit_undelayed(const IdData& data, int nb, ModalOptions o, const InputGenerator* input);
+}  // namespace
+
 Result<TransferFunction> modal_fit(const IdData& data, int nb, ModalOptions o, const InputGenerator* input) {
-  const auto t_start = std::chrono::steady_clock::now();
   o.validate();
-  const int n = static_cast<int>(o.shifts.size());
-  CTID_REQUIRE(nb >= 1 && nb <= n, "modal_fit: nb = {} numerator coefficients must be in [1, n = {}]", nb, n);
   CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "modal_fit: needs one input and one output (got {}, {})", data.nu(),
                data.ny());
+  if (o.delay == 0.0) return modal_fit_undelayed(data, nb, o.resolved(input == nullptr), input);
+  CTID_REQUIRE(data.is_uniform(), "modal_fit: a delay needs uniformly sampled data");
+  const double k = o.delay / data.ts();
+  CTID_REQUIRE_OPTION(std::abs(k - std::round(k)) <= 1e-9 * std::max(1.0, k),
+                      "modal_fit: delay = {} s is not a whole multiple of the sampling period {} s", o.delay, data.ts());
+  const int nk = static_cast<int>(std::lround(k));
+  CTID_REQUIRE(nk < data.size(), "modal_fit: the delay {} s is not shorter than the record", o.delay);
+  // The delayed input (zero before the record): the fit sees a delay-free system.
+  Eigen::MatrixXd u = Eigen::MatrixXd::Zero(data.size(), 1);
+  u.bottomRows(data.size() - nk) = data.u().topRows(data.size() - nk);
+  IdData d(u, data.y(), data.ts(), data.t0());
+  d.set_intersample(0, data.intersample(0));
+  const double delay = o.delay;
+  o.delay = 0.0;
+  Result<TransferFunction> r = modal_fit_undelayed(d, nb, o.resolved(input == nullptr), input);
+  r.model.set_io_delay(delay);
+  return r;
+}
+
+namespace {
+Result<TransferFunction> modal_fit_undelayed(const IdData& data, int nb, ModalOptions o, const InputGenerator* input) {
+  const auto t_start = std::chrono::steady_clock::now();
+  const int n = static_cast<int>(o.shifts.size());
+  CTID_REQUIRE(nb >= 1 && nb <= n, "modal_fit: nb = {} numerator coefficients must be in [1, n = {}]", nb, n);
   if (input) {
     CTID_REQUIRE(nb == n, "modal_fit: Theorem 4.2 estimates all n = {} numerator coefficients (nb = {})", n, nb);
     Result<TransferFunction> r = modal_transfer_function(data, *input, o);
@@ -402,6 +475,22 @@ Result<TransferFunction> modal_fit(const IdData& data, int nb, ModalOptions o, c
   r.fit = fit_report_or_inf(data.y().col(0), lsim(r.model, data, 0), n + nb);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return r;
+}
+}  // namespace
+
+InputGenerator generator_fitted_to_input(const std::vector<double>& frequencies, const IdData& d) {
+  CTID_REQUIRE(d.nu() == 1, "generator_fitted_to_input: needs one input (got {})", d.nu());
+  CTID_REQUIRE(!frequencies.empty(), "generator_fitted_to_input: no frequencies given");
+  InputGenerator g;
+  for (double w : frequencies) {
+    CTID_REQUIRE(std::isfinite(w) && w >= 0, "generator_fitted_to_input: frequency {} rad/s is not >= 0", w);
+    g = g + (w == 0 ? InputGenerator::constant(1.0) : InputGenerator::sinusoid(w, 1.0, 0.0));
+  }
+  Eigen::VectorXd t(d.size());
+  for (int i = 0; i < d.size(); ++i) t(i) = d.time(i) - d.t0();
+  const Eigen::MatrixXd X = g.basis(t);
+  const Eigen::VectorXd c = X.colPivHouseholderQr().solve(d.u().col(0));  // amplitudes from the measured input
+  return InputGenerator(g.A(), c, g.x0());
 }
 
 }  // namespace ctid

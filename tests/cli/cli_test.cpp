@@ -404,7 +404,7 @@ TEST(Cli, ModalFitPolesAndResponses) {
   const std::string data = steps_csv(), json = test::temp_path("modal.json");
   fs::remove(json);
   // fit --method modal: Walsh functions on the constant-input windows, Theorem 4.1, numerator by LS (exact data).
-  CliRun r = ctid_run("fit " + data + " --ts " + ts320() + " --method modal --nf 3 --nb 2 --set shifts=16,32,48 --json " + json);
+  CliRun r = ctid_run("fit " + data + " --ts " + ts320() + " --method modal --nf 3 --nb 2 --set shift_samples=16,32,48 --json " + json);
   ASSERT_EQ(r.code, 0) << r.err;
   const LinearModel m = read_model_json(json);
   const auto& tf = std::get<TransferFunction>(m);
@@ -456,26 +456,32 @@ TEST(Cli, ModalFitPolesAndResponses) {
   zero << Eigen::VectorXd::LinSpaced(400, -1, 1).array().sign().matrix(), Eigen::VectorXd::Zero(400);
   const std::string z = test::temp_path("zero.csv");
   write_csv(z, {"u", "y"}, zero);
-  r = ctid_run("fit " + z + " --ts " + ts320() + " --method modal --nf 3 --set shifts=16,32,48 --set basis=discrete");
+  r = ctid_run("fit " + z + " --ts " + ts320() + " --method modal --nf 3 --set shift_samples=16,32,48 --set basis=discrete");
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("output 'y' is constant (0)"), std::string::npos) << r.err;
 }
 
 TEST(Cli, ModalBadInputs) {
   const std::string data = steps_csv();
+  // A window START,LENGTH given in samples of Ts, written in seconds (the setting's unit).
+  auto win = [](int start, int length) { return detail::format("{},{}", start * kTs320, length * kTs320); };
   const std::string base = "fit " + data + " --ts " + ts320() + " --method modal --nf 3 ";
   struct Case {
     std::string args, message;
   };
   const std::vector<Case> cases = {
-      {base + "--set shifts=16,32", "one shift per pole"},
-      {base + "--set shifts=32,16,48", "increasing"},
-      {base + "--set shifts=16.5,32,48", "whole number of samples"},
-      {base + "--set shift_times=0.1,0.2,0.3", "not a whole multiple of the sampling period"},
-      {base + "--set shifts=16,32,48 --set basis=walsh --set functions=6", "power of two"},
-      {base + "--set shifts=16,32,48 --set basis=fourier --set functions=2 --set window=60,19", "Fourier functions for"},
-      {base + "--set shifts=16,32,48 --set basis=discrete --set window=60,2", "equations"},
-      {base + "--set shifts=16,32,48 --set colour=red", "not a setting of modal"},
+      {base + "--set shift_samples=16,32", "one shift per pole"},
+      {base + "--set shift_samples=32,16,48", "increasing"},
+      {base + "--set shift_samples=16.5,32,48", "whole number of samples"},
+      {base + "--set shifts=0.1,0.2,0.3", "not a whole multiple of the sampling period"},
+      {base + "--set shifts=1e-3,2e-3,3e-3 --set shift_samples=1,2,3", "either shifts (seconds) or shift_samples"},
+      {base + "--set shift_samples=16,32,48 --set basis=walsh --set functions=6", "power of two"},
+      {base + "--set shift_samples=16,32,48 --set basis=fourier --set functions=2 --set windows=" + win(60, 19),
+       "Fourier functions for"},
+      {base + "--set shift_samples=16,32,48 --set basis=discrete --set windows=" + win(60, 2), "equations"},
+      {base + "--set shift_samples=16,32,48 --set windows=0.1", "windows are pairs START,LENGTH"},
+      {base + "--set shift_samples=16,32,48 --set colour=red", "not a setting of modal"},
+      {base + "--set shift_samples=16,32,48 --set iv=2", "not a setting of modal; did you mean 'iv_shift'?"},
       {"poles " + data + " --ts " + ts320() + " --output y --order 3", "shifts"},
       {"response " + data + " --ts " + ts320() + " --order 3 --kind step", "period"},
   };
@@ -650,7 +656,7 @@ TEST(Cli, ReportsOpenInABrowserWithEveryPlotDrawn) {
       {"miso", "fit " + miso + " --ts 0.02 --input u1 --input u2 --output y --method srivc --nb 2,1 --nf 2,1"},
       {"srivc", "fit " + dryer + base + "--method srivc --nb 2 --nf 2 --nk 2"},
       {"fsf", "fit " + dryer + base + "--method fsf --set T=4 --set n=21"},
-      {"modal", "fit " + dryer + base + "--method modal --nf 2 --nk 2 --set shifts=1,2 --set basis=discrete"},
+      {"modal", "fit " + dryer + base + "--method modal --nf 2 --nk 2 --set shift_samples=1,2 --set basis=discrete"},
       {"narx", "fit " + bl + " --ts 0.0025 --method narx --set ylag=6 --set ulag=6"},
       {"kia", "fit " + bl + " --ts 0.0025 --method kia --set ylag=6 --set ulag=6 --set quadratic=y^2,y*Dy"},
   };
@@ -860,7 +866,7 @@ TEST(Cli, TrustCampaign) {
       // Flags that do not apply.
       {"fit " + good_csv() + base + "--method srivc --reference force", 2, "--reference needs --closed-loop-controller"},
       {"fit " + good_csv() + base + "--method srivc --responses r", 2, "--responses writes FSF responses"},
-      {"fit " + good_csv() + base + "--method modal --nf 2 --set shifts=1,2 --delay", 2, "--delay (delay estimation) needs"},
+      {"fit " + good_csv() + base + "--method modal --nf 2 --set shift_samples=1,2 --delay", 2, "--delay (delay estimation) needs"},
       {"fit " + good_csv() + base + "--method srivc --narx " + narx, 2, "--narx gives KIA its NARX model"},
       {"fit " + good_csv() + base + "--method physical --via bogus", 2, "--via must be fsf, frequency or raw (got 'bogus')"},
       {"fit " + good_csv() + base + "--method narx --nf 2", 2, "--nf sets transfer-function orders"},
@@ -977,7 +983,7 @@ TEST(Cli, MethodHelpListsEveryRegisteredSettingAndSetAcceptsIt) {
       {"lssvf", {"lssvf"}}, {"ivsvf", {"ivsvf"}}, {"rls-svf", {"rls_svf"}},
       {"srivc", {"srivc", "srivc_miso", "srivc_closed_loop"}}, {"oe", {"oe", "tf_from_frequency"}},
       {"tfest", {"tfest", "tf_from_frequency"}}, {"fsf", {"fsf"}}, {"physical", {"physical"}},
-      {"narx", {"narx"}}, {"kia", {"kia", "narx"}}};
+      {"modal", {"modal"}}, {"narx", {"narx"}}, {"kia", {"kia", "narx"}}};
   std::set<std::string> covered;
   for (const auto& [cli, entries] : cli_methods) {
     const CliRun h = ctid_run("fit --method " + cli + " --help");

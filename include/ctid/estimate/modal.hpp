@@ -24,6 +24,7 @@
 #include "ctid/core/types.hpp"
 #include "ctid/data/frequency_data.hpp"
 #include "ctid/data/iddata.hpp"
+#include "ctid/estimate/options.hpp"
 #include "ctid/model/modal.hpp"
 #include "ctid/model/transfer_function.hpp"
 #include "ctid/signal/modal_filter.hpp"
@@ -50,18 +51,28 @@ enum class ModalBasis {
 
 struct ModalOptions {
   Eigen::VectorXd shifts;            ///< T_1 < ... < T_n (seconds, > 0, multiples of Ts); n = system order
-  ModalBasis basis = ModalBasis::Fourier;
+  /// none: automatic — Walsh for a piecewise-constant input in modal_fit (the thesis' choice for step inputs),
+  /// Fourier otherwise.
+  std::optional<ModalBasis> basis;
   int max_order = 0;                 ///< estimate p_j, q_j for j = 0..max_order (> 0 needs Fourier or Walsh)
   std::vector<ModalWindow> windows;  ///< empty: one window from T_n to the end of the record
   /// Fourier: 2m functions (even, >= 2) on the concatenation of the windows (local time runs on from one
   /// window to the next; j > 0 needs a single window). Walsh: N = 2^k functions (blocks) on each window.
-  int functions = 6;
+  /// 0: automatic (6 Fourier, 8 Walsh functions).
+  int functions = 0;
   Quadrature quadrature = Quadrature::Simpson;  ///< Fourier/Walsh integrals; Trapezoid reproduces the thesis
   int stride = 1;                    ///< Discrete: every stride-th sample of each window is an equation
   double iv_shift = 0.0;             ///< Discrete: > 0 uses instruments y(t - T_i + iv_shift) (ES 3.19-3.20)
+  /// modal_fit: input delay (s, >= 0, a whole multiple of Ts): the fit runs on the input delayed by it (zero
+  /// before the record) and the model carries it as its io_delay. modal_estimate refuses a delay.
+  double delay = 0.0;
   /// Throws InvalidOptions naming the field (shifts not increasing or not > 0, functions, stride, ...).
   void validate() const;
+  /// The automatic choices made: basis (Walsh when piecewise_constant, else Fourier) and functions (6 or 8).
+  ModalOptions resolved(bool piecewise_constant) const;
 };
+template <>
+const OptionTable<ModalOptions>& option_table<ModalOptions>();
 
 /// Modal parameters p_j and modal-function coefficients q_j (j = 0..max_order) from one record.
 /// input_basis: N x n_c samples of the input generator basis x_c(t) (InputGenerator::basis at the
@@ -96,6 +107,12 @@ Result<TransferFunction> modal_transfer_function(const IdData& data, const Input
 /// or when nb is outside [1, n], or the shifts are not uniform for the Discrete piecewise route.
 Result<TransferFunction> modal_fit(const IdData& data, int nb, ModalOptions options,
                                   const InputGenerator* input = nullptr);
+
+/// The generator of the given angular frequencies (rad/s; 0 = a constant level, w > 0 = a sinusoid pair) whose
+/// coefficients are fitted to the measured input of `data` by least squares — the input model of modal_fit for a
+/// recorded sum of sinusoids. Throws InvalidArgument for a negative or non-finite frequency, or data without one
+/// input.
+InputGenerator generator_fitted_to_input(const std::vector<double>& frequencies, const IdData& data);
 
 /// Characteristic polynomial det(sI - M) by Newton's identities with T_k = trace(M^k) (ES 4.50 with
 /// the index fix of SEEDS-SPEC ES-C9): a_{n-1} = -T_1, a_{n-k} = -(a_{n-k+1} T_1 + ... + a_{n-1} T_{k-1} + T_k)/k.

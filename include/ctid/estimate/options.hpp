@@ -217,6 +217,23 @@ class OptionTable {
                                                   options_detail::format_real((o.*m)(i)), u);
                });
   }
+  /// A member of another type written as a list of reals through two conversions (e.g. windows as pairs).
+  template <class To, class From>
+  OptionTable& reals_via(const char* name, const char* unit, OptionRange r, const char* doc, To to, From from) {
+    const std::string n = name, u = unit;
+    return add({n, OptionKind::Reals, u, r.text() + " each", doc, {}, {}},
+               [n, from](O& o, const std::string& method, const std::string& t) {
+                 from(o, method, options_detail::parse_reals(method, n, t));
+               },
+               [to](const O& o) { return options_detail::format_reals(to(o)); }, [to](const O& o) { return OptionValue(to(o)); },
+               [from](O& o, const std::string& method, const OptionValue& v) {
+                 from(o, method, std::get<std::vector<double>>(v));
+               },
+               [to, n, r, u](const O& o, const std::string& method) {
+                 for (double x : to(o))
+                   if (!r.contains(x)) options_detail::out_of_range(method, n, r.text(), options_detail::format_real(x), u);
+               });
+  }
   /// Values by name (e.g. fixed coefficients); CLI: NAME.KEY=V, one per key. Values must be finite.
   OptionTable& named_reals(const char* name, std::map<std::string, double> O::*m, const char* doc) {
     const std::string n = name;
