@@ -331,16 +331,11 @@ int run(const FitArgs& a) {
   if (a.frequency && !a.report.empty()) throw UsageError("--report needs time-domain data (not --frequency)");
   if (a.frequency) return run_frequency(a);
   const IdData d = a.data.load(true);
-  // A constant channel carries no information on the dynamics: refuse instead of returning a model of nothing.
-  auto constant = [](const Eigen::VectorXd& v) { return v.size() > 0 && v.maxCoeff() == v.minCoeff(); };
-  for (int i = 0; i < d.nu(); ++i)
-    if (constant(d.u().col(i)))
-      throw UsageError(detail::format("input '{}' is constant ({}) over the whole record: it excites nothing (a step "
-                                      "response needs samples before the step)", d.input_names()[i], d.u()(0, i)));
-  for (int i = 0; i < d.ny(); ++i)
-    if (constant(d.y().col(i)))
-      throw UsageError(detail::format("output '{}' is constant ({}) over the whole record: there is nothing to fit",
-                                      d.output_names()[i], d.y()(0, i)));
+  // A constant channel carries no information on the dynamics (the library's check, made before any other).
+  call_library([&] {
+    require_io_data(d, a.method.c_str(), -1, -1);
+    return 0;
+  });
   if (d.ny() != 1) throw UsageError(detail::format("{} estimates single-output models (selected {} outputs)", a.method, d.ny()));
   // Orders per input: one value for every input, or one per input.
   auto per_input = [&](const std::vector<int>& v, const char* flag, int i) {

@@ -196,4 +196,20 @@ IdData IdData::detrend(Detrend kind, TrendInfo* removed) const {
   return d;
 }
 
+void require_io_data(const IdData& d, const char* who, int nu, int ny) {
+  CTID_REQUIRE((nu < 0 || d.nu() == nu) && (ny < 0 || d.ny() == ny),
+               "{}: needs {} input(s) and {} output(s) (the data have {} and {}); select channels first", who,
+               nu < 0 ? std::string("any number of") : std::to_string(nu), ny < 0 ? std::string("any number of") : std::to_string(ny),
+               d.nu(), d.ny());
+  auto constant = [](const Eigen::VectorXd& v) { return v.size() > 0 && v.maxCoeff() == v.minCoeff(); };
+  for (int i = 0; i < d.nu(); ++i)
+    CTID_REQUIRE(!constant(d.u().col(i)),
+                 "{}: input '{}' is constant ({}) over the whole record: it excites nothing (a step response needs samples "
+                 "before the step)",
+                 who, d.input_names()[i], d.u()(0, i));
+  for (int i = 0; i < d.ny(); ++i)
+    CTID_REQUIRE(!constant(d.y().col(i)), "{}: output '{}' is constant ({}) over the whole record: there is nothing to fit",
+                 who, d.output_names()[i], d.y()(0, i));
+}
+
 }  // namespace ctid

@@ -270,8 +270,7 @@ Result<NarxModel> frols_signals(const Signals& sig, double Ts, const std::vector
 }
 
 void check_siso(const IdData& data, const char* who) {
-  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "{}: needs one input and one output (got {}, {})", who, data.nu(),
-               data.ny());
+  require_io_data(data, who);
   CTID_REQUIRE(data.is_uniform(), "{}: needs uniformly sampled data", who);
 }
 }  // namespace

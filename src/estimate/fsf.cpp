@@ -68,8 +68,7 @@ Result<FsfModel> fsf_result(const internal::LinearSolution& sol, double Ts, int 
 Result<FsfModel> fsf(const IdData& data, const FsfOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   o.validate();
-  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "fsf: needs one input and one output (data has {} inputs, {} outputs)",
-               data.nu(), data.ny());
+  require_io_data(data, "fsf");
   CTID_REQUIRE(data.is_uniform(), "fsf: needs uniformly sampled data");
   const double Ts = data.ts();
   const double Nd = o.T / Ts;

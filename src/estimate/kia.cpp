@@ -467,7 +467,7 @@ Result<NdeModel> kia_cubic(const NarxModel& narx, const NdeModel& model_in, cons
 }
 
 KiaRun kia(const IdData& d, const NarxModel& narx, const KiaOptions& o) {
-  CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "kia: needs one input and one output (the data have {} and {})", d.nu(), d.ny());
+  require_io_data(d, "kia");
   CTID_REQUIRE(std::abs(narx.ts() - d.ts()) <= 1e-9 * d.ts(),
                "kia: the NARX model was identified at Ts = {} s, the data have {} s", narx.ts(), d.ts());
   o.validate();

@@ -104,9 +104,7 @@ SvfLayout make_layout(const TfOrders& o, double tau, const std::map<std::string,
 
 PreparedData prepare(const IdData& data, const TfOrders& o, double transient_time, double alpha, SvfWeights weights,
                      const char* who) {
-  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1,
-               "{}: needs one input and one output (data has {} inputs, {} outputs); select channels first", who,
-               data.nu(), data.ny());
+  require_io_data(data, who);
   CTID_REQUIRE(o.nk == 0 || data.is_uniform(), "{}: nk = {} needs uniformly sampled data (these are irregular)", who, o.nk);
   CTID_REQUIRE(o.nk < data.size(), "{}: nk = {} is not shorter than the record ({} samples)", who, o.nk, data.size());
   PreparedData P;

@@ -368,8 +368,7 @@ Result<TransferFunction> modal_fit_undelayed(const IdData& data, int nb, ModalOp
 
 Result<TransferFunction> modal_fit(const IdData& data, int nb, ModalOptions o, const InputGenerator* input) {
   o.validate();
-  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "modal_fit: needs one input and one output (got {}, {})", data.nu(),
-               data.ny());
+  require_io_data(data, "modal_fit");
   if (o.delay == 0.0) return modal_fit_undelayed(data, nb, o.resolved(input == nullptr), input);
   CTID_REQUIRE(data.is_uniform(), "modal_fit: a delay needs uniformly sampled data");
   const double k = o.delay / data.ts();

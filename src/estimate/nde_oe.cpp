@@ -32,8 +32,7 @@ void NdeOeOptions::validate() const { option_table<NdeOeOptions>().check(*this);
 Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOeOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   opt.validate();
-  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "nde_oe: needs SISO data (got {} inputs, {} outputs)", data.nu(),
-               data.ny());
+  require_io_data(data, "nde_oe");
   const auto& terms = initial.terms();
   const int m = static_cast<int>(terms.size());
   // Order of the model (number of states) and the reference term.

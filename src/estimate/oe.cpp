@@ -167,8 +167,7 @@ TransferFunction starting_model(const TransferFunction& s, const IdData& data) {
 void check_common(const IdData& data, const TfOrders& o, const OeOptions& opt, const char* who) {
   o.validate(/*allow_biproper=*/true);
   opt.validate();
-  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "{}: needs one input and one output (data has {} inputs, {} outputs)", who,
-               data.nu(), data.ny());
+  require_io_data(data, who);
   CTID_REQUIRE(o.nk == 0 || data.is_uniform(), "{}: nk = {} needs uniformly sampled data", who, o.nk);
   CTID_REQUIRE(data.size() > o.nf + o.nb + 1, "{}: {} samples cannot determine {} parameters", who, data.size(), o.nf + o.nb);
   const double delay = opt.delay + (o.nk > 0 ? o.nk * data.ts() : 0.0);

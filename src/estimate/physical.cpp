@@ -225,8 +225,7 @@ Eigen::VectorXd windowed_zoh_response(const TransferFunction& g, const Eigen::Ve
 
 Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
                                           const IdData& data, double a, const PhysicalFitOptions& opt) {
-  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "physical: needs one input and one output (data has {} inputs, {} outputs)",
-               data.nu(), data.ny());
+  require_io_data(data, "physical");
   CTID_REQUIRE(std::isfinite(a) && a >= 0, "physical: the window a must be >= 0 (got {})", a);
   CTID_REQUIRE(a == 0.0 || (data.is_uniform() && data.intersample(0) == Intersample::Zoh),
                "physical: the windowed raw route (a > 0) needs uniformly sampled data with a held (ZOH) input");

@@ -208,7 +208,7 @@ void CoefficientTracker::update(double t, double u, double y) {
 }
 
 Result<TransferFunction> rls_svf(const IdData& d, const TfOrders& orders, const RlsSvfOptions& options) {
-  CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "rls_svf: needs one input and one output (got {} and {})", d.nu(), d.ny());
+  require_io_data(d, "rls_svf");
   CTID_REQUIRE(orders.nk == 0, "rls_svf: nk must be 0 (got {}; delay the input column instead)", orders.nk);
   const auto start = std::chrono::steady_clock::now();
   RlsSvfOptions o = options;

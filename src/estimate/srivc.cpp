@@ -236,8 +236,7 @@ namespace {
 // SISO SRIVC in the units of `data` (srivc() calls it on the normalised record).
 // The checks of srivc()'s inputs, in the user's units (messages name seconds).
 void check_srivc_inputs(const IdData& data, const TfOrders& orders, const SrivcOptions& options) {
-  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "srivc: needs one input and one output (data has {} inputs, {} outputs)",
-               data.nu(), data.ny());
+  require_io_data(data, "srivc");
   CTID_REQUIRE(orders.nk == 0 || data.is_uniform(), "srivc: nk = {} needs uniformly sampled data", orders.nk);
   const int p = orders.nf + orders.nb;
   CTID_REQUIRE(data.size() > p, "srivc: {} samples cannot determine {} parameters", data.size(), p);
@@ -544,7 +543,7 @@ TransferFunction time_scaled(const TransferFunction& g, double c, double gain) {
 
 Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& orders, const SrivcMisoOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
-  CTID_REQUIRE(data.ny() == 1, "srivc_miso: needs one output (data has {})", data.ny());
+  require_io_data(data, "srivc_miso", -1, 1);
   CTID_REQUIRE(data.nu() >= 1 && static_cast<int>(orders.size()) == data.nu(), "srivc_miso: {} inputs but {} sets of orders",
                data.nu(), orders.size());
   // As srivc: estimated in normalised units (time / c, each input by its RMS, y by its RMS), mapped back.
@@ -663,8 +662,7 @@ Result<TransferFunction> srivc_closed_loop_in_units(const IdData& data, const Ei
 Result<TransferFunction> srivc_closed_loop(const IdData& data, const Eigen::VectorXd& reference, const TfOrders& orders,
                                            const ClosedLoopOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
-  CTID_REQUIRE(data.nu() == 1 && data.ny() == 1, "srivc_closed_loop: needs one input and one output (data has {} inputs, {} outputs)",
-               data.nu(), data.ny());
+  require_io_data(data, "srivc_closed_loop");
   // As srivc: estimated in normalised units and mapped back. The controller maps y to u: C'(s') = (sy/su) C(s'/c);
   // the reference has the units of u (added at the plant input) or of y (a setpoint).
   const tf_detail::TfNormalisation n = tf_detail::TfNormalisation::of(data);

@@ -138,13 +138,26 @@ TEST(Lssvf, DiagnosticsWarnings) {
   EXPECT_LT(max_rel_error(lssvf(simulate(kG, 0.001, 30), {2, 2, 0}, o), kTruth), 1e-5);
 }
 
-TEST(Lssvf, UnexcitedDataIsRankDeficientNotAnException) {
+// A constant channel is refused before any computation (require_io_data, the check shared by every estimator and
+// the CLI); an input that varies but excites too few modes gives a rank-deficient, unusable result.
+TEST(Lssvf, UnexcitedDataIsRefusedOrRankDeficient) {
   const int N = 2000;
   IdData d(Eigen::VectorXd::Zero(N), Eigen::VectorXd::Zero(N), 0.01);
   LssvfOptions o;
   o.tau = 0.5;
-  const auto r = lssvf(d, {2, 2, 0}, o);
-  EXPECT_EQ(r.summary.termination, Termination::RankDeficient);
+  try {
+    lssvf(d, {2, 2, 0}, o);
+    FAIL();
+  } catch (const InvalidArgument& e) {
+    EXPECT_EQ(std::string(e.what()), "lssvf: input 'u1' is constant (0) over the whole record: it excites nothing (a "
+                                     "step response needs samples before the step)");
+  }
+  // u = one sinusoid excites one mode pair: a 4th-order model is not identifiable from it.
+  Eigen::VectorXd u(N);
+  for (int k = 0; k < N; ++k) u(k) = std::sin(0.5 * 0.01 * k);
+  const IdData s(u, u, 0.01);  // y = u: a pure gain seen through one sinusoid
+  const auto r = lssvf(s, {4, 4, 0}, o);
+  EXPECT_EQ(r.summary.termination, Termination::RankDeficient) << r.summary.message;
   EXPECT_FALSE(r.usable());
   EXPECT_FALSE(r.summary.message.empty());
 }
@@ -166,7 +179,7 @@ TEST(Lssvf, BadInputsThrowWithClearMessages) {
     EXPECT_NE(std::string(e.what()).find("c7"), std::string::npos);
   }
   o.fixed.clear();
-  const IdData tiny(Eigen::VectorXd::Ones(3), Eigen::VectorXd::Ones(3), 0.1);
+  const IdData tiny(Eigen::VectorXd{{1.0, 0.0, 1.0}}, Eigen::VectorXd{{0.0, 0.5, 0.2}}, 0.1);
   try {
     lssvf(tiny, {2, 2, 0}, o);
     FAIL();

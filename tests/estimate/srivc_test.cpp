@@ -212,7 +212,7 @@ TEST(Srivc, BadInputs) {
   o = {};
   o.delay = -1;
   EXPECT_THROW(srivc(d, {1, 1, 0}, o), InvalidOptions);
-  const IdData tiny(Eigen::VectorXd::Ones(5), Eigen::VectorXd::Ones(5), 0.1);
+  const IdData tiny(Eigen::VectorXd{{1.0, 0.0, 1.0, 1.0, 0.0}}, Eigen::VectorXd{{0.0, 0.5, 0.2, 0.7, 0.6}}, 0.1);
   EXPECT_THROW(srivc(tiny, {2, 4, 0}), InvalidArgument);  // more parameters than data
   EXPECT_THROW(crlb(kRao, 2, d, -1.0), InvalidArgument);
 }

@@ -94,4 +94,10 @@ class IdData {
   std::vector<std::string> input_names_, output_names_, input_units_, output_units_;
 };
 
+/// The checks every estimator makes on its record (one place, so that C++, Python and the CLI refuse alike):
+/// `nu` inputs and `ny` outputs (-1: any number), and no constant channel — a constant input excites nothing (a
+/// step response needs samples before the step) and a constant output leaves nothing to fit. Throws
+/// InvalidArgument naming `who`, the channel and its value.
+void require_io_data(const IdData& data, const char* who, int nu = 1, int ny = 1);
+
 }  // namespace ctid
