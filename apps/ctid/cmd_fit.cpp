@@ -15,6 +15,7 @@ namespace {
 
 struct FitArgs {
   DataArgs data;
+  std::vector<std::string> paths;  ///< DATA arguments: several are several experiments of one system (srivc)
   std::string method = "lssvf";
   std::vector<int> nb, nf{1}, nk{0};
   std::vector<std::string> sets;
@@ -322,11 +323,46 @@ int run_modal(const FitArgs& a, const IdData& d) {
   return finish(r, "modal", d, a, settings);
 }
 
+// Several DATA files: several experiments of one system, the same columns in each, fitted jointly (SRIVC).
+int run_experiments(const FitArgs& a) {
+  if (a.method != "srivc")
+    throw UsageError(detail::format("{} DATA files are several experiments: fitted jointly by --method srivc (got {}; the "
+                                    "other estimators take one record so far)",
+                                    a.paths.size(), a.method));
+  if (!a.controller.empty() || a.frequency) throw UsageError("several DATA files: open-loop time-domain data only");
+  std::vector<IdData> ds;
+  for (const auto& p : a.paths) {
+    DataArgs da = a.data;
+    da.path = p;
+    ds.push_back(da.load(true));
+  }
+  if (ds[0].nu() != 1 || ds[0].ny() != 1)
+    throw UsageError(detail::format("several experiments: one --input and one --output (selected {} and {})", ds[0].nu(),
+                                    ds[0].ny()));
+  SrivcOptions o;
+  o.estimate_delay = a.delay;
+  apply_sets("srivc", a.sets, o);
+  const Result<TransferFunction> r = call_library([&] {
+    const TfOrders orders = siso_orders(a);
+    orders.validate();
+    return srivc(ds, orders, o);
+  });
+  std::printf("experiments: %zu (", ds.size());
+  for (std::size_t e = 0; e < ds.size(); ++e)
+    std::printf("%s%s: %d samples", e ? ", " : "", a.paths[e].c_str(), ds[e].size());
+  std::printf(")\n");
+  // The report and the printed samples are those of the first record; the fit is over all of them.
+  return finish(r, "srivc", ds[0], a, settings_of(o));
+}
+
 int run(const FitArgs& a) {
   reject_flags_that_do_not_apply(a);
+  std::vector<std::string> inputs = a.paths;
+  inputs.insert(inputs.end(), {a.narx, a.controller});
   check_outputs({a.json, a.report, a.responses.empty() ? "" : a.responses + "_time.csv",
                  a.responses.empty() ? "" : a.responses + "_freq.csv"},
-                {a.data.path, a.narx, a.controller}, a.force);
+                inputs, a.force);
+  if (a.paths.size() > 1) return run_experiments(a);
   if (!a.controller.empty()) return run_closed_loop(a);
   if (a.frequency && !a.report.empty()) throw UsageError("--report needs time-domain data (not --frequency)");
   if (a.frequency) return run_frequency(a);
@@ -413,7 +449,10 @@ std::string fit_method_help(const CLI::App& fit) {
 
 void setup_fit(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
-  app.add_option("DATA", a->data.path, "CSV/.dat table (header row optional) or .mat file")->required();
+  app.add_option("DATA", a->paths,
+                 "CSV/.dat table (header row optional) or .mat file; several files are several experiments of one system, "
+                 "fitted jointly (--method srivc; the same columns in each)")
+      ->required();
   std::vector<std::string> names;
   for (const auto& [name, m] : fit_methods()) names.push_back(name);
   app.add_option("--method", a->method,
@@ -466,6 +505,7 @@ void setup_fit(CLI::App& app) {
     for (const CLI::Option* o : app.get_options())
       if (o->count() > 0)
         for (const auto& n : o->get_lnames()) a->given.insert(n);
+    a->data.path = a->paths.empty() ? "" : a->paths.front();
     g_run = [a] { return run(*a); };
   });
 }

@@ -212,7 +212,9 @@ def ivsvf(data, nb, nf, nk=0, **options):
 
 
 def srivc(data, nb, nf, nk=0, **options):
-    """Simplified refined instrumental variables for continuous-time models (options: SrivcOptions)."""
+    """Simplified refined instrumental variables for continuous-time models (options: SrivcOptions). data: an IdData,
+    or a list of IdData — several experiments of one system, fitted jointly (one parameter set; transient_time=
+    leaves out the start of each record when they do not start at rest)."""
     return _ctid.srivc(data, nb, nf, nk, _options(_ctid.SrivcOptions, "srivc", options))
 
 

@@ -257,3 +257,22 @@ def test_units_do_not_matter_and_useless_fits_say_why(plant):
     # A leading denominator coefficient that is zero up to rounding is refused (it simulated to ~1e-30).
     with pytest.raises(ctid.InvalidArgument, match="zero up to rounding"):
         ctid.TransferFunction([1.0], [1e-20, 1.0, 2.0])
+
+
+def test_srivc_on_several_experiments_is_one_joint_estimate():
+    # Issue 14 (item 2): a list of IdData is several experiments of one system, fitted jointly; noise-free records of
+    # G = 3/(s^2 + 1.2 s + 4) with different inputs give the true parameters (to 1e-6), one record alone the same,
+    # and the joint result is what C++ returns for the same list (bindings of srivc(std::vector<IdData>)).
+    g = ctid.TransferFunction([3.0], [1.0, 1.2, 4.0])
+    t = 0.02 * np.arange(600)
+    u1 = ctid.prbs(600, register_length=7, clock_period=5)
+    u2 = np.sin(1.1 * t) + 0.5 * np.sin(3.7 * t)
+    d1 = ctid.IdData.from_arrays(u1, g.simulate(u1, t), ts=0.02)
+    d2 = ctid.IdData.from_arrays(u2, g.simulate(u2, t), ts=0.02)
+    joint = ctid.srivc([d1, d2], 1, 2)
+    assert joint.usable()
+    np.testing.assert_allclose(joint.parameters.values, [1.2, 4.0, 3.0], rtol=1e-6)
+    assert joint.diagnostics.scalars["experiments"] == 2
+    assert joint.fit.n_samples == 1200
+    with pytest.raises(ctid.InvalidArgument, match=r"record 2\): input 'u1' is constant"):
+        ctid.srivc([d1, ctid.IdData.from_arrays(np.zeros(600), g.simulate(u1, t), ts=0.02)], 1, 2)

@@ -33,7 +33,9 @@ const OptionTable<SrivcOptions>& option_table<SrivcOptions>() {
           .real("delay_max", &O::delay_max, "s", or_special(at_least(0), -1, "10 % of the record"),
                 "upper end of the delay search")
           .integer("delay_grid", &O::delay_grid, "", or_special(between(1, O::kMaxDelayGrid), 0, "one per sample period, at most 200"),
-                   "grid points of the delay search");
+                   "grid points of the delay search")
+          .real("transient_time", &O::transient_time, "s", at_least(0),
+                "seconds at the start of each record left out of the IV equations and the fit (records not at rest)");
   return t;
 }
 
@@ -109,17 +111,18 @@ void set_termination(Result<M>& r, bool rank_deficient, bool converged, double t
 
 namespace srivc_detail {
 
-// One SRIVC instrumental-variable step for y = sum_i B_i/A u_i (common denominator):
-// prefilter 1/A (A stabilised), regressors from the measured y and inputs, instruments from
-// the auxiliary-model output sum_i B_i/A u_i. theta = [a (n), b_1 (nb_1), ..., b_K (nb_K)].
-SrivcRun iv_step(const Eigen::VectorXd& y, const Eigen::VectorXd& t, const std::vector<IvChannel>& ch, int n,
-                 const Eigen::VectorXd& theta, const ClosedLoopInstruments* cl = nullptr) {
-  int p = n;
-  for (const auto& c : ch) p += c.nb;
-  Eigen::VectorXd den(n + 1);
-  den(0) = 1.0;
-  den.tail(n) = theta.head(n);
-  const Polynomial A = stabilized(TransferFunction(Polynomial{1.0}, Polynomial(den))).den();
+// One record of an IV step (several records: several experiments, each filtered from rest).
+struct IvRecord {
+  const Eigen::VectorXd* y;
+  const Eigen::VectorXd* t;
+  const std::vector<IvChannel>* ch;
+  Eigen::Index first = 0;  // rows before it (the record's transient) are left out
+};
+
+// Adds one record's rows of an SRIVC instrumental-variable step to iv (see iv_step).
+void iv_accumulate(internal::InstrumentalVariables& iv, const Polynomial& A, const Eigen::VectorXd& y, const Eigen::VectorXd& t,
+                   const std::vector<IvChannel>& ch, int n, int p, const Eigen::VectorXd& theta,
+                   const ClosedLoopInstruments* cl, Eigen::Index first) {
   const TransferFunction F(Polynomial{1.0}, A);
   const Eigen::MatrixXd yf = filtered_derivatives(F, n, y, t, Intersample::Foh);
   Eigen::MatrixXd xf = Eigen::MatrixXd::Zero(t.size(), n);
@@ -143,9 +146,8 @@ SrivcRun iv_step(const Eigen::VectorXd& y, const Eigen::VectorXd& t, const std::
       xf += filtered_derivatives(TransferFunction(Polynomial(b), A * A), n - 1, c.u, t, c.intersample, c.delay);
     }
   }
-  internal::InstrumentalVariables iv(p, /*with_rss=*/false);
   std::vector<double> phi(p), zeta(p);
-  for (Eigen::Index k = 0; k < t.size(); ++k) {
+  for (Eigen::Index k = first; k < t.size(); ++k) {
     for (int i = 1; i <= n; ++i) {
       phi[i - 1] = -yf(k, n - i);
       zeta[i - 1] = -xf(k, n - i);
@@ -161,6 +163,22 @@ SrivcRun iv_step(const Eigen::VectorXd& y, const Eigen::VectorXd& t, const std::
     }
     iv.add(zeta.data(), phi.data(), yf(k, n), 1.0);
   }
+}
+
+// One SRIVC instrumental-variable step for y = sum_i B_i/A u_i (common denominator):
+// prefilter 1/A (A stabilised), regressors from the measured y and inputs, instruments from
+// the auxiliary-model output sum_i B_i/A u_i. theta = [a (n), b_1 (nb_1), ..., b_K (nb_K)]. The normal equations
+// are summed over the records (each record's filters start at rest).
+SrivcRun iv_step(const std::vector<IvRecord>& records, int n, const Eigen::VectorXd& theta,
+                 const ClosedLoopInstruments* cl = nullptr) {
+  int p = n;
+  for (const auto& c : *records.front().ch) p += c.nb;
+  Eigen::VectorXd den(n + 1);
+  den(0) = 1.0;
+  den.tail(n) = theta.head(n);
+  const Polynomial A = stabilized(TransferFunction(Polynomial{1.0}, Polynomial(den))).den();
+  internal::InstrumentalVariables iv(p, /*with_rss=*/false);
+  for (const auto& rec : records) iv_accumulate(iv, A, *rec.y, *rec.t, *rec.ch, n, p, theta, cl, rec.first);
   SrivcRun run;
   run.sol = iv.solve();
   run.zz = iv.zz();
@@ -170,18 +188,38 @@ SrivcRun iv_step(const Eigen::VectorXd& y, const Eigen::VectorXd& t, const std::
   return run;
 }
 
+SrivcRun iv_step(const Eigen::VectorXd& y, const Eigen::VectorXd& t, const std::vector<IvChannel>& ch, int n,
+                 const Eigen::VectorXd& theta, const ClosedLoopInstruments* cl = nullptr) {
+  return iv_step(std::vector<IvRecord>{{&y, &t, &ch}}, n, theta, cl);
+}
+
 }  // namespace srivc_detail
 
 using srivc_detail::IvChannel;
 
 namespace {
 
-// SRIVC iterations at a fixed total delay (SISO).
-SrivcRun srivc_fixed_delay(const IdData& d, const TfOrders& o, double delay, Eigen::VectorXd theta, const SrivcOptions& opt,
+using Records = std::vector<IdData>;  // one or several experiments of one system
+
+// The first sample at or after `transient` seconds from the record's start.
+Eigen::Index first_after(const IdData& d, double transient) {
+  Eigen::Index k = 0;
+  while (k < d.size() && d.time(static_cast<int>(k)) - d.t0() < transient * (1 - 1e-12)) ++k;
+  return k;
+}
+
+// SRIVC iterations at a fixed total delay (SISO), the IV equations summed over the records.
+SrivcRun srivc_fixed_delay(const Records& ds, const TfOrders& o, double delay, Eigen::VectorXd theta, const SrivcOptions& opt,
                            int max_iterations) {
-  const Eigen::VectorXd t = d.times();
-  const Eigen::VectorXd y = d.y().col(0);
-  const std::vector<IvChannel> ch{{d.u().col(0), d.intersample(0), delay, o.nb}};
+  std::vector<Eigen::VectorXd> ts, ys;
+  std::vector<std::vector<IvChannel>> chs;
+  for (const IdData& d : ds) {
+    ts.push_back(d.times());
+    ys.push_back(d.y().col(0));
+    chs.push_back({{d.u().col(0), d.intersample(0), delay, o.nb}});
+  }
+  std::vector<srivc_detail::IvRecord> recs;
+  for (std::size_t e = 0; e < ds.size(); ++e) recs.push_back({&ys[e], &ts[e], &chs[e], first_after(ds[e], opt.transient_time)});
   SrivcRun run;
   run.theta = theta;
   for (int it = 1; it <= max_iterations; ++it) {
@@ -189,7 +227,7 @@ SrivcRun srivc_fixed_delay(const IdData& d, const TfOrders& o, double delay, Eig
       run.interrupted = true;
       return run;
     }
-    SrivcRun step = srivc_detail::iv_step(y, t, ch, o.nf, run.theta);
+    SrivcRun step = srivc_detail::iv_step(recs, o.nf, run.theta);
     step.iterations = it;
     if (step.rank_deficient) {
       step.theta = run.theta;
@@ -205,13 +243,36 @@ SrivcRun srivc_fixed_delay(const IdData& d, const TfOrders& o, double delay, Eig
   return run;
 }
 
-Eigen::VectorXd initial_theta(const IdData& d, const TfOrders& o, double delay, const SrivcOptions& opt) {
+// The measured and simulated (from rest) outputs of all records after their transients, concatenated.
+std::pair<Eigen::VectorXd, Eigen::VectorXd> pooled_outputs(const TransferFunction& g, const Records& ds, double transient) {
+  Eigen::Index total = 0;
+  for (const IdData& d : ds) total += d.size() - first_after(d, transient);
+  Eigen::VectorXd y(total), sim(total);
+  Eigen::Index at = 0;
+  for (const IdData& d : ds) {
+    const Eigen::Index f = first_after(d, transient), m = d.size() - f;
+    y.segment(at, m) = d.y().col(0).tail(m);
+    sim.segment(at, m) = lsim(g, d, 0).tail(m);
+    at += m;
+  }
+  return {y, sim};
+}
+
+// The mean squared output error over all records after their transients (+Inf when a simulation diverges).
+double pooled_mse(const TransferFunction& g, const Records& ds, double transient) {
+  const auto [y, sim] = pooled_outputs(g, ds, transient);
+  if (!sim.allFinite()) return std::numeric_limits<double>::infinity();
+  return (y - sim).squaredNorm() / double(std::max<Eigen::Index>(1, y.size()));
+}
+
+Eigen::VectorXd initial_theta(const Records& ds, const TfOrders& o, double delay, const SrivcOptions& opt) {
   if (opt.initial) {
     CTID_REQUIRE_OPTION(opt.initial->order() == o.nf, "srivc: the initial model has order {} but nf = {}", opt.initial->order(),
                         o.nf);
     return params_of(*opt.initial, o);
   }
-  // LSSVF with an automatic filter on the delay-shifted input (nk = 0, strictly proper).
+  // LSSVF with an automatic filter on the delay-shifted input (nk = 0, strictly proper), on the longest record.
+  const IdData& d = *std::max_element(ds.begin(), ds.end(), [](const IdData& a, const IdData& b) { return a.size() < b.size(); });
   IdData shifted = d;
   if (delay > 0) {
     const Eigen::VectorXd ud = filtered_derivatives(TransferFunction(Polynomial{1.0}, Polynomial{1.0}), 0, d.u().col(0),
@@ -233,35 +294,52 @@ Eigen::VectorXd initial_theta(const IdData& d, const TfOrders& o, double delay, 
 }  // namespace
 
 namespace {
-// SISO SRIVC in the units of `data` (srivc() calls it on the normalised record).
-// The checks of srivc()'s inputs, in the user's units (messages name seconds).
-void check_srivc_inputs(const IdData& data, const TfOrders& orders, const SrivcOptions& options) {
-  require_io_data(data, "srivc");
-  CTID_REQUIRE(orders.nk == 0 || data.is_uniform(), "srivc: nk = {} needs uniformly sampled data", orders.nk);
-  const int p = orders.nf + orders.nb;
-  CTID_REQUIRE(data.size() > p, "srivc: {} samples cannot determine {} parameters", data.size(), p);
-  const double base_delay = options.delay + (orders.nk > 0 ? orders.nk * data.ts() : 0.0);
-  CTID_REQUIRE(base_delay < data.duration(), "srivc: the input delay {} s is not shorter than the record ({} s)",
-               base_delay, data.duration());
-  CTID_REQUIRE(!options.estimate_delay || options.delay_max < data.duration(),
-               "srivc: delay_max = {} s is not shorter than the record ({} s)", options.delay_max, data.duration());
-  CTID_REQUIRE(!options.estimate_delay || options.delay_min < data.duration(),
-               "srivc: delay_min = {} s is not shorter than the record ({} s)", options.delay_min, data.duration());
+// The checks of srivc()'s inputs, in the user's units (messages name seconds), for each record.
+void check_srivc_inputs(const Records& ds, const TfOrders& orders, const SrivcOptions& options) {
+  CTID_REQUIRE(!ds.empty(), "srivc: no records given");
+  for (std::size_t e = 0; e < ds.size(); ++e) {
+    const IdData& data = ds[e];
+    const std::string who = ds.size() == 1 ? "srivc" : detail::format("srivc (record {})", e + 1);
+    require_io_data(data, who.c_str());
+    CTID_REQUIRE(orders.nk == 0 || data.is_uniform(), "{}: nk = {} needs uniformly sampled data", who, orders.nk);
+    const int p = orders.nf + orders.nb;
+    CTID_REQUIRE(ds.size() > 1 || data.size() > p, "srivc: {} samples cannot determine {} parameters", data.size(), p);
+    const double base_delay = options.delay + (orders.nk > 0 ? orders.nk * data.ts() : 0.0);
+    CTID_REQUIRE(base_delay < data.duration(), "{}: the input delay {} s is not shorter than the record ({} s)", who,
+                 base_delay, data.duration());
+    CTID_REQUIRE(!options.estimate_delay || options.delay_max < data.duration(),
+                 "{}: delay_max = {} s is not shorter than the record ({} s)", who, options.delay_max, data.duration());
+    CTID_REQUIRE(options.transient_time < data.duration(), "{}: transient_time = {} s is not shorter than the record ({} s)",
+                 who, options.transient_time, data.duration());
+    CTID_REQUIRE(!options.estimate_delay || options.delay_min < data.duration(),
+                 "{}: delay_min = {} s is not shorter than the record ({} s)", who, options.delay_min, data.duration());
+    CTID_REQUIRE(e == 0 || (orders.nk == 0 || std::abs(data.ts() - ds[0].ts()) <= 1e-9 * ds[0].ts()),
+                 "{}: nk counts samples, so the records need one sampling period (record 1: {} s, this one: {} s)", who,
+                 ds[0].ts(), data.ts());
+  }
+  long long total = 0;
+  for (const IdData& d : ds) total += d.size();
+  CTID_REQUIRE(total > orders.nf + orders.nb, "srivc: {} samples cannot determine {} parameters", total,
+               orders.nf + orders.nb);
   CTID_REQUIRE_OPTION(!options.initial || options.initial->order() == orders.nf,
                       "srivc: the initial model has order {} but nf = {}", options.initial ? options.initial->order() : 0,
                       orders.nf);
 }
 
-Result<TransferFunction> srivc_in_units(const IdData& data, const TfOrders& orders, const SrivcOptions& options) {
+// SISO SRIVC in the units of the records (srivc() calls it on the normalised records).
+Result<TransferFunction> srivc_in_units(const Records& ds, const TfOrders& orders, const SrivcOptions& options) {
   const auto start = std::chrono::steady_clock::now();
+  const IdData& data = ds.front();
   const int p = orders.nf + orders.nb;
   const double base_delay = options.delay + (orders.nk > 0 ? orders.nk * data.ts() : 0.0);
+  double shortest = data.duration();
+  for (const IdData& d : ds) shortest = std::min(shortest, d.duration());
 
   double delay = base_delay;
   Eigen::VectorXd theta;
   Eigen::VectorXd grid, grid_cost;
   if (options.estimate_delay) {
-    const double dmax = options.delay_max >= 0 ? options.delay_max : 0.1 * data.duration();
+    const double dmax = options.delay_max >= 0 ? options.delay_max : 0.1 * shortest;
     const double h = data.is_uniform() ? data.ts() : data.duration() / std::max(1, data.size() - 1);
     int G = options.delay_grid > 0 ? options.delay_grid
                                    : static_cast<int>(std::min(200.0, std::floor((dmax - options.delay_min) / h) + 1));
@@ -280,10 +358,10 @@ Result<TransferFunction> srivc_in_units(const IdData& data, const TfOrders& orde
       grid(i) = dl;
       // The first grid point starts from the user's model or LSSVF; the others from their
       // neighbour's estimate (the dynamics change little between neighbouring delays).
-      const Eigen::VectorXd th0 = i == 0 ? initial_theta(data, orders, dl, options) : warm;
-      const SrivcRun r = srivc_fixed_delay(data, orders, dl, th0, options, 3);
+      const Eigen::VectorXd th0 = i == 0 ? initial_theta(ds, orders, dl, options) : warm;
+      const SrivcRun r = srivc_fixed_delay(ds, orders, dl, th0, options, 3);
       warm = r.rank_deficient || !r.theta.allFinite() ? th0 : r.theta;
-      grid_cost(i) = r.rank_deficient ? INFINITY : output_error_mse(tf_of(r.theta, orders, dl), data);
+      grid_cost(i) = r.rank_deficient ? INFINITY : pooled_mse(tf_of(r.theta, orders, dl), ds, options.transient_time);
       if (grid_cost(i) < best) {
         best = grid_cost(i);
         delay = dl;
@@ -294,10 +372,10 @@ Result<TransferFunction> srivc_in_units(const IdData& data, const TfOrders& orde
     // output-error cost over one grid step on either side.
     const double step = (dmax - options.delay_min) / double(G - 1);
     double lo = std::max(options.delay_min, delay - step), hi = std::min(dmax, delay + step);
-    if (theta.size() == 0) theta = initial_theta(data, orders, delay, options);  // interrupted before the first point
+    if (theta.size() == 0) theta = initial_theta(ds, orders, delay, options);  // interrupted before the first point
     for (int outer = 0; outer < 40 && !interrupt_requested(); ++outer) {
-      theta = srivc_fixed_delay(data, orders, delay, theta, options, options.max_iterations).theta;
-      auto cost = [&](double dl) { return output_error_mse(tf_of(theta, orders, dl), data); };
+      theta = srivc_fixed_delay(ds, orders, delay, theta, options, options.max_iterations).theta;
+      auto cost = [&](double dl) { return pooled_mse(tf_of(theta, orders, dl), ds, options.transient_time); };
       const double gr = 0.5 * (std::sqrt(5.0) - 1.0);
       double a = lo, b = hi, c = b - gr * (b - a), e = a + gr * (b - a), fc = cost(c), fe = cost(e);
       while (b - a > 1e-6 * std::max(h, 1e-12)) {
@@ -315,18 +393,21 @@ Result<TransferFunction> srivc_in_units(const IdData& data, const TfOrders& orde
       if (done) break;
     }
   } else {
-    theta = initial_theta(data, orders, delay, options);
+    theta = initial_theta(ds, orders, delay, options);
   }
 
-  const SrivcRun run = srivc_fixed_delay(data, orders, delay, theta, options, options.max_iterations);
+  const SrivcRun run = srivc_fixed_delay(ds, orders, delay, theta, options, options.max_iterations);
   Result<TransferFunction> r;
   r.model = tf_of(run.theta, orders, delay);
   r.parameters.names = tf_parameter_names(orders);
   r.parameters.values = run.theta;
   r.parameters.fixed.assign(p, false);
-  r.fit = fit_report_or_inf(data.y().col(0), lsim(r.model, data, 0), p + (options.estimate_delay ? 1 : 0));
+  // The simulation fit over all records (each from rest, after its transient), as one concatenated output.
+  const auto [y_all, sim_all] = pooled_outputs(r.model, ds, options.transient_time);
+  const Eigen::Index total = y_all.size();
+  r.fit = fit_report_or_inf(y_all, sim_all, p + (options.estimate_delay ? 1 : 0));
   // Covariance sigma^2 (sum zeta zeta^T)^{-1}, sigma^2 from the output error.
-  const double sigma2 = r.fit.mse * data.size() / std::max(1, data.size() - p);
+  const double sigma2 = r.fit.mse * double(total) / double(std::max<Eigen::Index>(1, total - p));
   if (!run.rank_deficient && std::isfinite(sigma2) && run.zz.rows() == p) {  // no zz when interrupted before a step
     r.parameters.covariance = sigma2 * run.zz.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
     r.parameters.std = r.parameters.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
@@ -337,6 +418,7 @@ Result<TransferFunction> srivc_in_units(const IdData& data, const TfOrders& orde
   r.diagnostics.condition_number = run.sol.condition;
   r.diagnostics.scalars["delay"] = delay;
   r.diagnostics.scalars["noise_variance"] = sigma2;
+  if (ds.size() > 1) r.diagnostics.scalars["experiments"] = static_cast<double>(ds.size());
   if (grid.size() > 0) {
     r.diagnostics.vectors["delay_grid"] = grid;
     r.diagnostics.vectors["delay_grid_mse"] = grid_cost;
@@ -355,24 +437,31 @@ Result<TransferFunction> srivc_in_units(const IdData& data, const TfOrders& orde
 }
 }  // namespace
 
-Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const SrivcOptions& options) {
+Result<TransferFunction> srivc(const std::vector<IdData>& data, const TfOrders& orders, const SrivcOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   orders.validate(/*allow_biproper=*/true);
   options.validate();
   check_srivc_inputs(data, orders, options);
   // The estimation runs in normalised time and amplitude units, so that its result does not depend on the
-  // units of the record (issue 13); the result is mapped back.
+  // units of the records (issue 13); the result is mapped back. One normalisation for all records.
   const tf_detail::TfNormalisation n = tf_detail::TfNormalisation::of(data);
   SrivcOptions o = options;
   if (o.initial) o.initial = n.to_normalised(*o.initial, orders);
   o.delay /= n.c;
   o.delay_min /= n.c;
   if (o.delay_max >= 0) o.delay_max /= n.c;
-  Result<TransferFunction> r = srivc_in_units(n.data(data), orders, o);
+  o.transient_time /= n.c;
+  Records normalised;
+  for (const IdData& d : data) normalised.push_back(n.data(d));
+  Result<TransferFunction> r = srivc_in_units(normalised, orders, o);
   n.restore(r, orders);
-  tf_detail::finish_tf_result(r, data);
+  tf_detail::finish_tf_result(r, data.front());
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
+}
+
+Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const SrivcOptions& options) {
+  return srivc(std::vector<IdData>{data}, orders, options);
 }
 
 template <>

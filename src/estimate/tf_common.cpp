@@ -71,24 +71,45 @@ bool warn_poles_beyond_bandwidth(Result<TransferFunction>& r, const IdData& d) {
   return false;
 }
 
-TfNormalisation TfNormalisation::of(const IdData& d) {
+namespace {
+// Pooled over the records: RMS of u and y over all samples; w_c from the mean squared derivative of y over every
+// record's intervals and the RMS of y about its pooled mean.
+TfNormalisation normalisation_of(const std::vector<const IdData*>& ds) {
   TfNormalisation n;
-  auto rms = [](const Eigen::VectorXd& v) { return std::sqrt(v.squaredNorm() / std::max<Eigen::Index>(1, v.size())); };
-  const Eigen::VectorXd y = d.y().col(0), u = d.u().col(0);
-  const double ru = rms(u), ry = rms(y);
+  double u2 = 0, y2 = 0, ysum = 0, dy2 = 0;
+  long long N = 0, intervals = 0;
+  for (const IdData* d : ds) {
+    const Eigen::VectorXd y = d->y().col(0), u = d->u().col(0);
+    u2 += u.squaredNorm();
+    y2 += y.squaredNorm();
+    ysum += y.sum();
+    N += y.size();
+    for (Eigen::Index k = 1; k < y.size(); ++k) {
+      const double dv = (y(k) - y(k - 1)) / (d->time(static_cast<int>(k)) - d->time(static_cast<int>(k - 1)));
+      dy2 += dv * dv;
+      ++intervals;
+    }
+  }
+  const double ru = std::sqrt(u2 / double(std::max<long long>(1, N))), ry = std::sqrt(y2 / double(std::max<long long>(1, N)));
   if (ru > 0 && std::isfinite(ru)) n.su = ru;
   if (ry > 0 && std::isfinite(ry)) n.sy = ry;
-  const Eigen::Index N = y.size();
-  if (N >= 3) {
-    double dy2 = 0;
-    for (Eigen::Index k = 1; k < N; ++k) {
-      const double dv = (y(k) - y(k - 1)) / (d.time(static_cast<int>(k)) - d.time(static_cast<int>(k - 1)));
-      dy2 += dv * dv;
-    }
-    const double wc = std::sqrt(dy2 / double(N - 1)) / rms((y.array() - y.mean()).matrix());
+  if (N >= 3 && intervals > 0) {
+    const double mean = ysum / double(N);
+    double c2 = 0;
+    for (const IdData* d : ds) c2 += (d->y().col(0).array() - mean).matrix().squaredNorm();
+    const double wc = std::sqrt(dy2 / double(intervals)) / std::sqrt(c2 / double(N));
     if (wc > 0 && std::isfinite(wc)) n.c = 1.0 / wc;
   }
   return n;
+}
+}  // namespace
+
+TfNormalisation TfNormalisation::of(const IdData& d) { return normalisation_of({&d}); }
+
+TfNormalisation TfNormalisation::of(const std::vector<IdData>& ds) {
+  std::vector<const IdData*> p;
+  for (const IdData& d : ds) p.push_back(&d);
+  return normalisation_of(p);
 }
 
 IdData TfNormalisation::data(const IdData& d) const { return data(d, Eigen::RowVectorXd::Constant(d.nu(), su)); }

@@ -39,6 +39,8 @@ bool warn_poles_beyond_bandwidth(Result<TransferFunction>& r, const IdData& d);
 struct TfNormalisation {
   double c = 1.0, su = 1.0, sy = 1.0;
   static TfNormalisation of(const IdData& d);
+  /// Pooled over several records of one system (one set of units for all).
+  static TfNormalisation of(const std::vector<IdData>& ds);
   /// The normalised record (times / c, u / su, y / sy; names and intersample kept).
   IdData data(const IdData& d) const;
   /// The same with input i divided by input_scales(i) instead of su (MISO: each input by its own RMS).

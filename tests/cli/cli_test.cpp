@@ -1040,3 +1040,42 @@ TEST(Cli, MethodHelpListsEveryRegisteredSettingAndSetAcceptsIt) {
     }
   }
 }
+
+// Issue 14 (item 2): several DATA files are several experiments of one system, fitted jointly by SRIVC: the CLI's
+// estimate is the library's srivc(std::vector<IdData>) (to 1e-9), other methods refuse several files by name.
+TEST(Cli, SeveralDataFilesAreFittedJointly) {
+  const TransferFunction g(Eigen::VectorXd{{3.0}}, Eigen::VectorXd{{1.0, 1.2, 4.0}});
+  const int N = 600;
+  const Eigen::VectorXd t = time_grid(0.02, N);
+  const Eigen::VectorXd u1 = prbs(N, {.register_length = 7, .clock_period = 5});
+  Eigen::VectorXd u2(N);
+  for (int k = 0; k < N; ++k) u2(k) = std::sin(1.1 * t(k)) + 0.5 * std::sin(3.7 * t(k));
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.02);
+  std::vector<IdData> ds;
+  std::vector<std::string> files;
+  for (const Eigen::VectorXd* u : std::vector<const Eigen::VectorXd*>{&u1, &u2}) {
+    Eigen::VectorXd y = lsim(g, *u, t);
+    for (int k = 0; k < N; ++k) y(k) += noise(rng);
+    Eigen::MatrixXd m(N, 3);
+    m << t, *u, y;
+    files.push_back(test::temp_path("exp" + std::to_string(files.size() + 1) + ".csv"));
+    write_csv(files.back(), {"time", "force", "position"}, m);
+    ds.emplace_back(*u, y, 0.02);
+  }
+  const std::string json = test::temp_path("joint.json");
+  const CliRun r = ctid_run("fit " + files[0] + " " + files[1] +
+                            " --time time --input force --output position --method srivc --nf 2 --nb 1 --json " + json);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("experiments: 2"), std::string::npos) << r.out;
+  const Result<TransferFunction> lib = srivc(ds, {1, 2, 0});
+  const auto j = nlohmann::json::parse(std::ifstream(json));
+  const auto& ps = j.at("parameters");
+  ASSERT_EQ(ps.size(), 3u);
+  for (int i = 0; i < 3; ++i)
+    EXPECT_NEAR(ps.at(i).at("value").get<double>(), lib.parameters.values(i), 1e-9 * std::abs(lib.parameters.values(i)));
+  const CliRun o = ctid_run("fit " + files[0] + " " + files[1] + " --time time --input force --output position --method oe --nf 2");
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("2 DATA files are several experiments: fitted jointly by --method srivc (got oe"), std::string::npos)
+      << o.err;
+}

@@ -39,6 +39,10 @@ struct SrivcOptions {
   double delay_max = -1.0;       ///< s; < 0: 10 % of the record
   int delay_grid = 0;            ///< grid points in [0, kMaxDelayGrid]; 0: one per sample period (at most 200)
   static constexpr int kMaxDelayGrid = 10000;
+  /// Seconds at the start of each record left out of the IV equations and of the fit: a record that does not
+  /// start at rest (or several experiments, each with its own initial state) has a transient the filters, started
+  /// at rest, do not model.
+  double transient_time = 0.0;
   void validate() const;
 };
 /// The settings of SrivcOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
@@ -50,6 +54,15 @@ const OptionTable<SrivcOptions>& option_table<SrivcOptions>();
 /// srivc_closed_loop it estimates in normalised time and amplitude units and maps the result
 /// back, so the estimate does not depend on the units of the record (docs/guide.md).
 Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const SrivcOptions& options = {});
+
+/// SRIVC on several experiments of one system (issue 14, item 2): one parameter set; each record is filtered and
+/// simulated from rest (its own initial conditions and transient), and the instrumental-variable normal equations
+/// are summed over the records (Young's SRIVC with the sums of (Garnier & Wang 2008, ch. 4) taken over
+/// experiments). The records may differ in length, input and sampling (nk needs one sampling period); units must
+/// agree. fit: the simulation fit over all records; covariance sigma^2 (sum zeta zeta^T)^{-1} with sigma^2 from
+/// the pooled output error; diagnostics.scalars "experiments". Warnings about the poles use the first record's
+/// bandwidth. Throws as srivc, naming the record.
+Result<TransferFunction> srivc(const std::vector<IdData>& data, const TfOrders& orders, const SrivcOptions& options = {});
 
 struct SrivcMisoOptions {
   int max_iterations = 100;   ///< sweeps over all channels (>= 1)
