@@ -323,11 +323,30 @@ int run_modal(const FitArgs& a, const IdData& d) {
   return finish(r, "modal", d, a, settings);
 }
 
-// Several DATA files: several experiments of one system, the same columns in each, fitted jointly (SRIVC).
+// Several DATA files: several experiments of one system, the same columns in each, fitted jointly.
+template <class O>
+int fit_experiments(const FitArgs& a, const std::vector<IdData>& ds,
+                    Result<TransferFunction> (*estimator)(const std::vector<IdData>&, const TfOrders&, const O&)) {
+  O o;
+  o.estimate_delay = a.delay;
+  apply_sets(a.method, a.sets, o);
+  const Result<TransferFunction> r = call_library([&] {
+    const TfOrders orders = siso_orders(a);
+    orders.validate();
+    return estimator(ds, orders, o);
+  });
+  std::printf("experiments: %zu (", ds.size());
+  for (std::size_t e = 0; e < ds.size(); ++e)
+    std::printf("%s%s: %d samples", e ? ", " : "", a.paths[e].c_str(), ds[e].size());
+  std::printf(")\n");
+  // The report and the printed samples are those of the first record; the fit is over all of them.
+  return finish(r, a.method, ds[0], a, settings_of(o));
+}
+
 int run_experiments(const FitArgs& a) {
-  if (a.method != "srivc")
-    throw UsageError(detail::format("{} DATA files are several experiments: fitted jointly by --method srivc (got {}; the "
-                                    "other estimators take one record so far)",
+  if (a.method != "srivc" && a.method != "oe" && a.method != "tfest")
+    throw UsageError(detail::format("{} DATA files are several experiments: fitted jointly by --method srivc, oe or tfest "
+                                    "(got {}; the other estimators take one record so far)",
                                     a.paths.size(), a.method));
   if (!a.controller.empty() || a.frequency) throw UsageError("several DATA files: open-loop time-domain data only");
   std::vector<IdData> ds;
@@ -339,20 +358,9 @@ int run_experiments(const FitArgs& a) {
   if (ds[0].nu() != 1 || ds[0].ny() != 1)
     throw UsageError(detail::format("several experiments: one --input and one --output (selected {} and {})", ds[0].nu(),
                                     ds[0].ny()));
-  SrivcOptions o;
-  o.estimate_delay = a.delay;
-  apply_sets("srivc", a.sets, o);
-  const Result<TransferFunction> r = call_library([&] {
-    const TfOrders orders = siso_orders(a);
-    orders.validate();
-    return srivc(ds, orders, o);
-  });
-  std::printf("experiments: %zu (", ds.size());
-  for (std::size_t e = 0; e < ds.size(); ++e)
-    std::printf("%s%s: %d samples", e ? ", " : "", a.paths[e].c_str(), ds[e].size());
-  std::printf(")\n");
-  // The report and the printed samples are those of the first record; the fit is over all of them.
-  return finish(r, "srivc", ds[0], a, settings_of(o));
+  if (a.method == "srivc") return fit_experiments<SrivcOptions>(a, ds, &srivc);
+  using Joint = Result<TransferFunction> (*)(const std::vector<IdData>&, const TfOrders&, const OeOptions&);
+  return fit_experiments<OeOptions>(a, ds, a.method == "oe" ? static_cast<Joint>(&oe) : static_cast<Joint>(&tfest));
 }
 
 int run(const FitArgs& a) {

@@ -219,12 +219,14 @@ def srivc(data, nb, nf, nk=0, **options):
 
 
 def oe(data, nb, nf, nk=0, **options):
-    """Continuous-time output error by Levenberg-Marquardt (options: OeOptions)."""
+    """Continuous-time output error by Levenberg-Marquardt (options: OeOptions). data: an IdData or a list of IdData
+    (several experiments of one system, fitted jointly)."""
     return _ctid.oe(data, nb, nf, nk, _options(_ctid.OeOptions, "oe", options))
 
 
 def tfest(data, nb, nf, nk=0, **options):
-    """SRIVC start, then output-error refinement (options: OeOptions)."""
+    """SRIVC start, then output-error refinement (options: OeOptions). data: an IdData or a list of IdData (several
+    experiments of one system, fitted jointly)."""
     return _ctid.tfest(data, nb, nf, nk, _options(_ctid.OeOptions, "tfest", options))
 
 

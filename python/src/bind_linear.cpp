@@ -18,6 +18,19 @@ void def_tf_estimator(py::module_& m, const char* name, Estimator<Options> f, co
       },
       py::arg("data"), py::arg("nb"), py::arg("nf"), py::arg("nk") = 0, py::arg("options") = Options{}, doc);
 }
+template <class Options>
+using ExperimentsEstimator = Result<TransferFunction> (*)(const std::vector<IdData>&, const TfOrders&, const Options&);
+
+template <class Options>
+void def_experiments_estimator(py::module_& m, const char* name, ExperimentsEstimator<Options> f) {
+  m.def(
+      name,
+      [f](const std::vector<IdData>& d, int nb, int nf, int nk, const Options& o) {
+        return interruptible([&] { return f(d, TfOrders{nb, nf, nk}, o); });
+      },
+      py::arg("data"), py::arg("nb"), py::arg("nf"), py::arg("nk") = 0, py::arg("options") = Options{},
+      "The same on several experiments (a list of IdData) of one system: one parameter set.");
+}
 }  // namespace
 
 void bind_linear(py::module_& m) {
@@ -75,13 +88,10 @@ void bind_linear(py::module_& m) {
   def_tf_estimator<LssvfOptions>(m, "lssvf", &lssvf, "Johansson (1986) least squares on state-variable-filtered signals.");
   def_tf_estimator<IvsvfOptions>(m, "ivsvf", &ivsvf, "Johansson's regression with instrumental variables.");
   def_tf_estimator<SrivcOptions>(m, "srivc", &srivc, "Simplified refined instrumental variables (SISO).");
-  m.def(
-      "srivc",
-      [](const std::vector<IdData>& d, int nb, int nf, int nk, const SrivcOptions& o) {
-        return interruptible([&] { return srivc(d, TfOrders{nb, nf, nk}, o); });
-      },
-      py::arg("data"), py::arg("nb"), py::arg("nf"), py::arg("nk") = 0, py::arg("options") = SrivcOptions{},
-      "SRIVC on several experiments (a list of IdData) of one system: one parameter set.");
+  // Several experiments (a list of IdData) of one system: one parameter set.
+  def_experiments_estimator<SrivcOptions>(m, "srivc", &srivc);
+  def_experiments_estimator<OeOptions>(m, "oe", &oe);
+  def_experiments_estimator<OeOptions>(m, "tfest", &tfest);
   def_tf_estimator<OeOptions>(m, "oe", &oe, "Continuous-time output error (Levenberg-Marquardt).");
   def_tf_estimator<OeOptions>(m, "tfest", &tfest, "SRIVC start, then output-error refinement.");
   def_tf_estimator<RlsSvfOptions>(m, "rls_svf", &rls_svf,

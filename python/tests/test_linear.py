@@ -274,5 +274,9 @@ def test_srivc_on_several_experiments_is_one_joint_estimate():
     np.testing.assert_allclose(joint.parameters.values, [1.2, 4.0, 3.0], rtol=1e-6)
     assert joint.diagnostics.scalars["experiments"] == 2
     assert joint.fit.n_samples == 1200
+    for method in (ctid.oe, ctid.tfest):  # output error on the summed cost: the same exact answer
+        r = method([d1, d2], 1, 2)
+        np.testing.assert_allclose(r.parameters.values, [1.2, 4.0, 3.0], rtol=1e-6)
+        assert r.diagnostics.scalars["experiments"] == 2
     with pytest.raises(ctid.InvalidArgument, match=r"record 2\): input 'u1' is constant"):
         ctid.srivc([d1, ctid.IdData.from_arrays(np.zeros(600), g.simulate(u1, t), ts=0.02)], 1, 2)

@@ -29,6 +29,8 @@ const OptionTable<OeOptions>& option_table<OeOptions>() {
           .named_bounds("bounds", &O::bounds, "parameter bounds by name (bounds.a1=0,inf); the delay is always >= 0")
           .flag("estimate_delay", &O::estimate_delay, "add the input delay (s) as a parameter named delay")
           .real("delay", &O::delay, "s", at_least(0), "initial or fixed input delay, added to nk Ts")
+          .real("transient_time", &O::transient_time, "s", at_least(0),
+                "seconds at the start of each record left out of the cost (records not at rest)")
           .include(&O::srivc, option_table<SrivcOptions>(), {"delay_min", "delay_max", "delay_grid"})
           .include(&O::srivc, option_table<SrivcOptions>(), {"max_iterations", "tolerance"},
                    {{"max_iterations", "start_max_iterations"}, {"tolerance", "start_tolerance"}});
@@ -42,7 +44,43 @@ void OeOptions::validate() const {
 
 namespace {
 
-Result<TransferFunction> refine(const IdData& data, const TfOrders& o, const TransferFunction& start, const OeOptions& opt,
+using Records = std::vector<IdData>;  // one or several experiments of one system
+
+// The first sample at or after `transient` seconds from the record's start.
+Eigen::Index first_after(const IdData& d, double transient) {
+  Eigen::Index k = 0;
+  while (k < d.size() && d.time(static_cast<int>(k)) - d.t0() < transient * (1 - 1e-12)) ++k;
+  return k;
+}
+
+double shortest_duration(const Records& ds) {
+  double s = ds.front().duration();
+  for (const IdData& d : ds) s = std::min(s, d.duration());
+  return s;
+}
+
+// The output-error residuals y - G u of every record after its transient (each simulated from rest), stacked, and
+// (J != nullptr) their sensitivities to the parameters.
+bool stacked_residuals(const TransferFunction& g, const Records& ds, double transient, int nb, bool with_delay,
+                       Eigen::VectorXd& r, Eigen::MatrixXd* S) {
+  Eigen::Index total = 0;
+  for (const IdData& d : ds) total += d.size() - first_after(d, transient);
+  r.resize(total);
+  Eigen::Index at = 0;
+  for (const IdData& d : ds) {
+    const Eigen::Index f = first_after(d, transient), m = d.size() - f;
+    r.segment(at, m) = (d.y().col(0) - lsim(g, d, 0)).tail(m);
+    if (S) {
+      const Eigen::MatrixXd s = output_sensitivities(g, nb, d, with_delay);
+      if (S->rows() != total) S->resize(total, s.cols());
+      S->middleRows(at, m) = s.bottomRows(m);
+    }
+    at += m;
+  }
+  return r.allFinite();
+}
+
+Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const TransferFunction& start, const OeOptions& opt,
                                 std::chrono::steady_clock::time_point t0) {
   std::vector<std::string> names = tf_parameter_names(o);
   if (opt.estimate_delay) names.push_back("delay");
@@ -72,7 +110,7 @@ Result<TransferFunction> refine(const IdData& data, const TfOrders& o, const Tra
   const int p = static_cast<int>(free.size());
   Eigen::VectorXd lo = Eigen::VectorXd::Constant(p, -INFINITY), hi = Eigen::VectorXd::Constant(p, INFINITY), x0(p);
   // The delay stays in the range the delay search used (delay_min, delay_max; default 10 % of the record).
-  const double delay_hi = opt.srivc.delay_max >= 0 ? opt.srivc.delay_max : 0.1 * data.duration();
+  const double delay_hi = opt.srivc.delay_max >= 0 ? opt.srivc.delay_max : 0.1 * shortest_duration(ds);
   for (int j = 0; j < p; ++j) {
     x0(j) = full(free[j]);
     if (names[free[j]] == "delay") {
@@ -91,7 +129,6 @@ Result<TransferFunction> refine(const IdData& data, const TfOrders& o, const Tra
     for (const auto& nm : names) found = found || nm == k;
     CTID_REQUIRE_OPTION(found, "oe: bounds given for '{}', which is not a parameter", k);
   }
-  const Eigen::VectorXd y = data.y().col(0);
   auto model_of = [&](const Eigen::VectorXd& x) {
     Eigen::VectorXd f = full;
     for (int j = 0; j < p; ++j) f(free[j]) = x(j);
@@ -102,11 +139,10 @@ Result<TransferFunction> refine(const IdData& data, const TfOrders& o, const Tra
   // loop) are simulated exactly like any other; a step whose simulation overflows is rejected by LM.
   auto evaluate = [&](const Eigen::VectorXd& x, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
     const TransferFunction g = model_of(x);
-    r = y - lsim(g, data, 0);
-    if (!r.allFinite()) return false;
+    Eigen::MatrixXd S;
+    if (!stacked_residuals(g, ds, opt.transient_time, o.nb, opt.estimate_delay, r, J ? &S : nullptr)) return false;
     if (J) {
-      const Eigen::MatrixXd S = output_sensitivities(g, o.nb, data, opt.estimate_delay);
-      J->resize(data.size(), p);
+      J->resize(r.size(), p);
       for (int j = 0; j < p; ++j) J->col(j) = -S.col(free[j]);
     }
     return true;
@@ -123,8 +159,17 @@ Result<TransferFunction> refine(const IdData& data, const TfOrders& o, const Tra
   r.parameters.values = full;
   for (int j = 0; j < p; ++j) r.parameters.values(free[j]) = lm.x(j);
   r.parameters.fixed = is_fixed;
-  r.fit = fit_report_or_inf(y, lsim(r.model, data, 0), p);
-  const double sigma2 = 2.0 * lm.cost / std::max(1, data.size() - p);
+  Eigen::VectorXd res;
+  stacked_residuals(r.model, ds, opt.transient_time, o.nb, false, res, nullptr);
+  Eigen::VectorXd y_all(res.size());
+  Eigen::Index at = 0;
+  for (const IdData& d : ds) {
+    const Eigen::Index m = d.size() - first_after(d, opt.transient_time);
+    y_all.segment(at, m) = d.y().col(0).tail(m);
+    at += m;
+  }
+  r.fit = fit_report_or_inf(y_all, y_all - res, p);
+  const double sigma2 = 2.0 * lm.cost / double(std::max<Eigen::Index>(1, y_all.size() - p));
   r.parameters.covariance = Eigen::MatrixXd::Zero(np, np);
   r.parameters.std = Eigen::VectorXd::Zero(np);
   if (lm.jtj.size() == p * p && std::isfinite(sigma2)) {
@@ -135,6 +180,7 @@ Result<TransferFunction> refine(const IdData& data, const TfOrders& o, const Tra
   }
   r.diagnostics.scalars["noise_variance"] = sigma2;
   r.diagnostics.scalars["delay"] = r.model.io_delay();
+  if (ds.size() > 1) r.diagnostics.scalars["experiments"] = static_cast<double>(ds.size());
   if (lm.jtj.size() == p * p) {
     const Eigen::VectorXd dg = lm.jtj.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
     const Eigen::VectorXd ev =
@@ -156,20 +202,23 @@ Result<TransferFunction> refine(const IdData& data, const TfOrders& o, const Tra
 
 // The starting model of the refinement: the equation-error (SRIVC) model as it is when it simulates better than
 // its stabilised copy (an unstable plant recorded in open loop), else the stabilised copy.
-TransferFunction starting_model(const TransferFunction& s, const IdData& data) {
+TransferFunction starting_model(const TransferFunction& s, const Records& ds, double transient) {
   if (s.is_stable()) return s;
   const TransferFunction st = tf_detail::stabilized(s);
-  const Eigen::VectorXd y = data.y().col(0);
-  const double raw = (y - lsim(s, data, 0)).squaredNorm(), stab = (y - lsim(st, data, 0)).squaredNorm();
-  return std::isfinite(raw) && raw < stab ? s : st;
+  Eigen::VectorXd r_raw, r_stab;
+  const bool raw_ok = stacked_residuals(s, ds, transient, 1, false, r_raw, nullptr);
+  stacked_residuals(st, ds, transient, 1, false, r_stab, nullptr);
+  return raw_ok && r_raw.squaredNorm() < r_stab.squaredNorm() ? s : st;
 }
 
-void check_common(const IdData& data, const TfOrders& o, const OeOptions& opt, const char* who) {
-  o.validate(/*allow_biproper=*/true);
-  opt.validate();
+void check_record(const IdData& data, const TfOrders& o, const OeOptions& opt, const std::string& who_s, bool several) {
+  const char* who = who_s.c_str();
   require_io_data(data, who);
   CTID_REQUIRE(o.nk == 0 || data.is_uniform(), "{}: nk = {} needs uniformly sampled data", who, o.nk);
-  CTID_REQUIRE(data.size() > o.nf + o.nb + 1, "{}: {} samples cannot determine {} parameters", who, data.size(), o.nf + o.nb);
+  CTID_REQUIRE(several || data.size() > o.nf + o.nb + 1, "{}: {} samples cannot determine {} parameters", who, data.size(),
+               o.nf + o.nb);
+  CTID_REQUIRE(opt.transient_time < data.duration(), "{}: transient_time = {} s is not shorter than the record ({} s)", who,
+               opt.transient_time, data.duration());
   const double delay = opt.delay + (o.nk > 0 ? o.nk * data.ts() : 0.0);
   CTID_REQUIRE(delay < data.duration(), "{}: the input delay {} s is not shorter than the record ({} s)", who, delay,
                data.duration());
@@ -181,6 +230,21 @@ void check_common(const IdData& data, const TfOrders& o, const OeOptions& opt, c
                "{}: delay_min = {} s is not shorter than the record ({} s)", who, opt.srivc.delay_min, data.duration());
   CTID_REQUIRE_OPTION(!opt.initial || opt.initial->order() == o.nf, "{}: the initial model has order {} but nf = {}", who,
                       opt.initial ? opt.initial->order() : 0, o.nf);
+}
+
+void check_common(const Records& ds, const TfOrders& o, const OeOptions& opt, const char* who) {
+  o.validate(/*allow_biproper=*/true);
+  opt.validate();
+  CTID_REQUIRE(!ds.empty(), "{}: no records given", who);
+  long long total = 0;
+  for (std::size_t e = 0; e < ds.size(); ++e) {
+    check_record(ds[e], o, opt, ds.size() == 1 ? std::string(who) : detail::format("{} (record {})", who, e + 1), ds.size() > 1);
+    CTID_REQUIRE(e == 0 || o.nk == 0 || std::abs(ds[e].ts() - ds[0].ts()) <= 1e-9 * ds[0].ts(),
+                 "{} (record {}): nk counts samples, so the records need one sampling period ({} s and {} s)", who, e + 1,
+                 ds[0].ts(), ds[e].ts());
+    total += ds[e].size();
+  }
+  CTID_REQUIRE(total > o.nf + o.nb + 1, "{}: {} samples cannot determine {} parameters", who, total, o.nf + o.nb);
 }
 
 // The options in the normalised units of n (tf_common.hpp): values, bounds and fixed values by parameter name,
@@ -198,17 +262,21 @@ OeOptions normalised(const OeOptions& o, const tf_detail::TfNormalisation& n, co
   s.srivc.delay /= n.c;
   s.srivc.delay_min /= n.c;
   if (s.srivc.delay_max >= 0) s.srivc.delay_max /= n.c;
+  s.transient_time /= n.c;
+  s.srivc.transient_time = s.transient_time;  // the SRIVC start leaves out the same transient
   return s;
 }
 
 // Runs `fit` (oe or tfest in the units of its record) on the normalised record and maps the result back.
 template <class F>
-Result<TransferFunction> in_normalised_units(const IdData& data, const TfOrders& orders, const OeOptions& options, F&& fit) {
+Result<TransferFunction> in_normalised_units(const Records& data, const TfOrders& orders, const OeOptions& options, F&& fit) {
   const auto t0 = std::chrono::steady_clock::now();
   const tf_detail::TfNormalisation n = tf_detail::TfNormalisation::of(data);
-  Result<TransferFunction> r = fit(n.data(data), normalised(options, n, orders), t0);
+  Records normalised_records;
+  for (const IdData& d : data) normalised_records.push_back(n.data(d));
+  Result<TransferFunction> r = fit(normalised_records, normalised(options, n, orders), t0);
   n.restore(r, orders);
-  tf_detail::finish_tf_result(r, data);
+  tf_detail::finish_tf_result(r, data.front());
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
@@ -217,7 +285,7 @@ double base_delay(const IdData& data, const TfOrders& o, const OeOptions& opt) {
   return opt.delay + (o.nk > 0 ? o.nk * data.ts() : 0.0);
 }
 
-Result<TransferFunction> oe_in_units(const IdData& data, const TfOrders& orders, const OeOptions& options,
+Result<TransferFunction> oe_in_units(const Records& data, const TfOrders& orders, const OeOptions& options,
                                      std::chrono::steady_clock::time_point t0) {
   TransferFunction start;
   if (options.estimate_delay) {
@@ -226,28 +294,28 @@ Result<TransferFunction> oe_in_units(const IdData& data, const TfOrders& orders,
     SrivcOptions so = options.srivc;
     so.estimate_delay = true;
     if (options.initial) so.initial = TransferFunction(options.initial->num(), options.initial->den());
-    start = starting_model(srivc(data, orders, so).model, data);
+    start = starting_model(srivc(data, orders, so).model, data, options.transient_time);
   } else if (options.initial) {
     start = *options.initial;
-    if (!options.estimate_delay && start.io_delay() == 0.0) start.set_io_delay(base_delay(data, orders, options));
+    if (!options.estimate_delay && start.io_delay() == 0.0) start.set_io_delay(base_delay(data.front(), orders, options));
   } else {
     SrivcOptions so = options.srivc;
     so.delay = options.delay;
     so.max_iterations = 1;  // LSSVF start plus one refinement: a cheap equation-error initial model
     const Result<TransferFunction> s = srivc(data, orders, so);
-    start = starting_model(s.model, data);
+    start = starting_model(s.model, data, options.transient_time);
   }
   return refine(data, orders, start, options, t0);
 }
 
-Result<TransferFunction> tfest_in_units(const IdData& data, const TfOrders& orders, const OeOptions& options,
+Result<TransferFunction> tfest_in_units(const Records& data, const TfOrders& orders, const OeOptions& options,
                                         std::chrono::steady_clock::time_point t0) {
   SrivcOptions so = options.srivc;
   so.delay = options.delay;
   so.estimate_delay = options.estimate_delay;
   if (options.initial) so.initial = options.initial;
   const Result<TransferFunction> s = srivc(data, orders, so);
-  Result<TransferFunction> r = refine(data, orders, starting_model(s.model, data), options, t0);
+  Result<TransferFunction> r = refine(data, orders, starting_model(s.model, data, options.transient_time), options, t0);
   r.diagnostics.scalars["srivc_iterations"] = s.summary.iterations;
   r.diagnostics.scalars["srivc_fit_percent"] = s.fit.fit_percent;
   return r;
@@ -257,18 +325,26 @@ Result<TransferFunction> tfest_in_units(const IdData& data, const TfOrders& orde
 
 // oe and tfest estimate in normalised time and amplitude units (issue 13: the result does not depend on the
 // units of the record) and map the result back.
-Result<TransferFunction> oe(const IdData& data, const TfOrders& orders, const OeOptions& options) {
+Result<TransferFunction> oe(const std::vector<IdData>& data, const TfOrders& orders, const OeOptions& options) {
   check_common(data, orders, options, "oe");
-  return in_normalised_units(data, orders, options, [&](const IdData& d, const OeOptions& o, auto t0) {
+  return in_normalised_units(data, orders, options, [&](const Records& d, const OeOptions& o, auto t0) {
     return oe_in_units(d, orders, o, t0);
   });
 }
 
-Result<TransferFunction> tfest(const IdData& data, const TfOrders& orders, const OeOptions& options) {
+Result<TransferFunction> tfest(const std::vector<IdData>& data, const TfOrders& orders, const OeOptions& options) {
   check_common(data, orders, options, "tfest");
-  return in_normalised_units(data, orders, options, [&](const IdData& d, const OeOptions& o, auto t0) {
+  return in_normalised_units(data, orders, options, [&](const Records& d, const OeOptions& o, auto t0) {
     return tfest_in_units(d, orders, o, t0);
   });
+}
+
+Result<TransferFunction> oe(const IdData& data, const TfOrders& orders, const OeOptions& options) {
+  return oe(std::vector<IdData>{data}, orders, options);
+}
+
+Result<TransferFunction> tfest(const IdData& data, const TfOrders& orders, const OeOptions& options) {
+  return tfest(std::vector<IdData>{data}, orders, options);
 }
 
 }  // namespace ctid

@@ -1074,8 +1074,17 @@ TEST(Cli, SeveralDataFilesAreFittedJointly) {
   ASSERT_EQ(ps.size(), 3u);
   for (int i = 0; i < 3; ++i)
     EXPECT_NEAR(ps.at(i).at("value").get<double>(), lib.parameters.values(i), 1e-9 * std::abs(lib.parameters.values(i)));
-  const CliRun o = ctid_run("fit " + files[0] + " " + files[1] + " --time time --input force --output position --method oe --nf 2");
+  const CliRun tf = ctid_run("fit " + files[0] + " " + files[1] +
+                            " --time time --input force --output position --method tfest --nf 2 --nb 1 --json " + json + " --force");
+  ASSERT_EQ(tf.code, 0) << tf.err;
+  const Result<TransferFunction> lib_t = tfest(ds, {1, 2, 0});
+  const auto jt = nlohmann::json::parse(std::ifstream(json));
+  for (int i = 0; i < 3; ++i)
+    EXPECT_NEAR(jt.at("parameters").at(i).at("value").get<double>(), lib_t.parameters.values(i),
+                1e-9 * std::abs(lib_t.parameters.values(i)));
+  const CliRun o = ctid_run("fit " + files[0] + " " + files[1] + " --time time --input force --output position --method lssvf --nf 2");
   EXPECT_EQ(o.code, 2);
-  EXPECT_NE(o.err.find("2 DATA files are several experiments: fitted jointly by --method srivc (got oe"), std::string::npos)
+  EXPECT_NE(o.err.find("2 DATA files are several experiments: fitted jointly by --method srivc, oe or tfest (got lssvf"),
+            std::string::npos)
       << o.err;
 }

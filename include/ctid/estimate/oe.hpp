@@ -35,6 +35,9 @@ struct OeOptions {
   bool estimate_delay = false;   ///< add the input delay T (s) as a parameter "delay"
   double delay = 0.0;            ///< initial / fixed delay (s), added to nk Ts
   SrivcOptions srivc;            ///< options of the SRIVC start (tfest); its delay search is used when estimate_delay
+  /// Seconds at the start of each record left out of the output-error cost (and of the SRIVC start): a record
+  /// simulated from rest that did not start at rest.
+  double transient_time = 0.0;
   void validate() const;
 };
 /// The settings of OeOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
@@ -46,5 +49,12 @@ const OptionTable<OeOptions>& option_table<OeOptions>();
 Result<TransferFunction> oe(const IdData& data, const TfOrders& orders, const OeOptions& options = {});
 /// SRIVC (with delay search when estimate_delay) followed by output-error refinement.
 Result<TransferFunction> tfest(const IdData& data, const TfOrders& orders, const OeOptions& options = {});
+
+/// Several experiments of one system (issue 14, item 2): one parameter set minimising the output error summed
+/// over the records, each simulated from rest (after transient_time); sensitivities stacked; the records may
+/// differ in length, input and sampling (nk needs one sampling period). tfest starts from the joint SRIVC
+/// estimate. diagnostics.scalars "experiments". Throws as oe/tfest, naming the record.
+Result<TransferFunction> oe(const std::vector<IdData>& data, const TfOrders& orders, const OeOptions& options = {});
+Result<TransferFunction> tfest(const std::vector<IdData>& data, const TfOrders& orders, const OeOptions& options = {});
 
 }  // namespace ctid
