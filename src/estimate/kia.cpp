@@ -215,25 +215,26 @@ const OptionTable<KiaLinearOptions>& option_table<KiaLinearOptions>() {
   return t;
 }
 
+namespace {
+// The table of a higher KIA stage: its candidate terms, then the shared stage settings.
+template <class O>
+OptionTable<O> candidate_stage_table(const char* method, const char* candidates_doc) {
+  OptionTable<O> x(method);
+  x.terms("candidates", &O::candidates, candidates_doc);
+  return stage_settings(x);
+}
+}  // namespace
+
 template <>
 const OptionTable<KiaQuadraticOptions>& option_table<KiaQuadraticOptions>() {
-  using O = KiaQuadraticOptions;
-  static const OptionTable<O> t = [] {
-    OptionTable<O> x("kia_quadratic");
-    x.terms("candidates", &O::candidates, "degree-2 candidate terms, e.g. y^2,y*Dy,Dy^2,y*u");
-    return stage_settings(x);
-  }();
+  static const auto t =
+      candidate_stage_table<KiaQuadraticOptions>("kia_quadratic", "degree-2 candidate terms, e.g. y^2,y*Dy,Dy^2,y*u");
   return t;
 }
 
 template <>
 const OptionTable<KiaCubicOptions>& option_table<KiaCubicOptions>() {
-  using O = KiaCubicOptions;
-  static const OptionTable<O> t = [] {
-    OptionTable<O> x("kia_cubic");
-    x.terms("candidates", &O::candidates, "degree-3 candidate terms, e.g. y^3,y^2*Dy");
-    return stage_settings(x);
-  }();
+  static const auto t = candidate_stage_table<KiaCubicOptions>("kia_cubic", "degree-3 candidate terms, e.g. y^3,y^2*Dy");
   return t;
 }
 

@@ -45,13 +45,8 @@ void OeOptions::validate() const {
 namespace {
 
 using Records = std::vector<IdData>;  // one or several experiments of one system
+using tf_detail::first_after;
 
-// The first sample at or after `transient` seconds from the record's start.
-Eigen::Index first_after(const IdData& d, double transient) {
-  Eigen::Index k = 0;
-  while (k < d.size() && d.time(static_cast<int>(k)) - d.t0() < transient * (1 - 1e-12)) ++k;
-  return k;
-}
 
 double shortest_duration(const Records& ds) {
   double s = ds.front().duration();

@@ -201,12 +201,6 @@ namespace {
 
 using Records = std::vector<IdData>;  // one or several experiments of one system
 
-// The first sample at or after `transient` seconds from the record's start.
-Eigen::Index first_after(const IdData& d, double transient) {
-  Eigen::Index k = 0;
-  while (k < d.size() && d.time(static_cast<int>(k)) - d.t0() < transient * (1 - 1e-12)) ++k;
-  return k;
-}
 
 // SRIVC iterations at a fixed total delay (SISO), the IV equations summed over the records.
 SrivcRun srivc_fixed_delay(const Records& ds, const TfOrders& o, double delay, Eigen::VectorXd theta, const SrivcOptions& opt,

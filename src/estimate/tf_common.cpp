@@ -183,6 +183,12 @@ void finish_tf_result(Result<TransferFunction>& r, const IdData& d) {
   warn_poles_beyond_bandwidth(r, d);
 }
 
+Eigen::Index first_after(const IdData& d, double transient) {
+  Eigen::Index k = 0;
+  while (k < d.size() && d.time(static_cast<int>(k)) - d.t0() < transient * (1 - 1e-12)) ++k;
+  return k;
+}
+
 TransferFunction stabilized(const TransferFunction& tf) {
   if (tf.is_stable()) return tf;
   Eigen::VectorXcd p = tf.poles();

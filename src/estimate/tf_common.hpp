@@ -19,6 +19,8 @@ Eigen::VectorXd params_of(const TransferFunction& g, const TfOrders& o);
 TransferFunction tf_of(const Eigen::VectorXd& p, const TfOrders& o, double delay);
 /// Mean squared output error of g simulated on d (+Inf if the simulation diverges).
 double output_error_mse(const TransferFunction& g, const IdData& d);
+/// The first sample at or after `transient` seconds from the record's start (the rows a transient_time leaves out).
+Eigen::Index first_after(const IdData& d, double transient);
 /// Mirror unstable poles into the left half plane (prefilters and auxiliary models must be stable).
 TransferFunction stabilized(const TransferFunction& tf);
 

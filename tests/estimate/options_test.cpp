@@ -5,19 +5,11 @@
 #include <gtest/gtest.h>
 
 #include "ctid/ctid.hpp"
+#include "test_util.hpp"
 
 using namespace ctid;
 
-namespace {
-std::string message_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InvalidOptions& e) {
-    return e.what();
-  }
-  return "";
-}
-}  // namespace
+using test::error_of;
 
 // Text forms: numbers, whole numbers written as 1e3, flags, choices, lists, named values, bounds, transfer
 // functions "NUM/DEN" (descending powers); each set lands in the struct's member.
@@ -64,34 +56,34 @@ TEST(Options, TextFormsSetTheMembers) {
 TEST(Options, ErrorsNameTheSettingTheRangeAndTheClosestName) {
   LssvfOptions l;
   const auto& t = option_table<LssvfOptions>();
-  EXPECT_EQ(message_of([&] { t.set(l, "tau_grid", "5"); }).find("lssvf: 'tau_grid' is not a setting; did you mean 'tau_grid_size'?"), 0u);
-  EXPECT_NE(message_of([&] { t.set(l, "transient", "1"); }).find("did you mean 'transient_time'?"), std::string::npos);
-  EXPECT_NE(message_of([&] { t.set(l, "alhpa", "1"); }).find("did you mean 'alpha'?"), std::string::npos);
-  EXPECT_EQ(message_of([&] { t.set(l, "tau", "fast"); }), "lssvf: tau must be a number (got 'fast')");
-  EXPECT_EQ(message_of([&] { t.set(l, "tau_grid_size", "2.5"); }), "lssvf: tau_grid_size must be a whole number (got '2.5')");
-  EXPECT_EQ(message_of([&] { t.set(l, "weights", "simpson"); }),
+  EXPECT_EQ(error_of([&] { t.set(l, "tau_grid", "5"); }).find("lssvf: 'tau_grid' is not a setting; did you mean 'tau_grid_size'?"), 0u);
+  EXPECT_NE(error_of([&] { t.set(l, "transient", "1"); }).find("did you mean 'transient_time'?"), std::string::npos);
+  EXPECT_NE(error_of([&] { t.set(l, "alhpa", "1"); }).find("did you mean 'alpha'?"), std::string::npos);
+  EXPECT_EQ(error_of([&] { t.set(l, "tau", "fast"); }), "lssvf: tau must be a number (got 'fast')");
+  EXPECT_EQ(error_of([&] { t.set(l, "tau_grid_size", "2.5"); }), "lssvf: tau_grid_size must be a whole number (got '2.5')");
+  EXPECT_EQ(error_of([&] { t.set(l, "weights", "simpson"); }),
             "lssvf: weights must be one of riemann, trapezoidal (got 'simpson')");
-  EXPECT_EQ(message_of([&] { t.set(l, "fixed", "3"); }).find("lssvf: fixed must be given per name"), 0u);
+  EXPECT_EQ(error_of([&] { t.set(l, "fixed", "3"); }).find("lssvf: fixed must be given per name"), 0u);
   l.tau = -0.5;
-  EXPECT_EQ(message_of([&] { l.validate(); }), "lssvf: tau must be > 0, or 0 (automatic) (got -0.5 s)");
+  EXPECT_EQ(error_of([&] { l.validate(); }), "lssvf: tau must be > 0, or 0 (automatic) (got -0.5 s)");
   l.tau = 0;
   l.tau_grid_size = 1;
-  EXPECT_EQ(message_of([&] { l.validate(); }), "lssvf: tau_grid_size must be in [2, 1000] (got 1)");
+  EXPECT_EQ(error_of([&] { l.validate(); }), "lssvf: tau_grid_size must be in [2, 1000] (got 1)");
   RlsSvfOptions r;
   r.forgetting = 1.5;
-  EXPECT_EQ(message_of([&] { r.validate(); }), "rls_svf: forgetting must be in (0, 1] (got 1.5)");
+  EXPECT_EQ(error_of([&] { r.validate(); }), "rls_svf: forgetting must be in (0, 1] (got 1.5)");
   OeOptions o;
   o.bounds["a1"] = {2, 1};
-  EXPECT_EQ(message_of([&] { o.validate(); }), "oe: bounds.a1 must be lower <= upper (got 2,1)");
+  EXPECT_EQ(error_of([&] { o.validate(); }), "oe: bounds.a1 must be lower <= upper (got 2,1)");
   o.bounds.clear();
   o.tolerance = std::numeric_limits<double>::infinity();
-  EXPECT_EQ(message_of([&] { o.validate(); }), "oe: tolerance must be > 0 (got inf)");
+  EXPECT_EQ(error_of([&] { o.validate(); }), "oe: tolerance must be > 0 (got inf)");
   SrivcOptions so;
-  EXPECT_NE(message_of([&] { option_table<SrivcOptions>().set(so, "initial", "1,2"); }).find("NUM/DEN"), std::string::npos);
+  EXPECT_NE(error_of([&] { option_table<SrivcOptions>().set(so, "initial", "1,2"); }).find("NUM/DEN"), std::string::npos);
   // A nested struct's setting is checked under the outer method's name.
   IvsvfOptions iv;
   iv.svf.alpha = -1;
-  EXPECT_EQ(message_of([&] { option_table<IvsvfOptions>().check(iv); }), "ivsvf: alpha must be >= 0 (got -1 1/s)");
+  EXPECT_EQ(error_of([&] { option_table<IvsvfOptions>().check(iv); }), "ivsvf: alpha must be >= 0 (got -1 1/s)");
   EXPECT_EQ(closest_name("xyz_unrelated", {"tau", "alpha"}), "");
 }
 
@@ -122,7 +114,7 @@ TEST(Options, RegistryListsEachMethodOnceWithDocumentedDefaults) {
   EXPECT_EQ(default_of("tfest", "start_max_iterations"), "50");
   EXPECT_EQ(default_of("srivc_closed_loop", "reference_at_plant_input"), "1");
   EXPECT_NE(std::string(settings_help(method_info("srivc"))).find("delay_max"), std::string::npos);
-  EXPECT_EQ(message_of([] { method_info("srvic"); }).find("'srvic' is not a method; did you mean 'srivc'?"), 0u);
+  EXPECT_EQ(error_of([] { method_info("srvic"); }).find("'srvic' is not a method; did you mean 'srivc'?"), 0u);
 }
 
 // The same table drives validate(): a struct accepted by every field's range passes, one outside fails.
@@ -131,14 +123,14 @@ TEST(Options, ValidateUsesTheTableAndKeepsCrossFieldRules) {
   f.T = 8;
   f.validate();
   f.n = 20;
-  EXPECT_NE(message_of([&] { f.validate(); }).find("must be odd"), std::string::npos);
+  EXPECT_NE(error_of([&] { f.validate(); }).find("must be odd"), std::string::npos);
   f.n = 21;
   f.unstable = true;
-  EXPECT_NE(message_of([&] { f.validate(); }).find("declared unstable"), std::string::npos);
+  EXPECT_NE(error_of([&] { f.validate(); }).find("declared unstable"), std::string::npos);
   f.a = 2;
   f.validate();
   SrivcOptions s;
   s.delay_min = 2;
   s.delay_max = 1;
-  EXPECT_NE(message_of([&] { s.validate(); }).find("the delay range [2, 1] s is empty"), std::string::npos);
+  EXPECT_NE(error_of([&] { s.validate(); }).find("the delay range [2, 1] s is empty"), std::string::npos);
 }

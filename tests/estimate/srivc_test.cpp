@@ -387,6 +387,56 @@ TEST(FrequencyFit, RaoGarnierFrequencyResponse) {
   EXPECT_THROW(tf_from_frequency(FrequencyData(w.head(2), G.head(2)), {2, 4, 0}), InvalidArgument);
 }
 
+namespace {
+// The two-experiment set-up of issue 14 (item 2): G = (s + 3)/(s^2 + 1.2 s + 4), Ts = 0.05 s, 1000 samples per record;
+// record 1: a PRBS from rest; record 2: a two-tone multisine starting 10 s into a run (not at rest); white output
+// noise of std 0.05. draw() gives a new noisy pair from the seeded generator.
+struct TwoRecords {
+  static constexpr int N = 1000, skip = 200;
+  static constexpr double Ts = 0.05, sigma = 0.05;
+  const Eigen::VectorXd truth{{1.2, 4.0, 1.0, 3.0}};
+  Eigen::VectorXd u1, x1, u2, x2;
+  std::mt19937_64 rng;
+  explicit TwoRecords(std::uint64_t seed) : rng(seed) {
+    const TransferFunction g(Eigen::VectorXd{{1.0, 3.0}}, Eigen::VectorXd{{1.0, 1.2, 4.0}});
+    u1 = prbs(N, {.register_length = 8, .clock_period = 4});
+    x1 = lsim(g, u1, time_grid(Ts, N));
+    Eigen::VectorXd u(N + skip);
+    for (int k = 0; k < N + skip; ++k) u(k) = std::sin(0.7 * k * Ts) + 0.8 * std::sin(2.9 * k * Ts + 1.0);
+    x2 = lsim(g, u, time_grid(Ts, N + skip)).tail(N);
+    u2 = u.tail(N);
+  }
+  Eigen::VectorXd noisy(const Eigen::VectorXd& x) {
+    std::normal_distribution<double> noise(0.0, sigma);
+    Eigen::VectorXd y = x;
+    for (Eigen::Index k = 0; k < y.size(); ++k) y(k) += noise(rng);
+    return y;
+  }
+  std::pair<IdData, IdData> draw() { return {IdData(u1, noisy(x1), Ts), IdData(u2, noisy(x2), Ts, skip * Ts)}; }
+
+  // R runs of fit(record) on each record alone and fit(both) jointly: the parameter errors of each (rows = runs) and
+  // the joint fit's reported standard deviations.
+  struct Runs {
+    Eigen::MatrixXd e1, e2, ej, sj;
+  };
+  template <class Fit>
+  Runs monte_carlo(int R, Fit fit) {
+    Runs m{Eigen::MatrixXd(R, 4), Eigen::MatrixXd(R, 4), Eigen::MatrixXd(R, 4), Eigen::MatrixXd(R, 4)};
+    for (int s = 0; s < R; ++s) {
+      const auto [a, b] = draw();
+      const auto r1 = fit(std::vector<IdData>{a}), r2 = fit(std::vector<IdData>{b}), rj = fit(std::vector<IdData>{a, b});
+      EXPECT_TRUE(r1.usable() && r2.usable() && rj.usable()) << s << ": " << rj.why_not_usable();
+      EXPECT_EQ(rj.diagnostics.scalars.at("experiments"), 2.0);
+      m.e1.row(s) = (r1.parameters.values - truth).transpose();
+      m.e2.row(s) = (r2.parameters.values - truth).transpose();
+      m.ej.row(s) = (rj.parameters.values - truth).transpose();
+      m.sj.row(s) = rj.parameters.std.transpose();
+    }
+    return m;
+  }
+};
+}  // namespace
+
 // Issue 14 (item 2): several experiments. Two records of G = (s + 3)/(s^2 + 1.2 s + 4) with different inputs (a
 // PRBS; a two-tone multisine) and different initial states (the second record starts 10 s into a run, not at rest),
 // Ts = 0.05 s, 1000 samples each, white output noise of std 0.05 (about 10 % of the output's RMS); every fit leaves
@@ -398,36 +448,12 @@ TEST(FrequencyFit, RaoGarnierFrequencyResponse) {
 // Without transient_time the joint estimate is biased by record 2's initial state (measured: 0.020 on a1, 8
 // standard errors), which the last check shows.
 TEST(Srivc, SeveralExperimentsGiveOneEstimateBetterThanEitherWithTheRightCovariance) {
-  const TransferFunction g(Eigen::VectorXd{{1.0, 3.0}}, Eigen::VectorXd{{1.0, 1.2, 4.0}});
-  const Eigen::VectorXd truth{{1.2, 4.0, 1.0, 3.0}};
-  const int N = 1000, skip = 200, R = 100;
-  const double Ts = 0.05, sigma = 0.05;
-  const Eigen::VectorXd u1 = prbs(N, {.register_length = 8, .clock_period = 4});
-  Eigen::VectorXd u2(N + skip);
-  for (int k = 0; k < N + skip; ++k) u2(k) = std::sin(0.7 * k * Ts) + 0.8 * std::sin(2.9 * k * Ts + 1.0);
-  const Eigen::VectorXd x1 = lsim(g, u1, time_grid(Ts, N));
-  const Eigen::VectorXd x2_full = lsim(g, u2, time_grid(Ts, N + skip));
-  const Eigen::VectorXd x2 = x2_full.tail(N), u2r = u2.tail(N);
-  std::mt19937_64 rng(2026);
-  std::normal_distribution<double> noise(0.0, sigma);
-  auto noisy = [&](const Eigen::VectorXd& x) {
-    Eigen::VectorXd y = x;
-    for (Eigen::Index k = 0; k < y.size(); ++k) y(k) += noise(rng);
-    return y;
-  };
-  Eigen::MatrixXd e1(R, 4), e2(R, 4), ej(R, 4), sj(R, 4);
-  for (int s = 0; s < R; ++s) {
-    const IdData a(u1, noisy(x1), Ts), b(u2r, noisy(x2), Ts, skip * Ts);
-    SrivcOptions o;
-    o.transient_time = 8.0;
-    const auto r1 = srivc(a, {2, 2, 0}, o), r2 = srivc(b, {2, 2, 0}, o), rj = srivc(std::vector<IdData>{a, b}, {2, 2, 0}, o);
-    ASSERT_TRUE(r1.usable() && r2.usable() && rj.usable()) << s << ": " << rj.why_not_usable();
-    EXPECT_EQ(rj.diagnostics.scalars.at("experiments"), 2.0);
-    e1.row(s) = (r1.parameters.values - truth).transpose();
-    e2.row(s) = (r2.parameters.values - truth).transpose();
-    ej.row(s) = (rj.parameters.values - truth).transpose();
-    sj.row(s) = rj.parameters.std.transpose();
-  }
+  TwoRecords set(2026);
+  const int R = 100, N = TwoRecords::N;
+  SrivcOptions o;
+  o.transient_time = 8.0;
+  const auto mc = set.monte_carlo(R, [&](const std::vector<IdData>& d) { return srivc(d, {2, 2, 0}, o); });
+  const Eigen::MatrixXd &e1 = mc.e1, &e2 = mc.e2, &ej = mc.ej, &sj = mc.sj;
   for (int i = 0; i < 4; ++i) {
     auto rmse = [&](const Eigen::MatrixXd& e) { return std::sqrt(e.col(i).squaredNorm() / R); };
     const double best_single = std::min(rmse(e1), rmse(e2));
@@ -443,8 +469,8 @@ TEST(Srivc, SeveralExperimentsGiveOneEstimateBetterThanEitherWithTheRightCovaria
     EXPECT_LT(std::abs(mean), 3.0 * sd / std::sqrt(double(R)) + 0.1 * sd) << "parameter " << i << " biased";
   }
   // A record that cannot be used is named by its position.
-  const IdData flat(Eigen::VectorXd::Zero(N), noisy(x1), Ts);
-  EXPECT_NE(test::error_of([&] { srivc(std::vector<IdData>{IdData(u1, noisy(x1), Ts), flat}, {2, 2, 0}); })
+  const IdData flat(Eigen::VectorXd::Zero(N), set.draw().first.y(), TwoRecords::Ts);
+  EXPECT_NE(test::error_of([&] { srivc(std::vector<IdData>{set.draw().first, flat}, {2, 2, 0}); })
                 .find("srivc (record 2): input 'u1' is constant (0)"),
             std::string::npos);
   EXPECT_THROW(srivc(std::vector<IdData>{}, {2, 2, 0}), InvalidArgument);
@@ -456,35 +482,12 @@ TEST(Srivc, SeveralExperimentsGiveOneEstimateBetterThanEitherWithTheRightCovaria
 // errors have ~13 % relative error), and its reported standard deviation agrees with the spread within 35 %
 // (measured 0.93-1.02).
 TEST(OutputError, SeveralExperimentsGiveOneEstimateBetterThanEither) {
-  const TransferFunction g(Eigen::VectorXd{{1.0, 3.0}}, Eigen::VectorXd{{1.0, 1.2, 4.0}});
-  const Eigen::VectorXd truth{{1.2, 4.0, 1.0, 3.0}};
-  const int N = 1000, skip = 200, R = 30;
-  const double Ts = 0.05, sigma = 0.05;
-  const Eigen::VectorXd u1 = prbs(N, {.register_length = 8, .clock_period = 4});
-  Eigen::VectorXd u2(N + skip);
-  for (int k = 0; k < N + skip; ++k) u2(k) = std::sin(0.7 * k * Ts) + 0.8 * std::sin(2.9 * k * Ts + 1.0);
-  const Eigen::VectorXd x1 = lsim(g, u1, time_grid(Ts, N));
-  const Eigen::VectorXd x2 = lsim(g, u2, time_grid(Ts, N + skip)).tail(N), u2r = u2.tail(N);
-  std::mt19937_64 rng(2027);
-  std::normal_distribution<double> noise(0.0, sigma);
-  auto noisy = [&](const Eigen::VectorXd& x) {
-    Eigen::VectorXd y = x;
-    for (Eigen::Index k = 0; k < y.size(); ++k) y(k) += noise(rng);
-    return y;
-  };
-  Eigen::MatrixXd e1(R, 4), e2(R, 4), ej(R, 4), sj(R, 4);
+  TwoRecords set(2027);
+  const int R = 30;
   OeOptions o;
   o.transient_time = 8.0;
-  for (int s = 0; s < R; ++s) {
-    const IdData a(u1, noisy(x1), Ts), b(u2r, noisy(x2), Ts, skip * Ts);
-    const auto r1 = tfest(a, {2, 2, 0}, o), r2 = tfest(b, {2, 2, 0}, o), rj = tfest(std::vector<IdData>{a, b}, {2, 2, 0}, o);
-    ASSERT_TRUE(r1.usable() && r2.usable() && rj.usable()) << s << ": " << rj.why_not_usable();
-    EXPECT_EQ(rj.diagnostics.scalars.at("experiments"), 2.0);
-    e1.row(s) = (r1.parameters.values - truth).transpose();
-    e2.row(s) = (r2.parameters.values - truth).transpose();
-    ej.row(s) = (rj.parameters.values - truth).transpose();
-    sj.row(s) = rj.parameters.std.transpose();
-  }
+  const auto mc = set.monte_carlo(R, [&](const std::vector<IdData>& d) { return tfest(d, {2, 2, 0}, o); });
+  const Eigen::MatrixXd &e1 = mc.e1, &e2 = mc.e2, &ej = mc.ej, &sj = mc.sj;
   for (int i = 0; i < 4; ++i) {
     auto rmse = [&](const Eigen::MatrixXd& e) { return std::sqrt(e.col(i).squaredNorm() / R); };
     const double mean = ej.col(i).mean();
