@@ -161,16 +161,24 @@ int run_poles(PolesArgs a) {
 
 struct ResponseArgs {
   DataArgs data;
-  std::string method = "modal", kind = "step", out;
+  std::string method = "modal", kind = "step", out, json;
   int order = 0;
   std::vector<std::string> sets;
   bool force = false;
 };
 
 int run_response(const ResponseArgs& a) {
-  check_outputs({a.out}, {a.data.path}, a.force);
+  check_outputs({a.out, a.json}, {a.data.path}, a.force);
   if (a.order < 1) throw UsageError("--order must be >= 1");
   const IdData d = a.data.load(true);
+  // The response as named columns: to --out (CSV) and --json.
+  auto write = [&](const std::vector<std::string>& names, const Eigen::MatrixXd& tab) {
+    if (!a.out.empty()) write_csv(a.out, names, tab);
+    if (!a.json.empty())
+      write_text_file(a.json, table_to_json("response", {{"method", a.method}, {"kind", a.kind},
+                                                         {"order", std::to_string(a.order)}},
+                                            names, tab));
+  };
   if (d.nu() != 1 || d.ny() != 1) throw UsageError("response needs one --input and one --output");
   const double Ts = d.ts();
   std::map<std::string, std::string> own;
@@ -220,7 +228,7 @@ int run_response(const ResponseArgs& a) {
         std::printf("  w = %-10.5g  H = %.6g %+.6gj   |H| = %.6g  phase = %.4g deg\n", f.w()(i), G.real(), G.imag(),
                     std::abs(G), tab(i, 4));
       }
-      if (!a.out.empty()) write_csv(a.out, {"w", "re", "im", "mag", "phase_deg"}, tab);
+      write({"w", "re", "im", "mag", "phase_deg"}, tab);
     } else {
       const double hz = horizon > 0 ? horizon : 10 * period * (a.order + 1);
       TimeResponse g = modal_step_response(d, m.model, period, hz);
@@ -234,16 +242,15 @@ int run_response(const ResponseArgs& a) {
       }
       const int K = static_cast<int>(g.t.size());
       for (int i = 0; i < K; i += std::max(1, K / 20)) std::printf("  t = %-10.5g  %s = %.6g\n", g.t(i), name, g.value(i));
-      if (!a.out.empty()) {
-        Eigen::MatrixXd tab(K, 2);
-        tab << g.t, g.value;
-        write_csv(a.out, {"t", name}, tab);
-      }
+      Eigen::MatrixXd tab(K, 2);
+      tab << g.t, g.value;
+      write({"t", name}, tab);
     }
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }
-  if (!a.out.empty()) std::printf("wrote %s\n", a.out.c_str());
+  for (const std::string* f : {&a.out, &a.json})
+    if (!f->empty()) std::printf("wrote %s\n", f->c_str());
   return kOk;
 }
 
@@ -284,6 +291,7 @@ void setup_response(CLI::App& app) {
                  "frequency), horizon (s), harmonics=1,3,5, window_start (s), and the modal settings (ctid fit --method "
                  "modal --help; basis default discrete), shift_samples (the shifts in samples)");
   app.add_option("--out", a->out, "Write the response to this CSV file");
+  app.add_option("--json", a->json, "Write the response to this JSON file (the --out columns, with kind and order)");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
   app.callback([a] { g_run = [a] { return run_response(*a); }; });
 }

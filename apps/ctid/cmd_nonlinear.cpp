@@ -110,14 +110,14 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
 
 namespace {
 struct GfrfArgs {
-  std::string model, out, points;
+  std::string model, out, points, json;
   int order = 1;
   std::vector<double> w;
   bool real = false, no_zoh = false, force = false;
 };
 
 int run_gfrf(const GfrfArgs& a) {
-  check_outputs({a.out}, {a.model, a.points}, a.force);
+  check_outputs({a.out, a.json}, {a.model, a.points}, a.force);
   if (a.order < 1 || a.order > 3) throw UsageError(detail::format("--order must be 1, 2 or 3 (got {})", a.order));
   if (a.w.empty() == a.points.empty())
     throw UsageError("give either the frequencies with --w w1,w2,.. (rad/s) or the points with --points FILE");
@@ -201,6 +201,12 @@ int run_gfrf(const GfrfArgs& a) {
     write_csv(a.out, names, tab);
     std::printf("wrote %s\n", a.out.c_str());
   }
+  if (!a.json.empty()) {
+    write_text_file(a.json, table_to_json("gfrf", {{"model", kind}, {"order", std::to_string(a.order)},
+                                                   {"hold_factor", kind == "narx" && !a.no_zoh ? "divided" : "none"}},
+                                          names, tab));
+    std::printf("wrote %s\n", a.json.c_str());
+  }
   return kOk;
 }
 }  // namespace
@@ -215,6 +221,7 @@ void setup_gfrf(CLI::App& app) {
   app.add_flag("--real", a->real, "Use s = w on the real axis instead of s = j w");
   app.add_flag("--no-zoh", a->no_zoh, "NARX: do not divide by the hold factor Z(s) (data not sampled with a held input)");
   app.add_option("--out", a->out, "Write the kernel values to this CSV file");
+  app.add_option("--json", a->json, "Write the kernel values to this JSON file (the --out columns, with model and order)");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
   app.callback([a] { g_run = [a] { return run_gfrf(*a); }; });
 }

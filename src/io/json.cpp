@@ -1,5 +1,6 @@
 #include "ctid/io/json.hpp"
 
+#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <type_traits>
@@ -372,6 +373,22 @@ std::string order_selection_to_json(const std::vector<OrderCandidate>& candidate
                     {"usable", c.usable},     {"termination", c.termination}});
   const json j = {{"type", "order_selection"}, {"rank_by", to_string(rank_by)}, {"interrupted", interrupted},
                   {"candidates", list}};
+  return j.dump(indent) + "\n";
+}
+
+std::string table_to_json(const std::string& type, const std::vector<std::pair<std::string, std::string>>& fields,
+                          const std::vector<std::string>& names, const Eigen::MatrixXd& values, int indent) {
+  CTID_REQUIRE(static_cast<Eigen::Index>(names.size()) == values.cols(), "table_to_json: {} names for {} columns",
+               names.size(), values.cols());
+  json j = {{"type", type}};
+  for (const auto& [k, v] : fields) {
+    char* end = nullptr;
+    const double x = std::strtod(v.c_str(), &end);
+    j[k] = !v.empty() && end == v.c_str() + v.size() ? num(x) : json(v);
+  }
+  json cols = json::object();
+  for (std::size_t c = 0; c < names.size(); ++c) cols[names[c]] = vec(values.col(static_cast<Eigen::Index>(c)));
+  j["columns"] = cols;
   return j.dump(indent) + "\n";
 }
 

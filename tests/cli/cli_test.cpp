@@ -413,12 +413,22 @@ TEST(Cli, ModalFitPolesAndResponses) {
   // response --kind step: the ES-C11 estimate written as CSV equals the true step response.
   const std::string g = test::temp_path("g.csv");
   fs::remove(g);
+  const std::string gj = test::temp_path("g.json");
+  fs::remove(gj);
   r = ctid_run("response " + data + " --ts " + ts320() + " --order 3 --kind step --set period=" +
-               detail::format("{}", 20 * kTs320) + " --set horizon=5 --out " + g);
+               detail::format("{}", 20 * kTs320) + " --set horizon=5 --out " + g + " --json " + gj);
   ASSERT_EQ(r.code, 0) << r.err;
   const CsvTable t = read_csv(g);
   const Eigen::VectorXd truth = step_response(kS3, t.values.col(0));
   EXPECT_LT((t.values.col(1) - truth).cwiseAbs().maxCoeff(), 1e-8);
+  // --json holds the same columns (issue 14 item 1: every computing command writes JSON).
+  const auto rj = nlohmann::json::parse(std::ifstream(gj));
+  EXPECT_EQ(rj.at("type"), "response");
+  EXPECT_EQ(rj.at("kind"), "step");
+  EXPECT_EQ(rj.at("order"), 3);
+  ASSERT_EQ(rj.at("columns").at("step").size(), static_cast<std::size_t>(t.values.rows()));
+  for (Eigen::Index k = 0; k < t.values.rows(); k += 50)
+    EXPECT_NEAR(rj.at("columns").at("step").at(k).get<double>(), t.values(k, 1), 1e-12 * (1 + std::abs(t.values(k, 1))));
   // poles: the output of this record after the last switch is not free, so use an S3 free response.
   const int N = 400;
   Eigen::MatrixXd fr(N, 1);
@@ -534,11 +544,19 @@ TEST(Cli, NarxKiaAndGfrf) {
   const NdeModel got = read_nde_json(nde);
   for (const char* s : {"Dy", "D^2y", "u", "y^2", "y*Dy"})
     EXPECT_NEAR(got.coefficient(s), truth.coefficient(s), 1e-3 * std::abs(truth.coefficient(s))) << s;
-  r = ctid_run("gfrf " + nde + " --order 2 --w 10,50 --out " + csv);
+  const std::string h2json = test::temp_path("h2.json");
+  fs::remove(h2json);
+  r = ctid_run("gfrf " + nde + " --order 2 --w 10,50 --out " + csv + " --json " + h2json);
   ASSERT_EQ(r.code, 0) << r.err;
   const CsvTable h2 = read_csv(csv);
   ASSERT_EQ(h2.values.rows(), 4);
   EXPECT_NEAR(h2.values(1, 4), got.h2({0, 10}, {0, 50}).real(), 1e-12 * std::abs(got.h2({0, 10}, {0, 50})));
+  const auto hj = nlohmann::json::parse(std::ifstream(h2json));
+  EXPECT_EQ(hj.at("type"), "gfrf");
+  EXPECT_EQ(hj.at("model"), "nde");
+  EXPECT_EQ(hj.at("order"), 2);
+  EXPECT_NEAR(hj.at("columns").at("re").at(1).get<double>(), h2.values(1, 4), 1e-12 * std::abs(h2.values(1, 4)));
+  EXPECT_NEAR(hj.at("columns").at("s2_im").at(1).get<double>(), 50.0, 1e-12);
   // --points: arbitrary complex pairs from a CSV (here the layout of the file just written, one row per pair).
   const std::string pts = write("points.csv", "s1_re,s1_im,s2_re,s2_im\n3,40,-1,7\n0,10,0,50\n");
   const std::string csv2 = test::temp_path("h2_points.csv");

@@ -68,6 +68,11 @@ std::string order_selection_to_json(const std::vector<OrderCandidate>& candidate
 /// "characteristic": [descending coefficients], "augmented": [...], "condition": c, "warnings": [...]}.
 std::string poles_to_json(const PoleEstimate& data_matrix, const PoleEstimate* prony, const std::string& prony_error,
                           int order, double ts, int indent = 2);
+/// A computed table (ctid response --json, ctid gfrf --json): {"type": type, <each field: name -> text, or a number
+/// when the text is one>, "columns": {name: [values, non-finite as null], ...}} with the columns of `values` named
+/// by `names` in order. Throws InvalidArgument when names and columns differ in number.
+std::string table_to_json(const std::string& type, const std::vector<std::pair<std::string, std::string>>& fields,
+                          const std::vector<std::string>& names, const Eigen::MatrixXd& values, int indent = 2);
 NarxModel read_narx_json(const std::string& path);
 NdeModel read_nde_json(const std::string& path);
 NarxModel parse_narx_json(const std::string& text, const std::string& source = "<json>");
