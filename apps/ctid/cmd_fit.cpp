@@ -328,7 +328,7 @@ template <class O>
 int fit_experiments(const FitArgs& a, const std::vector<IdData>& ds,
                     Result<TransferFunction> (*estimator)(const std::vector<IdData>&, const TfOrders&, const O&)) {
   O o;
-  o.estimate_delay = a.delay;
+  if constexpr (requires { o.estimate_delay; }) o.estimate_delay = a.delay;
   apply_sets(a.method, a.sets, o);
   const Result<TransferFunction> r = call_library([&] {
     const TfOrders orders = siso_orders(a);
@@ -344,9 +344,9 @@ int fit_experiments(const FitArgs& a, const std::vector<IdData>& ds,
 }
 
 int run_experiments(const FitArgs& a) {
-  if (a.method != "srivc" && a.method != "oe" && a.method != "tfest")
-    throw UsageError(detail::format("{} DATA files are several experiments: fitted jointly by --method srivc, oe or tfest "
-                                    "(got {}; the other estimators take one record so far)",
+  if (a.method != "srivc" && a.method != "oe" && a.method != "tfest" && a.method != "lssvf" && a.method != "ivsvf")
+    throw UsageError(detail::format("{} DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, "
+                                    "lssvf or ivsvf (got {}; the other estimators take one record so far)",
                                     a.paths.size(), a.method));
   if (!a.controller.empty() || a.frequency) throw UsageError("several DATA files: open-loop time-domain data only");
   std::vector<IdData> ds;
@@ -359,6 +359,8 @@ int run_experiments(const FitArgs& a) {
     throw UsageError(detail::format("several experiments: one --input and one --output (selected {} and {})", ds[0].nu(),
                                     ds[0].ny()));
   if (a.method == "srivc") return fit_experiments<SrivcOptions>(a, ds, &srivc);
+  if (a.method == "lssvf") return fit_experiments<LssvfOptions>(a, ds, &lssvf);
+  if (a.method == "ivsvf") return fit_experiments<IvsvfOptions>(a, ds, &ivsvf);
   using Joint = Result<TransferFunction> (*)(const std::vector<IdData>&, const TfOrders&, const OeOptions&);
   return fit_experiments<OeOptions>(a, ds, a.method == "oe" ? static_cast<Joint>(&oe) : static_cast<Joint>(&tfest));
 }

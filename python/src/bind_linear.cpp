@@ -90,6 +90,8 @@ void bind_linear(py::module_& m) {
   def_tf_estimator<SrivcOptions>(m, "srivc", &srivc, "Simplified refined instrumental variables (SISO).");
   // Several experiments (a list of IdData) of one system: one parameter set.
   def_experiments_estimator<SrivcOptions>(m, "srivc", &srivc);
+  def_experiments_estimator<LssvfOptions>(m, "lssvf", &lssvf);
+  def_experiments_estimator<IvsvfOptions>(m, "ivsvf", &ivsvf);
   def_experiments_estimator<OeOptions>(m, "oe", &oe);
   def_experiments_estimator<OeOptions>(m, "tfest", &tfest);
   def_tf_estimator<OeOptions>(m, "oe", &oe, "Continuous-time output error (Levenberg-Marquardt).");

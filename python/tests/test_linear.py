@@ -274,9 +274,11 @@ def test_srivc_on_several_experiments_is_one_joint_estimate():
     np.testing.assert_allclose(joint.parameters.values, [1.2, 4.0, 3.0], rtol=1e-6)
     assert joint.diagnostics.scalars["experiments"] == 2
     assert joint.fit.n_samples == 1200
-    for method in (ctid.oe, ctid.tfest):  # output error on the summed cost: the same exact answer
+    # Output error on the summed cost: exact as well. LSSVF/IVSVF sum their equations; their state-variable filters
+    # are discretised, which leaves 7.5e-5 (relative) on these records (each alone: 1.7e-4 and 5.9e-5).
+    for method, rtol in ((ctid.oe, 1e-6), (ctid.tfest, 1e-6), (ctid.lssvf, 1e-3), (ctid.ivsvf, 1e-3)):
         r = method([d1, d2], 1, 2)
-        np.testing.assert_allclose(r.parameters.values, [1.2, 4.0, 3.0], rtol=1e-6)
+        np.testing.assert_allclose(r.parameters.values, [1.2, 4.0, 3.0], rtol=rtol)
         assert r.diagnostics.scalars["experiments"] == 2
     with pytest.raises(ctid.InvalidArgument, match=r"record 2\): input 'u1' is constant"):
         ctid.srivc([d1, ctid.IdData.from_arrays(np.zeros(600), g.simulate(u1, t), ts=0.02)], 1, 2)

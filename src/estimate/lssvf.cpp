@@ -129,24 +129,29 @@ PreparedData prepare(const IdData& data, const TfOrders& o, double transient_tim
   return P;
 }
 
-internal::LinearSolution solve_ls(const PreparedData& P, const SvfLayout& L, const std::optional<TransferFunction>& filt) {
+internal::LinearSolution solve_ls(const std::vector<PreparedData>& Ps, const SvfLayout& L,
+                                  const std::optional<TransferFunction>& filt) {
   // Fast pass with the Gram matrix; a second pass with blocked QR when the problem is
   // ill-conditioned enough for the normal equations to lose accuracy.
   const int p = static_cast<int>(L.free.size());
   internal::GramLeastSquares gram(p);
-  svf_pass(P, L, filt, nullptr, [&](const double* row, double lhs, const double*, double w) { gram.add(row, lhs, w); });
+  for (const PreparedData& P : Ps)
+    svf_pass(P, L, filt, nullptr, [&](const double* row, double lhs, const double*, double w) { gram.add(row, lhs, w); });
   internal::LinearSolution s = gram.solve();
   if (s.condition < internal::kGramConditionLimit && s.theta.allFinite()) return s;
   internal::StreamingLeastSquares ls(p);
-  svf_pass(P, L, filt, nullptr, [&](const double* row, double lhs, const double*, double w) { ls.add(row, lhs, w); });
+  for (const PreparedData& P : Ps)
+    svf_pass(P, L, filt, nullptr, [&](const double* row, double lhs, const double*, double w) { ls.add(row, lhs, w); });
   return ls.solve();
 }
 
-internal::LinearSolution solve_iv(const PreparedData& P, const SvfLayout& L, const std::optional<TransferFunction>& filt,
-                                  const Eigen::VectorXd& aux) {
+internal::LinearSolution solve_iv(const std::vector<PreparedData>& Ps, const SvfLayout& L,
+                                  const std::optional<TransferFunction>& filt, const std::vector<Eigen::VectorXd>& aux) {
   const int p = static_cast<int>(L.free.size());
   internal::InstrumentalVariables iv(p);
-  svf_pass(P, L, filt, &aux, [&](const double* row, double lhs, const double* zrow, double w) { iv.add(zrow, row, lhs, w); });
+  for (std::size_t e = 0; e < Ps.size(); ++e)
+    svf_pass(Ps[e], L, filt, &aux[e],
+             [&](const double* row, double lhs, const double* zrow, double w) { iv.add(zrow, row, lhs, w); });
   return iv.solve();
 }
 
@@ -164,11 +169,11 @@ TransferFunction tf_from_theta(const SvfLayout& L, const Eigen::VectorXd& th, do
   return TransferFunction(num, den, delay);
 }
 
-Result<TransferFunction> make_result(const IdData& data, const TfOrders& o, const SvfLayout& L,
+Result<TransferFunction> make_result(const std::vector<IdData>& data, const TfOrders& o, const SvfLayout& L,
                                      const internal::LinearSolution& sol, double alpha) {
   Result<TransferFunction> r;
   const Eigen::VectorXd th = full_theta(L, sol.theta);
-  const double delay = o.nk > 0 ? o.nk * data.ts() : 0.0;
+  const double delay = o.nk > 0 ? o.nk * data.front().ts() : 0.0;
   const int np = o.nf + o.nb;
   r.parameters.names = tf_parameter_names(o);
   r.parameters.values.resize(np);
@@ -236,6 +241,7 @@ Result<TransferFunction> make_result(const IdData& data, const TfOrders& o, cons
   }
   // Output-error fit of the model on the estimation data.
   r.fit = simulation_fit(r.model, data, static_cast<int>(L.free.size()));
+  if (data.size() > 1) r.diagnostics.scalars["experiments"] = static_cast<double>(data.size());
   return r;
 }
 
@@ -246,11 +252,17 @@ Eigen::VectorXd svf_transform(const SvfLayout& L, const Eigen::VectorXd& th) {
   return tt;
 }
 
-double choose_tau(const IdData& data, const TfOrders& o, const LssvfOptions& opt, Eigen::VectorXd* grid_out,
+double choose_tau(const std::vector<IdData>& data, const TfOrders& o, const LssvfOptions& opt, Eigen::VectorXd* grid_out,
                   Eigen::VectorXd* fit_out) {
-  const PreparedData P = prepare(data, o, opt.transient_time, opt.alpha, opt.weights, "lssvf");
-  const double lo = 2.0 * P.h;
-  const double hi = std::max(lo * 4.0, data.duration() / 20.0);
+  std::vector<PreparedData> P;
+  double h = 0, shortest = std::numeric_limits<double>::infinity();
+  for (const IdData& d : data) {
+    P.push_back(prepare(d, o, opt.transient_time, opt.alpha, opt.weights, "lssvf"));
+    h = std::max(h, P.back().h);
+    shortest = std::min(shortest, d.duration());
+  }
+  const double lo = 2.0 * h;
+  const double hi = std::max(lo * 4.0, shortest / 20.0);
   const int G = opt.tau_grid_size;
   Eigen::VectorXd grid(G), fits(G);
   double best_tau = lo, best_fit = -std::numeric_limits<double>::infinity();
@@ -263,11 +275,10 @@ double choose_tau(const IdData& data, const TfOrders& o, const LssvfOptions& opt
     const SvfLayout L = make_layout(o, tau, opt.fixed, "lssvf");
     const internal::LinearSolution s = solve_ls(P, L, opt.data_filter);
     if (s.rank_deficient || !s.theta.allFinite()) continue;
-    const TransferFunction tf = tf_from_theta(L, full_theta(L, s.theta), o.nk > 0 ? o.nk * data.ts() : 0.0);
+    const TransferFunction tf = tf_from_theta(L, full_theta(L, s.theta), o.nk > 0 ? o.nk * data.front().ts() : 0.0);
     if (!tf.is_stable()) continue;
-    const Eigen::VectorXd yhat = lsim(tf, data, 0);
-    if (!yhat.allFinite()) continue;
-    const double f = fit_percent(data.y().col(0), yhat);
+    const double f = simulation_fit(tf, data, 0).fit_percent;
+    if (!std::isfinite(f)) continue;
     fits(i) = f;
     if (f > best_fit) { best_fit = f; best_tau = tau; have = true; }
   }
@@ -280,19 +291,47 @@ double choose_tau(const IdData& data, const TfOrders& o, const LssvfOptions& opt
 
 using namespace svf_detail;
 
+namespace {
+// The records prepared for the SVF regressions; `who` names the record when there are several.
+std::vector<PreparedData> prepare_all(const std::vector<IdData>& data, const TfOrders& o, const LssvfOptions& opt,
+                                      const char* who) {
+  CTID_REQUIRE(!data.empty(), "{}: no records given", who);
+  std::vector<PreparedData> P;
+  for (std::size_t e = 0; e < data.size(); ++e) {
+    const std::string name = data.size() == 1 ? std::string(who) : detail::format("{} (record {})", who, e + 1);
+    P.push_back(prepare(data[e], o, opt.transient_time, opt.alpha, opt.weights, name.c_str()));
+    CTID_REQUIRE(e == 0 || o.nk == 0 || std::abs(data[e].ts() - data[0].ts()) <= 1e-9 * data[0].ts(),
+                 "{}: nk counts samples, so the records need one sampling period ({} s and {} s)", name, data[0].ts(),
+                 data[e].ts());
+  }
+  return P;
+}
+}  // namespace
+
 Result<TransferFunction> lssvf(const IdData& data, const TfOrders& orders, const LssvfOptions& options) {
+  return lssvf(std::vector<IdData>{data}, orders, options);
+}
+
+Result<TransferFunction> ivsvf(const IdData& data, const TfOrders& orders, const IvsvfOptions& options) {
+  return ivsvf(std::vector<IdData>{data}, orders, options);
+}
+
+Result<TransferFunction> lssvf(const std::vector<IdData>& data, const TfOrders& orders, const LssvfOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   orders.validate();
   options.validate();
+  const std::vector<PreparedData> P = prepare_all(data, orders, options, "lssvf");
   Eigen::VectorXd grid, fits;
-  double tau = options.tau;
-  CTID_REQUIRE(tau <= 1e3 * data.duration(), "lssvf: tau = {} s is more than 1000 times the record ({} s): the filtered "
-               "signals would not move", tau, data.duration());
+  double tau = options.tau, longest = 0;
+  for (const IdData& d : data) longest = std::max(longest, d.duration());
+  CTID_REQUIRE(tau <= 1e3 * longest, "lssvf: tau = {} s is more than 1000 times the record ({} s): the filtered "
+               "signals would not move", tau, longest);
   if (tau == 0.0) tau = choose_tau(data, orders, options, &grid, &fits);
-  const PreparedData P = prepare(data, orders, options.transient_time, options.alpha, options.weights, "lssvf");
   const SvfLayout L = make_layout(orders, tau, options.fixed, "lssvf");
-  CTID_REQUIRE(P.n_used > static_cast<int>(L.free.size()),
-               "lssvf: {} samples in the criterion cannot determine {} free parameters", P.n_used, L.free.size());
+  int n_used = 0;
+  for (const PreparedData& p : P) n_used += p.n_used;
+  CTID_REQUIRE(n_used > static_cast<int>(L.free.size()),
+               "lssvf: {} samples in the criterion cannot determine {} free parameters", n_used, L.free.size());
   const internal::LinearSolution sol = solve_ls(P, L, options.data_filter);
   Result<TransferFunction> r = make_result(data, orders, L, sol, options.alpha);
   if (grid.size() > 0) {
@@ -301,7 +340,7 @@ Result<TransferFunction> lssvf(const IdData& data, const TfOrders& orders, const
   }
   r.summary.iterations = 1;
   tf_detail::check_cancellation(r);
-  tf_detail::warn_poles_beyond_bandwidth(r, data);
+  tf_detail::warn_poles_beyond_bandwidth(r, data.front());
   if (interrupt_requested()) {
     r.summary.termination = Termination::Interrupted;
     r.summary.message = "interrupted during the choice of tau";
@@ -310,14 +349,14 @@ Result<TransferFunction> lssvf(const IdData& data, const TfOrders& orders, const
   return r;
 }
 
-Result<TransferFunction> ivsvf(const IdData& data, const TfOrders& orders, const IvsvfOptions& options) {
+Result<TransferFunction> ivsvf(const std::vector<IdData>& data, const TfOrders& orders, const IvsvfOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   orders.validate();
   options.validate();
   Result<TransferFunction> r = lssvf(data, orders, options.svf);
   if (!r.usable()) return r;
   const double tau = r.diagnostics.scalars.at("tau");
-  const PreparedData P = prepare(data, orders, options.svf.transient_time, options.svf.alpha, options.svf.weights, "ivsvf");
+  const std::vector<PreparedData> P = prepare_all(data, orders, options.svf, "ivsvf");
   const SvfLayout L = make_layout(orders, tau, options.svf.fixed, "ivsvf");
   Eigen::VectorXd theta = full_theta(L, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(L.free.size())));
   for (std::size_t j = 0; j < L.free.size(); ++j) {
@@ -332,8 +371,9 @@ Result<TransferFunction> ivsvf(const IdData& data, const TfOrders& orders, const
   for (it = 1; it <= options.max_iterations; ++it) {
     TransferFunction aux = tf_from_theta(L, theta, 0.0);
     aux = tf_detail::stabilized(aux);
-    // Auxiliary-model output driven by the (delayed) input P.u.
-    const Eigen::VectorXd xhat = lsim(aux, P.delayed_u(), data.times(), P.u_intersample);
+    // Auxiliary-model output driven by the (delayed) input of each record.
+    std::vector<Eigen::VectorXd> xhat;
+    for (std::size_t e = 0; e < data.size(); ++e) xhat.push_back(lsim(aux, P[e].delayed_u(), data[e].times(), P[e].u_intersample));
     sol = solve_iv(P, L, options.svf.data_filter, xhat);
     if (sol.rank_deficient || !sol.theta.allFinite()) {
       term = sol.rank_deficient ? Termination::RankDeficient : Termination::NumericalFailure;
@@ -375,14 +415,23 @@ Result<TransferFunction> ivsvf(const IdData& data, const TfOrders& orders, const
 
 namespace ctid::svf_detail {
 
-FitReport simulation_fit(const TransferFunction& model, const IdData& data, int n_free) {
-  if (data.size() < 2) {
+FitReport simulation_fit(const TransferFunction& model, const std::vector<IdData>& data, int n_free) {
+  Eigen::Index total = 0;
+  for (const IdData& d : data) total += d.size();
+  if (total < 2) {
     FitReport f;
-    f.n_samples = data.size();
+    f.n_samples = static_cast<int>(total);
     f.n_parameters = n_free;
     return f;
   }
-  return fit_report_or_inf(data.y().col(0), lsim(model, data, 0), n_free);
+  Eigen::VectorXd y(total), sim(total);
+  Eigen::Index at = 0;
+  for (const IdData& d : data) {
+    y.segment(at, d.size()) = d.y().col(0);
+    sim.segment(at, d.size()) = lsim(model, d, 0);
+    at += d.size();
+  }
+  return fit_report_or_inf(y, sim, n_free);
 }
 
 }  // namespace ctid::svf_detail

@@ -74,20 +74,23 @@ int parameter_index(const TfOrders& o, const std::string& name, const char* who)
 SvfLayout make_layout(const TfOrders& o, double tau, const std::map<std::string, double>& fixed, const char* who);
 PreparedData prepare(const IdData& data, const TfOrders& o, double transient_time, double alpha, SvfWeights weights,
                      const char* who);
-internal::LinearSolution solve_ls(const PreparedData& P, const SvfLayout& L, const std::optional<TransferFunction>& filt);
-internal::LinearSolution solve_iv(const PreparedData& P, const SvfLayout& L, const std::optional<TransferFunction>& filt,
-                                  const Eigen::VectorXd& aux);
+/// Least squares (and instrumental variables, aux: the auxiliary model's output per record) with the normal
+/// equations summed over one or several prepared records (several experiments of one system).
+internal::LinearSolution solve_ls(const std::vector<PreparedData>& P, const SvfLayout& L,
+                                  const std::optional<TransferFunction>& filt);
+internal::LinearSolution solve_iv(const std::vector<PreparedData>& P, const SvfLayout& L,
+                                  const std::optional<TransferFunction>& filt, const std::vector<Eigen::VectorXd>& aux);
 Eigen::VectorXd full_theta(const SvfLayout& L, const Eigen::VectorXd& theta_free);
 Eigen::VectorXd svf_transform(const SvfLayout& L, const Eigen::VectorXd& theta);
 TransferFunction tf_from_theta(const SvfLayout& L, const Eigen::VectorXd& theta, double delay);
-Result<TransferFunction> make_result(const IdData& data, const TfOrders& o, const SvfLayout& L,
+Result<TransferFunction> make_result(const std::vector<IdData>& data, const TfOrders& o, const SvfLayout& L,
                                      const internal::LinearSolution& sol, double alpha);
-double choose_tau(const IdData& data, const TfOrders& o, const LssvfOptions& opt, Eigen::VectorXd* grid,
+double choose_tau(const std::vector<IdData>& data, const TfOrders& o, const LssvfOptions& opt, Eigen::VectorXd* grid,
                   Eigen::VectorXd* fits);
 
-/// Output-error fit of a model on the data (simulation from rest); -Inf fit when the
+/// Output-error fit of a model on the records (each simulated from rest, concatenated); -Inf fit when a
 /// simulation diverges.
-FitReport simulation_fit(const TransferFunction& model, const IdData& data, int n_free);
+FitReport simulation_fit(const TransferFunction& model, const std::vector<IdData>& data, int n_free);
 
 
 /// psi = F_tau^T phi (physical-coefficient regressor, RJ 25) from the chain outputs;

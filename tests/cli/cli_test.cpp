@@ -1100,9 +1100,10 @@ TEST(Cli, SeveralDataFilesAreFittedJointly) {
   for (int i = 0; i < 3; ++i)
     EXPECT_NEAR(jt.at("parameters").at(i).at("value").get<double>(), lib_t.parameters.values(i),
                 1e-9 * std::abs(lib_t.parameters.values(i)));
-  const CliRun o = ctid_run("fit " + files[0] + " " + files[1] + " --time time --input force --output position --method lssvf --nf 2");
+  const CliRun o = ctid_run("fit " + files[0] + " " + files[1] + " --time time --input force --output position --method fsf");
   EXPECT_EQ(o.code, 2);
-  EXPECT_NE(o.err.find("2 DATA files are several experiments: fitted jointly by --method srivc, oe or tfest (got lssvf"),
+  EXPECT_NE(o.err.find("2 DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, lssvf or "
+                       "ivsvf (got fsf"),
             std::string::npos)
       << o.err;
 }

@@ -75,6 +75,13 @@ Result<TransferFunction> lssvf(const IdData& data, const TfOrders& orders, const
 /// iterated to convergence (Young's IV idea applied to Johansson's regression).
 Result<TransferFunction> ivsvf(const IdData& data, const TfOrders& orders, const IvsvfOptions& options = {});
 
+/// Several experiments of one system (issue 14, item 2): the normal equations (LSSVF) or IV equations (IVSVF)
+/// summed over the records, each filtered from rest (transient_time leaves out the start of each); tau chosen on
+/// the pooled simulation fit; fit over all records; diagnostics.scalars "experiments". Throws as the one-record
+/// functions, naming the record.
+Result<TransferFunction> lssvf(const std::vector<IdData>& data, const TfOrders& orders, const LssvfOptions& options = {});
+Result<TransferFunction> ivsvf(const std::vector<IdData>& data, const TfOrders& orders, const IvsvfOptions& options = {});
+
 /// Parameter names for the given orders: a1..a<nf>, b0..b<nb-1>.
 std::vector<std::string> tf_parameter_names(const TfOrders& orders);
 
