@@ -424,13 +424,7 @@ FitReport simulation_fit(const TransferFunction& model, const std::vector<IdData
     f.n_parameters = n_free;
     return f;
   }
-  Eigen::VectorXd y(total), sim(total);
-  Eigen::Index at = 0;
-  for (const IdData& d : data) {
-    y.segment(at, d.size()) = d.y().col(0);
-    sim.segment(at, d.size()) = lsim(model, d, 0);
-    at += d.size();
-  }
+  const auto [y, sim] = tf_detail::pooled_outputs(model, data, 0.0);
   return fit_report_or_inf(y, sim, n_free);
 }
 

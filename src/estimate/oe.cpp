@@ -154,16 +154,8 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
   r.parameters.values = full;
   for (int j = 0; j < p; ++j) r.parameters.values(free[j]) = lm.x(j);
   r.parameters.fixed = is_fixed;
-  Eigen::VectorXd res;
-  stacked_residuals(r.model, ds, opt.transient_time, o.nb, false, res, nullptr);
-  Eigen::VectorXd y_all(res.size());
-  Eigen::Index at = 0;
-  for (const IdData& d : ds) {
-    const Eigen::Index m = d.size() - first_after(d, opt.transient_time);
-    y_all.segment(at, m) = d.y().col(0).tail(m);
-    at += m;
-  }
-  r.fit = fit_report_or_inf(y_all, y_all - res, p);
+  const auto [y_all, sim_all] = tf_detail::pooled_outputs(r.model, ds, opt.transient_time);
+  r.fit = fit_report_or_inf(y_all, sim_all, p);
   const double sigma2 = 2.0 * lm.cost / double(std::max<Eigen::Index>(1, y_all.size() - p));
   r.parameters.covariance = Eigen::MatrixXd::Zero(np, np);
   r.parameters.std = Eigen::VectorXd::Zero(np);

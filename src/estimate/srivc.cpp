@@ -237,21 +237,6 @@ SrivcRun srivc_fixed_delay(const Records& ds, const TfOrders& o, double delay, E
   return run;
 }
 
-// The measured and simulated (from rest) outputs of all records after their transients, concatenated.
-std::pair<Eigen::VectorXd, Eigen::VectorXd> pooled_outputs(const TransferFunction& g, const Records& ds, double transient) {
-  Eigen::Index total = 0;
-  for (const IdData& d : ds) total += d.size() - first_after(d, transient);
-  Eigen::VectorXd y(total), sim(total);
-  Eigen::Index at = 0;
-  for (const IdData& d : ds) {
-    const Eigen::Index f = first_after(d, transient), m = d.size() - f;
-    y.segment(at, m) = d.y().col(0).tail(m);
-    sim.segment(at, m) = lsim(g, d, 0).tail(m);
-    at += m;
-  }
-  return {y, sim};
-}
-
 // The mean squared output error over all records after their transients (+Inf when a simulation diverges).
 double pooled_mse(const TransferFunction& g, const Records& ds, double transient) {
   const auto [y, sim] = pooled_outputs(g, ds, transient);

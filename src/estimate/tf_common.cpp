@@ -189,6 +189,21 @@ Eigen::Index first_after(const IdData& d, double transient) {
   return k;
 }
 
+std::pair<Eigen::VectorXd, Eigen::VectorXd> pooled_outputs(const TransferFunction& g, const std::vector<IdData>& ds,
+                                                           double transient) {
+  Eigen::Index total = 0;
+  for (const IdData& d : ds) total += d.size() - first_after(d, transient);
+  Eigen::VectorXd y(total), sim(total);
+  Eigen::Index at = 0;
+  for (const IdData& d : ds) {
+    const Eigen::Index m = d.size() - first_after(d, transient);
+    y.segment(at, m) = d.y().col(0).tail(m);
+    sim.segment(at, m) = lsim(g, d, 0).tail(m);
+    at += m;
+  }
+  return {y, sim};
+}
+
 TransferFunction stabilized(const TransferFunction& tf) {
   if (tf.is_stable()) return tf;
   Eigen::VectorXcd p = tf.poles();

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <utility>
 #include <vector>
 
 #include "ctid/core/types.hpp"
@@ -21,6 +22,10 @@ TransferFunction tf_of(const Eigen::VectorXd& p, const TfOrders& o, double delay
 double output_error_mse(const TransferFunction& g, const IdData& d);
 /// The first sample at or after `transient` seconds from the record's start (the rows a transient_time leaves out).
 Eigen::Index first_after(const IdData& d, double transient);
+/// The measured and simulated (from rest) outputs of every record after its first `transient` seconds, each
+/// concatenated in record order (several experiments of one system).
+std::pair<Eigen::VectorXd, Eigen::VectorXd> pooled_outputs(const TransferFunction& g, const std::vector<IdData>& ds,
+                                                           double transient);
 /// Mirror unstable poles into the left half plane (prefilters and auxiliary models must be stable).
 TransferFunction stabilized(const TransferFunction& tf);
 
