@@ -120,12 +120,6 @@ void check_outputs(const std::vector<std::string>& outs_in, const std::vector<st
   }
 }
 
-std::vector<std::pair<std::string, std::string>> raw_settings(const std::vector<std::string>& sets) {
-  std::vector<std::pair<std::string, std::string>> s;
-  for (const auto& [k, v] : parse_sets(sets)) s.emplace_back(k, v);
-  return s;
-}
-
 std::map<std::string, std::string> parse_sets(const std::vector<std::string>& sets) {
   std::map<std::string, std::string> m;
   for (const auto& s : sets) {

@@ -130,8 +130,6 @@ std::vector<std::pair<std::string, std::string>> settings_of(const O&... o) {
       ...);
   return s;
 }
-/// --set pairs as given (methods without a table yet).
-std::vector<std::pair<std::string, std::string>> raw_settings(const std::vector<std::string>& sets);
 
 /// --report: write the HTML report of r on d (nothing when path is empty), with `settings` as the method
 /// settings. A report that cannot be made (e.g. multi-channel data) is a UsageError; a write failure an

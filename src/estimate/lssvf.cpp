@@ -119,9 +119,7 @@ PreparedData prepare(const IdData& data, const TfOrders& o, double transient_tim
   P.alpha = alpha;
   P.weights = weights;
   P.t_end = data.time(N - 1);
-  const double t0 = data.t0();
-  int first = 0;
-  while (first < N && data.time(first) - t0 < transient_time - 1e-12 * std::max(1.0, transient_time)) ++first;
+  const int first = static_cast<int>(tf_detail::first_after(data, transient_time));
   CTID_REQUIRE(first < N, "{}: transient_time = {} s leaves no samples (record lasts {} s)", who, transient_time,
                data.duration());
   P.first = first;

@@ -216,9 +216,5 @@ void unknown_key(const std::string& method, const std::string& key, const std::v
                                       near.empty() ? std::string() : "; did you mean '" + near + "'?", all));
 }
 
-void wrong_type(const std::string& method, const std::string& name, OptionKind kind) {
-  throw InvalidOptions(detail::format("{}: {} takes a {}", method, name, to_string(kind)));
-}
-
 }  // namespace options_detail
 }  // namespace ctid

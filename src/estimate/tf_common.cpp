@@ -185,7 +185,7 @@ void finish_tf_result(Result<TransferFunction>& r, const IdData& d) {
 
 Eigen::Index first_after(const IdData& d, double transient) {
   Eigen::Index k = 0;
-  while (k < d.size() && d.time(static_cast<int>(k)) - d.t0() < transient * (1 - 1e-12)) ++k;
+  while (k < d.size() && d.time(static_cast<int>(k)) - d.t0() < transient - 1e-12 * std::max(1.0, transient)) ++k;
   return k;
 }
 

@@ -94,7 +94,6 @@ std::string format_tf(const TransferFunction& g);
 [[noreturn]] void out_of_range(const std::string& method, const std::string& name, const std::string& range,
                                const std::string& got, const std::string& unit);
 [[noreturn]] void unknown_key(const std::string& method, const std::string& key, const std::vector<std::string>& names);
-[[noreturn]] void wrong_type(const std::string& method, const std::string& name, OptionKind kind);
 }  // namespace options_detail
 
 /// The settings of one options struct O. Built once (see option_table<O>()) and immutable afterwards.
