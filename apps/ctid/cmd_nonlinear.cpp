@@ -57,11 +57,10 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
   else apply_sets("kia", set_list, ko);
   NarxModel narx;
   if (!narx_file.empty()) {
-    try {
-      narx = read_narx_json(narx_file).process();
-    } catch (const FileError& e) {
-      throw InputError(e.what());
-    }
+    const AnyModel m = read_result(narx_file).result.model;
+    if (!std::holds_alternative<NarxModel>(m))
+      throw InputError(narx_file + ": --narx needs a NARX model; this is a " + model_type_name(m) + " model");
+    narx = std::get<NarxModel>(m).process();
   } else {
     const Result<NarxModel> r = run_narx(d, no);
     print_narx(r);
@@ -123,20 +122,18 @@ int run_gfrf(const GfrfArgs& a) {
     throw UsageError("give either the frequencies with --w w1,w2,.. (rad/s) or the points with --points FILE");
   std::function<Complex(const std::vector<Complex>&)> kernel;
   std::string kind;
-  try {
-    const NarxModel m = read_narx_json(a.model).process();
-    kernel = [m, zoh = !a.no_zoh](const std::vector<Complex>& s) { return narx_gfrf_ct(m, s, zoh); };
+  const AnyModel model = read_result(a.model).result.model;
+  if (const auto* narx = std::get_if<NarxModel>(&model)) {
+    kernel = [m = narx->process(), zoh = !a.no_zoh](const std::vector<Complex>& s) { return narx_gfrf_ct(m, s, zoh); };
     kind = "narx";
-  } catch (const FileError& narx_error) {
-    try {
-      const NdeModel m = read_nde_json(a.model);
-      kernel = [m](const std::vector<Complex>& s) {
-        return s.size() == 1 ? m.h1(s[0]) : s.size() == 2 ? m.h2(s[0], s[1]) : m.h3(s[0], s[1], s[2]);
-      };
-      kind = "nde";
-    } catch (const FileError&) {
-      throw InputError(std::string(narx_error.what()) + " (and it is not an NDE model either)");
-    }
+  } else if (const auto* nde = std::get_if<NdeModel>(&model)) {
+    kernel = [m = *nde](const std::vector<Complex>& s) {
+      return s.size() == 1 ? m.h1(s[0]) : s.size() == 2 ? m.h2(s[0], s[1]) : m.h3(s[0], s[1], s[2]);
+    };
+    kind = "nde";
+  } else {
+    throw InputError(a.model + ": GFRFs are computed for NARX and NDE models; this is a " + model_type_name(model) +
+                     " model");
   }
   std::vector<std::string> names;
   for (int i = 1; i <= a.order; ++i) {

@@ -1,8 +1,7 @@
-// ctid simulate MODEL.json DATA [--out OUT.csv] [--snr DB --seed N]: linear models exactly, NARX models at their
-// sampling period, NDE models by the adaptive integrator at the data's times.
+// ctid simulate MODEL.json DATA [--out OUT.csv] [--initial rest|measured|estimated] [--snr DB --seed N]: any
+// result or model file ctid writes, simulated by simulate() (simulate/simulate.hpp).
 #include <cstdio>
 #include <functional>
-#include <optional>
 
 #include "common.hpp"
 
@@ -16,47 +15,19 @@ struct SimArgs {
   std::string out;
   double snr = std::numeric_limits<double>::quiet_NaN();
   unsigned long long seed = 1;
+  std::string initial = "rest";
   bool force = false;
 };
 
 
 int run(const SimArgs& a) {
   check_outputs({a.out}, {a.data.path, a.model}, a.force);
-  const IdData d = a.data.load(false);
-  Eigen::MatrixXd y;
+  const ResultFile f = read_result(a.model);
+  const InitialCondition initial = initial_condition_from_string(a.initial);
+  const IdData d = a.data.load(initial != InitialCondition::Rest);
+  Eigen::MatrixXd y = simulate_result(f.result, d, a.initial);
   std::vector<std::string> ynames;
-  LinearModel m;
-  bool nonlinear = false;
-  try {
-    m = read_model_json(a.model);
-  } catch (const FileError& e) {
-    const std::optional<NonlinearModel> nl = read_nonlinear_model(a.model);
-    if (!nl) throw InputError(e.what());
-    y = simulate_nonlinear(*nl, d, a.model);
-    nonlinear = true;
-    ynames = {"y"};
-  }
-  if (nonlinear) {
-    // simulated by simulate_nonlinear
-  } else if (const auto* tf = std::get_if<TransferFunction>(&m)) {
-    if (d.nu() != 1) throw UsageError(detail::format("the transfer function has 1 input but {} input columns were selected", d.nu()));
-    y = lsim(*tf, d, 0);
-    require_finite_simulation(y, d, unstable_poles(MisoModel{{*tf}}));
-    ynames = {"y"};
-  } else if (const auto* mm = std::get_if<MisoModel>(&m)) {
-    if (d.nu() != mm->nu())
-      throw UsageError(detail::format("the model has {} inputs but {} input columns were selected", mm->nu(), d.nu()));
-    y = lsim(*mm, d);
-    require_finite_simulation(y, d, unstable_poles(*mm));
-    ynames = {"y"};
-  } else {
-    const auto& ss = std::get<StateSpace>(m);
-    if (d.nu() != ss.nu())
-      throw UsageError(detail::format("the model has {} inputs but {} input columns were selected", ss.nu(), d.nu()));
-    y = lsim(ss, d);
-    require_finite_simulation(y, d, "");
-    for (int j = 0; j < ss.ny(); ++j) ynames.push_back("y" + std::to_string(j + 1));
-  }
+  for (Eigen::Index j = 0; j < y.cols(); ++j) ynames.push_back(y.cols() == 1 ? "y" : "y" + std::to_string(j + 1));
   if (!std::isnan(a.snr)) {
     for (Eigen::Index j = 0; j < y.cols(); ++j) y.col(j) = add_noise_snr(y.col(j), a.snr, a.seed + static_cast<unsigned long long>(j));
   }
@@ -86,9 +57,10 @@ void setup_simulate(CLI::App& app) {
   auto a = std::make_shared<SimArgs>();
   app.add_option("MODEL", a->model, "Model JSON (a result file or a bare model)")->required();
   app.add_option("DATA", a->data.path, "Table with the input column(s) and a time axis")->required();
-  a->data.add_to(app, false);
+  a->data.add_to(app, true);  // --output: the record's output, read for --initial measured|estimated
   app.add_option("--out", a->out, "Write t, inputs and simulated outputs to this CSV (default: stdout)");
   app.add_option("--snr", a->snr, "Add white Gaussian noise at this signal-to-noise ratio (dB)");
+  add_initial_option(app, a->initial);
   app.add_option("--seed", a->seed, "Seed of the noise")->capture_default_str();
   app.add_flag("--force", a->force, "Overwrite an existing output file");
   app.callback([a] { g_run = [a] { return run(*a); }; });

@@ -1,7 +1,7 @@
-// ctid validate MODEL.json DATA [--json OUT.json]: fit and residual tests of a linear, NARX or NDE model on a record.
+// ctid validate MODEL.json DATA [--initial rest|measured|estimated] [--json OUT.json]: fit and residual tests of any
+// single-output result or model file on a record (simulated by simulate(), simulate/simulate.hpp).
 #include <cstdio>
 #include <functional>
-#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -16,6 +16,7 @@ struct ValArgs {
   DataArgs data;
   std::string json;
   int lags = 25;
+  std::string initial = "rest";
   bool force = false;
 };
 
@@ -27,54 +28,20 @@ nlohmann::json corr_json(const CorrelationTest& c) {
           {"passed", c.passed()}};
 }
 
-// The "model" member of a NARX/NDE result file (already read successfully), or the bare model file itself.
-nlohmann::json nonlinear_model_json(const std::string& path) {
-  nlohmann::json j = nlohmann::json::parse(read_text_file(path));
-  return j.contains("model") ? j["model"] : j;
-}
-
 int run(const ValArgs& a) {
   check_outputs({a.json}, {a.data.path, a.model}, a.force);
-  // Linear models (transfer function, MISO) are simulated exactly from rest; NARX and NDE model files as by
-  // `ctid simulate` (NARX at its Ts from rest, NDE by the adaptive integrator).
-  std::optional<LinearModel> linear;
-  std::optional<NonlinearModel> nonlinear;
-  std::string description, unstable;
-  int np = 0;
-  try {
-    linear = read_model_json(a.model);
-    if (std::holds_alternative<StateSpace>(*linear)) throw UsageError("validate supports transfer-function, MISO, NARX and NDE models");
-  } catch (const FileError& e) {
-    nonlinear = read_nonlinear_model(a.model);
-    if (!nonlinear) throw InputError(e.what());
-    std::visit([&](const auto& m) {
-      description = m.to_string(6);
-      np = static_cast<int>(m.coefficients().size());
-    }, *nonlinear);
-  }
+  const ResultFile file = read_result(a.model);
+  const AnyModel& model = file.result.model;
+  if (model_outputs(model) != 1) throw UsageError("validate compares one output; the model has " + std::to_string(model_outputs(model)));
   const IdData d = a.data.load(true);
   if (d.ny() != 1) throw UsageError(detail::format("validate compares one output; {} were selected", d.ny()));
   if (a.lags < 1 || a.lags >= d.size()) throw UsageError(detail::format("--lags must be in [1, {}]", d.size() - 1));
-  Eigen::VectorXd yhat;
-  if (linear) {
-    const MisoModel miso = std::holds_alternative<MisoModel>(*linear) ? std::get<MisoModel>(*linear)
-                                                                       : MisoModel{{std::get<TransferFunction>(*linear)}};
-    if (d.nu() != miso.nu())
-      throw UsageError(detail::format("the model has {} inputs and 1 output; {} inputs and {} outputs were selected",
-                                      miso.nu(), d.nu(), d.ny()));
-    yhat = lsim(miso, d);
-    unstable = unstable_poles(miso);
-    require_finite_simulation(yhat, d, unstable);
-    for (const auto& c : miso.channels) np += c.num().degree() + 1 + c.order();
-    description = miso.to_string(6);
-  } else {
-    yhat = simulate_nonlinear(*nonlinear, d, a.model);
-    require_finite_simulation(yhat, d, "");
-  }
+  const Eigen::VectorXd yhat = simulate_result(file.result, d, a.initial).col(0);
+  const std::string description = describe(model), unstable = unstable_poles_note(model);
   const Eigen::VectorXd y = d.y().col(0);
   FitReport f;
   try {
-    f = fit_report(y, yhat, np);
+    f = fit_report(y, yhat, model_coefficient_count(model));
   } catch (const InvalidArgument& e) {
     throw InputError(a.data.path + ": " + e.what());
   }
@@ -94,7 +61,8 @@ int run(const ValArgs& a) {
   if (!a.json.empty()) {
     nlohmann::json j;
     j["ctid_version"] = version();
-    j["model"] = linear ? nlohmann::json::parse(model_to_json(*linear)) : nonlinear_model_json(a.model);
+    j["model"] = nlohmann::json::parse(result_to_json(file.result, file.method))["model"];
+    j["initial"] = a.initial;
     j["fit"] = {{"fit_percent", f.fit_percent}, {"nrmse", f.nrmse}, {"mse", f.mse}, {"n_samples", f.n_samples}};
     j["residual_autocorrelation"] = corr_json(ac);
     j["input_residual_crosscorrelation"] = nlohmann::json::array();
@@ -111,6 +79,7 @@ void setup_validate(CLI::App& app) {
   app.add_option("MODEL", a->model, "Model JSON (a result file or a bare model)")->required();
   app.add_option("DATA", a->data.path, "Measured data table or .mat file")->required();
   a->data.add_to(app, true);
+  add_initial_option(app, a->initial);
   app.add_option("--lags", a->lags, "Lags of the residual correlation tests")->capture_default_str();
   app.add_option("--json", a->json, "Write fit and residual tests to this JSON file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");

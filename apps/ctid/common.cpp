@@ -133,64 +133,36 @@ std::map<std::string, std::string> parse_sets(const std::vector<std::string>& se
   return m;
 }
 
-std::optional<NonlinearModel> read_nonlinear_model(const std::string& path) {
+ResultFile read_result(const std::string& path) {
   try {
-    return read_narx_json(path);
-  } catch (const FileError&) {
-  }
-  try {
-    return read_nde_json(path);
-  } catch (const FileError&) {
-    return std::nullopt;
+    return read_result_file(path);
+  } catch (const FileError& e) {
+    throw InputError(e.what());
   }
 }
 
-Eigen::VectorXd simulate_nonlinear(const NonlinearModel& m, const IdData& d, const std::string& source) {
-  if (d.nu() != 1) throw UsageError(detail::format("the model has 1 input but {} input columns were selected", d.nu()));
-  if (const auto* narx = std::get_if<NarxModel>(&m)) {
-    if (!d.is_uniform() || std::abs(d.ts() - narx->ts()) > 1e-9 * narx->ts())
-      throw UsageError(detail::format("the NARX model runs at Ts = {} s; the data must be uniformly sampled at it",
-                                      narx->ts()));
-    bool escaped = false;
-    Eigen::VectorXd y = narx->process().simulate(d.u().col(0), {}, &escaped);
-    if (escaped) throw NotUsable(source + ": the NARX simulation escapes (blows up) for this input");
-    return y;
-  }
-  Eigen::VectorXd t(d.size());
-  for (int i = 0; i < d.size(); ++i) t(i) = d.time(i) - d.t0();
-  NdeSimulation s;
+void add_initial_option(CLI::App& app, std::string& initial) {
+  app.add_option("--initial", initial,
+                 "Initial condition of the simulation: rest (zero state), measured (NARX: the first measured outputs; "
+                 "NDE: y(0)) or estimated (linear: least-squares initial state; NDE: the fitted x0)")
+      ->check(CLI::IsMember({"rest", "measured", "estimated"}))
+      ->capture_default_str();
+}
+
+Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, const std::string& initial) {
+  SimulateOptions o;
+  Simulation s;
   try {
-    s = std::get<NdeModel>(m).simulate(d.u().col(0), t, d.intersample(0));
+    o.initial = initial_condition_from_string(initial);
+    if (const auto x0 = r.diagnostics.vectors.find("x0");
+        o.initial == InitialCondition::Estimated && x0 != r.diagnostics.vectors.end())
+      o.x0 = x0->second;
+    s = simulate(r.model, d, o);
   } catch (const InvalidArgument& e) {
-    throw UsageError(source + ": " + e.what());
+    throw UsageError(e.what());
   }
-  if (!s.ok()) throw NotUsable(source + ": " + s.message);
+  if (!s.ok()) throw NotUsable(s.problem);
   return s.y;
-}
-
-void require_finite_simulation(const Eigen::MatrixXd& y, const IdData& d, const std::string& why) {
-  // Diverged: a non-finite sample, or samples so large that their squares overflow (then every fit measure
-  // and correlation would be Inf or 0/Inf).
-  double acc = 0;
-  for (Eigen::Index k = 0; k < y.rows(); ++k) {
-    acc += y.row(k).squaredNorm();
-    if (!std::isfinite(acc))
-      throw NotUsable(detail::format("the simulated output is not finite from sample {} (t = {} s) on: the model diverges "
-                                     "on these inputs{}",
-                                     k, d.time(static_cast<int>(k)), why));
-  }
-}
-
-std::string unstable_poles(const MisoModel& m) {
-  std::string s;
-  for (int i = 0; i < m.nu(); ++i)
-    for (const auto& p : m.channels[static_cast<size_t>(i)].poles())
-      if (p.real() >= 0) {
-        char z[64];
-        std::snprintf(z, sizeof z, "%.6g%+.6gj", p.real(), p.imag());
-        s += (s.empty() ? "; unstable poles: " : ", ") + (m.nu() > 1 ? "u" + std::to_string(i + 1) + ": " : std::string()) + z;
-      }
-  return s;
 }
 
 double to_double(const std::string& key, const std::string& value) {

@@ -62,19 +62,15 @@ template <class F>
 void consume_sets(std::map<std::string, std::string>& sets, F&& handler) {
   for (auto it = sets.begin(); it != sets.end();) it = handler(it->first, it->second) ? sets.erase(it) : std::next(it);
 }
-/// A nonlinear model file (Billings & Li): NARX or NDE; nullopt when the file is neither.
-using NonlinearModel = std::variant<NarxModel, NdeModel>;
-std::optional<NonlinearModel> read_nonlinear_model(const std::string& path);
-/// A nonlinear model simulated on d's single input: NARX at its own sampling period from rest, NDE integrated
-/// at the data's sample times with the data's intersample behaviour. `source` names the model in messages. An
-/// escaping simulation throws NotUsable (exit 1), a wrong input count or sampling UsageError.
-Eigen::VectorXd simulate_nonlinear(const NonlinearModel& m, const IdData& d, const std::string& source);
-/// Throws NotUsable naming the first sample at which a simulated output y (columns = outputs) on d is not
-/// finite or its sum of squares overflows,
-/// with `why` (e.g. the unstable poles): a diverging simulation is never written or scored.
-void require_finite_simulation(const Eigen::MatrixXd& y, const IdData& d, const std::string& why);
-/// "; unstable poles: ..." for the channels of m with poles in the closed right half plane ("" if none).
-std::string unstable_poles(const MisoModel& m);
+/// The result or model file at `path`, whatever its model type (io/json.hpp); a file that cannot be read
+/// or recognised throws InputError naming it.
+ResultFile read_result(const std::string& path);
+/// `--initial rest|measured|estimated` (simulate/simulate.hpp) on a command; default rest.
+void add_initial_option(CLI::App& app, std::string& initial);
+/// The result's model simulated on d from `initial` (Estimated takes the result's diagnostics "x0" where it
+/// has one). Data that do not fit the model throw UsageError; a simulation that stops being finite throws
+/// NotUsable naming where and why (e.g. the unstable poles): a diverging simulation is never written or scored.
+Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, const std::string& initial);
 
 double to_double(const std::string& key, const std::string& value);
 int to_int(const std::string& key, const std::string& value);

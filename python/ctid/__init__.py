@@ -17,11 +17,11 @@ from . import _ctid
 from ._ctid import (  # noqa: F401  (re-exported)
     CorrelationTest, DeadbeatObserver, FileError, FrequencyData, FsfModel, IdData, InputGenerator, InvalidArgument,
     InvalidOptions, MisoModel, ModalModel, ModalWindow, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm,
-    NonlinearCorrelationTests, PhysicalModel, TransferFunction, add_noise_snr, fit_percent, frequency_grid,
+    NonlinearCorrelationTests, PhysicalModel, ResultFile, Simulation, StateSpace, TransferFunction, add_noise_snr, fit_percent, frequency_grid,
     generator_fitted_to_input, html_report,
     input_residual_crosscorrelation, load, magnitude_band, methods, settings, narx_candidates, narx_noise_candidates,
     nonlinear_correlation_tests, one_sided_dft, piecewise_constant_windows, prbs, read_narx_json, read_nde_json,
-    residual_autocorrelation, response_horizon, time_grid,
+    read_result, residual_autocorrelation, response_horizon, time_grid, write_result,
 )
 
 __version__ = _ctid.__version__
@@ -408,24 +408,20 @@ def rls_svf_recursive(nb, nf, **options):
 
 # ---- simulation of any model on a record ----
 
-def simulate(model, data, **kwargs):
-    """Simulated output of a model (or result) driven by the input of `data` (first output channel's
-    shape): TransferFunction exactly from rest with the data's intersample; FsfModel by its discrete
-    convolution; NarxModel free-run from the first measured outputs; NdeModel from y(0) at rest (x0= to
-    override)."""
+def simulate(model, data, initial="rest", x0=None):
+    """Simulated output of any model (or result) driven by the inputs of `data` — the library's one
+    simulate() (the CLI's simulate, validate and report use it too). initial: "rest" (zero state),
+    "measured" (NARX: the first measured outputs; NDE: y(0)) or "estimated" (linear models: the
+    least-squares initial state; NARX: the measured history; NDE: x0, by default the x0 an output-error
+    fit estimated). Returns a 1-D array for a single-output model (N x ny otherwise); a simulation that
+    stops being finite warns with the reason and returns NaN from there."""
+    diagnostics = getattr(model, "diagnostics", None)
     model = getattr(model, "model", model)
-    u = data.u[:, 0]
-    t = data.times - data.t0
-    if isinstance(model, TransferFunction):
-        return model.simulate(u, t, data.intersample[0])
-    if isinstance(model, MisoModel):
-        return model.simulate(data)
-    if isinstance(model, FsfModel):
-        return model.simulate(u)
-    if isinstance(model, NarxModel):
-        p = model.process()
-        return p.simulate(u, data.y[: p.max_lag, 0])
-    if isinstance(model, NdeModel):
-        s = model.simulate(u, t, kwargs.get("intersample", data.intersample[0]), kwargs.get("x0", _np.zeros(0)))
-        return s.y
-    raise InvalidArgument(f"simulate: no simulation for a {type(model).__name__}")
+    if x0 is None:
+        vectors = diagnostics.vectors if diagnostics is not None else {}
+        x0 = vectors["x0"] if initial == "estimated" and "x0" in vectors else _np.zeros(0)
+    s = _ctid.simulate_model(model, data, initial, _np.asarray(x0, dtype=float))
+    if not s.ok():
+        import warnings
+        warnings.warn(s.problem, RuntimeWarning, stacklevel=2)
+    return s.y[:, 0] if s.y.shape[1] == 1 else s.y

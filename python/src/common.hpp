@@ -68,15 +68,16 @@ void def_report(py::module_& m) {
   m.def(
       "html_report",
       [](const IdData& d, const Result<Model>& r, const std::string& path, const std::string& method,
-         const std::string& title, const std::map<std::string, std::string>& settings) {
+         const std::string& title, const std::map<std::string, std::string>& settings, const std::string& initial) {
         ReportOptions o;
         o.method = method;
         o.title = title;
         o.settings.assign(settings.begin(), settings.end());
+        o.initial = initial_condition_from_string(initial);
         write_text_file(path, html_report(d, r, o));
       },
       py::arg("data"), py::arg("result"), py::arg("path"), py::arg("method") = "", py::arg("title") = "",
-      py::arg("settings") = std::map<std::string, std::string>{},
+      py::arg("settings") = std::map<std::string, std::string>{}, py::arg("initial") = "rest",
       "Write the self-contained HTML report of a result on a record (plots, residual tests, parameters).");
 }
 
@@ -134,5 +135,6 @@ void bind_fsf(py::module_& m);
 void bind_nonlinear(py::module_& m);
 void bind_modal(py::module_& m);
 void bind_physical(py::module_& m);
+void bind_models(py::module_& m);
 
 }  // namespace ctid::python

@@ -27,4 +27,5 @@ PYBIND11_MODULE(_ctid, m) {
   ctid::python::bind_nonlinear(m);
   ctid::python::bind_modal(m);
   ctid::python::bind_physical(m);
+  ctid::python::bind_models(m);
 }

@@ -220,6 +220,46 @@ NdeModel parse_nde_json(const std::string& text, const std::string& source) {
 }
 
 NarxModel read_narx_json(const std::string& path) { return parse_narx_json(read_text_file(path), path); }
+
+namespace {
+json any_model_json(const AnyModel& m) {
+  if (const auto* f = std::get_if<FsfModel>(&m)) return fsf_json(*f);
+  if (const auto* n = std::get_if<NarxModel>(&m)) return narx_json(*n);
+  if (const auto* e = std::get_if<NdeModel>(&m)) return nde_json(*e);
+  if (const auto* t = std::get_if<TransferFunction>(&m)) return model_json(*t);
+  if (const auto* i = std::get_if<MisoModel>(&m)) return model_json(*i);
+  return model_json(std::get<StateSpace>(m));
+}
+
+FsfModel fsf_from(const json& m, const Reader& rd) {
+  const json& delta = rd.member(m, "delta", "the model");
+  if (!delta.is_number()) rd.fail("\"delta\" must be a number (seconds)");
+  const json& shift = m.contains("shift") ? m.at("shift") : json(0.0);
+  if (!shift.is_number()) rd.fail("\"shift\" must be a number (1/s)");
+  try {
+    return FsfModel(delta.get<double>(), rd.count(rd.member(m, "N", "the model"), "N"),
+                    rd.count(rd.member(m, "n", "the model"), "n"), rd.vector(rd.member(m, "theta", "the model"), "theta"),
+                    Eigen::MatrixXd(), shift.get<double>());
+  } catch (const InvalidArgument& e) {
+    rd.fail(std::string("invalid FSF model: ") + e.what());
+  }
+}
+
+// The model of a bare model object or of a result envelope, whatever its type.
+AnyModel any_model_from(const json& root, const Reader& rd) {
+  const json& m = root.is_object() && root.contains("model") ? root.at("model") : root;
+  const json& type = rd.member(m, "type", "the model");
+  if (!type.is_string()) rd.fail("model \"type\" must be a string");
+  const std::string t = type.get<std::string>();
+  if (t == "fsf") return fsf_from(m, rd);
+  if (t == "narx") return parse_narx_json(m.dump(), rd.source);
+  if (t == "nde") return parse_nde_json(m.dump(), rd.source);
+  if (t == "transfer_function" || t == "miso" || t == "state_space")
+    return std::visit([](const auto& x) { return AnyModel(x); }, model_from(m, rd));
+  rd.fail(detail::format("model type \"{}\" is not one ctid knows (transfer_function, miso, state_space, fsf, narx, nde)",
+                         t));
+}
+}  // namespace
 NdeModel read_nde_json(const std::string& path) { return parse_nde_json(read_text_file(path), path); }
 
 namespace {
@@ -228,10 +268,7 @@ std::string result_json(const Result<M>& r, const std::string& method, int inden
   json j;
   j["ctid_version"] = version();
   j["method"] = method;
-  if constexpr (std::is_same_v<M, FsfModel>) j["model"] = fsf_json(r.model);
-  else if constexpr (std::is_same_v<M, NarxModel>) j["model"] = narx_json(r.model);
-  else if constexpr (std::is_same_v<M, NdeModel>) j["model"] = nde_json(r.model);
-  else j["model"] = model_json(LinearModel(r.model));
+  j["model"] = any_model_json(AnyModel(r.model));
   json params = json::array();
   for (int i = 0; i < r.parameters.size(); ++i)
     params.push_back({{"name", r.parameters.names[i]},
@@ -337,16 +374,58 @@ void read_envelope(const json& j, const Reader& rd, Result<M>& r) {
 }
 }  // namespace
 
+std::string result_to_json(const Result<AnyModel>& r, const std::string& method, int indent) {
+  return result_json(r, method, indent);
+}
+void write_result_json(const std::string& path, const Result<AnyModel>& r, const std::string& method) {
+  write_text_file(path, result_to_json(r, method) + "\n");
+}
+
+ResultFile parse_result_file(const std::string& text, const std::string& source) {
+  const Reader rd{source};
+  const json j = parse_text(text, rd);
+  ResultFile f;
+  f.result.model = any_model_from(j, rd);
+  f.bare = !(j.is_object() && j.contains("model") && j.contains("parameters"));
+  if (!f.bare) {
+    read_envelope(j, rd, f.result);
+    if (j.contains("method") && j.at("method").is_string()) f.method = j.at("method").get<std::string>();
+  } else {
+    // A bare model (or a file with the model but no parameter table, e.g. ctid validate --json): the
+    // coefficients of term models are their parameters, without uncertainty.
+    ParameterSet& p = f.result.parameters;
+    std::visit(
+        [&p](const auto& m) {
+          using M = std::decay_t<decltype(m)>;
+          if constexpr (std::is_same_v<M, NarxModel> || std::is_same_v<M, NdeModel>) {
+            p.values = m.coefficients();
+            for (const auto& t : m.terms()) p.names.push_back(t.name());
+            p.std = Eigen::VectorXd::Constant(p.values.size(), kNaN);
+            p.fixed.assign(m.terms().size(), false);
+          }
+        },
+        f.result.model);
+  }
+  if (auto* fsf = std::get_if<FsfModel>(&f.result.model); fsf && f.result.parameters.covariance.rows() == fsf->n())
+    *fsf = FsfModel(fsf->delta(), fsf->N(), fsf->n(), fsf->theta(), f.result.parameters.covariance, fsf->shift());
+  return f;
+}
+
+ResultFile read_result_file(const std::string& path) { return parse_result_file(read_text_file(path), path); }
+
 namespace {
 template <class M>
 Result<M> parse_linear_result(const std::string& text, const std::string& source, const char* what) {
-  const Reader rd{source};
-  const json j = parse_text(text, rd);
+  ResultFile f = parse_result_file(text, source);
+  if (!std::holds_alternative<M>(f.result.model))
+    throw FileError(source + ": the result's model is " + model_type_name(f.result.model) + ", not " + what);
+  if (f.bare) throw FileError(source + ": a bare model, not a result (it has no \"parameters\")");
   Result<M> r;
-  const LinearModel m = model_from(j, rd);
-  if (!std::holds_alternative<M>(m)) rd.fail(std::string("the result's model is not ") + what);
-  r.model = std::get<M>(m);
-  read_envelope(j, rd, r);
+  r.model = std::get<M>(f.result.model);
+  r.parameters = f.result.parameters;
+  r.fit = f.result.fit;
+  r.summary = f.result.summary;
+  r.diagnostics = f.result.diagnostics;
   return r;
 }
 }  // namespace

@@ -13,6 +13,7 @@
 #include "ctid/core/check.hpp"
 #include "ctid/estimate/gfrf.hpp"
 #include "ctid/simulate/lsim.hpp"
+#include "ctid/simulate/simulate.hpp"
 #include "ctid/validate/metrics.hpp"
 #include "ctid/validate/residuals.hpp"
 #include "ctid/validate/uncertainty.hpp"
@@ -427,13 +428,27 @@ void time_responses(Page& page, const std::vector<std::pair<std::string, Transfe
 
 double nyquist(const IdData& d) { return d.is_uniform() ? std::numbers::pi / d.ts() : 0.0; }
 
+// The model simulated on the record with the report's initial condition (Estimated takes the initial state a
+// fit estimated, its diagnostics "x0", where the result has one); a diverging simulation is drawn up to
+// where it stops being finite, with the reason.
+Eigen::VectorXd simulated(Page& page, const IdData& d, const AnyModel& m, const Diagnostics& g, const ReportOptions& o) {
+  SimulateOptions so;
+  so.initial = o.initial;
+  if (const auto x0 = g.vectors.find("x0"); o.initial == InitialCondition::Estimated && x0 != g.vectors.end())
+    so.x0 = x0->second;
+  const Simulation s = simulate(m, d, so);
+  page.text("Simulated from the initial condition: " + std::string(to_string(o.initial)) + ".");
+  if (!s.ok()) page.text("<span class=\"warn\">" + escape(s.problem) + "</span>");
+  return s.y.col(0);
+}
+
 }  // namespace
 
 std::string html_report(const IdData& d, const Result<TransferFunction>& r, const ReportOptions& o) {
   CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "html_report: needs one input and one output (got {}, {})", d.nu(), d.ny());
   Page page;
-  overview(page, d, r, o, r.model.to_string(6));
-  validation(page, d, lsim(r.model, d, 0), o);
+  overview(page, d, r, o, describe(r.model));
+  validation(page, d, simulated(page, d, r.model, r.diagnostics, o), o);
   parameters(page, r.parameters);
   diagnostics(page, r.diagnostics);
   const Eigen::VectorXd w = frequency_grid(r.model.poles(), nyquist(d));
@@ -449,8 +464,8 @@ std::string html_report(const IdData& d, const Result<MisoModel>& r, const Repor
   CTID_REQUIRE(d.ny() == 1 && d.nu() == r.model.nu(), "html_report: the model has {} inputs and 1 output (data: {}, {})",
                r.model.nu(), d.nu(), d.ny());
   Page page;
-  overview(page, d, r, o, r.model.to_string(6));
-  validation(page, d, lsim(r.model, d), o);
+  overview(page, d, r, o, describe(r.model));
+  validation(page, d, simulated(page, d, r.model, r.diagnostics, o), o);
   parameters(page, r.parameters);
   diagnostics(page, r.diagnostics);
   Eigen::VectorXcd poles(0);
@@ -473,10 +488,12 @@ std::string html_report(const IdData& d, const Result<FsfModel>& r, const Report
   CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "html_report: needs one input and one output (got {}, {})", d.nu(), d.ny());
   Page page;
   const FsfModel& m = r.model;
-  overview(page, d, r, o, "FSF model: N = " + std::to_string(m.N()) + " samples per window, n = " + std::to_string(m.n()) +
-                              " filters, T = " + fmt(m.T()) + " s");
-  Eigen::VectorXd yhat = m.simulate(d.u().col(0));
-  validation(page, d, yhat, o);
+  overview(page, d, r, o, describe(m));
+  if (m.shift() == 0.0)
+    validation(page, d, simulated(page, d, m, r.diagnostics, o), o);
+  else
+    page.text("The model was fitted to exponentially windowed data (a = " + fmt(m.shift()) +
+              " 1/s): it describes G(s + a), not the system, and is not simulated against the record.");
   parameters(page, r.parameters);
   diagnostics(page, r.diagnostics);
   page.section("Compressed responses (Gawthrop & Wang): +-2 std bands from the parameter covariance");
@@ -521,10 +538,10 @@ std::string html_report(const IdData& d, const Result<NarxModel>& r, const Repor
   CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "html_report: needs one input and one output (got {}, {})", d.nu(), d.ny());
   Page page;
   const NarxModel p = r.model.process();
-  overview(page, d, r, o, p.to_string(6));
-  const Eigen::VectorXd y = d.y().col(0), u = d.u().col(0);
+  overview(page, d, r, o, describe(r.model));
+  const Eigen::VectorXd u = d.u().col(0);
   const int L = std::min(p.max_lag(), d.size());
-  validation(page, d, p.simulate(u, y.head(L)), o);
+  validation(page, d, simulated(page, d, r.model, r.diagnostics, o), o);
   const auto err = r.diagnostics.vectors.find("err");
   page.section("Selected terms");
   page.text("Terms in the order of selection by forward orthogonal least squares; ERR: the error reduction ratio "
@@ -558,15 +575,9 @@ std::string html_report(const IdData& d, const Result<NdeModel>& r, const Report
   CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "html_report: needs one input and one output (got {}, {})", d.nu(), d.ny());
   Page page;
   const NdeModel& m = r.model;
-  overview(page, d, r, o, m.to_string(6));
+  overview(page, d, r, o, describe(m));
   const Eigen::VectorXd u = d.u().col(0);
-  Eigen::VectorXd t(d.size());
-  for (int i = 0; i < d.size(); ++i) t(i) = d.time(i) - d.t0();
-  const auto x0 = r.diagnostics.vectors.find("x0");
-  const NdeSimulation sim =
-      m.simulate(u, t, d.intersample(0), x0 == r.diagnostics.vectors.end() ? Eigen::VectorXd() : x0->second);
-  if (!sim.ok()) page.text("<span class=\"warn\">" + escape(sim.message) + "</span>");
-  validation(page, d, sim.y, o);
+  validation(page, d, simulated(page, d, m, r.diagnostics, o), o);
   const auto err = r.diagnostics.vectors.find("err");
   parameters(page, r.parameters,
              err == r.diagnostics.vectors.end() || err->second.size() != r.parameters.size() ? nullptr : &err->second);
@@ -587,6 +598,28 @@ std::string html_report(const IdData& d, const Result<NdeModel>& r, const Report
   const NdeSimulation st = m.simulate(Eigen::VectorXd::Constant(400, level), ts);
   page.plot({"Response to a step of the input's RMS level (" + fmt(level, 3) + ")", "time (s)", "y", ts, {{"step", st.y}}});
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
+}
+
+std::string html_report(const IdData& data, const Result<AnyModel>& result, const ReportOptions& options) {
+  return std::visit(
+      [&](const auto& m) {
+        using M = std::decay_t<decltype(m)>;
+        if constexpr (std::is_same_v<M, StateSpace>) {
+          // A single-input single-output state-space model is reported as its transfer function.
+          CTID_REQUIRE(m.nu() == 1 && m.ny() == 1,
+                       "html_report: a state_space model with {} inputs and {} outputs has no report (one input and "
+                       "one output only)",
+                       m.nu(), m.ny());
+          return html_report(data,
+                             Result<TransferFunction>{m.to_transfer_function(), result.parameters, result.fit,
+                                                      result.summary, result.diagnostics},
+                             options);
+        } else {
+          return html_report(data, Result<M>{m, result.parameters, result.fit, result.summary, result.diagnostics},
+                             options);
+        }
+      },
+      result.model);
 }
 
 }  // namespace ctid

@@ -719,7 +719,12 @@ TEST(Cli, ReportsOpenInABrowserWithEveryPlotDrawn) {
   r = ctid_run("fit " + dryer + " --frequency --report " + test::temp_path("x.html"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--report needs time-domain data"), std::string::npos) << r.err;
-  const std::string ss = write("ss.json", R"J({"type": "state_space", "A": [[-1]], "B": [[1]], "C": [[1]], "D": [[0]]})J");
+  // A single-input single-output state-space model is reported as its transfer function; one with two outputs is
+  // refused (exit 2) by name.
+  const std::string ss1 = write("ss1.json", R"J({"type": "state_space", "A": [[-1]], "B": [[1]], "C": [[1]], "D": [[0]]})J");
+  r = ctid_run("report " + ss1 + " " + dryer + base + "--out " + test::temp_path("ss1.html"));
+  EXPECT_EQ(r.code, 0) << r.err;
+  const std::string ss = write("ss.json", R"J({"type": "state_space", "A": [[-1]], "B": [[1]], "C": [[1], [2]], "D": [[0], [0]]})J");
   r = ctid_run("report " + ss + " " + dryer + base + "--out " + test::temp_path("y.html"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("state_space"), std::string::npos) << r.err;
@@ -1106,4 +1111,56 @@ TEST(Cli, SeveralDataFilesAreFittedJointly) {
                        "ivsvf (got fsf"),
             std::string::npos)
       << o.err;
+}
+
+// Every result file ctid writes is read back by simulate, validate and report (issue 14, item 1), the model type
+// recognised from the file; --initial chooses the simulation's initial condition.
+TEST(Cli, EveryResultFileIsReadBackAndTheInitialConditionIsExplicit) {
+  const std::string data = good_csv(), cols = " --time time --input force --output position";
+  // FSF without window (a = 0): its discrete convolution simulates the system (T = 5 s of a plant whose slowest
+  // mode decays as e^{-0.6 t}: the truncated tail costs a few percent of fit; measured 95.2 %).
+  const std::string fsf = test::temp_path("fsf0.json");
+  fs::remove(fsf);
+  CliRun r = ctid_run("fit " + data + cols + " --method fsf --set T=5 --set n=21 --set a=0 --json " + fsf);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = ctid_run("validate " + fsf + " " + data + cols);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("FSF model: N = 500"), std::string::npos) << r.out;
+  const auto fit_of = [](const std::string& out) { return std::stod(out.substr(out.find("fit: ") + 5)); };
+  EXPECT_GT(fit_of(r.out), 90.0);
+  const std::string html = test::temp_path("fsf0.html");
+  fs::remove(html);
+  EXPECT_EQ(ctid_run("report " + fsf + " " + data + cols + " --out " + html).code, 0);
+  // A windowed FSF model (a > 0) describes G(s + a): simulating it is refused, naming why.
+  const std::string fsf1 = test::temp_path("fsf1.json");
+  fs::remove(fsf1);
+  ASSERT_EQ(ctid_run("fit " + data + cols + " --method fsf --set T=5 --set n=21 --set a=1 --json " + fsf1).code, 0);
+  r = ctid_run("simulate " + fsf1 + " " + data + " --time time --input force");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("exponentially windowed data (shift a = 1 1/s)"), std::string::npos) << r.err;
+  // validate's own JSON (the model without a parameter table) is read back too.
+  const std::string tf = test::temp_path("tf_rt.json"), vj = test::temp_path("tf_val.json");
+  fs::remove(tf);
+  fs::remove(vj);
+  ASSERT_EQ(ctid_run("fit " + data + cols + " --nf 2 --nb 1 --json " + tf).code, 0);
+  ASSERT_EQ(ctid_run("validate " + tf + " " + data + cols + " --json " + vj).code, 0);
+  r = ctid_run("validate " + vj + " " + data + cols);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_GT(fit_of(r.out), 99.9);
+  // A record that starts mid-motion (the last 1700 samples): from rest the start is missed; the estimated initial
+  // state recovers the noise-free record (fit > 99.9 %, as on the whole record).
+  const CsvTable all = read_csv(data);
+  const std::string late = test::temp_path("late.csv");
+  write_csv(late, all.names, all.values.bottomRows(1700));
+  r = ctid_run("validate " + tf + " " + late + cols);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const double from_rest = fit_of(r.out);
+  r = ctid_run("validate " + tf + " " + late + cols + " --initial estimated");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_GT(fit_of(r.out), 99.9);
+  EXPECT_LT(from_rest, fit_of(r.out) - 1.0) << "rest " << from_rest;
+  // "measured" has no meaning for a transfer function: a usage error naming the choices.
+  r = ctid_run("simulate " + tf + " " + late + cols + " --initial measured");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("no output history"), std::string::npos) << r.err;
 }

@@ -325,3 +325,60 @@ TEST(Mat, DamagedLevel4FilesAreRefused) {
                                       << std::string("\x3f\xf8\0\0\0\0\0\0\xc0\0\0\0\0\0\0\0", 16);
   EXPECT_EQ(read_mat_variable(be, "x"), Eigen::MatrixXd(Eigen::Vector2d(1.5, -2.0)));
 }
+
+// The one reader of result files (issue 14, item 1): every model type ctid writes comes back as the same model
+// (to the digits JSON keeps: 17 significant, compared to 1e-15 relative), with its method and parameter table; an
+// FSF result gets its covariance back; a bare model file is a result without a parameter table.
+TEST(Json, EveryModelTypeRoundTripsThroughOneResultReader) {
+  const TransferFunction g(Eigen::VectorXd{{1.0, 3.0}}, Eigen::VectorXd{{1.0, 1.2, 4.0}}, 0.25);
+  const NarxModel narx({NarxTerm::parse("y(k-1)"), NarxTerm::parse("u(k-1)*y(k-2)")}, Eigen::VectorXd{{0.5, -0.25}}, 0.1);
+  const NdeModel nde({NdeTerm::parse("Dy"), NdeTerm::parse("y"), NdeTerm::parse("u")}, Eigen::VectorXd{{0.5, 1.0, -2.0}});
+  const Eigen::MatrixXd cov = Eigen::Vector3d(0.01, 0.02, 0.03).asDiagonal();
+  const std::vector<AnyModel> models = {g,
+                                        MisoModel{{g, TransferFunction(Eigen::VectorXd{{2.0}}, Eigen::VectorXd{{1.0, 0.5}})}},
+                                        StateSpace(Eigen::MatrixXd{{-1, 0.5}, {0, -2}}, Eigen::MatrixXd{{1}, {1}},
+                                                   Eigen::MatrixXd{{1, 0}, {0, 1}}, Eigen::MatrixXd{{0}, {0}}),
+                                        FsfModel(0.1, 20, 3, Eigen::VectorXd{{1.0, 0.2, -0.1}}, cov),
+                                        narx,
+                                        nde};
+  const std::vector<std::string> names = {"transfer_function", "miso", "state_space", "fsf", "narx", "nde"};
+  for (size_t i = 0; i < models.size(); ++i) {
+    SCOPED_TRACE(names[i]);
+    Result<AnyModel> r;
+    r.model = models[i];
+    r.parameters.names = {"p1", "p2", "p3"};
+    r.parameters.values = Eigen::Vector3d(1, 2, 3);
+    r.parameters.std = Eigen::Vector3d(0.1, 0.2, 0.3);
+    r.parameters.fixed = {false, false, false};
+    r.parameters.covariance = cov;
+    r.fit.fit_percent = 91.5;
+    r.fit.n_samples = 100;
+    const ResultFile f = parse_result_file(result_to_json(r, "m" + std::to_string(i)), "f.json");
+    EXPECT_EQ(model_type_name(f.result.model), names[i]);
+    EXPECT_EQ(f.method, "m" + std::to_string(i));
+    EXPECT_FALSE(f.bare);
+    EXPECT_EQ(f.result.parameters.values, r.parameters.values);
+    EXPECT_EQ(f.result.fit.fit_percent, 91.5);
+    // The same model: the same JSON once more.
+    EXPECT_EQ(result_to_json(f.result, f.method), result_to_json(r, f.method));
+  }
+  const Result<AnyModel> fsf{models[3], {}, {}, {}, {}};
+  Result<AnyModel> with_cov = fsf;
+  with_cov.parameters.values = Eigen::Vector3d(1.0, 0.2, -0.1);
+  with_cov.parameters.std = cov.diagonal().cwiseSqrt();
+  with_cov.parameters.names = {"theta_0", "re_theta_1", "im_theta_1"};
+  with_cov.parameters.fixed = {false, false, false};
+  with_cov.parameters.covariance = cov;
+  const ResultFile back = parse_result_file(result_to_json(with_cov, "fsf"));
+  EXPECT_LT((std::get<FsfModel>(back.result.model).covariance() - cov).norm(), 1e-15);
+  // Bare model files: NARX/NDE terms become the parameters (no std); linear models have none.
+  const ResultFile bare = parse_result_file(R"J({"type": "narx", "ts": 0.1, "terms": [{"name": "y(k-1)", "value": 0.5}]})J");
+  EXPECT_TRUE(bare.bare);
+  EXPECT_EQ(bare.result.parameters.names, std::vector<std::string>{"y(k-1)"});
+  EXPECT_TRUE(std::isnan(bare.result.parameters.std(0)));
+  EXPECT_EQ(parse_result_file(R"({"type": "transfer_function", "num": [1], "den": [1, 2]})").result.parameters.size(), 0);
+  // An unknown type names the known ones.
+  EXPECT_NE(error_of([] { parse_result_file(R"({"type": "arx", "a": [1]})", "x.json"); })
+                .find("x.json: model type \"arx\" is not one ctid knows (transfer_function, miso, state_space, fsf"),
+            std::string::npos);
+}

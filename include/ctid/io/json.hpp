@@ -4,7 +4,8 @@
 // std, fixed}], "covariance": [[..]], "fit": {...}, "summary": {...}, "diagnostics": {...}}.
 // Models: {"type": "transfer_function", "num": [...], "den": [...], "io_delay": s} or
 // {"type": "state_space", "A": [[..]], "B": .., "C": .., "D": ..} (row-major nested arrays) or
-// {"type": "miso", "channels": [transfer_function, ...]} (y = sum of the channels).
+// {"type": "miso", "channels": [transfer_function, ...]} (y = sum of the channels); FSF, NARX and NDE
+// models below.
 // NaN values are written as null and read back as NaN.
 #pragma once
 
@@ -14,6 +15,7 @@
 #include "ctid/core/types.hpp"
 #include "ctid/estimate/modal.hpp"
 #include "ctid/estimate/order_selection.hpp"
+#include "ctid/model/any_model.hpp"
 #include "ctid/model/fsf.hpp"
 #include "ctid/model/miso.hpp"
 #include "ctid/model/narx.hpp"
@@ -73,6 +75,21 @@ std::string poles_to_json(const PoleEstimate& data_matrix, const PoleEstimate* p
 /// by `names` in order. Throws InvalidArgument when names and columns differ in number.
 std::string table_to_json(const std::string& type, const std::vector<std::pair<std::string, std::string>>& fields,
                           const std::vector<std::string>& names, const Eigen::MatrixXd& values, int indent = 2);
+/// Any result ctid writes, or a bare model object: Result<AnyModel> in the envelope above, model "type"
+/// one of model_type_name()'s. The one writer and reader of result files (the typed functions above are
+/// shorthands of it).
+std::string result_to_json(const Result<AnyModel>& result, const std::string& method, int indent = 2);
+void write_result_json(const std::string& path, const Result<AnyModel>& result, const std::string& method);
+/// A file read back: the result (a bare model gets its term coefficients as parameters, without
+/// uncertainty, and no fit), the method that wrote it ("" for a bare model) and whether it was bare.
+struct ResultFile {
+  Result<AnyModel> result;
+  std::string method;
+  bool bare = false;
+};
+/// Recognises the model type from the file. Throws FileError naming `source` and what is malformed.
+ResultFile parse_result_file(const std::string& text, const std::string& source = "<json>");
+ResultFile read_result_file(const std::string& path);
 NarxModel read_narx_json(const std::string& path);
 NdeModel read_nde_json(const std::string& path);
 NarxModel parse_narx_json(const std::string& text, const std::string& source = "<json>");

@@ -13,11 +13,13 @@
 
 #include "ctid/core/types.hpp"
 #include "ctid/data/iddata.hpp"
+#include "ctid/model/any_model.hpp"
 #include "ctid/model/fsf.hpp"
 #include "ctid/model/miso.hpp"
 #include "ctid/model/narx.hpp"
 #include "ctid/model/nde.hpp"
 #include "ctid/model/transfer_function.hpp"
+#include "ctid/simulate/simulate.hpp"
 
 namespace ctid {
 
@@ -28,6 +30,9 @@ struct ReportOptions {
   std::string data_source;                                  ///< e.g. the data file name
   int max_lag = 25;                                         ///< residual correlation lags
   int max_points = 4000;                                    ///< time plots are decimated (min/max pairs) above this
+  /// Initial condition of the simulation compared with the record (simulate/simulate.hpp); Estimated uses
+  /// the result's diagnostics "x0" where it has one (NDE output error).
+  InitialCondition initial = InitialCondition::Rest;
 };
 
 /// Report of a result on the record `data` (single input and output — for a MisoModel one input per channel;
@@ -38,6 +43,8 @@ std::string html_report(const IdData& data, const Result<MisoModel>& result, con
 std::string html_report(const IdData& data, const Result<FsfModel>& result, const ReportOptions& options);
 std::string html_report(const IdData& data, const Result<NarxModel>& result, const ReportOptions& options);
 std::string html_report(const IdData& data, const Result<NdeModel>& result, const ReportOptions& options);
+/// Any result (e.g. read back by read_result_file): the report of its model type.
+std::string html_report(const IdData& data, const Result<AnyModel>& result, const ReportOptions& options);
 
 /// Whether the plotting library was found at build time (scripts/install-deps.sh fetches it); without it
 /// a report still holds every table and says that its plots are missing.

@@ -1,0 +1,61 @@
+// ctid — simulate any model (model/any_model.hpp) on a record with an explicit initial condition (issue 14).
+// The one simulation the CLI (simulate, validate, report), the HTML report and Python use.
+//
+// Linear models are simulated exactly (simulate/lsim.hpp) with the record's times and intersample
+// behaviour; FSF models by their discrete convolution (uniform records at their Delta; only a model fitted
+// without exponential window, shift 0, describes the system itself); NARX models at
+// their sampling period (uniform records at it); NDE models by the adaptive integrator at the record's
+// times.
+//
+// Initial conditions:
+//  - Rest: zero state, zero input and output before the first sample (NARX: zero output history).
+//  - Measured: the record's first outputs are the model's history (NARX: y(0..max_lag-1); NDE:
+//    y(0) measured, its derivatives zero). Linear models have no output history: InvalidArgument.
+//  - Estimated: the state that fits the record best. `x0` when given (e.g. the initial state an NDE
+//    output-error fit estimated, its diagnostics "x0"); otherwise, for linear continuous-time models, the
+//    least-squares initial state (the output is affine in it: y = y_rest + O x0); NARX models: the
+//    measured history (their state is their past outputs); FSF and NDE models without `x0`:
+//    InvalidArgument.
+#pragma once
+
+#include <string>
+
+#include <Eigen/Dense>
+
+#include "ctid/data/iddata.hpp"
+#include "ctid/model/any_model.hpp"
+
+namespace ctid {
+
+enum class InitialCondition { Rest, Measured, Estimated };
+
+/// "rest", "measured", "estimated".
+const char* to_string(InitialCondition initial);
+/// Inverse of to_string; throws InvalidArgument naming the valid names.
+InitialCondition initial_condition_from_string(const std::string& name);
+
+struct SimulateOptions {
+  InitialCondition initial = InitialCondition::Rest;
+  /// Initial state for Estimated (empty: estimate it where the model allows). Linear models: the state of
+  /// their realisation (MISO: the channels' states stacked); NDE: [y, Dy, .., D^{L-1} y].
+  Eigen::VectorXd x0;
+};
+
+/// A simulation: the outputs (N x ny) at the record's sample times, the initial state used (empty for
+/// rest or where the model has none), and whether it stayed finite.
+struct Simulation {
+  Eigen::MatrixXd y;
+  Eigen::VectorXd x0;
+  /// "" when every output is finite; otherwise where it stopped being finite and why
+  /// ("the simulated output is not finite from sample k (t = .. s): the model diverges on these
+  /// inputs; unstable poles: ..." or the integrator's message).
+  std::string problem;
+  bool ok() const { return problem.empty(); }
+};
+
+/// Simulate `model` driven by the inputs of `data` (its outputs are read only for the Measured and
+/// Estimated initial conditions). Throws InvalidArgument when the data do not match the model (input
+/// count, sampling period, no outputs where the initial condition needs them, an x0 of the wrong size).
+Simulation simulate(const AnyModel& model, const IdData& data, const SimulateOptions& options = {});
+
+}  // namespace ctid

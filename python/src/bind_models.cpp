@@ -1,0 +1,82 @@
+// ctid Python module — any model (model/any_model.hpp): state-space models, simulate() with its initial
+// condition, and the one reader/writer of result files (io/json.hpp). Bound after every model type.
+#include "common.hpp"
+
+namespace ctid::python {
+
+namespace {
+template <class M>
+Result<AnyModel> to_any(const Result<M>& r) {
+  return {AnyModel(r.model), r.parameters, r.fit, r.summary, r.diagnostics};
+}
+
+// The typed Python result (TransferFunctionResult, MisoResult, ...) of a Result<AnyModel>.
+py::object typed(const Result<AnyModel>& r) {
+  return std::visit(
+      [&r](const auto& m) {
+        using M = std::decay_t<decltype(m)>;
+        return py::cast(Result<M>{m, r.parameters, r.fit, r.summary, r.diagnostics});
+      },
+      r.model);
+}
+
+template <class M>
+void def_write_result(py::module_& m) {
+  m.def(
+      "write_result",
+      [](const std::string& path, const Result<M>& r, const std::string& method) {
+        write_result_json(path, to_any(r), method);
+      },
+      py::arg("path"), py::arg("result"), py::arg("method"),
+      "Write a result as JSON (the file ctid fit --json writes; read back by read_result and the CLI).");
+}
+}  // namespace
+
+void bind_models(py::module_& m) {
+  py::class_<StateSpace>(m, "StateSpace", "Continuous-time state-space model x' = A x + B u, y = C x + D u.")
+      .def(py::init<Eigen::MatrixXd, Eigen::MatrixXd, Eigen::MatrixXd, Eigen::MatrixXd>(), py::arg("A"), py::arg("B"),
+           py::arg("C"), py::arg("D"))
+      .def_property_readonly("A", &StateSpace::A)
+      .def_property_readonly("B", &StateSpace::B)
+      .def_property_readonly("C", &StateSpace::C)
+      .def_property_readonly("D", &StateSpace::D)
+      .def_property_readonly("nx", &StateSpace::nx)
+      .def_property_readonly("nu", &StateSpace::nu)
+      .def_property_readonly("ny", &StateSpace::ny)
+      .def("poles", &StateSpace::poles)
+      .def("to_transfer_function", &StateSpace::to_transfer_function, py::arg("out") = 0, py::arg("input") = 0);
+  bind_result<StateSpace>(m, "StateSpaceResult");
+
+  py::class_<Simulation>(m, "Simulation", "A simulation: outputs y (N x ny), the initial state used, and the problem "
+                                          "('' when every output is finite).")
+      .def_readonly("y", &Simulation::y)
+      .def_readonly("x0", &Simulation::x0)
+      .def_readonly("problem", &Simulation::problem)
+      .def("ok", &Simulation::ok);
+  m.def(
+      "simulate_model",
+      [](const AnyModel& model, const IdData& d, const std::string& initial, const Eigen::VectorXd& x0) {
+        SimulateOptions o;
+        o.initial = initial_condition_from_string(initial);
+        o.x0 = x0;
+        return simulate(model, d, o);
+      },
+      py::arg("model"), py::arg("data"), py::arg("initial") = "rest", py::arg("x0") = Eigen::VectorXd(),
+      "Simulate any model on a record (simulate/simulate.hpp): initial 'rest', 'measured' or 'estimated'.");
+  m.def("model_type_name", &model_type_name, py::arg("model"), "The model's JSON type name.");
+
+  py::class_<ResultFile>(m, "ResultFile", "A result file read back: result (typed by its model), method, bare.")
+      .def_property_readonly("result", [](const ResultFile& f) { return typed(f.result); })
+      .def_readonly("method", &ResultFile::method)
+      .def_readonly("bare", &ResultFile::bare);
+  m.def("read_result", &read_result_file, py::arg("path"),
+        "Read any result or model file ctid writes; the model type is recognised from the file.");
+  def_write_result<TransferFunction>(m);
+  def_write_result<MisoModel>(m);
+  def_write_result<StateSpace>(m);
+  def_write_result<FsfModel>(m);
+  def_write_result<NarxModel>(m);
+  def_write_result<NdeModel>(m);
+}
+
+}  // namespace ctid::python

@@ -1,0 +1,125 @@
+// simulate(AnyModel, IdData, initial condition): the one simulation of every front end (issue 14, item 1).
+// Expected values are closed forms or the model classes' own simulations, tolerances stated per check.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "ctid/core/error.hpp"
+#include "ctid/simulate/lsim.hpp"
+#include "ctid/simulate/simulate.hpp"
+#include "test_util.hpp"
+
+using namespace ctid;
+
+namespace {
+const TransferFunction kSecond(Eigen::VectorXd{{1.0, 3.0}}, Eigen::VectorXd{{1.0, 1.2, 4.0}});  // (s+3)/(s^2+1.2s+4)
+const TransferFunction kFirst(Eigen::VectorXd{{2.0}}, Eigen::VectorXd{{1.0, 0.5}}, 0.13);       // 2 e^{-0.13s}/(s+0.5)
+
+Eigen::VectorXd random_input(int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g;
+  Eigen::VectorXd u(n);
+  for (int k = 0; k < n; ++k) u(k) = k % 20 == 0 || k == 0 ? g(rng) : u(k - 1);  // held steps
+  return u;
+}
+
+template <class F>
+std::string message_of(F&& f) {
+  try {
+    f();
+  } catch (const InvalidArgument& e) {
+    return e.what();
+  }
+  return "(no exception)";
+}
+}  // namespace
+
+// A record started from a non-zero state: "estimated" recovers that state (noise-free: to 1e-7 of its size, the
+// output to 1e-9 of its range); "rest" does not fit the start; "measured" has no meaning for a transfer function.
+TEST(Simulate, EstimatedInitialStateOfLinearModelsIsTheOneThatMadeTheRecord) {
+  const int n = 800;
+  const double ts = 0.02;
+  const Eigen::VectorXd u1 = random_input(n, 1), u2 = random_input(n, 2), t = time_grid(ts, n);
+  // SISO: the state of the transfer function's realisation.
+  const Eigen::VectorXd x0{{0.8, -1.5}};
+  LsimOptions o;
+  o.x0 = x0;
+  const Eigen::MatrixXd y = lsim(kSecond.to_state_space(), Eigen::MatrixXd(u1), t, {Intersample::Zoh}, o);
+  const IdData d(u1, y, ts);
+  const Simulation est = simulate(kSecond, d, {InitialCondition::Estimated, {}});
+  ASSERT_TRUE(est.ok()) << est.problem;
+  EXPECT_LT((est.x0 - x0).norm(), 1e-7 * x0.norm());
+  EXPECT_LT((est.y - y).cwiseAbs().maxCoeff(), 1e-9 * (y.maxCoeff() - y.minCoeff()));
+  const Simulation rest = simulate(kSecond, d);
+  EXPECT_EQ(rest.x0.size(), 0);
+  EXPECT_GT(std::abs(rest.y(0, 0) - y(0, 0)), 0.5);  // y(0) = C x0 = -1.5 + 3 * 0.8 = 0.9 against 0 from rest
+  EXPECT_NE(message_of([&] { simulate(kSecond, d, {InitialCondition::Measured, {}}); }).find("no output history"),
+            std::string::npos);
+  // MISO with a delayed channel: the channels' states stacked (2 + 1).
+  const MisoModel miso{{kSecond, kFirst}};
+  Eigen::MatrixXd u(n, 2);
+  u << u1, u2;
+  const IdData d2(u, Eigen::VectorXd::Zero(n), ts);
+  const Eigen::VectorXd x0m{{0.8, -1.5, 2.0}};
+  const Simulation made = simulate(miso, d2, {InitialCondition::Estimated, x0m});  // a given x0 is used as given
+  EXPECT_EQ(made.x0, x0m);
+  const Simulation back = simulate(miso, IdData(u, made.y, ts), {InitialCondition::Estimated, {}});
+  EXPECT_LT((back.x0 - x0m).norm(), 1e-7 * x0m.norm());
+  // The same outputs as lsim from rest when x0 is zero (the blocks are lsim's).
+  EXPECT_LT((simulate(miso, d2).y.col(0) - lsim(miso, d2)).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+// NARX: rest = zero output history, measured/estimated = the record's first max_lag outputs (both are the
+// model's own simulate()); a record at another sampling period is refused naming it.
+TEST(Simulate, NarxHistoryIsRestOrTheMeasuredOutputs) {
+  const NarxModel m({NarxTerm::parse("y(k-1)"), NarxTerm::parse("u(k-2)"), NarxTerm::parse("y(k-2)*u(k-1)")},
+                    Eigen::VectorXd{{0.6, 1.0, -0.1}}, 0.1);
+  const int n = 300;
+  const Eigen::VectorXd u = 0.5 * random_input(n, 3);
+  Eigen::VectorXd y = m.simulate(u, Eigen::VectorXd{{1.0, 2.0}});
+  const IdData d(u, y, 0.1);
+  EXPECT_EQ(simulate(m, d).y.col(0), m.simulate(u));
+  const Simulation meas = simulate(m, d, {InitialCondition::Measured, {}});
+  EXPECT_EQ(meas.y.col(0), y);
+  EXPECT_EQ(meas.x0, y.head(2));
+  EXPECT_EQ(simulate(m, d, {InitialCondition::Estimated, {}}).y.col(0), y);
+  EXPECT_NE(message_of([&] { simulate(m, IdData(u, y, 0.05)); }).find("Ts = 0.1 s"), std::string::npos);
+}
+
+// NDE: measured = y(0) from the record with zero derivatives (closed form y = 1 + (y0 - 1) e^{-2t} for
+// 0.5 Dy + y = u, u = 1, to 1e-7); estimated needs the fitted x0; rest starts at 0.
+TEST(Simulate, NdeStartsAtRestAtTheMeasuredOutputOrAtAGivenState) {
+  const NdeModel m({NdeTerm::parse("Dy"), NdeTerm::parse("y"), NdeTerm::parse("u")}, Eigen::VectorXd{{0.5, 1.0, -1.0}});
+  const int n = 200;
+  const double ts = 0.01;
+  const Eigen::VectorXd t = time_grid(ts, n);
+  const Eigen::VectorXd y = (1.0 + 2.0 * (-2.0 * t.array()).exp()).matrix();  // y0 = 3
+  const IdData d(Eigen::VectorXd::Ones(n), y, ts);
+  EXPECT_LT((simulate(m, d, {InitialCondition::Measured, {}}).y.col(0) - y).cwiseAbs().maxCoeff(), 1e-7);
+  EXPECT_LT((simulate(m, d, {InitialCondition::Estimated, Eigen::VectorXd{{3.0}}}).y.col(0) - y).cwiseAbs().maxCoeff(),
+            1e-7);
+  EXPECT_NEAR(simulate(m, d).y(0, 0), 0.0, 1e-12);
+  EXPECT_NE(message_of([&] { simulate(m, d, {InitialCondition::Estimated, {}}); }).find("diagnostics x0"),
+            std::string::npos);
+}
+
+// A diverging model is reported with where and why, not thrown; wrong input counts and FSF initial states are
+// refused naming the values.
+TEST(Simulate, DivergenceIsReportedAndMismatchesAreRefused) {
+  const TransferFunction unstable(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, -5.0}});
+  const int n = 20000;
+  const IdData d(Eigen::VectorXd::Ones(n), Eigen::VectorXd::Zero(n), 0.1);  // e^{5 t} overflows at t ~ 142 s
+  const Simulation s = simulate(unstable, d);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.problem.find("not finite from sample"), std::string::npos) << s.problem;
+  EXPECT_NE(s.problem.find("unstable poles: 5+0j"), std::string::npos) << s.problem;
+  EXPECT_NE(message_of([&] { simulate(MisoModel{{kSecond, kFirst}}, d); }).find("has 2 input(s) but the record has 1"),
+            std::string::npos);
+  const FsfModel fsf(0.1, 20, 3, Eigen::VectorXd{{1.0, 0.2, -0.1}});
+  EXPECT_TRUE(simulate(fsf, d.slice(0, 100)).ok());
+  EXPECT_NE(message_of([&] { simulate(fsf, d, {InitialCondition::Estimated, {}}); }).find("only be rest"),
+            std::string::npos);
+  EXPECT_THROW(initial_condition_from_string("zero"), InvalidArgument);
+  EXPECT_EQ(initial_condition_from_string("measured"), InitialCondition::Measured);
+}
