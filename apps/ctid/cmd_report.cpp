@@ -12,7 +12,7 @@ namespace {
 struct ReportArgs {
   std::string result, out, title;
   DataArgs data;
-  std::string initial = "rest";
+  std::string initial;  // "": the initial condition of the result's own fit
   bool force = false;
 };
 
@@ -50,7 +50,7 @@ int run(const ReportArgs& a) {
   o.method = file.method.empty() ? model_type_name(file.result.model) : file.method;
   o.title = a.title.empty() ? "ctid report: " + a.result : a.title;
   o.data_source = a.data.path;
-  o.initial = initial_condition_from_string(a.initial);
+  if (!a.initial.empty()) o.initial = initial_condition_from_string(a.initial);
   std::string html;
   try {
     html = html_report(d, file.result, o);

@@ -142,18 +142,19 @@ ResultFile read_result(const std::string& path) {
 }
 
 void add_initial_option(CLI::App& app, std::string& initial) {
-  app.add_option("--initial", initial,
-                 "Initial condition of the simulation: rest (zero state), measured (NARX: the first measured outputs; "
-                 "NDE: y(0)) or estimated (linear: least-squares initial state; NDE: the fitted x0)")
-      ->check(CLI::IsMember({"rest", "measured", "estimated"}))
-      ->capture_default_str();
+  auto* o = app.add_option("--initial", initial,
+                           "Initial condition of the simulation: rest (zero state), measured (NARX: the first measured "
+                           "outputs; NDE: y(0)) or estimated (linear: least-squares initial state; NDE: the fitted x0)" +
+                               std::string(initial.empty() ? "; default: the one the result's own fit used" : ""))
+                ->check(CLI::IsMember({"rest", "measured", "estimated"}));
+  if (!initial.empty()) o->capture_default_str();
 }
 
 Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, const std::string& initial) {
   SimulateOptions o;
   Simulation s;
   try {
-    o.initial = initial_condition_from_string(initial);
+    o.initial = initial.empty() ? fit_initial_condition(r.model, r.diagnostics) : initial_condition_from_string(initial);
     if (const auto x0 = r.diagnostics.vectors.find("x0");
         o.initial == InitialCondition::Estimated && x0 != r.diagnostics.vectors.end())
       o.x0 = x0->second;

@@ -65,9 +65,10 @@ void consume_sets(std::map<std::string, std::string>& sets, F&& handler) {
 /// The result or model file at `path`, whatever its model type (io/json.hpp); a file that cannot be read
 /// or recognised throws InputError naming it.
 ResultFile read_result(const std::string& path);
-/// `--initial rest|measured|estimated` (simulate/simulate.hpp) on a command; default rest.
+/// `--initial rest|measured|estimated` (simulate/simulate.hpp) on a command, defaulting to `initial`'s value
+/// ("" = fit_initial_condition(): the one the result's own fit used).
 void add_initial_option(CLI::App& app, std::string& initial);
-/// The result's model simulated on d from `initial` (Estimated takes the result's diagnostics "x0" where it
+/// The result's model simulated on d from `initial` ("" = fit_initial_condition(); Estimated takes the result's diagnostics "x0" where it
 /// has one). Data that do not fit the model throw UsageError; a simulation that stops being finite throws
 /// NotUsable naming where and why (e.g. the unstable poles): a diverging simulation is never written or scored.
 Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, const std::string& initial);

@@ -73,12 +73,13 @@ void def_report(py::module_& m) {
         o.method = method;
         o.title = title;
         o.settings.assign(settings.begin(), settings.end());
-        o.initial = initial_condition_from_string(initial);
+        if (!initial.empty()) o.initial = initial_condition_from_string(initial);
         write_text_file(path, html_report(d, r, o));
       },
       py::arg("data"), py::arg("result"), py::arg("path"), py::arg("method") = "", py::arg("title") = "",
-      py::arg("settings") = std::map<std::string, std::string>{}, py::arg("initial") = "rest",
-      "Write the self-contained HTML report of a result on a record (plots, residual tests, parameters).");
+      py::arg("settings") = std::map<std::string, std::string>{}, py::arg("initial") = "",
+      "Write the self-contained HTML report of a result on a record (plots, residual tests, parameters); initial: "
+      "'rest', 'measured' or 'estimated', or '' for the one the result's fit used.");
 }
 
 /// A setting's value from Python, converted by the setting's kind (estimate/options.hpp): numbers, 0/1 or

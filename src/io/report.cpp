@@ -433,11 +433,11 @@ double nyquist(const IdData& d) { return d.is_uniform() ? std::numbers::pi / d.t
 // where it stops being finite, with the reason.
 Eigen::VectorXd simulated(Page& page, const IdData& d, const AnyModel& m, const Diagnostics& g, const ReportOptions& o) {
   SimulateOptions so;
-  so.initial = o.initial;
-  if (const auto x0 = g.vectors.find("x0"); o.initial == InitialCondition::Estimated && x0 != g.vectors.end())
-    so.x0 = x0->second;
+  const auto x0 = g.vectors.find("x0");
+  so.initial = o.initial ? *o.initial : fit_initial_condition(m, g);
+  if (so.initial == InitialCondition::Estimated && x0 != g.vectors.end()) so.x0 = x0->second;
   const Simulation s = simulate(m, d, so);
-  page.text("Simulated from the initial condition: " + std::string(to_string(o.initial)) + ".");
+  page.text("Simulated from the initial condition: " + std::string(to_string(so.initial)) + ".");
   if (!s.ok()) page.text("<span class=\"warn\">" + escape(s.problem) + "</span>");
   return s.y.col(0);
 }

@@ -24,6 +24,11 @@ InitialCondition initial_condition_from_string(const std::string& name) {
   return InitialCondition::Rest;
 }
 
+InitialCondition fit_initial_condition(const AnyModel& model, const Diagnostics& diagnostics) {
+  if (std::holds_alternative<NarxModel>(model)) return InitialCondition::Measured;
+  return diagnostics.vectors.contains("x0") ? InitialCondition::Estimated : InitialCondition::Rest;
+}
+
 namespace {
 
 // One linear state-space block of a model: its realisation, the input column that drives it and its delay.

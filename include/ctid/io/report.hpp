@@ -7,6 +7,7 @@
 // and NDE models.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -31,8 +32,9 @@ struct ReportOptions {
   int max_lag = 25;                                         ///< residual correlation lags
   int max_points = 4000;                                    ///< time plots are decimated (min/max pairs) above this
   /// Initial condition of the simulation compared with the record (simulate/simulate.hpp); Estimated uses
-  /// the result's diagnostics "x0" where it has one (NDE output error).
-  InitialCondition initial = InitialCondition::Rest;
+  /// the result's diagnostics "x0" where it has one (NDE output error). Unset: fit_initial_condition(), the
+  /// one the result's own fit was computed with, so that the plotted fit is the fit the estimator reported.
+  std::optional<InitialCondition> initial;
 };
 
 /// Report of a result on the record `data` (single input and output — for a MisoModel one input per channel;

@@ -22,6 +22,7 @@
 
 #include <Eigen/Dense>
 
+#include "ctid/core/types.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/model/any_model.hpp"
 
@@ -52,6 +53,11 @@ struct Simulation {
   std::string problem;
   bool ok() const { return problem.empty(); }
 };
+
+/// The initial condition an estimator's own fit (Result::fit) was computed with: NARX models the measured
+/// history (FROLS, NARMAX), a result whose diagnostics hold a fitted "x0" (NDE output error) estimated, every
+/// other rest. Reports of a fit use it so that their plotted fit is the one the estimator reported.
+InitialCondition fit_initial_condition(const AnyModel& model, const Diagnostics& diagnostics);
 
 /// Simulate `model` driven by the inputs of `data` (its outputs are read only for the Measured and
 /// Estimated initial conditions). Throws InvalidArgument when the data do not match the model (input
