@@ -344,9 +344,10 @@ int fit_experiments(const FitArgs& a, const std::vector<IdData>& ds,
 }
 
 int run_experiments(const FitArgs& a) {
-  if (a.method != "srivc" && a.method != "oe" && a.method != "tfest" && a.method != "lssvf" && a.method != "ivsvf")
+  if (a.method != "srivc" && a.method != "oe" && a.method != "tfest" && a.method != "lssvf" && a.method != "ivsvf" &&
+      a.method != "narx")
     throw UsageError(detail::format("{} DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, "
-                                    "lssvf or ivsvf (got {}; the other estimators take one record so far)",
+                                    "lssvf, ivsvf or narx (got {}; the other estimators take one record so far)",
                                     a.paths.size(), a.method));
   if (!a.controller.empty() || a.frequency) throw UsageError("several DATA files: open-loop time-domain data only");
   std::vector<IdData> ds;
@@ -358,6 +359,7 @@ int run_experiments(const FitArgs& a) {
   if (ds[0].nu() != 1 || ds[0].ny() != 1)
     throw UsageError(detail::format("several experiments: one --input and one --output (selected {} and {})", ds[0].nu(),
                                     ds[0].ny()));
+  if (a.method == "narx") return run_narx_or_kia(a.method, ds, a.sets, a.narx, a.json, a.report);
   if (a.method == "srivc") return fit_experiments<SrivcOptions>(a, ds, &srivc);
   if (a.method == "lssvf") return fit_experiments<LssvfOptions>(a, ds, &lssvf);
   if (a.method == "ivsvf") return fit_experiments<IvsvfOptions>(a, ds, &ivsvf);
@@ -421,10 +423,10 @@ const std::map<std::string, FitMethod>& fit_methods() {
       {"modal", {{"modal"}, run_modal}},
       {"narx",
        {{"narx"},
-        [](const FitArgs& a, const IdData& d) { return run_narx_or_kia(a.method, d, a.sets, a.narx, a.json, a.report); }}},
+        [](const FitArgs& a, const IdData& d) { return run_narx_or_kia(a.method, {d}, a.sets, a.narx, a.json, a.report); }}},
       {"kia",
        {{"kia", "narx"},
-        [](const FitArgs& a, const IdData& d) { return run_narx_or_kia(a.method, d, a.sets, a.narx, a.json, a.report); }}},
+        [](const FitArgs& a, const IdData& d) { return run_narx_or_kia(a.method, {d}, a.sets, a.narx, a.json, a.report); }}},
   };
   return m;
 }

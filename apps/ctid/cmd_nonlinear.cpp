@@ -22,26 +22,27 @@ void print_narx(const Result<NarxModel>& r) {
 }
 }  // namespace
 
-// The library's NARX workflow (narx()) with the settings of its table.
-Result<NarxModel> run_narx(const IdData& d, const NarxOptions& o) {
+// The library's NARX workflow (narx()) with the settings of its table, on one record or several.
+Result<NarxModel> run_narx(const std::vector<IdData>& ds, const NarxOptions& o) {
   try {
     o.validate();
     std::printf("candidates: %zu (degree %d, ylag %d, ulag %d)\n",
                 narx_candidates(o.degree, o.ylag, o.ulag, o.constant, o.umin).size(), o.degree, o.ylag, o.ulag);
-    return narx(d, o);
+    return narx(ds, o);
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }
 }
 
-int run_narx_or_kia(const std::string& method, const IdData& d, const std::vector<std::string>& set_list,
+int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, const std::vector<std::string>& set_list,
                     const std::string& narx_file, const std::string& json,
                     const std::string& report) {
+  const IdData& d = ds.front();
   if (d.nu() != 1 || d.ny() != 1) throw UsageError(method + " needs one --input and one --output");
   NarxOptions no;
   if (method == "narx") {
     apply_sets("narx", set_list, no);
-    const Result<NarxModel> r = run_narx(d, no);
+    const Result<NarxModel> r = run_narx(ds, no);
     print_narx(r);
     if (!json.empty()) {
       write_result_json(json, r, "narx");
@@ -50,6 +51,10 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
     write_report(report, d, r, "narx", settings_of(no), "");
     return r.usable() ? kOk : kNotUsable;
   }
+  if (ds.size() > 1)
+    throw UsageError(detail::format("kia takes one record ({} DATA files given); fit the NARX model on all of them with "
+                                    "--method narx --json N.json, then --method kia --narx N.json on one record",
+                                    ds.size()));
   // kia: the NARX model from --narx, or identified here with the narx settings; then the library's workflow (kia()).
   KiaOptions ko;
   ko.linear.zoh = ko.quadratic.zoh = ko.cubic.zoh = d.intersample(0) == Intersample::Zoh;
@@ -62,7 +67,7 @@ int run_narx_or_kia(const std::string& method, const IdData& d, const std::vecto
       throw InputError(narx_file + ": --narx needs a NARX model; this is a " + model_type_name(m) + " model");
     narx = std::get<NarxModel>(m).process();
   } else {
-    const Result<NarxModel> r = run_narx(d, no);
+    const Result<NarxModel> r = run_narx({d}, no);
     print_narx(r);
     narx = r.model.process();
   }

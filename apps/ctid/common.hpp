@@ -160,8 +160,8 @@ void write_report(const std::string& path, const IdData& d, const Result<M>& r, 
 ModalOptions modal_options(const std::string& method, const std::vector<std::string>& sets, double Ts,
                            const std::vector<std::string>& own, std::map<std::string, std::string>& own_values);
 
-/// Billings & Li: fit --method narx | kia (cmd_nonlinear.cpp).
-int run_narx_or_kia(const std::string& method, const IdData& d, const std::vector<std::string>& sets,
+/// Billings & Li: fit --method narx | kia (cmd_nonlinear.cpp); narx on one record or several (jointly).
+int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, const std::vector<std::string>& sets,
                     const std::string& narx_file, const std::string& json,
                     const std::string& report);
 

@@ -281,19 +281,21 @@ def fsf_from_spectra(U, Y, L, ts, **options):
 
 
 def frols(data, candidates, **options):
-    """Polynomial NARX structure selection by FROLS/ERR (options: FrolsOptions; criterion='aic', ...)."""
+    """Polynomial NARX structure selection by FROLS/ERR (options: FrolsOptions; criterion='aic', ...). data: an
+    IdData or a list of IdData (several records of one system: one regression of their rows, none across records)."""
     return _ctid.frols(data, _terms(NarxTerm, candidates), _options(_ctid.FrolsOptions, "frols", options))
 
 
 def narmax(data, candidates, **options):
     """NARMAX by FROLS and extended least squares (options: NarmaxOptions: the FROLS settings, noise_candidates,
-    max_noise_terms, iterations, tolerance)."""
+    max_noise_terms, iterations, tolerance). data: an IdData or a list of IdData."""
     return _ctid.narmax(data, _terms(NarxTerm, candidates), _options(_ctid.NarmaxOptions, "narmax", options))
 
 
 def narx(data, **options):
     """The NARX workflow of `ctid fit --method narx`: candidates from degree, ylag, ulag, umin, constant; FROLS with
-    an information criterion (criterion='aic' by default); NARMAX when noise_terms > 0 (options: NarxOptions)."""
+    an information criterion (criterion='aic' by default); NARMAX when noise_terms > 0 (options: NarxOptions). data: an
+    IdData or a list of IdData (several records of one system)."""
     return _ctid.narx(data, _options(_ctid.NarxOptions, "narx", options))
 
 

@@ -55,14 +55,23 @@ void bind_nonlinear(py::module_& m) {
 
   bind_options<FrolsOptions>(m, "FrolsOptions");
   bind_options<NarmaxOptions>(m, "NarmaxOptions");
+  // Each NARX estimator takes one record or a list of records of one system (one regression, no row across records).
   m.def("frols", [](const IdData& d, const std::vector<NarxTerm>& c, const FrolsOptions& o) {
+          return interruptible([&] { return frols(d, c, o); });
+        }, py::arg("data"), py::arg("candidates"), py::arg("options") = FrolsOptions{});
+  m.def("frols", [](const std::vector<IdData>& d, const std::vector<NarxTerm>& c, const FrolsOptions& o) {
           return interruptible([&] { return frols(d, c, o); });
         }, py::arg("data"), py::arg("candidates"), py::arg("options") = FrolsOptions{});
   bind_options<NarxOptions>(m, "NarxOptions");
   m.def("narx", [](const IdData& d, const NarxOptions& o) { return interruptible([&] { return narx(d, o); }); },
         py::arg("data"), py::arg("options") = NarxOptions{},
         "The NARX workflow: candidates from degree and lags, FROLS with a criterion (AIC), NARMAX when noise_terms > 0.");
+  m.def("narx", [](const std::vector<IdData>& d, const NarxOptions& o) { return interruptible([&] { return narx(d, o); }); },
+        py::arg("data"), py::arg("options") = NarxOptions{});
   m.def("narmax", [](const IdData& d, const std::vector<NarxTerm>& c, const NarmaxOptions& o) {
+          return interruptible([&] { return narmax(d, c, o); });
+        }, py::arg("data"), py::arg("candidates"), py::arg("options") = NarmaxOptions{});
+  m.def("narmax", [](const std::vector<IdData>& d, const std::vector<NarxTerm>& c, const NarmaxOptions& o) {
           return interruptible([&] { return narmax(d, c, o); });
         }, py::arg("data"), py::arg("candidates"), py::arg("options") = NarmaxOptions{});
 

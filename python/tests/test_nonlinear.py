@@ -79,3 +79,23 @@ def test_nde_simulation_reports_an_escape():
     s = m.simulate(-np.ones(100), ctid.time_grid(0.01, 100))
     assert not s.ok() and s.termination == "numerical_failure" and "escapes" in s.message
     assert np.isnan(s.y[-1])
+
+
+def test_frols_and_narx_take_several_records():
+    """A list of records is one regression of their rows: the same record twice gives the same coefficients (to
+    1e-10) and standard deviations smaller by sqrt((Ne - k) / (2 Ne - k)) exactly (twice the rows, same residuals)."""
+    rng = np.random.default_rng(4)
+    n = 400
+    u = rng.standard_normal(n)
+    y = np.zeros(n)
+    for k in range(2, n):
+        y[k] = 0.5 * y[k - 1] - 0.2 * y[k - 2] + 0.3 * u[k - 1] + 0.1 * y[k - 1] * u[k - 1] + 0.05 * rng.standard_normal()
+    d = ctid.IdData.from_arrays(u, y, ts=0.01)
+    terms = ["y(k-1)", "y(k-2)", "u(k-1)", "y(k-1)*u(k-1)"]
+    one = ctid.frols(d, terms, err_tolerance=0.0)
+    two = ctid.frols([d, d], terms, err_tolerance=0.0)
+    assert one.parameters.names == two.parameters.names
+    np.testing.assert_allclose(two.parameters.values, one.parameters.values, atol=1e-10)
+    ne, k = n - 2, 4
+    np.testing.assert_allclose(two.parameters.std / one.parameters.std, np.sqrt((ne - k) / (2 * ne - k)), rtol=1e-8)
+    assert ctid.narx([d, d], degree=1).usable()

@@ -124,6 +124,16 @@ class CandidateProducts {
   std::vector<Item> items_;
 };
 
+// Several records are concatenated; a regression row k (signal index) belongs to the record that starts at
+// the largest start <= k and is used only when all its lags stay inside that record (k - start >= L). The
+// mask over rows k = L .. N-1 is 1 for used rows and 0 for rows whose lags reach into the previous record.
+Eigen::VectorXd row_mask(const std::vector<Eigen::Index>& starts, Eigen::Index N, Eigen::Index L) {
+  Eigen::VectorXd mask = Eigen::VectorXd::Ones(std::max<Eigen::Index>(0, N - L));
+  for (Eigen::Index s : starts)
+    for (Eigen::Index k = std::max(s, L); k < std::min(s + L, N); ++k) mask(k - L) = 0.0;
+  return mask;
+}
+
 double criterion_value(InformationCriterion c, double mse, int n, int k) {
   switch (c) {
     case InformationCriterion::Aic: return aic(mse, n, k);
@@ -137,8 +147,11 @@ double criterion_value(InformationCriterion c, double mse, int n, int k) {
 }  // namespace
 
 namespace {
-// FROLS on given signals (e may be all zero when no candidate is a noise term).
-Result<NarxModel> frols_signals(const Signals& sig, double Ts, const std::vector<NarxTerm>& cand, const FrolsOptions& o) {
+// FROLS on given signals (e may be all zero when no candidate is a noise term): the records concatenated,
+// record r starting at starts[r] (starts[0] = 0); rows whose lags cross into the previous record are masked out
+// of every inner product (row_mask), so the regression is the stack of the records' own regressions.
+Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Index>& starts, double Ts,
+                                const std::vector<NarxTerm>& cand, const FrolsOptions& o) {
   const auto t_start = std::chrono::steady_clock::now();
   int L = 0;
   for (const auto& t : cand) L = std::max(L, t.max_lag());
@@ -146,9 +159,15 @@ Result<NarxModel> frols_signals(const Signals& sig, double Ts, const std::vector
   const Eigen::VectorXd& u = sig.u;
   const Eigen::Index N = y.size(), Ne = N - L;
   const int M = static_cast<int>(cand.size());
-  CTID_REQUIRE(Ne > M, "frols: {} candidate terms but only {} usable rows ({} samples minus the largest lag {}); reduce "
-               "the lags or the degree", M, Ne, N, L);
-  const Eigen::VectorXd yt = y.tail(Ne);
+  for (size_t r = 0; r < starts.size(); ++r) {
+    const Eigen::Index n = (r + 1 < starts.size() ? starts[r + 1] : N) - starts[r];
+    CTID_REQUIRE(n > L, "frols: record {} has {} samples, not more than the largest lag {}", r + 1, n, L);
+  }
+  const Eigen::VectorXd mask = row_mask(starts, N, L);
+  const Eigen::Index rows_used = static_cast<Eigen::Index>(mask.sum());
+  CTID_REQUIRE(rows_used > M, "frols: {} candidate terms but only {} usable rows ({} samples minus the largest lag {}{}); "
+               "reduce the lags or the degree", M, rows_used, N, L, starts.size() > 1 ? " in each record" : "");
+  const Eigen::VectorXd yt = y.tail(Ne).cwiseProduct(mask);
   const double yy = yt.squaredNorm();
   CTID_REQUIRE(yy > 0, "frols: the output is identically zero");
   const int K = std::min(o.max_terms, M);
@@ -157,7 +176,7 @@ Result<NarxModel> frols_signals(const Signals& sig, double Ts, const std::vector
   // Pass 0: p_m^T y and p_m^T p_m.
   const CandidateProducts products(cand);
   const Eigen::VectorXd py = products.dot(sig, L, yt, BR);
-  const Eigen::VectorXd pp = products.dot(sig, L, Eigen::VectorXd::Ones(Ne), BR, true);
+  const Eigen::VectorXd pp = products.dot(sig, L, mask, BR, true);
 
   std::vector<int> sel;
   std::vector<double> err, g, ww;
@@ -197,6 +216,7 @@ Result<NarxModel> frols_signals(const Signals& sig, double Ts, const std::vector
       candidate_block({cand[best]}, sig, L + r0, rows, one);
       p.segment(r0, rows) = one.col(0);
     }
+    p.array() *= mask.array();
     for (int r = 0; r < s; ++r) p -= (C(r, best) / ww[r]) * W.col(r);
     W.col(s) = p;
     const double w2 = p.squaredNorm();
@@ -207,8 +227,8 @@ Result<NarxModel> frols_signals(const Signals& sig, double Ts, const std::vector
     g.push_back(W.col(s).dot(yt) / w2);
     err.push_back(g.back() * g.back() * w2 / yy);
     err_sum += err.back();
-    const double mse_k = std::max(0.0, yy * (1 - err_sum)) / static_cast<double>(Ne);
-    crit(s) = criterion_value(o.criterion, mse_k, static_cast<int>(Ne), s + 1);
+    const double mse_k = std::max(0.0, yy * (1 - err_sum)) / static_cast<double>(rows_used);
+    crit(s) = criterion_value(o.criterion, mse_k, static_cast<int>(rows_used), s + 1);
     if (o.criterion == InformationCriterion::None && 1 - err_sum <= o.err_tolerance) break;
   }
   CTID_REQUIRE(!sel.empty(), "frols: every candidate column is zero");
@@ -231,7 +251,7 @@ Result<NarxModel> frols_signals(const Signals& sig, double Ts, const std::vector
   const Eigen::VectorXd theta = Atri.solve(gv);
   double esr = 1;
   for (int s = 0; s < k; ++s) esr -= err[s];
-  const double sigma2 = std::max(0.0, yy * esr) / static_cast<double>(std::max<Eigen::Index>(1, Ne - k));
+  const double sigma2 = std::max(0.0, yy * esr) / static_cast<double>(std::max<Eigen::Index>(1, rows_used - k));
   const Eigen::MatrixXd Ainv = Atri.solve(Eigen::MatrixXd::Identity(k, k));
   const Eigen::MatrixXd cov = sigma2 * Ainv * winv.asDiagonal() * Ainv.transpose();
 
@@ -252,13 +272,25 @@ Result<NarxModel> frols_signals(const Signals& sig, double Ts, const std::vector
   res.diagnostics.scalars["esr"] = esr;
   res.diagnostics.scalars["candidates"] = M;
   res.diagnostics.condition_number = Ainv.norm() * A.norm();
+  // The fit: each record's free run from its own first L measured outputs, pooled after those L samples.
+  const NarxModel process = res.model.process();
+  Eigen::VectorXd ypool(N - L * static_cast<Eigen::Index>(starts.size())), spool(ypool.size());
   bool escaped = false;
-  const Eigen::VectorXd ys = res.model.process().simulate(u, y.head(L), &escaped);
+  for (size_t r = 0, at = 0; r < starts.size(); ++r) {
+    const Eigen::Index n = (r + 1 < starts.size() ? starts[r + 1] : N) - starts[r];
+    bool esc = false;
+    const Eigen::VectorXd ys =
+        process.simulate(u.segment(starts[r], n), y.segment(starts[r], L), &esc);
+    escaped = escaped || esc;
+    ypool.segment(static_cast<Eigen::Index>(at), n - L) = y.segment(starts[r] + L, n - L);
+    spool.segment(static_cast<Eigen::Index>(at), n - L) = ys.tail(n - L);
+    at += static_cast<size_t>(n - L);
+  }
   if (escaped) {
-    res.fit = fit_report_or_inf(y, Eigen::VectorXd::Constant(N, NAN), k);
+    res.fit = fit_report_or_inf(ypool, Eigen::VectorXd::Constant(ypool.size(), NAN), k);
     res.diagnostics.warnings.push_back("the free-run simulation of the selected model escapes (blows up)");
   } else {
-    res.fit = fit_report_or_inf(y.tail(Ne), ys.tail(Ne), k);
+    res.fit = fit_report_or_inf(ypool, spool, k);
   }
   res.summary.iterations = static_cast<int>(sel.size());
   if (interrupted) {
@@ -273,16 +305,52 @@ void check_siso(const IdData& data, const char* who) {
   require_io_data(data, who);
   CTID_REQUIRE(data.is_uniform(), "{}: needs uniformly sampled data", who);
 }
+
+// Several records concatenated (each checked: one input, one output, uniform at the first record's Ts).
+struct Records {
+  Eigen::VectorXd y, u;
+  std::vector<Eigen::Index> starts;
+  double ts = 1.0;
+};
+
+Records concatenate(const std::vector<IdData>& data, const char* who) {
+  CTID_REQUIRE(!data.empty(), "{}: no records", who);
+  Records r;
+  r.ts = data.front().is_uniform() ? data.front().ts() : 0.0;
+  Eigen::Index n = 0;
+  for (size_t i = 0; i < data.size(); ++i) {
+    check_siso(data[i], who);
+    CTID_REQUIRE(std::abs(data[i].ts() - r.ts) <= 1e-9 * r.ts,
+                 "{}: record {} is sampled at {} s, record 1 at {} s; a NARX model has one sampling period", who, i + 1,
+                 data[i].ts(), r.ts);
+    n += data[i].size();
+  }
+  r.y.resize(n);
+  r.u.resize(n);
+  n = 0;
+  for (const auto& d : data) {
+    r.starts.push_back(n);
+    r.y.segment(n, d.size()) = d.y().col(0);
+    r.u.segment(n, d.size()) = d.u().col(0);
+    n += d.size();
+  }
+  return r;
+}
 }  // namespace
 
 Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& cand, const FrolsOptions& o) {
+  return frols(std::vector<IdData>{data}, cand, o);
+}
+
+Result<NarxModel> frols(const std::vector<IdData>& data, const std::vector<NarxTerm>& cand, const FrolsOptions& o) {
   o.validate();
-  check_siso(data, "frols");
+  const Records r = concatenate(data, "frols");
   CTID_REQUIRE(!cand.empty(), "frols: no candidate terms");
   for (const auto& t : cand) CTID_REQUIRE(!t.has_noise(), "frols: candidate {} is a noise term (use narmax)", t.name());
-  const Eigen::VectorXd y = data.y().col(0), u = data.u().col(0), e = Eigen::VectorXd::Zero(y.size());
-  return frols_signals({y, u, e}, data.ts(), cand, o);
+  const Eigen::VectorXd e = Eigen::VectorXd::Zero(r.y.size());
+  return frols_signals({r.y, r.u, e}, r.starts, r.ts, cand, o);
 }
+
 
 template <>
 const OptionTable<NarmaxOptions>& option_table<NarmaxOptions>() {
@@ -321,7 +389,9 @@ void NarxOptions::validate() const {
   narmax.validate();
 }
 
-Result<NarxModel> narx(const IdData& data, const NarxOptions& o) {
+Result<NarxModel> narx(const IdData& data, const NarxOptions& o) { return narx(std::vector<IdData>{data}, o); }
+
+Result<NarxModel> narx(const std::vector<IdData>& data, const NarxOptions& o) {
   o.validate();
   const std::vector<NarxTerm> candidates = narx_candidates(o.degree, o.ylag, o.ulag, o.constant, o.umin);
   if (o.noise_terms == 0) return frols(data, candidates, o.narmax.frols);
@@ -338,11 +408,16 @@ void NarmaxOptions::validate() const {
 }
 
 Result<NarxModel> narmax(const IdData& data, const std::vector<NarxTerm>& process, const NarmaxOptions& o) {
+  return narmax(std::vector<IdData>{data}, process, o);
+}
+
+Result<NarxModel> narmax(const std::vector<IdData>& data, const std::vector<NarxTerm>& process, const NarmaxOptions& o) {
   const auto t_start = std::chrono::steady_clock::now();
   o.validate();
-  check_siso(data, "narmax");
+  const Records rec = concatenate(data, "narmax");
   for (const auto& t : process) CTID_REQUIRE(!t.has_noise(), "narmax: process candidate {} is a noise term", t.name());
-  const Eigen::VectorXd y = data.y().col(0), u = data.u().col(0);
+  const Eigen::VectorXd& y = rec.y;
+  const Eigen::VectorXd& u = rec.u;
   // Iteration 0: NARX; then residual-driven selection over process and noise candidates (extended LS).
   Result<NarxModel> r = frols(data, process, o.frols);
   std::vector<NarxTerm> all = process;
@@ -364,6 +439,7 @@ Result<NarxModel> narmax(const IdData& data, const std::vector<NarxTerm>& proces
       candidate_block({m.terms()[i]}, {y, u, e}, L, Ne, col);
       next.tail(Ne) -= m.coefficients()(static_cast<Eigen::Index>(i)) * col.col(0);
     }
+    next.tail(Ne).array() *= row_mask(rec.starts, y.size(), L).array();  // a record's first L residuals are 0
     return next;
   };
   for (; it < o.iterations && !o.noise_candidates.empty(); ++it) {
@@ -374,7 +450,7 @@ Result<NarxModel> narmax(const IdData& data, const std::vector<NarxTerm>& proces
       break;
     }
     e = residuals(r.model);
-    Result<NarxModel> next = frols_signals({y, u, e}, data.ts(), all, fo);
+    Result<NarxModel> next = frols_signals({y, u, e}, rec.starts, rec.ts, all, fo);
     // Convergence: the same process terms with coefficients within tolerance (relative); noise terms may
     // trade places among themselves.
     change = std::numeric_limits<double>::infinity();

@@ -1107,10 +1107,25 @@ TEST(Cli, SeveralDataFilesAreFittedJointly) {
                 1e-9 * std::abs(lib_t.parameters.values(i)));
   const CliRun o = ctid_run("fit " + files[0] + " " + files[1] + " --time time --input force --output position --method fsf");
   EXPECT_EQ(o.code, 2);
-  EXPECT_NE(o.err.find("2 DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, lssvf or "
-                       "ivsvf (got fsf"),
+  EXPECT_NE(o.err.find("2 DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, lssvf, "
+                       "ivsvf or narx (got fsf"),
             std::string::npos)
       << o.err;
+  // NARX on both records (resampled NARX at Ts = 0.02 s): the CLI's file equals the library's joint fit.
+  const CliRun n = ctid_run("fit " + files[0] + " " + files[1] +
+                            " --time time --input force --output position --method narx --set degree=1 --json " + json +
+                            " --force");
+  ASSERT_EQ(n.code, 0) << n.err;
+  NarxOptions no;
+  no.degree = 1;
+  const Result<NarxModel> lib_n = narx(ds, no);
+  const Result<AnyModel> file_n = read_result_file(json).result;
+  ASSERT_EQ(file_n.parameters.size(), lib_n.parameters.size());
+  for (int i = 0; i < lib_n.parameters.size(); ++i)
+    EXPECT_NEAR(file_n.parameters.values(i), lib_n.parameters.values(i), 1e-9 * std::abs(lib_n.parameters.values(i)));
+  EXPECT_EQ(ctid_run("fit " + files[0] + " " + files[1] + " --time time --input force --output position --method kia")
+                .code,
+            2);
 }
 
 // Every result file ctid writes is read back by simulate, validate and report (issue 14, item 1), the model type

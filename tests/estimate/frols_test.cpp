@@ -8,6 +8,7 @@
 #include "ctid/data/input_design.hpp"
 #include "ctid/estimate/frols.hpp"
 #include "ctid/validate/residuals.hpp"
+#include "test_util.hpp"
 
 using namespace ctid;
 
@@ -167,4 +168,79 @@ TEST(Narmax, NoiseTermsRemoveTheBiasOfOutputNoiseAndTheResidualsPassTheCorrelati
   EXPECT_LE(good.e_eu.n_outside, ideal.e_eu.n_outside + 1);
   EXPECT_LE(good.u2_e.n_outside, ideal.u2_e.n_outside + 1);
   EXPECT_LE(good.u2_e2.n_outside, ideal.u2_e2.n_outside + 1);
+}
+
+namespace {
+// A record of truth() with input amplitude `amp`, started from the outputs y(0), y(1) = y0.
+IdData record_from(int N, double noise, unsigned seed, double amp, Eigen::Vector2d y0) {
+  const Eigen::VectorXd u = white_noise(N, amp, seed), e = white_noise(N, noise, seed + 100);
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(N);
+  y.head(2) = y0;
+  for (int k = 2; k < N; ++k)
+    y(k) = 0.5 * y(k - 1) - 0.2 * y(k - 2) + 0.3 * u(k - 1) + 0.2 * u(k - 2) + 0.1 * y(k - 1) * u(k - 1) -
+           0.05 * y(k - 2) * y(k - 2) + e(k);
+  return IdData(u, y, 0.01);
+}
+}  // namespace
+
+// Several records (issue 14, item 2): FROLS on two records is least squares on the two records' rows stacked — no
+// row reaches across the records (checked against a direct solve to 1e-10); over 60 noisy runs with two records of
+// different input amplitude and initial state the joint estimate is more accurate than either record's for every
+// coefficient, and its reported standard deviation matches the spread (within 25 %: 60 runs estimate a spread to
+// ~9 %).
+TEST(Frols, SeveralRecordsAreOneStackedRegressionMoreAccurateThanEither) {
+  const std::vector<NarxTerm> terms = truth().terms();
+  FrolsOptions o;
+  o.err_tolerance = 0.0;  // select all six candidates: the same structure for every fit
+  {
+    const IdData a = record_from(300, 0.05, 1, 1.0, {0, 0}), b = record_from(200, 0.05, 2, 0.5, {2.0, -1.0});
+    const Result<NarxModel> r = frols(std::vector<IdData>{a, b}, terms, o);
+    ASSERT_EQ(r.parameters.size(), 6);
+    Eigen::MatrixXd P(300 - 2 + 200 - 2, 6);
+    Eigen::VectorXd Y(P.rows());
+    int row = 0;
+    for (const IdData* d : {&a, &b})
+      for (int k = 2; k < d->size(); ++k, ++row) {
+        const double y1 = d->y()(k - 1, 0), y2 = d->y()(k - 2, 0), u1 = d->u()(k - 1, 0), u2 = d->u()(k - 2, 0);
+        P.row(row) << y1, y2, u1, u2, y1 * u1, y2 * y2;
+        Y(row) = d->y()(k, 0);
+      }
+    const Eigen::VectorXd ls = P.colPivHouseholderQr().solve(Y);
+    for (int i = 0; i < 6; ++i) {
+      const auto at = std::find(r.model.terms().begin(), r.model.terms().end(), terms[i]) - r.model.terms().begin();
+      EXPECT_NEAR(r.model.coefficients()(at), ls(i), 1e-10) << terms[i].name();
+    }
+  }
+  const int R = 60;
+  const Eigen::VectorXd truth_c = truth().coefficients();
+  Eigen::MatrixXd e1(R, 6), e2(R, 6), ej(R, 6), sj(R, 6);
+  auto errors = [&](const Result<NarxModel>& r, Eigen::MatrixXd& e, int run, Eigen::MatrixXd* s) {
+    for (int i = 0; i < 6; ++i) {
+      const auto at = std::find(r.model.terms().begin(), r.model.terms().end(), terms[i]) - r.model.terms().begin();
+      e(run, i) = r.model.coefficients()(at) - truth_c(i);
+      if (s) (*s)(run, i) = r.parameters.std(at);
+    }
+  };
+  for (int run = 0; run < R; ++run) {
+    const IdData a = record_from(400, 0.1, 1000 + 2 * run, 1.0, {0, 0});
+    const IdData b = record_from(400, 0.1, 1001 + 2 * run, 0.6, {1.5, -0.5});
+    errors(frols(a, terms, o), e1, run, nullptr);
+    errors(frols(b, terms, o), e2, run, nullptr);
+    errors(frols(std::vector<IdData>{a, b}, terms, o), ej, run, &sj);
+  }
+  for (int i = 0; i < 6; ++i) {
+    auto rmse = [&](const Eigen::MatrixXd& e) { return std::sqrt(e.col(i).squaredNorm() / R); };
+    const double mean = ej.col(i).mean(), sd = std::sqrt((ej.col(i).array() - mean).square().sum() / (R - 1));
+    std::printf("%s: rmse joint %.4g, record 1 %.4g, record 2 %.4g; reported std / spread %.3f\n", terms[i].name().c_str(),
+                rmse(ej), rmse(e1), rmse(e2), sj.col(i).mean() / sd);
+    EXPECT_LT(rmse(ej), std::min(rmse(e1), rmse(e2))) << terms[i].name();
+    EXPECT_NEAR(sj.col(i).mean() / sd, 1.0, 0.25) << terms[i].name();
+  }
+  // Records at different sampling periods, or shorter than the largest lag, are refused naming the record.
+  const IdData a = record_from(100, 0.0, 5, 1.0, {0, 0});
+  EXPECT_NE(test::error_of([&] { frols(std::vector<IdData>{a, IdData(a.u(), a.y(), 0.02)}, terms, o); })
+                .find("record 2 is sampled at 0.02 s, record 1 at 0.01 s"),
+            std::string::npos);
+  EXPECT_NE(test::error_of([&] { frols(std::vector<IdData>{a, record_from(100, 0.0, 6, 1.0, {1.0, 2.0}).slice(0, 2)}, terms, o); }).find("record 2 has 2 samples"),
+            std::string::npos);
 }

@@ -39,6 +39,11 @@ struct FrolsOptions {
 /// outputs (an escaping simulation gives an infinite error and a warning).
 /// Throws InvalidArgument for a multi-channel record, noise terms, or as many candidates as rows.
 Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& candidates, const FrolsOptions& options = {});
+/// Several records of one system (same Ts): one regression stacking each record's rows k = L .. N_r-1 (no row
+/// reaches across records), one term selection; the fit pools each record's free run from its own first L
+/// outputs. Throws InvalidArgument for records at different sampling periods or not longer than L.
+Result<NarxModel> frols(const std::vector<IdData>& data, const std::vector<NarxTerm>& candidates,
+                        const FrolsOptions& options = {});
 
 struct NarmaxOptions {
   FrolsOptions frols;                      ///< process-term selection (max_terms counts process terms)
@@ -57,6 +62,9 @@ struct NarmaxOptions {
 /// equation errors (e.g. output measurement noise) so that the process coefficients are not biased;
 /// model.process() drops them for simulation. diagnostics.scalars: "narmax_iterations", "relative_change".
 Result<NarxModel> narmax(const IdData& data, const std::vector<NarxTerm>& process_candidates,
+                         const NarmaxOptions& options = {});
+/// Several records (as frols): the residuals of each record start from zero at its own first L samples.
+Result<NarxModel> narmax(const std::vector<IdData>& data, const std::vector<NarxTerm>& process_candidates,
                          const NarmaxOptions& options = {});
 
 /// The NARX workflow (`ctid fit --method narx`, Python ctid.narx, C++ narx()): the polynomial candidates of
@@ -80,6 +88,8 @@ struct NarxOptions {
 
 /// Fits the NARX (or NARMAX) workflow on one SISO record. Throws InvalidArgument / InvalidOptions as frols/narmax.
 Result<NarxModel> narx(const IdData& data, const NarxOptions& options = {});
+/// The workflow on several records of one system (frols/narmax on records).
+Result<NarxModel> narx(const std::vector<IdData>& data, const NarxOptions& options = {});
 
 /// The settings tables (estimate/options.hpp).
 template <>
