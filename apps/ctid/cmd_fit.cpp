@@ -65,13 +65,14 @@ void reject_flags_that_do_not_apply(const FitArgs& a) {
 
 // Print, write the JSON file and the HTML report if asked, and map usability to the exit code.
 template <class M>
-int finish(const Result<M>& r, const std::string& method, const IdData& d, const FitArgs& a, const Settings& settings) {
+int finish(const Result<M>& r, const std::string& method, const IdData& d, const FitArgs& a, const Settings& settings,
+           const std::vector<std::pair<std::string, IdData>>& more_records = {}) {
   print_result(r, method, d);
   if (!a.json.empty()) {
     write_result_json(a.json, r, method);
     std::printf("wrote %s\n", a.json.c_str());
   }
-  write_report(a.report, d, r, method, settings, a.data.path);
+  write_report(a.report, d, r, method, settings, a.paths.empty() ? a.data.path : a.paths.front(), more_records);
   if (!r.usable()) {
     std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", r.why_not_usable().c_str());
     return kNotUsable;
@@ -323,6 +324,13 @@ int run_modal(const FitArgs& a, const IdData& d) {
   return finish(r, "modal", d, a, settings);
 }
 
+// Records 2.. of several DATA files, named by their files (for the report's section per record).
+std::vector<std::pair<std::string, IdData>> more_records_of(const FitArgs& a, const std::vector<IdData>& ds) {
+  std::vector<std::pair<std::string, IdData>> more;
+  for (std::size_t e = 1; e < ds.size(); ++e) more.emplace_back(a.paths[e], ds[e]);
+  return more;
+}
+
 // Several DATA files: several experiments of one system, the same columns in each, fitted jointly.
 template <class O>
 int fit_experiments(const FitArgs& a, const std::vector<IdData>& ds,
@@ -339,8 +347,8 @@ int fit_experiments(const FitArgs& a, const std::vector<IdData>& ds,
   for (std::size_t e = 0; e < ds.size(); ++e)
     std::printf("%s%s: %d samples", e ? ", " : "", a.paths[e].c_str(), ds[e].size());
   std::printf(")\n");
-  // The report and the printed samples are those of the first record; the fit is over all of them.
-  return finish(r, a.method, ds[0], a, settings_of(o));
+  // The printed samples are those of the first record; the fit is over all of them; the report shows each record.
+  return finish(r, a.method, ds[0], a, settings_of(o), more_records_of(a, ds));
 }
 
 int run_experiments(const FitArgs& a) {
@@ -359,7 +367,7 @@ int run_experiments(const FitArgs& a) {
   if (ds[0].nu() != 1 || ds[0].ny() != 1)
     throw UsageError(detail::format("several experiments: one --input and one --output (selected {} and {})", ds[0].nu(),
                                     ds[0].ny()));
-  if (a.method == "narx") return run_narx_or_kia(a.method, ds, a.sets, a.narx, a.json, a.report);
+  if (a.method == "narx") return run_narx_or_kia(a.method, ds, a.sets, a.narx, a.json, a.report, more_records_of(a, ds));
   if (a.method == "srivc") return fit_experiments<SrivcOptions>(a, ds, &srivc);
   if (a.method == "lssvf") return fit_experiments<LssvfOptions>(a, ds, &lssvf);
   if (a.method == "ivsvf") return fit_experiments<IvsvfOptions>(a, ds, &ivsvf);
@@ -423,10 +431,10 @@ const std::map<std::string, FitMethod>& fit_methods() {
       {"modal", {{"modal"}, run_modal}},
       {"narx",
        {{"narx"},
-        [](const FitArgs& a, const IdData& d) { return run_narx_or_kia(a.method, {d}, a.sets, a.narx, a.json, a.report); }}},
+        [](const FitArgs& a, const IdData& d) { return run_narx_or_kia(a.method, {d}, a.sets, a.narx, a.json, a.report, {}); }}},
       {"kia",
        {{"kia", "narx"},
-        [](const FitArgs& a, const IdData& d) { return run_narx_or_kia(a.method, {d}, a.sets, a.narx, a.json, a.report); }}},
+        [](const FitArgs& a, const IdData& d) { return run_narx_or_kia(a.method, {d}, a.sets, a.narx, a.json, a.report, {}); }}},
   };
   return m;
 }

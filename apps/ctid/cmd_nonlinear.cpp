@@ -35,8 +35,8 @@ Result<NarxModel> run_narx(const std::vector<IdData>& ds, const NarxOptions& o) 
 }
 
 int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, const std::vector<std::string>& set_list,
-                    const std::string& narx_file, const std::string& json,
-                    const std::string& report) {
+                    const std::string& narx_file, const std::string& json, const std::string& report,
+                    const std::vector<std::pair<std::string, IdData>>& more_records) {
   const IdData& d = ds.front();
   if (d.nu() != 1 || d.ny() != 1) throw UsageError(method + " needs one --input and one --output");
   NarxOptions no;
@@ -48,7 +48,7 @@ int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, co
       write_result_json(json, r, "narx");
       std::printf("wrote %s\n", json.c_str());
     }
-    write_report(report, d, r, "narx", settings_of(no), "");
+    write_report(report, d, r, "narx", settings_of(no), "", more_records);
     return r.usable() ? kOk : kNotUsable;
   }
   if (ds.size() > 1)

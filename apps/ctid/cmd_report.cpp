@@ -11,6 +11,7 @@ extern std::function<int()> g_run;
 namespace {
 struct ReportArgs {
   std::string result, out, title;
+  std::vector<std::string> paths;  // several: experiments of one system, a section each
   DataArgs data;
   std::string initial;  // "": the initial condition of the result's own fit
   bool force = false;
@@ -35,9 +36,17 @@ void check_result(const ResultFile& file, const IdData& d, const std::string& in
 
 int run(const ReportArgs& a) {
   if (a.out.empty()) throw UsageError("give the report file with --out REPORT.html");
-  check_outputs({a.out}, {a.data.path, a.result}, a.force);
+  std::vector<std::string> inputs = a.paths;
+  inputs.push_back(a.result);
+  check_outputs({a.out}, inputs, a.force);
   ResultFile file = read_result(a.result);
-  const IdData d = a.data.load(true);
+  std::vector<IdData> ds;
+  for (const auto& p : a.paths) {
+    DataArgs da = a.data;
+    da.path = p;
+    ds.push_back(da.load(true));
+  }
+  const IdData& d = ds.front();
   if (d.ny() != 1 || d.nu() != model_inputs(file.result.model))
     throw UsageError(detail::format("report needs one --output and one --input per model input (the {} model has {})",
                                     model_type_name(file.result.model), model_inputs(file.result.model)));
@@ -49,7 +58,13 @@ int run(const ReportArgs& a) {
   ReportOptions o;
   o.method = file.method.empty() ? model_type_name(file.result.model) : file.method;
   o.title = a.title.empty() ? "ctid report: " + a.result : a.title;
-  o.data_source = a.data.path;
+  o.data_source = a.paths.front();
+  for (std::size_t e = 1; e < ds.size(); ++e) {
+    // Further records start as ReportOptions::more_records says (a fitted x0 belongs to the first record).
+    const bool narx = std::holds_alternative<NarxModel>(file.result.model);
+    simulate_result(file.result, ds[e], a.initial.empty() ? (narx ? "measured" : "rest") : a.initial);
+    o.more_records.emplace_back(a.paths[e], ds[e]);
+  }
   if (!a.initial.empty()) o.initial = initial_condition_from_string(a.initial);
   std::string html;
   try {
@@ -70,7 +85,7 @@ int run(const ReportArgs& a) {
 void setup_report(CLI::App& app) {
   auto a = std::make_shared<ReportArgs>();
   app.add_option("RESULT", a->result, "Result or model JSON (ctid fit --json)")->required();
-  app.add_option("DATA", a->data.path, "The record to report on (CSV/.dat or .mat)")->required();
+  app.add_option("DATA", a->paths, "The record(s) to report on (CSV/.dat or .mat; several: a section each)")->required();
   a->data.add_to(app, true);
   app.add_option("--out", a->out, "The HTML file to write")->required();
   app.add_option("--title", a->title, "Report title");

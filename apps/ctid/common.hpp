@@ -133,13 +133,15 @@ std::vector<std::pair<std::string, std::string>> settings_of(const O&... o) {
 /// InputError.
 template <class M>
 void write_report(const std::string& path, const IdData& d, const Result<M>& r, const std::string& method,
-                  const std::vector<std::pair<std::string, std::string>>& settings, const std::string& source) {
+                  const std::vector<std::pair<std::string, std::string>>& settings, const std::string& source,
+                  const std::vector<std::pair<std::string, IdData>>& more_records = {}) {
   if (path.empty()) return;
   ReportOptions o;
   o.method = method;
   o.title = "ctid " + method + " fit";
   o.data_source = source;
   o.settings = settings;
+  o.more_records = more_records;
   std::string html;
   try {
     html = html_report(d, r, o);
@@ -162,8 +164,8 @@ ModalOptions modal_options(const std::string& method, const std::vector<std::str
 
 /// Billings & Li: fit --method narx | kia (cmd_nonlinear.cpp); narx on one record or several (jointly).
 int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, const std::vector<std::string>& sets,
-                    const std::string& narx_file, const std::string& json,
-                    const std::string& report);
+                    const std::string& narx_file, const std::string& json, const std::string& report,
+                    const std::vector<std::pair<std::string, IdData>>& more_records);
 
 void setup_fit(CLI::App& app);
 /// After `ctid fit --method M --help`: M's settings (names, units, ranges, defaults) from the library's registry;

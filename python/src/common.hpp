@@ -68,8 +68,10 @@ void def_report(py::module_& m) {
   m.def(
       "html_report",
       [](const IdData& d, const Result<Model>& r, const std::string& path, const std::string& method,
-         const std::string& title, const std::map<std::string, std::string>& settings, const std::string& initial) {
+         const std::string& title, const std::map<std::string, std::string>& settings, const std::string& initial,
+         const std::vector<std::pair<std::string, IdData>>& more_records) {
         ReportOptions o;
+        o.more_records = more_records;
         o.method = method;
         o.title = title;
         o.settings.assign(settings.begin(), settings.end());
@@ -78,8 +80,10 @@ void def_report(py::module_& m) {
       },
       py::arg("data"), py::arg("result"), py::arg("path"), py::arg("method") = "", py::arg("title") = "",
       py::arg("settings") = std::map<std::string, std::string>{}, py::arg("initial") = "",
+      py::arg("more_records") = std::vector<std::pair<std::string, IdData>>{},
       "Write the self-contained HTML report of a result on a record (plots, residual tests, parameters); initial: "
-      "'rest', 'measured' or 'estimated', or '' for the one the result's fit used.");
+      "'rest', 'measured' or 'estimated', or '' for the one the result's fit used; more_records: [(name, IdData), ..] "
+      "further records of the system, a section each.");
 }
 
 /// A setting's value from Python, converted by the setting's kind (estimate/options.hpp): numbers, 0/1 or

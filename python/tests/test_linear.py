@@ -284,6 +284,20 @@ def test_srivc_on_several_experiments_is_one_joint_estimate():
         ctid.srivc([d1, ctid.IdData.from_arrays(np.zeros(600), g.simulate(u1, t), ts=0.02)], 1, 2)
 
 
+def test_report_shows_each_record(tmp_path):
+    # A report of a joint fit has a section per further record (ReportOptions::more_records).
+    g = ctid.TransferFunction([3.0], [1.0, 1.2, 4.0])
+    t = 0.02 * np.arange(600)
+    u1 = ctid.prbs(600, register_length=7, clock_period=5)
+    u2 = np.sin(1.1 * t) + 0.5 * np.sin(3.7 * t)
+    d1 = ctid.IdData.from_arrays(u1, g.simulate(u1, t), ts=0.02)
+    d2 = ctid.IdData.from_arrays(u2, g.simulate(u2, t), ts=0.02)
+    path = tmp_path / "joint.html"
+    ctid.html_report(d1, ctid.srivc([d1, d2], 1, 2), str(path), method="srivc", more_records=[("sines", d2)])
+    html = path.read_text()
+    assert "Record 2: sines" in html and html.count("Measured and simulated output") == 2
+
+
 def test_simulate_any_model_with_an_explicit_initial_condition_and_read_back_results(plant, tmp_path):
     """ctid.simulate is the library's simulate(): the same initial-condition policies as the CLI, and every
     result written by write_result comes back typed by read_result."""

@@ -159,7 +159,7 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
   const Eigen::VectorXd& u = sig.u;
   const Eigen::Index N = y.size(), Ne = N - L;
   const int M = static_cast<int>(cand.size());
-  for (size_t r = 0; r < starts.size(); ++r) {
+  for (size_t r = 0; r < starts.size() && starts.size() > 1; ++r) {  // one record: the row count below says it
     const Eigen::Index n = (r + 1 < starts.size() ? starts[r + 1] : N) - starts[r];
     CTID_REQUIRE(n > L, "frols: record {} has {} samples, not more than the largest lag {}", r + 1, n, L);
   }

@@ -442,6 +442,19 @@ Eigen::VectorXd simulated(Page& page, const IdData& d, const AnyModel& m, const 
   return s.y.col(0);
 }
 
+// The further records of ReportOptions::more_records, each in its own section.
+void more_records(Page& page, const AnyModel& m, const ReportOptions& o) {
+  for (size_t i = 0; i < o.more_records.size(); ++i) {
+    const auto& [name, d] = o.more_records[i];
+    CTID_REQUIRE(d.nu() == model_inputs(m) && d.ny() == 1,
+                 "html_report: record {} ({}) has {} input(s) and {} output(s); the model has {} input(s) and 1 output",
+                 i + 2, name, d.nu(), d.ny(), model_inputs(m));
+    page.section("Record " + std::to_string(i + 2) + ": " + name);
+    page.text(std::to_string(d.size()) + " samples, " + fmt(d.duration()) + " s.");
+    validation(page, d, simulated(page, d, m, Diagnostics{}, o), o);
+  }
+}
+
 }  // namespace
 
 std::string html_report(const IdData& d, const Result<TransferFunction>& r, const ReportOptions& o) {
@@ -449,6 +462,7 @@ std::string html_report(const IdData& d, const Result<TransferFunction>& r, cons
   Page page;
   overview(page, d, r, o, describe(r.model));
   validation(page, d, simulated(page, d, r.model, r.diagnostics, o), o);
+  more_records(page, r.model, o);
   parameters(page, r.parameters);
   diagnostics(page, r.diagnostics);
   const Eigen::VectorXd w = frequency_grid(r.model.poles(), nyquist(d));
@@ -466,6 +480,7 @@ std::string html_report(const IdData& d, const Result<MisoModel>& r, const Repor
   Page page;
   overview(page, d, r, o, describe(r.model));
   validation(page, d, simulated(page, d, r.model, r.diagnostics, o), o);
+  more_records(page, r.model, o);
   parameters(page, r.parameters);
   diagnostics(page, r.diagnostics);
   Eigen::VectorXcd poles(0);
@@ -489,9 +504,10 @@ std::string html_report(const IdData& d, const Result<FsfModel>& r, const Report
   Page page;
   const FsfModel& m = r.model;
   overview(page, d, r, o, describe(m));
-  if (m.shift() == 0.0)
+  if (m.shift() == 0.0) {
     validation(page, d, simulated(page, d, m, r.diagnostics, o), o);
-  else
+    more_records(page, m, o);
+  } else
     page.text("The model was fitted to exponentially windowed data (a = " + fmt(m.shift()) +
               " 1/s): it describes G(s + a), not the system, and is not simulated against the record.");
   parameters(page, r.parameters);
@@ -542,6 +558,7 @@ std::string html_report(const IdData& d, const Result<NarxModel>& r, const Repor
   const Eigen::VectorXd u = d.u().col(0);
   const int L = std::min(p.max_lag(), d.size());
   validation(page, d, simulated(page, d, r.model, r.diagnostics, o), o);
+  more_records(page, r.model, o);
   const auto err = r.diagnostics.vectors.find("err");
   page.section("Selected terms");
   page.text("Terms in the order of selection by forward orthogonal least squares; ERR: the error reduction ratio "
@@ -578,6 +595,7 @@ std::string html_report(const IdData& d, const Result<NdeModel>& r, const Report
   overview(page, d, r, o, describe(m));
   const Eigen::VectorXd u = d.u().col(0);
   validation(page, d, simulated(page, d, m, r.diagnostics, o), o);
+  more_records(page, m, o);
   const auto err = r.diagnostics.vectors.find("err");
   parameters(page, r.parameters,
              err == r.diagnostics.vectors.end() || err->second.size() != r.parameters.size() ? nullptr : &err->second);

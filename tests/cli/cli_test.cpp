@@ -1126,6 +1126,30 @@ TEST(Cli, SeveralDataFilesAreFittedJointly) {
   EXPECT_EQ(ctid_run("fit " + files[0] + " " + files[1] + " --time time --input force --output position --method kia")
                 .code,
             2);
+  // Validation and reports show each record: validate --json lists both (the fit of each equals a fit_report of the
+  // library's simulation of the joint SRIVC model on that record, to 1e-6 %), the report has a section per record.
+  const std::string cols = " --time time --input force --output position", vj = test::temp_path("joint_val.json"),
+                    html = test::temp_path("joint.html");
+  fs::remove(vj);
+  fs::remove(html);
+  ASSERT_EQ(ctid_run("fit " + files[0] + " " + files[1] + cols + " --method srivc --nf 2 --nb 1 --json " + json +
+                     " --force --report " + html)
+                .code,
+            0);
+  EXPECT_NE(read_text_file(html).find("Record 2: " + files[1]), std::string::npos);
+  const CliRun v = ctid_run("validate " + json + " " + files[0] + " " + files[1] + cols + " --json " + vj);
+  ASSERT_EQ(v.code, 0) << v.err;
+  EXPECT_NE(v.out.find("record 2 (" + files[1] + "):"), std::string::npos) << v.out;
+  const auto jv = nlohmann::json::parse(std::ifstream(vj));
+  ASSERT_EQ(jv.at("experiments").size(), 2u);
+  for (int e = 0; e < 2; ++e) {
+    const double f = fit_report(ds[e].y().col(0), lsim(lib.model, ds[e]), 3).fit_percent;
+    EXPECT_NEAR(jv.at("experiments").at(e).at("fit").at("fit_percent").get<double>(), f, 1e-6) << "record " << e + 1;
+  }
+  const std::string html2 = test::temp_path("joint2.html");
+  fs::remove(html2);
+  ASSERT_EQ(ctid_run("report " + json + " " + files[0] + " " + files[1] + cols + " --out " + html2).code, 0);
+  EXPECT_NE(read_text_file(html2).find("Record 2: " + files[1]), std::string::npos);
 }
 
 // Every result file ctid writes is read back by simulate, validate and report (issue 14, item 1), the model type

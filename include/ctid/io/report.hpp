@@ -35,6 +35,10 @@ struct ReportOptions {
   /// the result's diagnostics "x0" where it has one (NDE output error). Unset: fit_initial_condition(), the
   /// one the result's own fit was computed with, so that the plotted fit is the fit the estimator reported.
   std::optional<InitialCondition> initial;
+  /// Further records of the same system (several experiments: name, record), each compared with the model in a
+  /// section of its own after the first record's; simulated from `initial` (unset: rest, or the measured history
+  /// for NARX — a fitted x0 belongs to the first record).
+  std::vector<std::pair<std::string, IdData>> more_records;
 };
 
 /// Report of a result on the record `data` (single input and output — for a MisoModel one input per channel;
