@@ -10,9 +10,11 @@
 #include <numbers>
 
 #include "ctid/core/check.hpp"
+#include "ctid/estimate/lssvf.hpp"
 #include "ctid/signal/walsh.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/validate/metrics.hpp"
+#include "tf_common.hpp"
 #include "estimate/modal_common.hpp"
 #include "internal/least_squares.hpp"
 
@@ -346,13 +348,11 @@ Result<TransferFunction> modal_transfer_function(const IdData& data, const Input
   r.model = m.model.transfer_function(input);
   r.summary = m.summary;
   r.diagnostics = m.diagnostics;
-  for (int j = 0; j < n; ++j) r.parameters.names.push_back(detail::format("a{}", j));
-  for (int j = 0; j < n; ++j) r.parameters.names.push_back(detail::format("b{}", j));
-  r.parameters.values.resize(2 * n);
-  for (int j = 0; j < n; ++j) {
-    r.parameters.values(j) = r.model.den().coefficient_of_power(j);
-    r.parameters.values(n + j) = r.model.num().coefficient_of_power(j);
-  }
+  // Named as every transfer-function estimator names them (tf_parameter_names: a1..an of s^(n-1)..s^0, b0.. from
+  // the highest power of the numerator).
+  const TfOrders orders{n, n, 0};
+  r.parameters.names = tf_parameter_names(orders);
+  r.parameters.values = tf_detail::params_of(r.model, orders);
   r.parameters.std = Eigen::VectorXd::Constant(2 * n, std::numeric_limits<double>::quiet_NaN());
   r.parameters.fixed.assign(2 * n, false);
   // Validation by exact simulation from rest with the generated input (the method's input model).
@@ -462,13 +462,12 @@ Result<TransferFunction> modal_fit_undelayed(const IdData& data, int nb, ModalOp
   Eigen::VectorXd numc(nb);
   for (int j = 0; j < nb; ++j) numc(j) = sol.theta(nb - 1 - j);
   r.model = TransferFunction(Polynomial(numc), den);
-  for (int j = 0; j < n; ++j) r.parameters.names.push_back(detail::format("a{}", j));
-  for (int j = 0; j < nb; ++j) r.parameters.names.push_back(detail::format("b{}", j));
-  r.parameters.values.resize(n + nb);
-  for (int j = 0; j < n; ++j) r.parameters.values(j) = den.coefficient_of_power(j);
-  r.parameters.values.tail(nb) = sol.theta;
+  // Named as every transfer-function estimator names them (tf_parameter_names); b0 is the numerator's highest power.
+  const TfOrders orders{nb, n, 0};
+  r.parameters.names = tf_parameter_names(orders);
+  r.parameters.values = tf_detail::params_of(r.model, orders);
   r.parameters.std = Eigen::VectorXd::Constant(n + nb, std::numeric_limits<double>::quiet_NaN());
-  r.parameters.std.tail(nb) = sol.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();  // given A(s)
+  r.parameters.std.tail(nb) = sol.covariance.diagonal().cwiseMax(0.0).cwiseSqrt().reverse();  // given A(s)
   r.parameters.fixed.assign(n + nb, false);
   if (!r.model.is_stable()) r.diagnostics.warnings.push_back("the estimated model is unstable");
   r.fit = fit_report_or_inf(data.y().col(0), lsim(r.model, data, 0), n + nb);

@@ -10,6 +10,7 @@
 
 #include "ctid/core/error.hpp"
 #include "ctid/data/input_design.hpp"
+#include "ctid/estimate/lssvf.hpp"
 #include "ctid/estimate/modal.hpp"
 #include "ctid/simulate/lsim.hpp"
 
@@ -152,6 +153,8 @@ TEST(ModalEstimate, TheoremsFourOneAndFourTwoGiveTheTransferFunction) {
   EXPECT_NEAR(r.model.num().coefficient_of_power(1), 13.0, 1e-4 * 52);
   EXPECT_NEAR(r.model.num().coefficient_of_power(0), 52.0, 1e-4 * 52);
   EXPECT_GT(r.fit.fit_percent, 99.9);
+  EXPECT_EQ(r.parameters.names, tf_parameter_names({3, 3, 0}));  // a1..a3, b0..b2 (b0 of s^2: 0 here)
+  EXPECT_NEAR(r.parameters.value("b2"), 52.0, 1e-4 * 52);
 }
 
 TEST(FreeResponsePoles, Table48DataMatrixOnTheS4FreeResponse) {
@@ -486,6 +489,13 @@ TEST(ModalFit, PiecewiseConstantInputsGiveTheTransferFunctionByBothRoutes) {
     EXPECT_NEAR(r.model.num().coefficient_of_power(1), 13.0, 1e-5);
     EXPECT_NEAR(r.model.num().coefficient_of_power(0), 52.0, 1e-5);
     EXPECT_GT(r.fit.fit_percent, 99.999);
+    // One naming of transfer-function coefficients across methods (issue 14): a1..a3 of s^2..s^0, b0 of the
+    // numerator's highest power — SRIVC's names for the same coefficients of S3 = (13 s + 52)/(s^3 + ...).
+    EXPECT_EQ(r.parameters.names, tf_parameter_names({2, 3, 0}));
+    EXPECT_NEAR(r.parameters.value("a1"), kS3.den().coefficient_of_power(2), 1e-6 * 52);
+    EXPECT_NEAR(r.parameters.value("a3"), kS3.den().coefficient_of_power(0), 1e-6 * 52);
+    EXPECT_NEAR(r.parameters.value("b0"), 13.0, 1e-5);
+    EXPECT_NEAR(r.parameters.value("b1"), 52.0, 1e-5);
   }
   EXPECT_THROW(modal_fit(d, 4, {.shifts = shifts}), InvalidArgument);  // nb > n
   EXPECT_THROW(modal_fit(d, 2, {.shifts = Eigen::Vector3d(16, 32, 56) * Ts, .basis = ModalBasis::Discrete}),
