@@ -351,6 +351,29 @@ int fit_experiments(const FitArgs& a, const std::vector<IdData>& ds,
   return finish(r, a.method, ds[0], a, settings_of(o), more_records_of(a, ds));
 }
 
+// Several inputs: MISO SRIVC on one record or several (jointly). Orders per input: one value for every input, or
+// one per input.
+int run_miso(const FitArgs& a, const std::vector<IdData>& ds) {
+  const int nu = ds.front().nu();
+  auto per_input = [&](const std::vector<int>& v, const char* flag, int i) {
+    if (v.size() != 1 && static_cast<int>(v.size()) != nu)
+      throw UsageError(detail::format("{} has {} values for {} inputs (give one value, or one per input)", flag, v.size(), nu));
+    return v.size() == 1 ? v[0] : v[i];
+  };
+  std::vector<TfOrders> all;
+  for (int i = 0; i < nu; ++i) {
+    const int nf_i = per_input(a.nf, "--nf", i);
+    all.push_back({a.nb.empty() ? nf_i : per_input(a.nb, "--nb", i), nf_i, per_input(a.nk, "--nk", i)});
+  }
+  if (a.method != "srivc")
+    throw UsageError(detail::format("{} estimates single-input models; use --method srivc for {} inputs", a.method, nu));
+  if (a.delay) throw UsageError("--delay is available for single-input models");
+  SrivcMisoOptions o;
+  apply_sets("srivc_miso", a.sets, o);
+  const Result<MisoModel> r = call_library([&] { return srivc_miso(ds, all, o); });
+  return finish(r, "srivc", ds.front(), a, settings_of(o), more_records_of(a, ds));
+}
+
 int run_experiments(const FitArgs& a) {
   if (a.method != "srivc" && a.method != "oe" && a.method != "tfest" && a.method != "lssvf" && a.method != "ivsvf" &&
       a.method != "narx")
@@ -364,9 +387,9 @@ int run_experiments(const FitArgs& a) {
     da.path = p;
     ds.push_back(da.load(true));
   }
-  if (ds[0].nu() != 1 || ds[0].ny() != 1)
-    throw UsageError(detail::format("several experiments: one --input and one --output (selected {} and {})", ds[0].nu(),
-                                    ds[0].ny()));
+  if (ds[0].ny() != 1)
+    throw UsageError(detail::format("several experiments: one --output (selected {})", ds[0].ny()));
+  if (ds[0].nu() > 1) return run_miso(a, ds);
   if (a.method == "narx") return run_narx_or_kia(a.method, ds, a.sets, a.narx, a.json, a.report, more_records_of(a, ds));
   if (a.method == "srivc") return fit_experiments<SrivcOptions>(a, ds, &srivc);
   if (a.method == "lssvf") return fit_experiments<LssvfOptions>(a, ds, &lssvf);
@@ -393,27 +416,7 @@ int run(const FitArgs& a) {
     return 0;
   });
   if (d.ny() != 1) throw UsageError(detail::format("{} estimates single-output models (selected {} outputs)", a.method, d.ny()));
-  // Orders per input: one value for every input, or one per input.
-  auto per_input = [&](const std::vector<int>& v, const char* flag, int i) {
-    if (v.size() != 1 && static_cast<int>(v.size()) != d.nu())
-      throw UsageError(detail::format("{} has {} values for {} inputs (give one value, or one per input)", flag, v.size(),
-                                      d.nu()));
-    return v.size() == 1 ? v[0] : v[i];
-  };
-  std::vector<TfOrders> all;
-  for (int i = 0; i < d.nu(); ++i) {
-    const int nf_i = per_input(a.nf, "--nf", i);
-    all.push_back({a.nb.empty() ? nf_i : per_input(a.nb, "--nb", i), nf_i, per_input(a.nk, "--nk", i)});
-  }
-  if (d.nu() > 1) {
-    if (a.method != "srivc")
-      throw UsageError(detail::format("{} estimates single-input models; use --method srivc for {} inputs", a.method, d.nu()));
-    if (a.delay) throw UsageError("--delay is available for single-input models");
-    SrivcMisoOptions o;
-    apply_sets("srivc_miso", a.sets, o);
-    const Result<MisoModel> r = call_library([&] { return srivc_miso(d, all, o); });
-    return finish(r, "srivc", d, a, settings_of(o));
-  }
+  if (d.nu() > 1) return run_miso(a, {d});
   return fit_methods().at(a.method).run(a, d);
 }
 

@@ -238,7 +238,7 @@ def rls_svf(data, nb, nf, nk=0, **options):
 
 def srivc_miso(data, orders, **options):
     """SRIVC with several inputs: orders is one (nb, nf, nk) per input (options: SrivcMisoOptions, e.g.
-    common_denominator=True, delays=[..] in s)."""
+    common_denominator=True, delays=[..] in s). data: an IdData or a list of IdData (several experiments, jointly)."""
     return _ctid.srivc_miso(data, [tuple(o) for o in orders], _options(_ctid.SrivcMisoOptions, "srivc_miso", options))
 
 

@@ -116,9 +116,10 @@ void bind_core(py::module_& m) {
   def_report<TransferFunction>(m);
 
   m.def("time_grid", &time_grid, py::arg("ts"), py::arg("n"));
-  m.def("prbs", [](int n, int register_length, int clock_period) {
-          return prbs(n, {.register_length = register_length, .clock_period = clock_period});
-        }, py::arg("n"), py::arg("register_length") = 10, py::arg("clock_period") = 1, "PRBS of +-1.");
+  m.def("prbs", [](int n, int register_length, int clock_period, std::uint32_t initial_state) {
+          return prbs(n, {.register_length = register_length, .clock_period = clock_period, .initial_state = initial_state});
+        }, py::arg("n"), py::arg("register_length") = 10, py::arg("clock_period") = 1, py::arg("initial_state") = 1,
+        "PRBS of +-1 (initial_state: the non-zero register seed).");
   m.def("add_noise_snr", &add_noise_snr, py::arg("x"), py::arg("snr_db"), py::arg("seed"),
         "x plus white Gaussian noise at the given signal-to-noise ratio (dB, power of x - mean).");
   m.def("fit_percent", &fit_percent, py::arg("y"), py::arg("yhat"), "100 (1 - ||y - yhat|| / ||y - mean(y)||).");

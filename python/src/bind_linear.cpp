@@ -100,6 +100,15 @@ void bind_linear(py::module_& m) {
                                   "Recursive least squares on filtered signals run once over the record (final estimate).");
   m.def(
       "srivc_miso",
+      [](const std::vector<IdData>& d, const std::vector<std::tuple<int, int, int>>& orders, const SrivcMisoOptions& o) {
+        std::vector<TfOrders> to;
+        for (const auto& [nb, nf, nk] : orders) to.push_back({nb, nf, nk});
+        return interruptible([&] { return srivc_miso(d, to, o); });
+      },
+      py::arg("data"), py::arg("orders"), py::arg("options") = SrivcMisoOptions{},
+      "SRIVC with several inputs on several experiments (a list of IdData), jointly; orders: one (nb, nf, nk) per input.");
+  m.def(
+      "srivc_miso",
       [](const IdData& d, const std::vector<std::tuple<int, int, int>>& orders, const SrivcMisoOptions& o) {
         std::vector<TfOrders> to;
         for (const auto& [nb, nf, nk] : orders) to.push_back({nb, nf, nk});

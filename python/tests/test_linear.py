@@ -95,6 +95,22 @@ def test_srivc_miso_noise_free_recovers_both_channels():
         ctid.srivc_miso(d, [(1, 1, 0)])
 
 
+def test_srivc_miso_on_several_experiments():
+    # Two noise-free records of a two-input system with different inputs: the joint fit is exact (1e-6).
+    g1 = ctid.TransferFunction([1.0, 3.0], [1.0, 2.0, 5.0])
+    g2 = ctid.TransferFunction([2.0], [1.0, 1.0])
+    t = ctid.time_grid(0.02, 1500)
+    records = []
+    for seed, (a1, a2) in ((3, (1.0, 0.6)), (11, (0.6, 1.0))):
+        u1 = a1 * ctid.prbs(1500, register_length=9, clock_period=5, initial_state=seed)
+        u2 = a2 * ctid.prbs(1500, register_length=10, clock_period=3, initial_state=seed + 7)
+        records.append(ctid.IdData.from_arrays(np.column_stack([u1, u2]), g1.simulate(u1, t) + g2.simulate(u2, t),
+                                               ts=0.02))
+    r = ctid.srivc_miso(records, [(2, 2, 0), (1, 1, 0)])
+    np.testing.assert_allclose(r.parameters.values, [2.0, 5.0, 1.0, 3.0, 1.0, 2.0], rtol=1e-6)
+    assert r.diagnostics.scalars["experiments"] == 2
+
+
 def test_srivc_closed_loop_with_known_pi_controller():
     # Plant G = 1/(s^2 + 1.2 s + 2) under C = (2 s + 1)/s, reference added at the plant input: u = r - C y.
     # Closed loop: y/r = B Dc / (A Dc + B Nc), u/r = A Dc / (A Dc + B Nc), simulated in continuous time, so u is

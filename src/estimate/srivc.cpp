@@ -459,55 +459,76 @@ const OptionTable<SrivcMisoOptions>& option_table<SrivcMisoOptions>() {
 void SrivcMisoOptions::validate() const { option_table<SrivcMisoOptions>().check(*this); }
 
 namespace {
-Result<MisoModel> srivc_miso_in_units(const IdData& data, const std::vector<TfOrders>& orders, const SrivcMisoOptions& opt) {
+// MISO SRIVC on one or several records (experiments of one system), each record's filters from rest; the IV
+// equations of every step are summed over the records.
+Result<MisoModel> srivc_miso_in_units(const Records& ds, const std::vector<TfOrders>& orders, const SrivcMisoOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
   opt.validate();
-  const int K = data.nu();
+  const int K = ds.front().nu(), E = static_cast<int>(ds.size());
   CTID_REQUIRE_OPTION(opt.delays.empty() || static_cast<int>(opt.delays.size()) == K,
                       "srivc_miso: {} delays for {} inputs", opt.delays.size(), K);
-  int p = 0;
+  int p = 0, total = 0;
+  for (const auto& d : ds) total += d.size();
   for (int i = 0; i < K; ++i) {
     orders[i].validate(/*allow_biproper=*/true);
-    CTID_REQUIRE(orders[i].nk == 0 || data.is_uniform(), "srivc_miso: nk needs uniformly sampled data");
+    for (const auto& d : ds) CTID_REQUIRE(orders[i].nk == 0 || d.is_uniform(), "srivc_miso: nk needs uniformly sampled data");
     CTID_REQUIRE_OPTION(!opt.common_denominator || orders[i].nf == orders[0].nf,
                         "srivc_miso: a common denominator needs equal nf for every input (input 1 has {}, input {} has {})",
                         orders[0].nf, i + 1, orders[i].nf);
     p += orders[i].nb + (opt.common_denominator ? 0 : orders[i].nf);
   }
   if (opt.common_denominator) p += orders[0].nf;
-  CTID_REQUIRE(data.size() > p, "srivc_miso: {} samples cannot determine {} parameters", data.size(), p);
+  CTID_REQUIRE(total > p, "srivc_miso: {} samples cannot determine {} parameters", total, p);
 
-  const Eigen::VectorXd t = data.times();
-  const Eigen::VectorXd y = data.y().col(0);
-  std::vector<IvChannel> ch;
-  for (int i = 0; i < K; ++i)
-    ch.push_back({data.u().col(i), data.intersample(i),
-                  (opt.delays.empty() ? 0.0 : opt.delays[i]) + (orders[i].nk > 0 ? orders[i].nk * data.ts() : 0.0),
-                  orders[i].nb});
+  // Per record: times, output and the channels (input, intersample, total delay, nb).
+  std::vector<Eigen::VectorXd> ts(E), ys(E);
+  std::vector<std::vector<IvChannel>> chs(E);
+  for (int e = 0; e < E; ++e) {
+    const IdData& d = ds[e];
+    ts[e] = d.times();
+    ys[e] = d.y().col(0);
+    for (int i = 0; i < K; ++i)
+      chs[e].push_back({d.u().col(i), d.intersample(i),
+                        (opt.delays.empty() ? 0.0 : opt.delays[i]) + (orders[i].nk > 0 ? orders[i].nk * d.ts() : 0.0),
+                        orders[i].nb});
+  }
+  // The delay of channel i (nk counted in the first record's sampling period, as every record shares the model).
   auto channel_model = [&](int i, const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-    return tf_detail::make_tf(a, b, ch[i].delay);
+    return tf_detail::make_tf(a, b, chs[0][i].delay);
   };
   // Start, input by input: SISO SRIVC of y minus the outputs of the channels fitted before (the later inputs
   // act as noise). Fitting every channel on y alone instead gives starts biased by all other inputs (at
   // equal input powers a 0 dB "noise"), from which the iterations can end rank-deficient.
-  std::vector<Eigen::VectorXd> th(K), xhat(K);  // channel parameters and simulated channel outputs
+  std::vector<Eigen::VectorXd> th(K);                                       // channel parameters
+  std::vector<std::vector<Eigen::VectorXd>> xhat(E, std::vector<Eigen::VectorXd>(K));  // simulated channel outputs
   {
-    Eigen::VectorXd rest = y;
+    std::vector<Eigen::VectorXd> rest = ys;
     for (int i = 0; i < K; ++i) {
-      const Eigen::MatrixXd ui = data.u().col(i);
-      IdData rk = data.is_uniform() ? IdData(ui, rest, data.ts(), data.t0()) : IdData(ui, rest, t);
-      rk.set_intersample(data.intersample(i));
+      Records rk;
+      for (int e = 0; e < E; ++e) {
+        const IdData& d = ds[e];
+        const Eigen::MatrixXd ui = d.u().col(i);
+        rk.push_back(d.is_uniform() ? IdData(ui, rest[e], d.ts(), d.t0()) : IdData(ui, rest[e], ts[e]));
+        rk.back().set_intersample(d.intersample(i));
+      }
       SrivcOptions so;
-      so.delay = ch[i].delay;
+      so.delay = chs[0][i].delay;
       so.max_iterations = 20;
       const Result<TransferFunction> s = srivc(rk, {orders[i].nb, orders[i].nf, 0}, so);
-      th[i] = s.parameters.values;
-      const TransferFunction gi = tf_detail::stabilized(channel_model(i, th[i].head(orders[i].nf), th[i].tail(orders[i].nb)));
+      const TransferFunction gi =
+          tf_detail::stabilized(channel_model(i, s.parameters.values.head(orders[i].nf), s.parameters.values.tail(orders[i].nb)));
       th[i] = tf_detail::params_of(gi, {orders[i].nb, orders[i].nf, 0});
-      xhat[i] = lsim(gi, data, i);
-      rest -= xhat[i];
+      for (int e = 0; e < E; ++e) {
+        xhat[e][i] = lsim(gi, ds[e], i);
+        rest[e] -= xhat[e][i];
+      }
     }
   }
+  auto records_of = [&](const std::vector<Eigen::VectorXd>& y, const std::vector<std::vector<IvChannel>>& ch) {
+    std::vector<srivc_detail::IvRecord> rec;
+    for (int e = 0; e < E; ++e) rec.push_back({&y[e], &ts[e], &ch[e]});
+    return rec;
+  };
   Result<MisoModel> r;
   SrivcRun last;
   bool converged = false, failed = false;
@@ -522,7 +543,7 @@ Result<MisoModel> srivc_miso_in_units(const IdData& data, const std::vector<TfOr
       off += orders[i].nb;
     }
     for (it = 1; it <= opt.max_iterations; ++it) {
-      last = srivc_detail::iv_step(y, t, ch, n, theta);
+      last = srivc_detail::iv_step(records_of(ys, chs), n, theta);
       if (last.rank_deficient) { failed = true; break; }
       const double change = relative_change(last.theta, theta);
       theta = last.theta;
@@ -539,22 +560,28 @@ Result<MisoModel> srivc_miso_in_units(const IdData& data, const std::vector<TfOr
       for (int j = 0; j < orders[i].nb; ++j) r.parameters.names.push_back("u" + std::to_string(i + 1) + ".b" + std::to_string(j));
     r.parameters.covariance = last.zz;  // sum zeta zeta^T; scaled by sigma^2 below
   } else {
-    // Backfitting: channel i is refitted on y minus the other channels' model outputs.
+    // Backfitting: channel i is refitted on y minus the other channels' model outputs, in every record.
     Eigen::MatrixXd zz_blocks = Eigen::MatrixXd::Zero(p, p);
+    std::vector<Eigen::VectorXd> yi(E);
+    std::vector<std::vector<IvChannel>> chi(E);
     for (it = 1; it <= opt.max_iterations; ++it) {
       double change = 0;
       int off = 0;
       for (int i = 0; i < K; ++i) {
-        Eigen::VectorXd yi = y;
-        for (int k = 0; k < K; ++k)
-          if (k != i) yi -= xhat[k];
-        SrivcRun s = srivc_detail::iv_step(yi, t, {ch[i]}, orders[i].nf, th[i]);
+        for (int e = 0; e < E; ++e) {
+          yi[e] = ys[e];
+          for (int k = 0; k < K; ++k)
+            if (k != i) yi[e] -= xhat[e][k];
+          chi[e] = {chs[e][i]};
+        }
+        SrivcRun s = srivc_detail::iv_step(records_of(yi, chi), orders[i].nf, th[i]);
         if (s.rank_deficient) { failed = true; break; }
         change = std::max(change, relative_change(s.theta, th[i]));
         th[i] = s.theta;
         // The other channels see this one through its simulated output: an unstable intermediate estimate
         // would swamp them, so it is simulated with its poles mirrored into the left half plane.
-        xhat[i] = lsim(tf_detail::stabilized(channel_model(i, th[i].head(orders[i].nf), th[i].tail(orders[i].nb))), data, i);
+        const TransferFunction gi = tf_detail::stabilized(channel_model(i, th[i].head(orders[i].nf), th[i].tail(orders[i].nb)));
+        for (int e = 0; e < E; ++e) xhat[e][i] = lsim(gi, ds[e], i);
         const int pi = orders[i].nf + orders[i].nb;
         zz_blocks.block(off, off, pi, pi) = s.zz;
         off += pi;
@@ -577,8 +604,14 @@ Result<MisoModel> srivc_miso_in_units(const IdData& data, const std::vector<TfOr
     r.parameters.covariance = zz_blocks;  // scaled below (block-diagonal approximation across channels)
   }
   r.parameters.fixed.assign(p, false);
-  r.fit = fit_report_or_inf(y, lsim(r.model, data), p);
-  const double sigma2 = r.fit.mse * data.size() / std::max(1, data.size() - p);
+  // The simulation fit over all records (each from rest), as one concatenated output.
+  Eigen::VectorXd yall(total), sall(total);
+  for (int e = 0, at = 0; e < E; at += ds[e].size(), ++e) {
+    yall.segment(at, ds[e].size()) = ys[e];
+    sall.segment(at, ds[e].size()) = lsim(r.model, ds[e]);
+  }
+  r.fit = fit_report_or_inf(yall, sall, p);
+  const double sigma2 = r.fit.mse * total / std::max(1, total - p);
   if (!failed && std::isfinite(sigma2)) {
     const Eigen::MatrixXd zz = r.parameters.covariance;
     r.parameters.covariance = sigma2 * zz.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
@@ -589,6 +622,7 @@ Result<MisoModel> srivc_miso_in_units(const IdData& data, const std::vector<TfOr
   }
   r.diagnostics.condition_number = last.sol.condition;
   r.diagnostics.scalars["noise_variance"] = sigma2;
+  if (E > 1) r.diagnostics.scalars["experiments"] = E;
   r.summary.iterations = std::min(it, opt.max_iterations);
   set_termination(r, failed, converged, opt.tolerance, opt.max_iterations,
                   "the instrumental-variable matrix is singular; the inputs do not excite every parameter");
@@ -610,22 +644,41 @@ TransferFunction time_scaled(const TransferFunction& g, double c, double gain) {
 }  // namespace
 
 Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& orders, const SrivcMisoOptions& opt) {
+  return srivc_miso(std::vector<IdData>{data}, orders, opt);
+}
+
+Result<MisoModel> srivc_miso(const std::vector<IdData>& ds, const std::vector<TfOrders>& orders, const SrivcMisoOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
-  require_io_data(data, "srivc_miso", -1, 1);
-  CTID_REQUIRE(data.nu() >= 1 && static_cast<int>(orders.size()) == data.nu(), "srivc_miso: {} inputs but {} sets of orders",
-               data.nu(), orders.size());
-  // As srivc: estimated in normalised units (time / c, each input by its RMS, y by its RMS), mapped back.
-  const tf_detail::TfNormalisation n = tf_detail::TfNormalisation::of(data);
+  CTID_REQUIRE(!ds.empty(), "srivc_miso: no records");
+  const int K = ds.front().nu();
+  for (std::size_t e = 0; e < ds.size(); ++e) {
+    const std::string who = ds.size() > 1 ? "srivc_miso (record " + std::to_string(e + 1) + ")" : "srivc_miso";
+    require_io_data(ds[e], who.c_str(), -1, 1);
+    CTID_REQUIRE(ds[e].nu() == K, "{}: {} inputs; record 1 has {}", who, ds[e].nu(), K);
+  }
+  CTID_REQUIRE(K >= 1 && static_cast<int>(orders.size()) == K, "srivc_miso: {} inputs but {} sets of orders", K,
+               orders.size());
+  // As srivc: estimated in normalised units (time / c, each input by its RMS, y by its RMS; pooled over the
+  // records), mapped back.
+  const tf_detail::TfNormalisation n = tf_detail::TfNormalisation::of(ds);
   std::vector<tf_detail::TfNormalisation> per_input;  // c, the input's RMS, sy
-  Eigen::RowVectorXd su(data.nu());
-  for (int i = 0; i < data.nu(); ++i) {
-    const double rms = std::sqrt(data.u().col(i).squaredNorm() / std::max(1, data.size()));
+  Eigen::RowVectorXd su(K);
+  for (int i = 0; i < K; ++i) {
+    double ss = 0;
+    int count = 0;
+    for (const auto& d : ds) {
+      ss += d.u().col(i).squaredNorm();
+      count += d.size();
+    }
+    const double rms = std::sqrt(ss / std::max(1, count));
     su(i) = rms > 0 && std::isfinite(rms) ? rms : 1.0;
     per_input.push_back({n.c, su(i), n.sy});
   }
   SrivcMisoOptions o = opt;
   for (double& dl : o.delays) dl /= n.c;
-  Result<MisoModel> r = srivc_miso_in_units(n.data(data, su), orders, o);
+  Records normalised;
+  for (const auto& d : ds) normalised.push_back(n.data(d, su));
+  Result<MisoModel> r = srivc_miso_in_units(normalised, orders, o);
   // Parameters "a<k>" (common denominator), "u<i>.a<k>", "u<i>.b<j>".
   Eigen::VectorXd f(r.parameters.size());
   for (int k = 0; k < r.parameters.size(); ++k) {

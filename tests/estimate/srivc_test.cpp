@@ -274,6 +274,65 @@ TEST(SrivcMiso, SeparateDenominatorsConvergeWhateverTheInputOrder) {
   EXPECT_LT(max_rel(s.parameters.values, Eigen::VectorXd{{1.0, 2.0, 2.0, 5.0, 1.0, 3.0}}), 1e-6);
 }
 
+// Several experiments of a two-input system (issue 14, item 2): y = (s + 3)/(s^2 + 2 s + 5) u1 + 2/(s + 1) u2,
+// record 1 exciting u1 more than u2 (PRBS amplitudes 1 and 0.6), record 2 the reverse, 1500 samples
+// each at 20 ms, white output noise of std 0.1. Noise-free, the joint fit is exact (1e-6). Over 30 runs the joint
+// estimate is more accurate than either record's for every parameter and its reported standard deviation matches
+// the spread within 35 % (30 runs estimate a spread to ~13 %; measured 0.82-1.02: the backfitting covariance is
+// block-diagonal across channels). Measured joint RMS error 0.69-0.93 of the better record's.
+TEST(SrivcMiso, SeveralExperimentsGiveOneEstimateMoreAccurateThanEither) {
+  const double Ts = 0.02;
+  const int N = 1500;
+  const Eigen::VectorXd t = time_grid(Ts, N);
+  const TransferFunction g1(Eigen::VectorXd{{1.0, 3.0}}, Eigen::VectorXd{{1.0, 2.0, 5.0}});
+  const TransferFunction g2(Eigen::VectorXd{{2.0}}, Eigen::VectorXd{{1.0, 1.0}});
+  const Eigen::VectorXd truth{{2.0, 5.0, 1.0, 3.0, 1.0, 2.0}};
+  const std::vector<TfOrders> orders = {{2, 2, 0}, {1, 1, 0}};
+  auto inputs = [&](double a1, double a2, std::uint32_t seed) {
+    Eigen::MatrixXd u(N, 2);
+    u.col(0) = a1 * prbs(N, {.register_length = 9, .clock_period = 5, .initial_state = seed});
+    u.col(1) = a2 * prbs(N, {.register_length = 10, .clock_period = 3, .initial_state = seed + 7});
+    return u;
+  };
+  const Eigen::MatrixXd u1 = inputs(1.0, 0.6, 3), u2 = inputs(0.6, 1.0, 11);
+  const Eigen::VectorXd x1 = lsim(g1, Eigen::VectorXd(u1.col(0)), t) + lsim(g2, Eigen::VectorXd(u1.col(1)), t);
+  const Eigen::VectorXd x2 = lsim(g1, Eigen::VectorXd(u2.col(0)), t) + lsim(g2, Eigen::VectorXd(u2.col(1)), t);
+  const auto exact = srivc_miso(std::vector<IdData>{IdData(u1, x1, Ts), IdData(u2, x2, Ts)}, orders);
+  ASSERT_EQ(exact.summary.termination, Termination::Converged) << exact.summary.message;
+  EXPECT_LT(max_rel(exact.parameters.values, truth), 1e-6);
+  EXPECT_EQ(exact.diagnostics.scalars.at("experiments"), 2);
+  const int R = 30;
+  Eigen::MatrixXd e1(R, 6), e2(R, 6), ej(R, 6), sj(R, 6);
+  std::mt19937_64 rng(99);
+  std::normal_distribution<double> noise(0.0, 0.1);
+  for (int run = 0; run < R; ++run) {
+    Eigen::VectorXd y1 = x1, y2 = x2;
+    for (int k = 0; k < N; ++k) {
+      y1(k) += noise(rng);
+      y2(k) += noise(rng);
+    }
+    const IdData d1(u1, y1, Ts), d2(u2, y2, Ts);
+    e1.row(run) = (srivc_miso(d1, orders).parameters.values - truth).transpose();
+    e2.row(run) = (srivc_miso(d2, orders).parameters.values - truth).transpose();
+    const auto j = srivc_miso(std::vector<IdData>{d1, d2}, orders);
+    ASSERT_TRUE(j.usable()) << j.why_not_usable();
+    ej.row(run) = (j.parameters.values - truth).transpose();
+    sj.row(run) = j.parameters.std.transpose();
+  }
+  for (int i = 0; i < 6; ++i) {
+    auto rmse = [&](const Eigen::MatrixXd& e) { return std::sqrt(e.col(i).squaredNorm() / R); };
+    const double mean = ej.col(i).mean(), sd = std::sqrt((ej.col(i).array() - mean).square().sum() / (R - 1));
+    std::printf("parameter %d: rmse joint %.4g, record 1 %.4g, record 2 %.4g; reported std / spread %.3f\n", i, rmse(ej),
+                rmse(e1), rmse(e2), sj.col(i).mean() / sd);
+    EXPECT_LT(rmse(ej), std::min(rmse(e1), rmse(e2))) << "parameter " << i;
+    EXPECT_NEAR(sj.col(i).mean() / sd, 1.0, 0.35) << "parameter " << i;
+  }
+  EXPECT_NE(test::error_of([&] {
+              srivc_miso(std::vector<IdData>{IdData(u1, x1, Ts), IdData(Eigen::MatrixXd(u1.col(0)), x1, Ts)}, orders);
+            }).find("srivc_miso (record 2): 1 inputs; record 1 has 2"),
+            std::string::npos);
+}
+
 TEST(SrivcMiso, CommonDenominatorNoiseFreeExact) {
   const Miso m;
   const TransferFunction c1(Eigen::VectorXd{{2.0}}, Eigen::VectorXd{{1.0, 1.5, 4.0}});

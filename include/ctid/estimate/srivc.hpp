@@ -106,5 +106,9 @@ Result<TransferFunction> srivc_closed_loop(const IdData& data, const Eigen::Vect
 /// Throws InvalidArgument / InvalidOptions when the orders do not match the inputs (count,
 /// different nf with a common denominator) or the data are too short.
 Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& orders, const SrivcMisoOptions& options = {});
+/// Several experiments of one multi-input system (the same inputs in each record): one parameter set, the IV
+/// equations of each step summed over the records (each filtered from rest), the fit pooled over the records.
+Result<MisoModel> srivc_miso(const std::vector<IdData>& data, const std::vector<TfOrders>& orders,
+                             const SrivcMisoOptions& options = {});
 
 }  // namespace ctid
