@@ -323,7 +323,8 @@ def kia(data, narx, **options):
 
 
 def nde_oe(data, initial, **options):
-    """Output-error refinement of an NDE model's coefficients and initial state (options: NdeOeOptions)."""
+    """Output-error refinement of an NDE model's coefficients and initial state (options: NdeOeOptions). data: an
+    IdData or a list of IdData (several experiments: shared coefficients, each record's own initial state)."""
     return _ctid.nde_oe(data, initial, _options(_ctid.NdeOeOptions, "nde_oe", options))
 
 

@@ -117,6 +117,9 @@ void bind_nonlinear(py::module_& m) {
   m.def("nde_oe", [](const IdData& d, const NdeModel& initial, const NdeOeOptions& o) {
           return interruptible([&] { return nde_oe(d, initial, o); });
         }, py::arg("data"), py::arg("initial"), py::arg("options") = NdeOeOptions{});
+  m.def("nde_oe", [](const std::vector<IdData>& d, const NdeModel& initial, const NdeOeOptions& o) {
+          return interruptible([&] { return nde_oe(d, initial, o); });
+        }, py::arg("data"), py::arg("initial"), py::arg("options") = NdeOeOptions{});
 
   bind_options<KiaOptions>(m, "KiaOptions");
   py::class_<KiaRun>(m, "KiaRun", "The KIA workflow's stages: reconstructed, narx_fit_percent, refined, result().")

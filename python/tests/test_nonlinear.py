@@ -99,3 +99,16 @@ def test_frols_and_narx_take_several_records():
     ne, k = n - 2, 4
     np.testing.assert_allclose(two.parameters.std / one.parameters.std, np.sqrt((ne - k) / (2 * ne - k)), rtol=1e-8)
     assert ctid.narx([d, d], degree=1).usable()
+
+
+def test_nde_oe_on_several_records_keeps_each_initial_state(bl33):
+    """Two noise-free records of (33), the first from rest and the second (the record's second half) from mid-motion:
+    one coefficient set (to 1e-5 from a 10 % perturbed start) and an initial state per record."""
+    m, d = bl33
+    half = ctid.IdData.from_arrays(d.u[500:, 0], d.y[500:, 0], ts=0.0025)
+    start = ctid.NdeModel(["y", "Dy", "D^2y", "u", "y^2", "y*Dy"], np.array([1, 0.0022, 1.1e-4, -1.1, 0.11, -0.0066]))
+    r = ctid.nde_oe([d, half], start)
+    assert r.usable()
+    np.testing.assert_allclose(r.model.coefficients, m.coefficients, rtol=1e-5)
+    assert abs(r.parameters["r2.y(0)"] - d.y[500, 0]) < 1e-6
+    assert r.diagnostics.scalars["experiments"] == 2

@@ -30,9 +30,18 @@ const OptionTable<NdeOeOptions>& option_table<NdeOeOptions>() {
 void NdeOeOptions::validate() const { option_table<NdeOeOptions>().check(*this); }
 
 Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOeOptions& opt) {
+  return nde_oe(std::vector<IdData>{data}, initial, opt);
+}
+
+Result<NdeModel> nde_oe(const std::vector<IdData>& records, const NdeModel& initial, const NdeOeOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   opt.validate();
-  require_io_data(data, "nde_oe");
+  CTID_REQUIRE(!records.empty(), "nde_oe: no records");
+  const int E = static_cast<int>(records.size());
+  for (int e = 0; e < E; ++e) {
+    const std::string who = E > 1 ? "nde_oe (record " + std::to_string(e + 1) + ")" : "nde_oe";
+    require_io_data(records[static_cast<size_t>(e)], who.c_str());
+  }
   const auto& terms = initial.terms();
   const int m = static_cast<int>(terms.size());
   // Order of the model (number of states) and the reference term.
@@ -62,15 +71,31 @@ Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOe
   for (int i = 0; i < m; ++i)
     if (!fixed[static_cast<size_t>(i)]) free.push_back(i);
   const int pc = static_cast<int>(free.size());
+  // Parameters x = [free coefficients (pc), initial state of record 1 (nx), of record 2, ...]: every record
+  // has its own initial state (several experiments of one system, DESIGN.md: per-experiment initial conditions).
   const int nx = opt.estimate_initial_state ? L : 0;
-  const int p = pc + nx;
-  const int N = data.size();
+  const int p = pc + E * nx;
+  // Records concatenated: record e's samples are rows [start[e], start[e] + size) of the residual vector.
+  std::vector<Eigen::VectorXd> us(E), ys(E), ts(E);
+  std::vector<Intersample> holds(E);
+  std::vector<Eigen::Index> starts(E);
+  int N = 0;
+  for (int e = 0; e < E; ++e) {
+    const IdData& d = records[static_cast<size_t>(e)];
+    starts[e] = N;
+    N += d.size();
+    us[e] = d.u().col(0);
+    ys[e] = d.y().col(0);
+    ts[e].resize(d.size());
+    for (int k = 0; k < d.size(); ++k) ts[e](k) = d.time(k) - d.t0();
+    holds[e] = d.intersample(0) == Intersample::Zoh ? Intersample::Zoh : Intersample::Foh;
+  }
   CTID_REQUIRE(N > p, "nde_oe: {} samples for {} free parameters", N, p);
-
-  const Eigen::VectorXd u = data.u().col(0), y = data.y().col(0);
-  Eigen::VectorXd t(N);
-  for (int k = 0; k < N; ++k) t(k) = data.time(k) - data.t0();
-  const Intersample hold = data.intersample(0) == Intersample::Zoh ? Intersample::Zoh : Intersample::Foh;
+  Eigen::VectorXd y(N);
+  for (int e = 0; e < E; ++e) y.segment(starts[e], ys[e].size()) = ys[e];
+  auto x0_of = [&](const Eigen::VectorXd& x, int e) {
+    return nx ? Eigen::VectorXd(x.segment(pc + e * nx, nx)) : Eigen::VectorXd();
+  };
 
   auto coefficients = [&](const Eigen::VectorXd& x) {
     Eigen::VectorXd c = c_init;
@@ -79,33 +104,40 @@ Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOe
   };
   auto simulate = [&](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
     const NdeModel model(terms, coefficients(x));
-    const NdeSimulation s = model.simulate(u, t, hold, nx ? Eigen::VectorXd(x.tail(nx)) : Eigen::VectorXd(), opt.rtol);
-    out = s.y;
-    return s.ok();
+    out.resize(N);
+    for (int e = 0; e < E; ++e) {
+      const NdeSimulation s = model.simulate(us[e], ts[e], holds[e], x0_of(x, e), opt.rtol);
+      out.segment(starts[e], ys[e].size()) = s.y;
+      if (!s.ok()) return false;
+    }
+    return true;
   };
 
-  // Start: the given coefficients, y(0) measured and its derivatives 0 (differences of noisy samples are
-  // worse); when that simulation escapes, the free nonlinear coefficients are halved until it does not.
+  // Start: the given coefficients, each record's y(0) measured and its derivatives 0 (differences of noisy
+  // samples are worse); when that simulation escapes, the free nonlinear coefficients are halved until it does not.
   Eigen::VectorXd x0 = Eigen::VectorXd::Zero(p);
-  if (nx) x0(pc) = y(0);
+  for (int e = 0; e < E && nx; ++e) x0(pc + e * nx) = ys[e](0);
   double start_scale = 1.0;
-  Eigen::VectorXd ys;
+  Eigen::VectorXd ystart;
   for (int shrink = 0;; ++shrink) {
     start_scale = shrink > 30 ? 0.0 : std::ldexp(1.0, -shrink);
     for (int j = 0; j < pc; ++j) {
       const int i = free[static_cast<size_t>(j)];
       x0(j) = c_init(i) * (terms[static_cast<size_t>(i)].degree() >= 2 ? start_scale : 1.0);
     }
-    if (simulate(x0, ys) || start_scale == 0.0) break;
+    if (simulate(x0, ystart) || start_scale == 0.0) break;
   }
 
   // Forward sensitivities (DESIGN.md §6: analytic, not differences). With x = [y, Dy, .., D^{L-1}y] and the
   // explicit form D^L y = f_L(x, u) = -(1/c_top) sum_{i != top} c_i phi_i(x, u), the sensitivity S_j = dx/dtheta_j
   // obeys S_j' = [S_j(1..L-1); grad_x f_L . S_j + df_L/dtheta_j], with df_L/dc_i = -phi_i/c_top (i != top),
   // df_L/dc_top = -f_L/c_top, 0 for the initial state, and S_j(0) = e_k for theta_j = D^k y(0).
-  const Eigen::Index nz = L + static_cast<Eigen::Index>(L) * p;
+  // Per record the sensitivities of its pc coefficients and its own nx initial states (q columns); the other
+  // records' initial states do not move its output.
+  const int q = pc + nx;
+  const Eigen::Index nz = L + static_cast<Eigen::Index>(L) * q;
   Eigen::VectorXd phi(m), grad(L);
-  auto sensitivities = [&](const Eigen::VectorXd& x, Eigen::VectorXd& yhat, Eigen::MatrixXd& S) {
+  auto record_sensitivities = [&](const Eigen::VectorXd& x, int e, Eigen::VectorXd& yhat, Eigen::MatrixXd& S) {
     const Eigen::VectorXd c = coefficients(x);
     const double ctop = c(top);
     internal::OdeRhs rhs = [&](const Eigen::VectorXd& z, double uu, Eigen::VectorXd& dz) {
@@ -130,7 +162,7 @@ Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOe
       grad /= -ctop;
       dz.head(L - 1) = z.segment(1, L - 1);
       dz(L - 1) = fl;
-      for (int j = 0; j < p; ++j) {
+      for (int j = 0; j < q; ++j) {
         const Eigen::Index o = L + static_cast<Eigen::Index>(L) * j;
         dz.segment(o, L - 1) = z.segment(o + 1, L - 1);
         double b = 0;
@@ -142,16 +174,32 @@ Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOe
       }
     };
     Eigen::VectorXd z0 = Eigen::VectorXd::Zero(nz);
-    if (nx) z0.head(L) = x.tail(nx);
+    if (nx) z0.head(L) = x0_of(x, e);
     for (int k = 0; k < nx; ++k) z0(L + static_cast<Eigen::Index>(L) * (pc + k) + k) = 1.0;
-    yhat.resize(N);
-    S.resize(N, p);
-    return internal::dopri45(rhs, z0, u, t, hold == Intersample::Zoh, opt.rtol, 1e-12, L,
+    const Eigen::Index n = ys[e].size();
+    yhat.resize(n);
+    S.resize(n, q);
+    return internal::dopri45(rhs, z0, us[e], ts[e], holds[e] == Intersample::Zoh, opt.rtol, 1e-12, L,
                              [&](Eigen::Index k, const Eigen::VectorXd& z) {
                                yhat(k) = z(0);
-                               for (int j = 0; j < p; ++j) S(k, j) = z(L + static_cast<Eigen::Index>(L) * j);
+                               for (int j = 0; j < q; ++j) S(k, j) = z(L + static_cast<Eigen::Index>(L) * j);
                              })
         .ok;
+  };
+  // The stacked output and Jacobian (coefficients shared; record e's initial state only in its rows).
+  auto sensitivities = [&](const Eigen::VectorXd& x, Eigen::VectorXd& yhat, Eigen::MatrixXd& S) {
+    yhat.resize(N);
+    S = Eigen::MatrixXd::Zero(N, p);
+    Eigen::VectorXd ye;
+    Eigen::MatrixXd Se;
+    for (int e = 0; e < E; ++e) {
+      if (!record_sensitivities(x, e, ye, Se)) return false;
+      const Eigen::Index n = ys[e].size();
+      yhat.segment(starts[e], n) = ye;
+      S.block(starts[e], 0, n, pc) = Se.leftCols(pc);
+      if (nx) S.block(starts[e], pc + e * nx, n, nx) = Se.rightCols(nx);
+    }
+    return true;
   };
   auto evaluate = [&](const Eigen::VectorXd& x, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
     Eigen::VectorXd yx;
@@ -175,7 +223,7 @@ Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOe
   Result<NdeModel> r;
   const Eigen::VectorXd c = coefficients(lm.x);
   r.model = NdeModel(terms, c);
-  const int np = m + nx;
+  const int np = m + E * nx;
   r.parameters.names.resize(static_cast<size_t>(np));
   r.parameters.values.resize(np);
   r.parameters.fixed.assign(static_cast<size_t>(np), false);
@@ -184,13 +232,15 @@ Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOe
     r.parameters.values(i) = c(i);
     r.parameters.fixed[static_cast<size_t>(i)] = fixed[static_cast<size_t>(i)];
   }
-  for (int k = 0; k < nx; ++k) {
-    r.parameters.names[static_cast<size_t>(m + k)] =
-        k == 0 ? "y(0)" : (k == 1 ? "Dy(0)" : "D^" + std::to_string(k) + "y(0)");
-    r.parameters.values(m + k) = lm.x(pc + k);
-  }
+  // Initial states: "y(0)", "Dy(0)", ..; with several records "r<e>.y(0)", ...
+  for (int e = 0; e < E; ++e)
+    for (int k = 0; k < nx; ++k) {
+      const std::string state = k == 0 ? "y(0)" : (k == 1 ? "Dy(0)" : "D^" + std::to_string(k) + "y(0)");
+      r.parameters.names[static_cast<size_t>(m + e * nx + k)] = E > 1 ? "r" + std::to_string(e + 1) + "." + state : state;
+      r.parameters.values(m + e * nx + k) = lm.x(pc + e * nx + k);
+    }
   std::vector<int> slot(free);
-  for (int k = 0; k < nx; ++k) slot.push_back(m + k);
+  for (int k = 0; k < E * nx; ++k) slot.push_back(m + k);
   const double sigma2 = 2.0 * lm.cost / std::max(1, N - p);
   r.parameters.covariance = Eigen::MatrixXd::Zero(np, np);
   r.parameters.std = Eigen::VectorXd::Zero(np);
@@ -206,7 +256,11 @@ Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOe
                                    .eigenvalues();
     r.diagnostics.condition_number = ev(0) > 0 ? std::sqrt(ev(p - 1) / ev(0)) : INFINITY;
   }
-  r.diagnostics.vectors["x0"] = nx ? Eigen::VectorXd(lm.x.tail(nx)) : Eigen::VectorXd::Zero(L);
+  // The first record's initial state is "x0" (what simulate()'s estimated initial condition takes); further
+  // records' are "x0_2", "x0_3", ...
+  for (int e = 0; e < E; ++e)
+    r.diagnostics.vectors[e == 0 ? "x0" : "x0_" + std::to_string(e + 1)] = nx ? x0_of(lm.x, e) : Eigen::VectorXd::Zero(L);
+  if (E > 1) r.diagnostics.scalars["experiments"] = E;
   r.diagnostics.scalars["noise_variance"] = sigma2;
   r.diagnostics.scalars["start_scale"] = start_scale;
   if (start_scale < 1.0)

@@ -41,5 +41,9 @@ const OptionTable<NdeOeOptions>& option_table<NdeOeOptions>();
 /// Throws InvalidArgument for data that are not SISO, fewer samples than free parameters, a model that
 /// NdeModel::simulate rejects, unknown names in `fixed`; InvalidOptions for bad options.
 Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOeOptions& options = {});
+/// Several experiments of one system: one set of coefficients, each record with its own estimated initial
+/// state (parameters "r<e>.y(0)", ..; diagnostics "x0" of record 1, "x0_<e>" of the others), the output error
+/// summed over the records, the fit pooled.
+Result<NdeModel> nde_oe(const std::vector<IdData>& data, const NdeModel& initial, const NdeOeOptions& options = {});
 
 }  // namespace ctid
