@@ -275,16 +275,21 @@ def test_units_do_not_matter_and_useless_fits_say_why(plant):
         ctid.TransferFunction([1.0], [1e-20, 1.0, 2.0])
 
 
-def test_srivc_on_several_experiments_is_one_joint_estimate():
-    # Issue 14 (item 2): a list of IdData is several experiments of one system, fitted jointly; noise-free records of
-    # G = 3/(s^2 + 1.2 s + 4) with different inputs give the true parameters (to 1e-6), one record alone the same,
-    # and the joint result is what C++ returns for the same list (bindings of srivc(std::vector<IdData>)).
+def two_records():
+    """Noise-free records of G = 3/(s^2 + 1.2 s + 4) (600 samples at 20 ms): a PRBS and a two-tone multisine."""
     g = ctid.TransferFunction([3.0], [1.0, 1.2, 4.0])
     t = 0.02 * np.arange(600)
     u1 = ctid.prbs(600, register_length=7, clock_period=5)
     u2 = np.sin(1.1 * t) + 0.5 * np.sin(3.7 * t)
-    d1 = ctid.IdData.from_arrays(u1, g.simulate(u1, t), ts=0.02)
-    d2 = ctid.IdData.from_arrays(u2, g.simulate(u2, t), ts=0.02)
+    return g, t, u1, ctid.IdData.from_arrays(u1, g.simulate(u1, t), ts=0.02), ctid.IdData.from_arrays(
+        u2, g.simulate(u2, t), ts=0.02)
+
+
+def test_srivc_on_several_experiments_is_one_joint_estimate():
+    # Issue 14 (item 2): a list of IdData is several experiments of one system, fitted jointly; noise-free records
+    # with different inputs give the true parameters (to 1e-6), one record alone the same, and the joint result is
+    # what C++ returns for the same list (bindings of srivc(std::vector<IdData>)).
+    g, t, u1, d1, d2 = two_records()
     joint = ctid.srivc([d1, d2], 1, 2)
     assert joint.usable()
     np.testing.assert_allclose(joint.parameters.values, [1.2, 4.0, 3.0], rtol=1e-6)
@@ -302,12 +307,7 @@ def test_srivc_on_several_experiments_is_one_joint_estimate():
 
 def test_report_shows_each_record(tmp_path):
     # A report of a joint fit has a section per further record (ReportOptions::more_records).
-    g = ctid.TransferFunction([3.0], [1.0, 1.2, 4.0])
-    t = 0.02 * np.arange(600)
-    u1 = ctid.prbs(600, register_length=7, clock_period=5)
-    u2 = np.sin(1.1 * t) + 0.5 * np.sin(3.7 * t)
-    d1 = ctid.IdData.from_arrays(u1, g.simulate(u1, t), ts=0.02)
-    d2 = ctid.IdData.from_arrays(u2, g.simulate(u2, t), ts=0.02)
+    _, _, _, d1, d2 = two_records()
     path = tmp_path / "joint.html"
     ctid.html_report(d1, ctid.srivc([d1, d2], 1, 2), str(path), method="srivc", more_records=[("sines", d2)])
     html = path.read_text()
