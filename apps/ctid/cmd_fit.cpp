@@ -216,7 +216,17 @@ int run_fsf(const FitArgs& a, const IdData& d) {
   return code;
 }
 
-int run_physical(const FitArgs& a, const IdData& d) {
+std::vector<std::pair<std::string, IdData>> more_records_of(const FitArgs& a, const std::vector<IdData>& ds);
+int run_physical_records(const FitArgs& a, const std::vector<IdData>& ds);
+int run_physical(const FitArgs& a, const IdData& d) { return run_physical_records(a, {d}); }
+
+// Physical parameters on one record, or on several by the raw route (their output errors stacked).
+int run_physical_records(const FitArgs& a, const std::vector<IdData>& ds) {
+  const IdData& d = ds.front();
+  if (ds.size() > 1 && a.via != "raw")
+    throw UsageError(detail::format("{} DATA files: the physical fit of several experiments is by --via raw (the FSF "
+                                    "routes compress one record)",
+                                    ds.size()));
   if (a.model_expr.empty()) throw UsageError("--method physical needs --model EXPRESSION (e.g. \"k1/(s^2-k2)\")");
   std::vector<PhysicalParameter> ps;
   std::vector<std::string> names;
@@ -280,7 +290,7 @@ int run_physical(const FitArgs& a, const IdData& d) {
     if (a.via == "raw") {
       CTID_REQUIRE_OPTION(!fo.unstable || fo.a > 0, "physical: the plant is declared unstable: give a window a > 0 (got a = {})",
                           fo.a);
-      return fit_physical_raw(model, ps, d, fo.a, po);
+      return fit_physical_raw(model, ps, ds, fo.a, po);
     }
     require_fsf_window(fo);
     const Result<FsfModel> c = fsf(d, fo);
@@ -292,7 +302,7 @@ int run_physical(const FitArgs& a, const IdData& d) {
   Settings settings = a.via == "raw" ? Settings{{"a", options_detail::format_real(fo.a)}} : settings_of(fo);
   for (auto& s : settings_of(po)) settings.push_back(s);
   for (auto& s : constraints) settings.push_back(s);
-  return finish(r, "physical-" + a.via, d, a, settings);
+  return finish(r, "physical-" + a.via, d, a, settings, more_records_of(a, ds));
 }
 
 // El-Shafey: modal functions (modal_fit). Besides the table's settings: shift_samples (the shifts in samples) and
@@ -376,9 +386,10 @@ int run_miso(const FitArgs& a, const std::vector<IdData>& ds) {
 
 int run_experiments(const FitArgs& a) {
   if (a.method != "srivc" && a.method != "oe" && a.method != "tfest" && a.method != "lssvf" && a.method != "ivsvf" &&
-      a.method != "narx")
+      a.method != "narx" && a.method != "physical")
     throw UsageError(detail::format("{} DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, "
-                                    "lssvf, ivsvf or narx (got {}; the other estimators take one record so far)",
+                                    "lssvf, ivsvf, narx or physical --via raw (got {}; the other estimators take one "
+                                    "record so far)",
                                     a.paths.size(), a.method));
   if (!a.controller.empty() || a.frequency) throw UsageError("several DATA files: open-loop time-domain data only");
   std::vector<IdData> ds;
@@ -390,6 +401,7 @@ int run_experiments(const FitArgs& a) {
   if (ds[0].ny() != 1)
     throw UsageError(detail::format("several experiments: one --output (selected {})", ds[0].ny()));
   if (ds[0].nu() > 1) return run_miso(a, ds);
+  if (a.method == "physical") return run_physical_records(a, ds);
   if (a.method == "narx") return run_narx_or_kia(a.method, ds, a.sets, a.narx, a.json, a.report, more_records_of(a, ds));
   if (a.method == "srivc") return fit_experiments<SrivcOptions>(a, ds, &srivc);
   if (a.method == "lssvf") return fit_experiments<LssvfOptions>(a, ds, &lssvf);

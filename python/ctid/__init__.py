@@ -397,7 +397,8 @@ def fit_physical_frequency(model, parameters, compressed, **options):
 
 
 def fit_physical_raw(model, parameters, data, a=0.0, **options):
-    """Physical parameters by output error on the raw record (exponentially windowed when a > 0)."""
+    """Physical parameters by output error on the raw record (exponentially windowed when a > 0). data: an IdData or
+    a list of IdData (several experiments: their output errors stacked, one parameter set)."""
     return _ctid.fit_physical_raw(model, parameters, data, a,
                                   _options(_ctid.PhysicalFitOptions, "fit_physical_raw", options))
 

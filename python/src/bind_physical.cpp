@@ -51,6 +51,12 @@ void bind_physical(py::module_& m) {
           return interruptible([&] { return fit_physical_raw(pm, ps, d, a, o); });
         }, py::arg("model"), py::arg("parameters"), py::arg("data"), py::arg("a") = 0.0,
         py::arg("options") = PhysicalFitOptions{});
+  m.def("fit_physical_raw", [](const PhysicalModel& pm, const py::dict& p, const std::vector<IdData>& d, double a,
+                               const PhysicalFitOptions& o) {
+          const auto ps = parameters_of(p);
+          return interruptible([&] { return fit_physical_raw(pm, ps, d, a, o); });
+        }, py::arg("model"), py::arg("parameters"), py::arg("data"), py::arg("a") = 0.0,
+        py::arg("options") = PhysicalFitOptions{});
 
   py::class_<RlsSvf>(m, "RlsSvf", "Johansson (1986) recursive least squares on filtered signals (one sample at a time).")
       .def(py::init([](int nb, int nf, const RlsSvfOptions& o) { return RlsSvf(TfOrders{nb, nf, 0}, o); }),

@@ -225,28 +225,51 @@ Eigen::VectorXd windowed_zoh_response(const TransferFunction& g, const Eigen::Ve
 
 Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
                                           const IdData& data, double a, const PhysicalFitOptions& opt) {
-  require_io_data(data, "physical");
+  return fit_physical_raw(model, params, std::vector<IdData>{data}, a, opt);
+}
+
+Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
+                                          const std::vector<IdData>& records, double a, const PhysicalFitOptions& opt) {
+  CTID_REQUIRE(!records.empty(), "physical: no records");
   CTID_REQUIRE(std::isfinite(a) && a >= 0, "physical: the window a must be >= 0 (got {})", a);
-  CTID_REQUIRE(a == 0.0 || (data.is_uniform() && data.intersample(0) == Intersample::Zoh),
-               "physical: the windowed raw route (a > 0) needs uniformly sampled data with a held (ZOH) input");
-  const Eigen::VectorXd t = data.times();
-  const Eigen::VectorXd u = data.u().col(0);
-  Eigen::VectorXd y = data.y().col(0);
-  if (a > 0) y = y.cwiseProduct((-a * (t.array() - t(0))).exp().matrix());  // y_a = e^{-at} y
+  // Several records (experiments of one system): their residuals stacked, each record simulated from rest and
+  // windowed from its own start.
+  Eigen::Index n = 0;
+  for (std::size_t e = 0; e < records.size(); ++e) {
+    const IdData& d = records[e];
+    const std::string who = records.size() > 1 ? "physical (record " + std::to_string(e + 1) + ")" : "physical";
+    require_io_data(d, who.c_str());
+    CTID_REQUIRE(a == 0.0 || (d.is_uniform() && d.intersample(0) == Intersample::Zoh),
+                 "{}: the windowed raw route (a > 0) needs uniformly sampled data with a held (ZOH) input", who);
+    n += d.size();
+  }
+  Eigen::VectorXd y(n);
+  for (Eigen::Index e = 0, at = 0; e < static_cast<Eigen::Index>(records.size()); at += records[e].size(), ++e) {
+    const IdData& d = records[e];
+    const Eigen::VectorXd t = d.times();
+    y.segment(at, d.size()) = d.y().col(0);
+    if (a > 0) y.segment(at, d.size()).array() *= (-a * (t.array() - t(0))).exp();  // y_a = e^{-at} y
+  }
   // Model output for the (windowed) input: exact for the held input in both cases.
   auto simulate = [&](const TransferFunction& g) -> Eigen::VectorXd {
-    if (a > 0) return windowed_zoh_response(g, u, data.ts(), a);
-    return lsim(g, data, 0);
+    Eigen::VectorXd out(n);
+    for (Eigen::Index e = 0, at = 0; e < static_cast<Eigen::Index>(records.size()); at += records[e].size(), ++e) {
+      const IdData& d = records[e];
+      out.segment(at, d.size()) = a > 0 ? windowed_zoh_response(g, d.u().col(0), d.ts(), a) : lsim(g, d, 0);
+    }
+    return out;
   };
   ResidualFn res = [&](const TransferFunction& g, const std::vector<TransferFunction>* sens, Eigen::VectorXd& r,
                        Eigen::MatrixXd* J) {
     r = simulate(g) - y;
     if (J) {
-      J->resize(t.size(), static_cast<Eigen::Index>(sens->size()));
+      J->resize(n, static_cast<Eigen::Index>(sens->size()));
       for (std::size_t j = 0; j < sens->size(); ++j) J->col(static_cast<Eigen::Index>(j)) = simulate((*sens)[j]);
     }
   };
-  return fit(model, params, a, opt, res, y, "raw");
+  Result<TransferFunction> r = fit(model, params, a, opt, res, y, "raw");
+  if (records.size() > 1) r.diagnostics.scalars["experiments"] = static_cast<double>(records.size());
+  return r;
 }
 
 }  // namespace ctid

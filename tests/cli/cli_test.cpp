@@ -1123,7 +1123,7 @@ TEST(Cli, SeveralDataFilesAreFittedJointly) {
   const CliRun o = ctid_run("fit " + files[0] + " " + files[1] + " --time time --input force --output position --method fsf");
   EXPECT_EQ(o.code, 2);
   EXPECT_NE(o.err.find("2 DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, lssvf, "
-                       "ivsvf or narx (got fsf"),
+                       "ivsvf, narx or physical --via raw (got fsf"),
             std::string::npos)
       << o.err;
   // NARX on both records (resampled NARX at Ts = 0.02 s): the CLI's file equals the library's joint fit.
@@ -1161,6 +1161,20 @@ TEST(Cli, SeveralDataFilesAreFittedJointly) {
     const double f = fit_report(ds[e].y().col(0), lsim(lib.model, ds[e]), 3).fit_percent;
     EXPECT_NEAR(jv.at("experiments").at(e).at("fit").at("fit_percent").get<double>(), f, 1e-6) << "record " << e + 1;
   }
+  // The physical raw route on both records: the library's fit_physical_raw on the list (to 1e-9 relative).
+  const CliRun ph = ctid_run("fit " + files[0] + " " + files[1] + cols +
+                             " --method physical --model \"k/(s^2 + c*s + w)\" --param k=2 --param c=1 --param w=3 --via raw "
+                             "--json " + json + " --force");
+  ASSERT_EQ(ph.code, 0) << ph.err;
+  const Result<TransferFunction> lib_p = fit_physical_raw(PhysicalModel("k/(s^2 + c*s + w)", {"k", "c", "w"}),
+                                                          {{"k", 2.0}, {"c", 1.0}, {"w", 3.0}}, ds);
+  const ResultFile file_p = read_result_file(json);
+  for (int i = 0; i < 3; ++i)
+    EXPECT_NEAR(file_p.result.parameters.values(i), lib_p.parameters.values(i), 1e-9 * std::abs(lib_p.parameters.values(i)));
+  EXPECT_EQ(ctid_run("fit " + files[0] + " " + files[1] + cols +
+                     " --method physical --model \"k/(s^2 + c*s + w)\" --param k=2 --param c=1 --param w=3 --set T=4")
+                .code,
+            2);
   const std::string html2 = test::temp_path("joint2.html");
   fs::remove(html2);
   ASSERT_EQ(ctid_run("report " + json + " " + files[0] + " " + files[1] + cols + " --out " + html2).code, 0);

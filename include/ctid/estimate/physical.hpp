@@ -50,5 +50,10 @@ Result<TransferFunction> fit_physical_frequency(const PhysicalModel& model, cons
 /// sampling and a ZOH input.
 Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std::vector<PhysicalParameter>& parameters,
                                           const IdData& data, double a = 0.0, const PhysicalFitOptions& options = {});
+/// Several experiments of one system: the records' output errors stacked (each simulated from rest and, for a > 0,
+/// windowed from its own start), one parameter set; diagnostics "experiments".
+Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std::vector<PhysicalParameter>& parameters,
+                                          const std::vector<IdData>& data, double a = 0.0,
+                                          const PhysicalFitOptions& options = {});
 
 }  // namespace ctid
