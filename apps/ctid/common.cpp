@@ -166,18 +166,22 @@ Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, cons
   return s.y;
 }
 
+// The library's parsers of setting values (estimate/options.hpp), with the CLI's exit code for a bad value.
 double to_double(const std::string& key, const std::string& value) {
-  char* end = nullptr;
-  const double v = std::strtod(value.c_str(), &end);
-  if (value.empty() || *end != '\0' || !std::isfinite(v)) throw UsageError("--set " + key + ": '" + value + "' is not a number");
-  return v;
+  try {
+    const double v = options_detail::parse_real("--set", key, value);
+    if (!std::isfinite(v)) throw UsageError("--set " + key + ": '" + value + "' is not a finite number");
+    return v;
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
 }
-
 int to_int(const std::string& key, const std::string& value) {
-  const double v = to_double(key, value);
-  if (v != std::floor(v)) throw UsageError("--set " + key + ": '" + value + "' is not a whole number");
-  if (std::abs(v) > 1e9) throw UsageError("--set " + key + ": '" + value + "' is out of range (|value| <= 1e9)");
-  return static_cast<int>(v);
+  try {
+    return options_detail::parse_int("--set", key, value);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
 }
 
 namespace {

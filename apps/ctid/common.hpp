@@ -73,6 +73,7 @@ void add_initial_option(CLI::App& app, std::string& initial);
 /// NotUsable naming where and why (e.g. the unstable poles): a diverging simulation is never written or scored.
 Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, const std::string& initial);
 
+/// A --set value as a finite number / a whole number, parsed by the library's option parsers; UsageError otherwise.
 double to_double(const std::string& key, const std::string& value);
 int to_int(const std::string& key, const std::string& value);
 
