@@ -386,10 +386,10 @@ int run_miso(const FitArgs& a, const std::vector<IdData>& ds) {
 
 int run_experiments(const FitArgs& a) {
   if (a.method != "srivc" && a.method != "oe" && a.method != "tfest" && a.method != "lssvf" && a.method != "ivsvf" &&
-      a.method != "narx" && a.method != "physical")
+      a.method != "rls-svf" && a.method != "narx" && a.method != "physical")
     throw UsageError(detail::format("{} DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, "
-                                    "lssvf, ivsvf, narx or physical --via raw (got {}; the other estimators take one "
-                                    "record so far)",
+                                    "lssvf, ivsvf, rls-svf, narx or physical --via raw (got {}; the other estimators "
+                                    "take one record so far)",
                                     a.paths.size(), a.method));
   if (!a.controller.empty() || a.frequency) throw UsageError("several DATA files: open-loop time-domain data only");
   std::vector<IdData> ds;
@@ -406,6 +406,7 @@ int run_experiments(const FitArgs& a) {
   if (a.method == "srivc") return fit_experiments<SrivcOptions>(a, ds, &srivc);
   if (a.method == "lssvf") return fit_experiments<LssvfOptions>(a, ds, &lssvf);
   if (a.method == "ivsvf") return fit_experiments<IvsvfOptions>(a, ds, &ivsvf);
+  if (a.method == "rls-svf") return fit_experiments<RlsSvfOptions>(a, ds, &rls_svf);
   using Joint = Result<TransferFunction> (*)(const std::vector<IdData>&, const TfOrders&, const OeOptions&);
   return fit_experiments<OeOptions>(a, ds, a.method == "oe" ? static_cast<Joint>(&oe) : static_cast<Joint>(&tfest));
 }

@@ -232,7 +232,8 @@ def tfest(data, nb, nf, nk=0, **options):
 
 def rls_svf(data, nb, nf, nk=0, **options):
     """Johansson's recursive least squares on filtered signals, run once over the record: the final estimate, its
-    simulation fit, no standard deviations (options: RlsSvfOptions; ctid.settings("rls_svf") lists them)."""
+    simulation fit, no standard deviations (options: RlsSvfOptions; ctid.settings("rls_svf") lists them). data: an
+    IdData or a list of IdData (several experiments: the recursion runs over them in turn, the filters restarting)."""
     return _ctid.rls_svf(data, nb, nf, nk, _options(_ctid.RlsSvfOptions, "rls_svf", options))
 
 

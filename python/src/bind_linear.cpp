@@ -94,6 +94,7 @@ void bind_linear(py::module_& m) {
   def_experiments_estimator<IvsvfOptions>(m, "ivsvf", &ivsvf);
   def_experiments_estimator<OeOptions>(m, "oe", &oe);
   def_experiments_estimator<OeOptions>(m, "tfest", &tfest);
+  def_experiments_estimator<RlsSvfOptions>(m, "rls_svf", &rls_svf);
   def_tf_estimator<OeOptions>(m, "oe", &oe, "Continuous-time output error (Levenberg-Marquardt).");
   def_tf_estimator<OeOptions>(m, "tfest", &tfest, "SRIVC start, then output-error refinement.");
   def_tf_estimator<RlsSvfOptions>(m, "rls_svf", &rls_svf,

@@ -14,7 +14,7 @@
 #include "ctid/signal/walsh.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/validate/metrics.hpp"
-#include "tf_common.hpp"
+#include "estimate/tf_common.hpp"
 #include "estimate/modal_common.hpp"
 #include "internal/least_squares.hpp"
 

@@ -11,6 +11,7 @@
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/validate/metrics.hpp"
 #include "estimate/svf_common.hpp"
+#include "estimate/tf_common.hpp"
 
 namespace ctid {
 
@@ -86,6 +87,8 @@ void RlsSvf::reset() {
   }
   n_updates_ = 0;
 }
+
+void RlsSvf::start_record() { stream_.reset(); }
 
 void RlsSvf::update(double t, double u, double y) {
   if (!stream_.push(t, u, y)) return;
@@ -208,13 +211,27 @@ void CoefficientTracker::update(double t, double u, double y) {
 }
 
 Result<TransferFunction> rls_svf(const IdData& d, const TfOrders& orders, const RlsSvfOptions& options) {
-  require_io_data(d, "rls_svf");
+  return rls_svf(std::vector<IdData>{d}, orders, options);
+}
+
+Result<TransferFunction> rls_svf(const std::vector<IdData>& ds, const TfOrders& orders, const RlsSvfOptions& options) {
+  CTID_REQUIRE(!ds.empty(), "rls_svf: no records");
+  for (std::size_t e = 0; e < ds.size(); ++e) {
+    const std::string who = ds.size() > 1 ? "rls_svf (record " + std::to_string(e + 1) + ")" : "rls_svf";
+    require_io_data(ds[e], who.c_str());
+    CTID_REQUIRE(ds[e].intersample(0) == ds[0].intersample(0), "{}: input intersample {}; record 1's is {}", who,
+                 to_string(ds[e].intersample(0)), to_string(ds[0].intersample(0)));
+  }
   CTID_REQUIRE(orders.nk == 0, "rls_svf: nk must be 0 (got {}; delay the input column instead)", orders.nk);
   const auto start = std::chrono::steady_clock::now();
   RlsSvfOptions o = options;
-  o.input_intersample = d.intersample(0);
+  o.input_intersample = ds[0].intersample(0);
   RlsSvf rls(orders, o);
-  for (int k = 0; k < d.size(); ++k) rls.update(d.time(k), d.u()(k, 0), d.y()(k, 0));
+  for (std::size_t e = 0; e < ds.size(); ++e) {
+    const IdData& d = ds[e];
+    if (e > 0) rls.start_record();
+    for (int k = 0; k < d.size(); ++k) rls.update(d.time(k), d.u()(k, 0), d.y()(k, 0));
+  }
   Result<TransferFunction> r;
   r.model = rls.model();
   r.parameters.names = tf_parameter_names(orders);
@@ -223,10 +240,12 @@ Result<TransferFunction> rls_svf(const IdData& d, const TfOrders& orders, const 
   r.parameters.fixed.assign(orders.n_parameters(), false);
   for (int i = 0; i < orders.n_parameters(); ++i) r.parameters.fixed[i] = options.fixed.count(r.parameters.names[i]) > 0;
   r.diagnostics.scalars["tau"] = options.tau;
+  if (ds.size() > 1) r.diagnostics.scalars["experiments"] = static_cast<double>(ds.size());
   r.summary.iterations = static_cast<int>(rls.n_updates());
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  r.fit = fit_report_or_inf(d.y().col(0), lsim(r.model, d, 0),
-                            orders.n_parameters() - static_cast<int>(options.fixed.size()));
+  // The simulation fit over all records (each from rest), as one concatenated output.
+  const auto [y, yhat] = tf_detail::pooled_outputs(r.model, ds, 0.0);
+  r.fit = fit_report_or_inf(y, yhat, orders.n_parameters() - static_cast<int>(options.fixed.size()));
   if (!r.model.is_stable()) r.diagnostics.warnings.push_back("the estimated model is unstable");
   return r;
 }

@@ -54,6 +54,9 @@ class RlsSvf {
   void update(double t, double u, double y);
   /// Restart: filters at rest, P = P(0), parameters = theta0.
   void reset();
+  /// A new record of the same system follows: the filters restart at rest and its time axis starts anew; the
+  /// estimate and P carry on (several experiments).
+  void start_record();
 
   /// Current estimate as parameters [a1..an, b0..b(nb-1)].
   Eigen::VectorXd parameters() const;
@@ -86,6 +89,10 @@ class RlsSvf {
 /// unknown noise). The input's intersample behaviour is the record's. The CLI's `fit --method rls-svf` and Python's ctid.rls_svf. Throws InvalidArgument for data
 /// that are not SISO or nk > 0, InvalidOptions for bad options.
 Result<TransferFunction> rls_svf(const IdData& data, const TfOrders& orders, const RlsSvfOptions& options = {});
+/// Several experiments of one system (the same input intersample behaviour): the recursion runs over the records in
+/// turn, the filters restarting at rest at each (start_record), P and the estimate carried on; the fit is pooled.
+Result<TransferFunction> rls_svf(const std::vector<IdData>& data, const TfOrders& orders,
+                                 const RlsSvfOptions& options = {});
 
 struct CoefficientTrackerOptions {
   double tau = 0.5;                  ///< filter time constant (s)
