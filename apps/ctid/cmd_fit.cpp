@@ -392,12 +392,7 @@ int run_experiments(const FitArgs& a) {
                                     "take one record so far)",
                                     a.paths.size(), a.method));
   if (!a.controller.empty() || a.frequency) throw UsageError("several DATA files: open-loop time-domain data only");
-  std::vector<IdData> ds;
-  for (const auto& p : a.paths) {
-    DataArgs da = a.data;
-    da.path = p;
-    ds.push_back(da.load(true));
-  }
+  const std::vector<IdData> ds = a.data.load_each(a.paths, true);
   if (ds[0].ny() != 1)
     throw UsageError(detail::format("several experiments: one --output (selected {})", ds[0].ny()));
   if (ds[0].nu() > 1) return run_miso(a, ds);

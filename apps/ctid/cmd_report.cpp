@@ -19,8 +19,9 @@ struct ReportArgs {
 
 // A result file with a parameter table is reported as strictly as `ctid validate` scores it: its parameters and
 // covariance must be sound (finite, of the right size, positive semi-definite, no zero standard deviation unless
-// the fit was exact), else exit 3; a model that diverges on the record is not drawn (exit 1).
-void check_result(const ResultFile& file, const IdData& d, const std::string& initial, const std::string& path) {
+// the fit was exact), else exit 3; a model that diverges on the record is not drawn (exit 1). Returns the simulated
+// output on d.
+Eigen::VectorXd check_result(const ResultFile& file, const IdData& d, const std::string& initial, const std::string& path) {
   if (!file.bare) {
     FitReport f;  // only the rules about parameters and covariance (the record may be another one)
     if (file.result.fit.nrmse < 1e-6) {
@@ -31,7 +32,7 @@ void check_result(const ResultFile& file, const IdData& d, const std::string& in
     if (const std::string why = usability_problem(Summary{}, file.result.parameters, f); !why.empty())
       throw InputError(path + ": " + why + " (its uncertainty bands would be meaningless)");
   }
-  simulate_result(file.result, d, initial);
+  return simulate_result(file.result, d, initial).col(0);
 }
 
 int run(const ReportArgs& a) {
@@ -40,21 +41,14 @@ int run(const ReportArgs& a) {
   inputs.push_back(a.result);
   check_outputs({a.out}, inputs, a.force);
   ResultFile file = read_result(a.result);
-  std::vector<IdData> ds;
-  for (const auto& p : a.paths) {
-    DataArgs da = a.data;
-    da.path = p;
-    ds.push_back(da.load(true));
-  }
+  const std::vector<IdData> ds = a.data.load_each(a.paths, true);
   const IdData& d = ds.front();
   if (d.ny() != 1 || d.nu() != model_inputs(file.result.model))
     throw UsageError(detail::format("report needs one --output and one --input per model input (the {} model has {})",
                                     model_type_name(file.result.model), model_inputs(file.result.model)));
-  check_result(file, d, a.initial, a.result);
+  const Eigen::VectorXd yhat = check_result(file, d, a.initial, a.result);
   // A bare model's fit is the one on this record.
-  if (file.bare)
-    file.result.fit = fit_report_or_inf(d.y().col(0), simulate_result(file.result, d, a.initial).col(0),
-                                        model_coefficient_count(file.result.model));
+  if (file.bare) file.result.fit = fit_report_or_inf(d.y().col(0), yhat, model_coefficient_count(file.result.model));
   ReportOptions o;
   o.method = file.method.empty() ? model_type_name(file.result.model) : file.method;
   o.title = a.title.empty() ? "ctid report: " + a.result : a.title;

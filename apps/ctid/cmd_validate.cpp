@@ -68,12 +68,7 @@ int run(const ValArgs& a) {
   const ResultFile file = read_result(a.model);
   const AnyModel& model = file.result.model;
   if (model_outputs(model) != 1) throw UsageError("validate compares one output; the model has " + std::to_string(model_outputs(model)));
-  std::vector<IdData> ds;
-  for (const auto& p : a.paths) {
-    DataArgs da = a.data;
-    da.path = p;
-    ds.push_back(da.load(true));
-  }
+  const std::vector<IdData> ds = a.data.load_each(a.paths, true);
   std::printf("model:  %s\n", describe(model).c_str());
   // Finite on these records, but growing: the numbers below say little beyond them.
   if (const std::string unstable = unstable_poles_note(model); !unstable.empty())

@@ -90,6 +90,16 @@ IdData DataArgs::load(bool need_output) const {
   }
 }
 
+std::vector<IdData> DataArgs::load_each(const std::vector<std::string>& paths, bool need_output) const {
+  std::vector<IdData> ds;
+  for (const auto& p : paths) {
+    DataArgs one = *this;
+    one.path = p;
+    ds.push_back(one.load(need_output));
+  }
+  return ds;
+}
+
 void check_outputs(const std::vector<std::string>& outs_in, const std::vector<std::string>& inputs, bool force) {
   namespace fs = std::filesystem;
   std::vector<std::string> outs;

@@ -2,9 +2,7 @@
 #pragma once
 
 #include <map>
-#include <optional>
 #include <string>
-#include <variant>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -45,6 +43,8 @@ struct DataArgs {
   /// Load, select and detrend; maps every failure to InputError (file/content) or
   /// UsageError (inconsistent options).
   IdData load(bool need_output) const;
+  /// The same selection loaded from each of `paths` (several records of one system), in order.
+  std::vector<IdData> load_each(const std::vector<std::string>& paths, bool need_output) const;
 };
 
 /// Output file guard, run before any computation; every failure is a UsageError (exit 2). Refuses an output

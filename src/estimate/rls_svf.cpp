@@ -8,7 +8,6 @@
 
 #include "ctid/core/check.hpp"
 #include "ctid/estimate/lssvf.hpp"
-#include "ctid/simulate/lsim.hpp"
 #include "ctid/validate/metrics.hpp"
 #include "estimate/svf_common.hpp"
 #include "estimate/tf_common.hpp"

@@ -192,12 +192,9 @@ std::pair<std::vector<Term>, Eigen::VectorXd> read_terms(const json& m, const Re
   }
   return {terms, c};
 }
-}  // namespace
 
-NarxModel parse_narx_json(const std::string& text, const std::string& source) {
-  const Reader rd{source};
-  const json j = parse_text(text, rd);
-  const json& m = typed_model(j, "narx", rd);
+// A NARX / NDE model object (already of its type).
+NarxModel narx_from(const json& m, const Reader& rd) {
   auto [terms, c] = read_terms<NarxTerm>(m, rd);
   const json& ts = rd.member(m, "ts", "the model");
   if (!ts.is_number()) rd.fail("\"ts\" must be a number (seconds)");
@@ -208,15 +205,24 @@ NarxModel parse_narx_json(const std::string& text, const std::string& source) {
   }
 }
 
-NdeModel parse_nde_json(const std::string& text, const std::string& source) {
-  const Reader rd{source};
-  const json j = parse_text(text, rd);
-  auto [terms, c] = read_terms<NdeTerm>(typed_model(j, "nde", rd), rd);
+NdeModel nde_from(const json& m, const Reader& rd) {
+  auto [terms, c] = read_terms<NdeTerm>(m, rd);
   try {
     return NdeModel(terms, c);
   } catch (const InvalidArgument& e) {
     rd.fail(std::string("invalid NDE model: ") + e.what());
   }
+}
+}  // namespace
+
+NarxModel parse_narx_json(const std::string& text, const std::string& source) {
+  const Reader rd{source};
+  return narx_from(typed_model(parse_text(text, rd), "narx", rd), rd);
+}
+
+NdeModel parse_nde_json(const std::string& text, const std::string& source) {
+  const Reader rd{source};
+  return nde_from(typed_model(parse_text(text, rd), "nde", rd), rd);
 }
 
 NarxModel read_narx_json(const std::string& path) { return parse_narx_json(read_text_file(path), path); }
@@ -252,8 +258,8 @@ AnyModel any_model_from(const json& root, const Reader& rd) {
   if (!type.is_string()) rd.fail("model \"type\" must be a string");
   const std::string t = type.get<std::string>();
   if (t == "fsf") return fsf_from(m, rd);
-  if (t == "narx") return parse_narx_json(m.dump(), rd.source);
-  if (t == "nde") return parse_nde_json(m.dump(), rd.source);
+  if (t == "narx") return narx_from(m, rd);
+  if (t == "nde") return nde_from(m, rd);
   if (t == "transfer_function" || t == "miso" || t == "state_space")
     return std::visit([](const auto& x) { return AnyModel(x); }, model_from(m, rd));
   rd.fail(detail::format("model type \"{}\" is not one ctid knows (transfer_function, miso, state_space, fsf, narx, nde)",
