@@ -14,6 +14,19 @@ int ParameterSet::index(const std::string& name) const {
   throw InvalidArgument(detail::format("no parameter named '{}' (parameters: {})", name, known));
 }
 
+void ParameterSet::set_covariance(const Eigen::MatrixXd& c, const std::vector<int>& slots) {
+  const Eigen::Index n = values.size();
+  const Eigen::Index k = slots.empty() ? n : static_cast<Eigen::Index>(slots.size());
+  auto slot = [&](Eigen::Index i) { return slots.empty() ? i : static_cast<Eigen::Index>(slots[static_cast<size_t>(i)]); };
+  const bool known = c.rows() == k && c.cols() == k && c.allFinite();
+  covariance = Eigen::MatrixXd::Zero(n, n);
+  for (Eigen::Index i = 0; i < k; ++i) {
+    CTID_ASSERT(slot(i) >= 0 && slot(i) < n);
+    for (Eigen::Index j = 0; j < k; ++j) covariance(slot(i), slot(j)) = known ? c(i, j) : NAN;
+  }
+  std = covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+}
+
 std::string usability_problem(const Summary& summary, const ParameterSet& p, const FitReport& fit) {
   if (!summary.succeeded())
     return summary.message.empty() ? std::string("the estimator ended with '") + to_string(summary.termination) + "'"

@@ -223,9 +223,8 @@ Result<TransferFunction> tf_from_frequency(const FrequencyData& data, const TfOr
   r.parameters.values = x;
   r.parameters.fixed.assign(p, false);
   const double sigma2 = 2.0 * lm.cost / std::max(1, 2 * K - p);  // per real/imaginary part
-  const Eigen::MatrixXd Cs = sigma2 * lm.jtj.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
-  r.parameters.covariance = scale.asDiagonal() * Cs * scale.asDiagonal();
-  r.parameters.std = r.parameters.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  const Eigen::MatrixXd Cs = internal::covariance(lm.jtj, sigma2);
+  r.parameters.set_covariance(Cs.size() ? Eigen::MatrixXd(scale.asDiagonal() * Cs * scale.asDiagonal()) : Cs);
   // Fit on the complex response: 100 (1 - ||G - Gm|| / ||G - mean(G)||).
   Eigen::VectorXcd Gm = r.model.frequency_response(data.w());
   const double num = (G - Gm).norm(), den = (G.array() - G.mean()).matrix().norm();

@@ -263,9 +263,8 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
   }
   res.model = NarxModel(terms, theta, Ts);
   res.parameters.values = theta;
-  res.parameters.covariance = cov;
-  res.parameters.std = cov.diagonal().cwiseMax(0.0).cwiseSqrt();
   res.parameters.fixed.assign(k, false);
+  res.parameters.set_covariance(cov);
   res.diagnostics.vectors["err"] = 100.0 * Eigen::Map<const Eigen::VectorXd>(err.data(), k);
   if (o.criterion != InformationCriterion::None)
     res.diagnostics.vectors["criterion"] = crit.head(static_cast<Eigen::Index>(sel.size()));

@@ -55,8 +55,7 @@ Result<FsfModel> fsf_result(const internal::LinearSolution& sol, double Ts, int 
     r.parameters.names.push_back("im_theta" + std::to_string(k));
   }
   r.parameters.values = sol.theta;
-  r.parameters.covariance = sol.covariance;
-  r.parameters.std = sol.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  r.parameters.set_covariance(sol.covariance);
   r.parameters.fixed.assign(n, false);
   r.diagnostics.condition_number = sol.condition;
   r.diagnostics.scalars["N"] = N;

@@ -2,6 +2,7 @@
 // See include/ctid/estimate/lssvf.hpp.
 #include "ctid/estimate/lssvf.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -176,7 +177,6 @@ Result<TransferFunction> make_result(const std::vector<IdData>& data, const TfOr
   r.parameters.names = tf_parameter_names(o);
   r.parameters.values.resize(np);
   r.parameters.fixed.assign(np, false);
-  r.parameters.covariance = Eigen::MatrixXd::Zero(np, np);
   // Map between the parameter vector [a1..an, b0..b(nb-1)] and theta = [-a, b_1..b_n].
   Eigen::VectorXd sign(np);
   std::vector<int> tidx(np);
@@ -186,18 +186,16 @@ Result<TransferFunction> make_result(const std::vector<IdData>& data, const TfOr
     r.parameters.values(i) = sign(i) * th(tidx[i]);
     r.parameters.fixed[i] = L.fixed[tidx[i]];
   }
-  for (int i = 0; i < np; ++i)
-    for (int j = 0; j < np; ++j) {
-      int fi = -1, fj = -1;
-      for (std::size_t k = 0; k < L.free.size(); ++k) {
-        if (L.free[k] == tidx[i]) fi = static_cast<int>(k);
-        if (L.free[k] == tidx[j]) fj = static_cast<int>(k);
-      }
-      if (fi >= 0 && fj >= 0) r.parameters.covariance(i, j) = sign(i) * sign(j) * sol.covariance(fi, fj);
-    }
-  r.parameters.std = r.parameters.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
-  for (int i = 0; i < np; ++i)
-    if (r.parameters.fixed[i]) r.parameters.std(i) = 0.0;
+  // The free entries of theta are parameters slots[k], with sign flips.
+  std::vector<int> slots;
+  Eigen::VectorXd flip(static_cast<Eigen::Index>(L.free.size()));
+  for (std::size_t k = 0; k < L.free.size(); ++k) {
+    const int i = static_cast<int>(std::find(tidx.begin(), tidx.end(), L.free[k]) - tidx.begin());
+    CTID_ASSERT(i < np);
+    slots.push_back(i);
+    flip(static_cast<Eigen::Index>(k)) = sign(i);
+  }
+  r.parameters.set_covariance(flip.asDiagonal() * sol.covariance * flip.asDiagonal(), slots);
 
   r.model = tf_from_theta(L, th, delay);
   r.diagnostics.condition_number = sol.condition;

@@ -242,20 +242,8 @@ Result<NdeModel> nde_oe(const std::vector<IdData>& records, const NdeModel& init
   std::vector<int> slot(free);
   for (int k = 0; k < E * nx; ++k) slot.push_back(m + k);
   const double sigma2 = 2.0 * lm.cost / std::max(1, N - p);
-  r.parameters.covariance = Eigen::MatrixXd::Zero(np, np);
-  r.parameters.std = Eigen::VectorXd::Zero(np);
-  if (lm.jtj.rows() == p && std::isfinite(sigma2)) {
-    const Eigen::MatrixXd C = sigma2 * lm.jtj.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
-    for (int i = 0; i < p; ++i)
-      for (int j = 0; j < p; ++j)
-        r.parameters.covariance(slot[static_cast<size_t>(i)], slot[static_cast<size_t>(j)]) = C(i, j);
-    r.parameters.std = r.parameters.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
-    const Eigen::VectorXd dg = lm.jtj.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
-    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
-                                   dg.asDiagonal() * lm.jtj * dg.asDiagonal(), Eigen::EigenvaluesOnly)
-                                   .eigenvalues();
-    r.diagnostics.condition_number = ev(0) > 0 ? std::sqrt(ev(p - 1) / ev(0)) : INFINITY;
-  }
+  r.parameters.set_covariance(internal::covariance(lm.jtj, sigma2), slot);
+  r.diagnostics.condition_number = internal::gram_condition(lm.jtj);
   // The first record's initial state is "x0" (what simulate()'s estimated initial condition takes); further
   // records' are "x0_2", "x0_3", ...
   for (int e = 0; e < E; ++e)
@@ -267,14 +255,13 @@ Result<NdeModel> nde_oe(const std::vector<IdData>& records, const NdeModel& init
     r.diagnostics.warnings.push_back(detail::format(
         "the starting model escapes on these data; the search started with its nonlinear coefficients times {}",
         start_scale));
-  r.summary.iterations = lm.iterations;
+  const std::string failure = "the model cannot be simulated on these data, even with its nonlinear terms removed";
+  internal::set_termination(r.summary, lm, failure);
   Eigen::VectorXd yfit;
   if (!std::isfinite(lm.cost) || !simulate(lm.x, yfit)) {
     r.summary.termination = Termination::NumericalFailure;
-    r.summary.message = "the model cannot be simulated on these data, even with its nonlinear terms removed";
+    r.summary.message = failure;
     yfit = Eigen::VectorXd::Constant(N, NAN);
-  } else {
-    internal::set_termination(r.summary, lm);
   }
   r.fit = fit_report_or_inf(y, yfit, p);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -157,32 +157,15 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
   const auto [y_all, sim_all] = tf_detail::pooled_outputs(r.model, ds, opt.transient_time);
   r.fit = fit_report_or_inf(y_all, sim_all, p);
   const double sigma2 = 2.0 * lm.cost / double(std::max<Eigen::Index>(1, y_all.size() - p));
-  r.parameters.covariance = Eigen::MatrixXd::Zero(np, np);
-  r.parameters.std = Eigen::VectorXd::Zero(np);
-  if (lm.jtj.size() == p * p && std::isfinite(sigma2)) {
-    const Eigen::MatrixXd C = sigma2 * lm.jtj.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
-    for (int i = 0; i < p; ++i)
-      for (int j = 0; j < p; ++j) r.parameters.covariance(free[i], free[j]) = C(i, j);
-    r.parameters.std = r.parameters.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
-  }
+  r.parameters.set_covariance(internal::covariance(lm.jtj, sigma2), free);
+  r.diagnostics.condition_number = internal::gram_condition(lm.jtj);
   r.diagnostics.scalars["noise_variance"] = sigma2;
   r.diagnostics.scalars["delay"] = r.model.io_delay();
   if (ds.size() > 1) r.diagnostics.scalars["experiments"] = static_cast<double>(ds.size());
-  if (lm.jtj.size() == p * p) {
-    const Eigen::VectorXd dg = lm.jtj.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
-    const Eigen::VectorXd ev =
-        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(dg.asDiagonal() * lm.jtj * dg.asDiagonal(), Eigen::EigenvaluesOnly)
-            .eigenvalues();
-    r.diagnostics.condition_number = ev(0) > 0 ? std::sqrt(ev(p - 1) / ev(0)) : INFINITY;
-  }
-  r.summary.iterations = lm.iterations;
-  if (!std::isfinite(lm.cost)) {
-    r.summary.termination = Termination::NumericalFailure;
-    r.summary.message = "the simulation of the starting model overflows on this record (its poles are far in the right "
-                        "half plane); fix or bound the coefficients (--set fixed.NAME=VALUE, bounds.NAME=LOWER,UPPER)";
-  } else {
-    internal::set_termination(r.summary, lm);
-  }
+  internal::set_termination(
+      r.summary, lm,
+      "the simulation of the starting model overflows on this record (its poles are far in the right half plane); "
+      "fix or bound the coefficients (--set fixed.NAME=VALUE, bounds.NAME=LOWER,UPPER)");
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }

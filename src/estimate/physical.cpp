@@ -114,15 +114,9 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
   res.parameters.names = model.parameter_names();
   res.parameters.values = th;
   res.parameters.fixed = fixed;
-  res.parameters.covariance = Eigen::MatrixXd::Zero(P, P);
-  res.parameters.std = Eigen::VectorXd::Zero(P);
   const double sigma2 = 2.0 * lm.cost / std::max(1, n_data - p);
-  if (lm.jtj.rows() == p && std::isfinite(sigma2)) {
-    const Eigen::MatrixXd C = sigma2 * lm.jtj.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
-    for (int i = 0; i < p; ++i)
-      for (int j = 0; j < p; ++j) res.parameters.covariance(free[i], free[j]) = C(i, j);
-    res.parameters.std = res.parameters.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
-  }
+  res.parameters.set_covariance(internal::covariance(lm.jtj, sigma2), free);
+  res.diagnostics.condition_number = internal::gram_condition(lm.jtj);
   {
     Eigen::VectorXd r;
     if (std::isfinite(lm.cost) && evaluate(lm.x, r, nullptr)) res.fit = fit_report_or_inf(target, target + r, p);
@@ -143,13 +137,7 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
         "the window a = {} does not exceed the largest real part of the fitted plant's poles ({}): G(s + a) is not "
         "stable and the compressed response is not meaningful; increase a",
         a, slowest));
-  res.summary.iterations = lm.iterations;
-  if (!std::isfinite(lm.cost)) {
-    res.summary.termination = Termination::NumericalFailure;
-    res.summary.message = "the model cannot be evaluated at the initial parameters";
-  } else {
-    internal::set_termination(res.summary, lm);
-  }
+  internal::set_termination(res.summary, lm, "the model cannot be evaluated at the initial parameters");
   res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return res;
 }

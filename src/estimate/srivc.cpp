@@ -387,13 +387,8 @@ Result<TransferFunction> srivc_in_units(const Records& ds, const TfOrders& order
   r.fit = fit_report_or_inf(y_all, sim_all, p + (options.estimate_delay ? 1 : 0));
   // Covariance sigma^2 (sum zeta zeta^T)^{-1}, sigma^2 from the output error.
   const double sigma2 = r.fit.mse * double(total) / double(std::max<Eigen::Index>(1, total - p));
-  if (!run.rank_deficient && std::isfinite(sigma2) && run.zz.rows() == p) {  // no zz when interrupted before a step
-    r.parameters.covariance = sigma2 * run.zz.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
-    r.parameters.std = r.parameters.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
-  } else {
-    r.parameters.covariance = Eigen::MatrixXd::Constant(p, p, NAN);
-    r.parameters.std = Eigen::VectorXd::Constant(p, NAN);
-  }
+  // (no zz when interrupted before a step)
+  r.parameters.set_covariance(run.rank_deficient ? Eigen::MatrixXd() : internal::covariance(run.zz, sigma2));
   r.diagnostics.condition_number = run.sol.condition;
   r.diagnostics.scalars["delay"] = delay;
   r.diagnostics.scalars["noise_variance"] = sigma2;
@@ -531,6 +526,7 @@ Result<MisoModel> srivc_miso_in_units(const Records& ds, const std::vector<TfOrd
   };
   Result<MisoModel> r;
   SrivcRun last;
+  Eigen::MatrixXd information;  // sum zeta zeta^T of the estimated parameters
   bool converged = false, failed = false;
   int it = 0;
   if (opt.common_denominator) {
@@ -558,7 +554,7 @@ Result<MisoModel> srivc_miso_in_units(const Records& ds, const std::vector<TfOrd
     for (int k = 1; k <= n; ++k) r.parameters.names.push_back("a" + std::to_string(k));
     for (int i = 0; i < K; ++i)
       for (int j = 0; j < orders[i].nb; ++j) r.parameters.names.push_back("u" + std::to_string(i + 1) + ".b" + std::to_string(j));
-    r.parameters.covariance = last.zz;  // sum zeta zeta^T; scaled by sigma^2 below
+    information = last.zz;  // sum zeta zeta^T
   } else {
     // Backfitting: channel i is refitted on y minus the other channels' model outputs, in every record.
     Eigen::MatrixXd zz_blocks = Eigen::MatrixXd::Zero(p, p);
@@ -601,7 +597,7 @@ Result<MisoModel> srivc_miso_in_units(const Records& ds, const std::vector<TfOrd
       for (int k = 1; k <= orders[i].nf; ++k) r.parameters.names.push_back(u + "a" + std::to_string(k));
       for (int j = 0; j < orders[i].nb; ++j) r.parameters.names.push_back(u + "b" + std::to_string(j));
     }
-    r.parameters.covariance = zz_blocks;  // scaled below (block-diagonal approximation across channels)
+    information = zz_blocks;  // block-diagonal approximation across channels
   }
   r.parameters.fixed.assign(p, false);
   // The simulation fit over all records (each from rest), as one concatenated output.
@@ -612,14 +608,7 @@ Result<MisoModel> srivc_miso_in_units(const Records& ds, const std::vector<TfOrd
   }
   r.fit = fit_report_or_inf(yall, sall, p);
   const double sigma2 = r.fit.mse * total / std::max(1, total - p);
-  if (!failed && std::isfinite(sigma2)) {
-    const Eigen::MatrixXd zz = r.parameters.covariance;
-    r.parameters.covariance = sigma2 * zz.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
-    r.parameters.std = r.parameters.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
-  } else {
-    r.parameters.covariance = Eigen::MatrixXd::Constant(p, p, NAN);
-    r.parameters.std = Eigen::VectorXd::Constant(p, NAN);
-  }
+  r.parameters.set_covariance(failed ? Eigen::MatrixXd() : internal::covariance(information, sigma2));
   r.diagnostics.condition_number = last.sol.condition;
   r.diagnostics.scalars["noise_variance"] = sigma2;
   if (E > 1) r.diagnostics.scalars["experiments"] = E;
@@ -762,13 +751,11 @@ Result<TransferFunction> srivc_closed_loop_in_units(const IdData& data, const Ei
   // Covariance sigma^2 (Z^T Phi)^{-1} (Z^T Z) (Phi^T Z)^{-1} (IV sandwich: the instruments differ
   // from the regressors in closed loop).
   const double sigma2 = r.fit.mse * data.size() / std::max(1, data.size() - p);
-  if (!run.rank_deficient && std::isfinite(sigma2) && run.zx.size() == p * p) {
+  if (!run.rank_deficient && run.zx.size() == p * p) {
     const Eigen::MatrixXd inv = run.zx.fullPivLu().inverse();
-    r.parameters.covariance = sigma2 * inv * run.zz * inv.transpose();
-    r.parameters.std = r.parameters.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+    r.parameters.set_covariance(sigma2 * inv * run.zz * inv.transpose());
   } else {
-    r.parameters.covariance = Eigen::MatrixXd::Constant(p, p, NAN);
-    r.parameters.std = Eigen::VectorXd::Constant(p, NAN);
+    r.parameters.set_covariance({});
   }
   r.diagnostics.condition_number = run.sol.condition;
   r.diagnostics.scalars["noise_variance"] = sigma2;

@@ -172,4 +172,20 @@ LinearSolution InstrumentalVariables::solve(double tol) const {
   return s;
 }
 
+Eigen::MatrixXd covariance(const Eigen::MatrixXd& information, double sigma2) {
+  const Eigen::Index p = information.rows();
+  if (p == 0 || information.cols() != p || !std::isfinite(sigma2)) return {};
+  return sigma2 * information.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
+}
+
+double gram_condition(const Eigen::MatrixXd& jtj) {
+  const Eigen::Index p = jtj.rows();
+  if (p == 0 || jtj.cols() != p || !jtj.allFinite()) return NAN;
+  const Eigen::VectorXd dg = jtj.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+  const Eigen::VectorXd ev =
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(dg.asDiagonal() * jtj * dg.asDiagonal(), Eigen::EigenvaluesOnly)
+          .eigenvalues();
+  return ev(0) > 0 ? std::sqrt(ev(p - 1) / ev(0)) : INFINITY;
+}
+
 }  // namespace ctid::internal

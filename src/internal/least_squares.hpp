@@ -125,4 +125,13 @@ class InstrumentalVariables {
 /// 2-norm condition number of a square matrix after scaling its columns to unit norm.
 double scaled_condition(const Eigen::MatrixXd& M);
 
+/// The covariance sigma2 M^{-1} of estimated parameters from their information matrix M (J^T J of a search,
+/// sum zeta zeta^T of instrumental variables); an empty matrix (unknown, see ParameterSet::set_covariance)
+/// when M is empty or sigma2 is not finite.
+Eigen::MatrixXd covariance(const Eigen::MatrixXd& information, double sigma2);
+
+/// The condition number of J with its columns scaled to unit norm, from J^T J (the square root of the eigenvalue
+/// ratio of the scaled J^T J): what scaled_condition(J) gives without J. Infinite when singular, NaN when empty.
+double gram_condition(const Eigen::MatrixXd& jtj);
+
 }  // namespace ctid::internal

@@ -7,8 +7,13 @@
 
 namespace ctid::internal {
 
-void set_termination(Summary& s, const LmResult& lm) {
+void set_termination(Summary& s, const LmResult& lm, const std::string& failure) {
   s.iterations = lm.iterations;
+  if (!std::isfinite(lm.cost)) {
+    s.termination = Termination::NumericalFailure;
+    s.message = failure.empty() ? lm.message : failure;
+    return;
+  }
   s.termination = lm.interrupted ? Termination::Interrupted
                   : lm.converged ? Termination::Converged
                                  : Termination::MaxIterations;

@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 
 #include "ctid/core/status.hpp"
+#include "internal/least_squares.hpp"
 
 namespace ctid::internal {
 
@@ -33,8 +34,11 @@ struct LmResult {
 /// cannot be evaluated at x (e.g. an unstable simulation), which rejects the step.
 using LmEvaluate = std::function<bool(const Eigen::VectorXd& x, Eigen::VectorXd& r, Eigen::MatrixXd* J)>;
 
-/// How a search that could evaluate its start ended: Interrupted, Converged or MaxIterations (with the message).
-void set_termination(Summary& summary, const LmResult& lm);
+/// How the search ended, with its iteration count: NumericalFailure with `failure` (or the search's own
+/// message when `failure` is empty) when it could not evaluate its start, else Interrupted, Converged or
+/// MaxIterations (with the message).
+void set_termination(Summary& summary, const LmResult& lm, const std::string& failure = "");
+
 
 LmResult levenberg_marquardt(const LmEvaluate& evaluate, Eigen::VectorXd x0, const Eigen::VectorXd& lower,
                              const Eigen::VectorXd& upper, const LmOptions& options);

@@ -108,3 +108,32 @@ TEST(Core, UsabilityRulesNameTheCause) {
   r.parameters.covariance.setZero();
   EXPECT_TRUE(r.usable()) << r.why_not_usable();
 }
+
+// ParameterSet::set_covariance, the one covariance finishing of every estimator: the covariance of the estimated
+// parameters is scattered into their slots, fixed parameters get zero rows (std 0), an unknown covariance is NaN
+// for the estimated ones only (so usable() names the singular information matrix).
+TEST(Core, SetCovarianceScattersTheEstimatedParameters) {
+  ParameterSet p;
+  p.names = {"a1", "a2", "b0"};
+  p.values = Eigen::Vector3d(1.0, 2.0, 3.0);
+  p.fixed = {false, true, false};
+  Eigen::Matrix2d c;
+  c << 4.0, 1.0, 1.0, 9.0;
+  p.set_covariance(c, {0, 2});
+  EXPECT_EQ(p.covariance(0, 0), 4.0);
+  EXPECT_EQ(p.covariance(0, 2), 1.0);
+  EXPECT_EQ(p.covariance(2, 2), 9.0);
+  EXPECT_EQ(p.covariance(1, 1), 0.0);
+  EXPECT_EQ(p.std(0), 2.0);
+  EXPECT_EQ(p.std(1), 0.0);
+  EXPECT_EQ(p.std(2), 3.0);
+  p.set_covariance(Eigen::MatrixXd(), {0, 2});
+  EXPECT_TRUE(std::isnan(p.std(0)) && std::isnan(p.std(2)));
+  EXPECT_EQ(p.std(1), 0.0);
+  Result<int> r;
+  r.parameters = p;
+  r.summary.termination = Termination::Converged;
+  EXPECT_NE(r.why_not_usable().find("singular"), std::string::npos) << r.why_not_usable();
+  p.set_covariance(Eigen::Matrix3d::Identity());  // no slots: all parameters in order
+  EXPECT_EQ(p.std(1), 1.0);
+}

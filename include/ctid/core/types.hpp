@@ -24,6 +24,12 @@ struct ParameterSet {
   int index(const std::string& name) const;
   /// Value of a parameter by name; throws InvalidArgument when absent.
   double value(const std::string& name) const { return values(index(name)); }
+  /// Sets `covariance` and `std` from the covariance `c` of the estimated parameters: `c` is over the
+  /// parameters at the indices `slots` (all parameters in order when `slots` is empty); the rows and columns
+  /// of the others (fixed parameters) are zero. An empty, wrongly sized or non-finite `c` means "unknown":
+  /// the entries of the estimated parameters become NaN (usable() then names the singular information
+  /// matrix). Call after `values`.
+  void set_covariance(const Eigen::MatrixXd& c, const std::vector<int>& slots = {});
 };
 
 /// Quality of fit of the model's simulated output against measured data.
