@@ -111,7 +111,11 @@ int run_tf(const FitArgs& a, const IdData& d, Result<TransferFunction> (*estimat
   return finish(r, a.method, d, a, settings_of(o));
 }
 
-// Closed-loop SRIVC: the reference column is loaded with the data and split off.
+std::vector<std::pair<std::string, IdData>> more_records_of(const FitArgs& a, const std::vector<IdData>& ds);
+void print_experiments(const FitArgs& a, const std::vector<IdData>& ds);
+
+// Closed-loop SRIVC on one record or several (jointly, one controller): each record's reference column is loaded
+// with its data and split off.
 int run_closed_loop(const FitArgs& a) {
   if (a.method != "srivc") throw UsageError("--closed-loop-controller needs --method srivc");
   if (a.reference.empty()) throw UsageError("--closed-loop-controller needs --reference COLUMN");
@@ -125,15 +129,19 @@ int run_closed_loop(const FitArgs& a) {
   if (!std::holds_alternative<TransferFunction>(c)) throw UsageError(a.controller + ": the controller must be a transfer_function");
   DataArgs da = a.data;
   da.inputs.push_back(a.reference);
-  const IdData both = da.load(true);
-  const IdData d = both.select({0}, {0});
-  const Eigen::VectorXd r = both.u().col(1);
+  std::vector<IdData> ds;
+  std::vector<Eigen::VectorXd> refs;
   ClosedLoopOptions o;
+  for (const IdData& both : da.load_each(a.paths, true)) {
+    ds.push_back(both.select({0}, {0}));
+    refs.push_back(both.u().col(1));
+    o.reference_intersample = both.intersample(1);
+  }
   o.controller = std::get<TransferFunction>(c);
-  o.reference_intersample = both.intersample(1);
   apply_sets("srivc_closed_loop", a.sets, o);
-  const Result<TransferFunction> r2 = call_library([&] { return srivc_closed_loop(d, r, siso_orders(a), o); });
-  return finish(r2, "clsrivc", d, a, settings_of(o));
+  const Result<TransferFunction> r = call_library([&] { return srivc_closed_loop(ds, refs, siso_orders(a), o); });
+  print_experiments(a, ds);
+  return finish(r, "clsrivc", ds[0], a, settings_of(o), more_records_of(a, ds));
 }
 
 // Frequency-response data: columns w, re, im (G) or the spectra U and Y.
@@ -216,7 +224,6 @@ int run_fsf(const FitArgs& a, const IdData& d) {
   return code;
 }
 
-std::vector<std::pair<std::string, IdData>> more_records_of(const FitArgs& a, const std::vector<IdData>& ds);
 int run_physical_records(const FitArgs& a, const std::vector<IdData>& ds);
 int run_physical(const FitArgs& a, const IdData& d) { return run_physical_records(a, {d}); }
 
@@ -342,6 +349,15 @@ std::vector<std::pair<std::string, IdData>> more_records_of(const FitArgs& a, co
 }
 
 // Several DATA files: several experiments of one system, the same columns in each, fitted jointly.
+// "experiments: 2 (a.csv: 1000 samples, b.csv: 800 samples)" before a joint fit's result (nothing for one record).
+void print_experiments(const FitArgs& a, const std::vector<IdData>& ds) {
+  if (ds.size() < 2) return;
+  std::printf("experiments: %zu (", ds.size());
+  for (std::size_t e = 0; e < ds.size(); ++e)
+    std::printf("%s%s: %d samples", e ? ", " : "", a.paths[e].c_str(), ds[e].size());
+  std::printf(")\n");
+}
+
 template <class O>
 int fit_experiments(const FitArgs& a, const std::vector<IdData>& ds,
                     Result<TransferFunction> (*estimator)(const std::vector<IdData>&, const TfOrders&, const O&)) {
@@ -353,10 +369,7 @@ int fit_experiments(const FitArgs& a, const std::vector<IdData>& ds,
     orders.validate();
     return estimator(ds, orders, o);
   });
-  std::printf("experiments: %zu (", ds.size());
-  for (std::size_t e = 0; e < ds.size(); ++e)
-    std::printf("%s%s: %d samples", e ? ", " : "", a.paths[e].c_str(), ds[e].size());
-  std::printf(")\n");
+  print_experiments(a, ds);
   // The printed samples are those of the first record; the fit is over all of them; the report shows each record.
   return finish(r, a.method, ds[0], a, settings_of(o), more_records_of(a, ds));
 }
@@ -388,10 +401,10 @@ int run_experiments(const FitArgs& a) {
   if (a.method != "srivc" && a.method != "oe" && a.method != "tfest" && a.method != "lssvf" && a.method != "ivsvf" &&
       a.method != "rls-svf" && a.method != "narx" && a.method != "physical")
     throw UsageError(detail::format("{} DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, "
-                                    "lssvf, ivsvf, rls-svf, narx or physical --via raw (got {}; the other estimators "
-                                    "take one record so far)",
+                                    "lssvf, ivsvf, rls-svf, narx, physical --via raw or srivc with "
+                                    "--closed-loop-controller (got {}; the other estimators take one record so far)",
                                     a.paths.size(), a.method));
-  if (!a.controller.empty() || a.frequency) throw UsageError("several DATA files: open-loop time-domain data only");
+  if (a.frequency) throw UsageError("several DATA files: time-domain data only (not --frequency)");
   const std::vector<IdData> ds = a.data.load_each(a.paths, true);
   if (ds[0].ny() != 1)
     throw UsageError(detail::format("several experiments: one --output (selected {})", ds[0].ny()));
@@ -413,8 +426,8 @@ int run(const FitArgs& a) {
   check_outputs({a.json, a.report, a.responses.empty() ? "" : a.responses + "_time.csv",
                  a.responses.empty() ? "" : a.responses + "_freq.csv"},
                 inputs, a.force);
-  if (a.paths.size() > 1) return run_experiments(a);
   if (!a.controller.empty()) return run_closed_loop(a);
+  if (a.paths.size() > 1) return run_experiments(a);
   if (a.frequency && !a.report.empty()) throw UsageError("--report needs time-domain data (not --frequency)");
   if (a.frequency) return run_frequency(a);
   const IdData d = a.data.load(true);

@@ -245,11 +245,18 @@ def srivc_miso(data, orders, **options):
 
 def srivc_closed_loop(data, reference, nb, nf, nk=0, **options):
     """Closed-loop SRIVC: data holds the plant input and output, reference the reference signal (one value per
-    sample); options: ClosedLoopOptions, controller= the known TransferFunction (required)."""
+    sample); options: ClosedLoopOptions, controller= the known TransferFunction (required). Several experiments of
+    one loop: data a list of IdData and reference a list of as many signals (one per record), fitted jointly."""
     if "controller" not in options:
         raise InvalidOptions("srivc_closed_loop: the known controller is required (controller=TransferFunction(...))")
-    return _ctid.srivc_closed_loop(data, _np.asarray(reference, dtype=float).ravel(), nb, nf, nk,
-                                   _options(_ctid.ClosedLoopOptions, "srivc_closed_loop", options))
+    o = _options(_ctid.ClosedLoopOptions, "srivc_closed_loop", options)
+    if isinstance(data, (list, tuple)):
+        if not isinstance(reference, (list, tuple)):
+            raise InvalidArgument("srivc_closed_loop: with a list of records, reference is a list of as many signals "
+                                  "(one per record)")
+        return _ctid.srivc_closed_loop(list(data), [_np.asarray(r, dtype=float).ravel() for r in reference], nb, nf,
+                                       nk, o)
+    return _ctid.srivc_closed_loop(data, _np.asarray(reference, dtype=float).ravel(), nb, nf, nk, o)
 
 
 def tf_from_frequency(data, nb, nf, **options):

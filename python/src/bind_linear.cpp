@@ -125,6 +125,14 @@ void bind_linear(py::module_& m) {
       py::arg("data"), py::arg("reference"), py::arg("nb"), py::arg("nf"), py::arg("nk"), py::arg("options"),
       "Closed-loop SRIVC with a known controller (instruments from the reference).");
   m.def(
+      "srivc_closed_loop",
+      [](const std::vector<IdData>& d, const std::vector<Eigen::VectorXd>& references, int nb, int nf, int nk,
+         const ClosedLoopOptions& o) {
+        return interruptible([&] { return srivc_closed_loop(d, references, TfOrders{nb, nf, nk}, o); });
+      },
+      py::arg("data"), py::arg("references"), py::arg("nb"), py::arg("nf"), py::arg("nk"), py::arg("options"),
+      "Closed-loop SRIVC on several experiments of one loop (a list of IdData, one reference per record), jointly.");
+  m.def(
       "tf_from_frequency",
       [](const FrequencyData& d, int nb, int nf, const FrequencyFitOptions& o) {
         return interruptible([&] { return tf_from_frequency(d, TfOrders{nb, nf, 0}, o); });

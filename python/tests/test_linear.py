@@ -129,6 +129,18 @@ def test_srivc_closed_loop_with_known_pi_controller():
     np.testing.assert_allclose(res.model.num, b, rtol=0.02)
     with pytest.raises(ctid.InvalidOptions, match="controller"):
         ctid.srivc_closed_loop(d, r_, 1, 2)
+    # Several experiments of the loop (a second record with another reference), fitted jointly: one estimate, to the
+    # same O(Ts) tolerance; a list of records needs a list of references.
+    r2 = 0.5 * ctid.prbs(6000, register_length=9, clock_period=40, initial_state=5)
+    d2 = ctid.IdData.from_arrays(ctid.TransferFunction(np.polymul(a, dc), cl).simulate(r2, t),
+                                 ctid.TransferFunction(np.polymul(b, dc), cl).simulate(r2, t), ts=0.01)
+    joint = ctid.srivc_closed_loop([d, d2], [r_, r2], 1, 2, controller=ctid.TransferFunction(nc, dc))
+    assert joint.usable(), joint.summary.message
+    assert joint.diagnostics.scalars["experiments"] == 2
+    np.testing.assert_allclose(joint.model.den, a, rtol=0.02)
+    np.testing.assert_allclose(joint.model.num, b, rtol=0.02)
+    with pytest.raises(ctid.InvalidArgument, match="one per record"):
+        ctid.srivc_closed_loop([d, d2], r_, 1, 2, controller=ctid.TransferFunction(nc, dc))
 
 
 def test_tf_from_frequency_exact_data_and_pairs():

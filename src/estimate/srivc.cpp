@@ -116,7 +116,8 @@ struct IvRecord {
   const Eigen::VectorXd* y;
   const Eigen::VectorXd* t;
   const std::vector<IvChannel>* ch;
-  Eigen::Index first = 0;  // rows before it (the record's transient) are left out
+  Eigen::Index first = 0;                   // rows before it (the record's transient) are left out
+  const ClosedLoopInstruments* cl = nullptr;  // closed loop: instruments from this record's reference
 };
 
 // Adds one record's rows of an SRIVC instrumental-variable step to iv (see iv_step).
@@ -169,8 +170,7 @@ void iv_accumulate(internal::InstrumentalVariables& iv, const Polynomial& A, con
 // prefilter 1/A (A stabilised), regressors from the measured y and inputs, instruments from
 // the auxiliary-model output sum_i B_i/A u_i. theta = [a (n), b_1 (nb_1), ..., b_K (nb_K)]. The normal equations
 // are summed over the records (each record's filters start at rest).
-SrivcRun iv_step(const std::vector<IvRecord>& records, int n, const Eigen::VectorXd& theta,
-                 const ClosedLoopInstruments* cl = nullptr) {
+SrivcRun iv_step(const std::vector<IvRecord>& records, int n, const Eigen::VectorXd& theta) {
   int p = n;
   for (const auto& c : *records.front().ch) p += c.nb;
   Eigen::VectorXd den(n + 1);
@@ -178,7 +178,7 @@ SrivcRun iv_step(const std::vector<IvRecord>& records, int n, const Eigen::Vecto
   den.tail(n) = theta.head(n);
   const Polynomial A = stabilized(TransferFunction(Polynomial{1.0}, Polynomial(den))).den();
   internal::InstrumentalVariables iv(p, /*with_rss=*/false);
-  for (const auto& rec : records) iv_accumulate(iv, A, *rec.y, *rec.t, *rec.ch, n, p, theta, cl, rec.first);
+  for (const auto& rec : records) iv_accumulate(iv, A, *rec.y, *rec.t, *rec.ch, n, p, theta, rec.cl, rec.first);
   SrivcRun run;
   run.sol = iv.solve();
   run.zz = iv.zz();
@@ -189,8 +189,8 @@ SrivcRun iv_step(const std::vector<IvRecord>& records, int n, const Eigen::Vecto
 }
 
 SrivcRun iv_step(const Eigen::VectorXd& y, const Eigen::VectorXd& t, const std::vector<IvChannel>& ch, int n,
-                 const Eigen::VectorXd& theta, const ClosedLoopInstruments* cl = nullptr) {
-  return iv_step(std::vector<IvRecord>{{&y, &t, &ch}}, n, theta, cl);
+                 const Eigen::VectorXd& theta) {
+  return iv_step(std::vector<IvRecord>{{&y, &t, &ch}}, n, theta);
 }
 
 }  // namespace srivc_detail
@@ -695,7 +695,9 @@ const OptionTable<ClosedLoopOptions>& option_table<ClosedLoopOptions>() {
                   {{"zoh", Intersample::Zoh}, {"foh", Intersample::Foh}, {"bl", Intersample::BandLimited}},
                   "intersample behaviour of the reference")
           .integer("max_iterations", &O::max_iterations, "", at_least(1), "IV iterations")
-          .real("tolerance", &O::tolerance, "", above(0), "stop when the relative parameter change is below");
+          .real("tolerance", &O::tolerance, "", above(0), "stop when the relative parameter change is below")
+          .real("transient_time", &O::transient_time, "s", at_least(0),
+                "seconds at the start of each record left out of the IV equations and the fit (loops not at rest)");
   return t;
 }
 
@@ -706,30 +708,32 @@ void ClosedLoopOptions::validate() const {
 }
 
 namespace {
-Result<TransferFunction> srivc_closed_loop_in_units(const IdData& data, const Eigen::VectorXd& reference,
+Result<TransferFunction> srivc_closed_loop_in_units(const std::vector<IdData>& ds, const std::vector<Eigen::VectorXd>& refs,
                                                     const TfOrders& orders, const ClosedLoopOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
-  orders.validate(/*allow_biproper=*/false);
-  opt.validate();
-  CTID_REQUIRE(reference.size() == data.size(), "srivc_closed_loop: the reference has {} samples but the data have {}",
-               reference.size(), data.size());
-  CTID_REQUIRE(reference.allFinite(), "srivc_closed_loop: the reference contains NaN or Inf");
-  CTID_REQUIRE_OPTION(orders.nk == 0, "srivc_closed_loop: nk must be 0 (got {})", orders.nk);
   const int p = orders.nf + orders.nb;
-  CTID_REQUIRE(data.size() > p, "srivc_closed_loop: {} samples cannot determine {} parameters", data.size(), p);
-  srivc_detail::ClosedLoopInstruments cl{reference, opt.reference_intersample, opt.controller, opt.reference_at_plant_input};
-  const Eigen::VectorXd t = data.times();
-  const Eigen::VectorXd y = data.y().col(0);
-  const std::vector<IvChannel> ch{{data.u().col(0), data.intersample(0), 0.0, orders.nb}};
+  const std::size_t E = ds.size();
+  std::vector<srivc_detail::ClosedLoopInstruments> cl;
+  std::vector<Eigen::VectorXd> ys, ts;
+  std::vector<std::vector<IvChannel>> chs;
+  for (std::size_t e = 0; e < E; ++e) {
+    cl.push_back({refs[e], opt.reference_intersample, opt.controller, opt.reference_at_plant_input});
+    ys.push_back(ds[e].y().col(0));
+    ts.push_back(ds[e].times());
+    chs.push_back({{ds[e].u().col(0), ds[e].intersample(0), 0.0, orders.nb}});
+  }
+  std::vector<srivc_detail::IvRecord> recs;
+  for (std::size_t e = 0; e < E; ++e) recs.push_back({&ys[e], &ts[e], &chs[e], first_after(ds[e], opt.transient_time), &cl[e]});
   // Start: open-loop SRIVC (biased in closed loop, but a stable model near the truth).
   SrivcOptions so;
   so.max_iterations = 10;
-  Eigen::VectorXd theta = srivc(data, orders, so).parameters.values;
+  so.transient_time = opt.transient_time;
+  Eigen::VectorXd theta = srivc(ds, orders, so).parameters.values;
   SrivcRun run;
   bool converged = false;
   int it = 0;
   for (it = 1; it <= opt.max_iterations; ++it) {
-    SrivcRun step = srivc_detail::iv_step(y, t, ch, orders.nf, theta, &cl);
+    SrivcRun step = srivc_detail::iv_step(recs, orders.nf, theta);
     if (step.rank_deficient) {
       run = step;
       break;
@@ -747,10 +751,13 @@ Result<TransferFunction> srivc_closed_loop_in_units(const IdData& data, const Ei
   r.parameters.names = tf_parameter_names(orders);
   r.parameters.values = theta;
   r.parameters.fixed.assign(p, false);
-  r.fit = fit_report_or_inf(y, lsim(r.model, data, 0), p);
+  // The simulation fit over all records (each from rest, after its transient), as one concatenated output.
+  const auto [y_all, sim_all] = pooled_outputs(r.model, ds, opt.transient_time);
+  r.fit = fit_report_or_inf(y_all, sim_all, p);
   // Covariance sigma^2 (Z^T Phi)^{-1} (Z^T Z) (Phi^T Z)^{-1} (IV sandwich: the instruments differ
-  // from the regressors in closed loop).
-  const double sigma2 = r.fit.mse * data.size() / std::max(1, data.size() - p);
+  // from the regressors in closed loop), the sums over all records.
+  const Eigen::Index total = y_all.size();
+  const double sigma2 = r.fit.mse * double(total) / double(std::max<Eigen::Index>(1, total - p));
   if (!run.rank_deficient && run.zx.size() == p * p) {
     const Eigen::MatrixXd inv = run.zx.fullPivLu().inverse();
     r.parameters.set_covariance(sigma2 * inv * run.zz * inv.transpose());
@@ -759,6 +766,19 @@ Result<TransferFunction> srivc_closed_loop_in_units(const IdData& data, const Ei
   }
   r.diagnostics.condition_number = run.sol.condition;
   r.diagnostics.scalars["noise_variance"] = sigma2;
+  if (E > 1) r.diagnostics.scalars["experiments"] = static_cast<double>(E);
+  // The sandwich assumes white noise. Coloured noise (why CLSRIVC is used) makes it too small, by about
+  // sqrt((1 + rho)/(1 - rho)) for AR(1) noise of lag-1 correlation rho: say so when that exceeds 1.5.
+  const Eigen::VectorXd err = y_all - sim_all;
+  const Eigen::Index ne = err.size();
+  const double e0 = err.squaredNorm();
+  const double rho = ne > 1 && e0 > 0 ? err.head(ne - 1).dot(err.tail(ne - 1)) / e0 : 0.0;
+  r.diagnostics.scalars["output_error_lag1_correlation"] = rho;
+  if (rho > 0.4)
+    r.diagnostics.warnings.push_back(detail::format(
+        "the output error is correlated (lag-1 correlation {}): the standard deviations assume white noise and may be "
+        "too small by a factor of about {}",
+        std::round(rho * 1000) / 1000, std::round(std::sqrt((1 + rho) / (1 - rho)) * 10) / 10));
   r.summary.iterations = std::min(it, opt.max_iterations);
   set_termination(r, run.rank_deficient, converged, opt.tolerance, opt.max_iterations,
                   "the closed-loop instrument matrix is singular; the reference does not excite every parameter");
@@ -767,21 +787,50 @@ Result<TransferFunction> srivc_closed_loop_in_units(const IdData& data, const Ei
 }
 }  // namespace
 
-Result<TransferFunction> srivc_closed_loop(const IdData& data, const Eigen::VectorXd& reference, const TfOrders& orders,
-                                           const ClosedLoopOptions& opt) {
+Result<TransferFunction> srivc_closed_loop(const std::vector<IdData>& data, const std::vector<Eigen::VectorXd>& references,
+                                           const TfOrders& orders, const ClosedLoopOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
-  require_io_data(data, "srivc_closed_loop");
-  // As srivc: estimated in normalised units and mapped back. The controller maps y to u: C'(s') = (sy/su) C(s'/c);
-  // the reference has the units of u (added at the plant input) or of y (a setpoint).
+  orders.validate(/*allow_biproper=*/false);
+  opt.validate();
+  CTID_REQUIRE(!data.empty(), "srivc_closed_loop: no records");
+  CTID_REQUIRE(references.size() == data.size(), "srivc_closed_loop: {} references for {} records", references.size(),
+               data.size());
+  CTID_REQUIRE_OPTION(orders.nk == 0, "srivc_closed_loop: nk must be 0 (got {})", orders.nk);
+  const int p = orders.nf + orders.nb;
+  Eigen::Index total = 0;
+  for (std::size_t e = 0; e < data.size(); ++e) {
+    const std::string who = data.size() > 1 ? "srivc_closed_loop (record " + std::to_string(e + 1) + ")" : "srivc_closed_loop";
+    require_io_data(data[e], who.c_str());
+    CTID_REQUIRE(references[e].size() == data[e].size(), "{}: the reference has {} samples but the data have {}", who,
+                 references[e].size(), data[e].size());
+    CTID_REQUIRE(references[e].allFinite(), "{}: the reference contains NaN or Inf", who);
+    CTID_REQUIRE(opt.transient_time < data[e].duration(), "{}: transient_time = {} s is not shorter than the record ({} s)",
+                 who, opt.transient_time, data[e].duration());
+    total += data[e].size();
+  }
+  CTID_REQUIRE(total > p, "srivc_closed_loop: {} samples cannot determine {} parameters", total, p);
+  // As srivc: estimated in normalised units (pooled over the records) and mapped back. The controller maps y to
+  // u: C'(s') = (sy/su) C(s'/c); the reference has the units of u (added at the plant input) or of y (a setpoint).
   const tf_detail::TfNormalisation n = tf_detail::TfNormalisation::of(data);
   ClosedLoopOptions o = opt;
   o.controller = time_scaled(opt.controller, n.c, n.sy / n.su);
-  const Eigen::VectorXd r_scaled = reference / (opt.reference_at_plant_input ? n.su : n.sy);
-  Result<TransferFunction> r = srivc_closed_loop_in_units(n.data(data), r_scaled, orders, o);
+  o.transient_time /= n.c;
+  std::vector<IdData> scaled;
+  std::vector<Eigen::VectorXd> refs;
+  for (std::size_t e = 0; e < data.size(); ++e) {
+    scaled.push_back(n.data(data[e]));
+    refs.push_back(references[e] / (opt.reference_at_plant_input ? n.su : n.sy));
+  }
+  Result<TransferFunction> r = srivc_closed_loop_in_units(scaled, refs, orders, o);
   n.restore(r, orders);
   tf_detail::check_cancellation(r);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
+}
+
+Result<TransferFunction> srivc_closed_loop(const IdData& data, const Eigen::VectorXd& reference, const TfOrders& orders,
+                                           const ClosedLoopOptions& opt) {
+  return srivc_closed_loop(std::vector<IdData>{data}, std::vector<Eigen::VectorXd>{reference}, orders, opt);
 }
 
 }  // namespace ctid

@@ -313,6 +313,39 @@ TEST(Cli, ClosedLoopFit) {
   EXPECT_NEAR(res.parameters.value("b1"), 1.0, 1e-6);
   EXPECT_EQ(ctid_run("fit " + csv + " --time t --input u --output y --method srivc --closed-loop-controller " + c).code, 2);
   EXPECT_EQ(ctid_run("fit " + csv + " --time t --input u --output y --method srivc --closed-loop-controller /nonexistent.json --reference r").code, 3);
+  // Two DATA files are two experiments of the loop (each from rest, with its own reference column): one joint fit,
+  // the library's to 1e-9, the plant to 1e-6 (noise-free).
+  auto loop_run = [&](const Eigen::VectorXd& ref) {
+    Eigen::MatrixXd out(N, 4);
+    Eigen::VectorXd xs = Eigen::VectorXd::Zero(2);
+    double in = 0;
+    for (int k = 0; k < N; ++k) {
+      const double y = (ss.C() * xs)(0);
+      const double u = ref(k) - (10 * y + 15 * in);
+      in += Ts * y;
+      out.row(k) << k * Ts, ref(k), u, y;
+      xs = D.Phi * xs + D.Gamma0 * u;
+    }
+    return out;
+  };
+  const Eigen::MatrixXd m2 = loop_run(prbs(N, {.register_length = 9, .clock_period = 40, .initial_state = 7}));
+  const std::string b_csv = test::temp_path("loop_b.csv");
+  write_csv(b_csv, {"t", "r", "u", "y"}, m2);
+  fs::remove(json);
+  const CliRun two = ctid_run("fit " + csv + " " + b_csv + " --time t --input u --output y --method srivc --nb 2 --nf 2 " +
+                              "--closed-loop-controller " + c + " --reference r --json " + json);
+  ASSERT_EQ(two.code, 0) << two.err;
+  EXPECT_NE(two.out.find("experiments: 2"), std::string::npos) << two.out;
+  ClosedLoopOptions o;
+  o.controller = TransferFunction(Eigen::VectorXd{{10.0, 15.0}}, Eigen::VectorXd{{1.0, 0.0}});
+  const auto lib = srivc_closed_loop(std::vector<IdData>{IdData(m.col(2), m.col(3), Ts), IdData(m2.col(2), m2.col(3), Ts)},
+                                     {r, m2.col(1)}, {2, 2, 0}, o);
+  const auto joint = parse_result_json(read_text_file(json));
+  EXPECT_EQ(joint.diagnostics.scalars.at("experiments"), 2.0);
+  for (int i = 0; i < lib.parameters.size(); ++i)
+    EXPECT_NEAR(joint.parameters.values(i), lib.parameters.values(i), 1e-9 * std::abs(lib.parameters.values(i)));
+  for (const auto& [name, value] : {std::pair{"a1", 0.5}, {"a2", 1.0}, {"b0", 1.0}, {"b1", 1.0}})
+    EXPECT_NEAR(joint.parameters.value(name), value, 1e-6) << name;
 }
 
 TEST(Cli, FrequencyData) {
@@ -1123,7 +1156,7 @@ TEST(Cli, SeveralDataFilesAreFittedJointly) {
   const CliRun o = ctid_run("fit " + files[0] + " " + files[1] + " --time time --input force --output position --method fsf");
   EXPECT_EQ(o.code, 2);
   EXPECT_NE(o.err.find("2 DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, lssvf, "
-                       "ivsvf, rls-svf, narx or physical --via raw (got fsf"),
+                       "ivsvf, rls-svf, narx, physical --via raw or srivc with --closed-loop-controller (got fsf"),
             std::string::npos)
       << o.err;
   // NARX on both records (resampled NARX at Ts = 0.02 s): the CLI's file equals the library's joint fit.

@@ -325,7 +325,7 @@ TEST(SrivcMiso, SeveralExperimentsGiveOneEstimateMoreAccurateThanEither) {
     std::printf("parameter %d: rmse joint %.4g, record 1 %.4g, record 2 %.4g; reported std / spread %.3f\n", i, rmse(ej),
                 rmse(e1), rmse(e2), sj.col(i).mean() / sd);
     EXPECT_LT(rmse(ej), std::min(rmse(e1), rmse(e2))) << "parameter " << i;
-    EXPECT_NEAR(sj.col(i).mean() / sd, 1.0, 0.35) << "parameter " << i;
+    EXPECT_NEAR(sj.col(i).mean() / sd, 1.0, 0.3) << "parameter " << i;
   }
   EXPECT_NE(test::error_of([&] {
               srivc_miso(std::vector<IdData>{IdData(u1, x1, Ts), IdData(Eigen::MatrixXd(u1.col(0)), x1, Ts)}, orders);
@@ -393,6 +393,11 @@ TEST(SrivcClosedLoop, ConsistentWhereOpenLoopSrivcIsBiased) {
     ol.row(s) = srivc(d, {2, 2, 0}).parameters.values.transpose();
     const auto c = srivc_closed_loop(d, r, {2, 2, 0}, o);
     ASSERT_TRUE(c.usable()) << c.why_not_usable();
+    // The AR(1) noise (pole 0.95) makes the white-noise sandwich too small (about sqrt(1.95/0.05) = 6.2 times
+    // for this pole): the result says so.
+    ASSERT_EQ(c.diagnostics.warnings.size(), 1u);
+    EXPECT_NE(c.diagnostics.warnings[0].find("the standard deviations assume white noise"), std::string::npos);
+    EXPECT_NEAR(c.diagnostics.scalars.at("output_error_lag1_correlation"), 0.95, 0.03);
     cl.row(s) = c.parameters.values.transpose();
   }
   const Eigen::VectorXd truth{{0.5, 1.0, 1.0, 1.0}};
@@ -407,6 +412,95 @@ TEST(SrivcClosedLoop, ConsistentWhereOpenLoopSrivcIsBiased) {
   EXPECT_GT(std::abs(m - 1.0), 10 * sd / std::sqrt(double(R)));
   // Bad use.
   EXPECT_THROW(srivc_closed_loop(IdData(u0, y0, Ts), r.head(10), {2, 2, 0}, o), InvalidArgument);
+}
+
+// Several experiments of one loop (issue 14, item 2): set-up 6's plant and PI controller, two records of 8000
+// samples with different references (PRBS clock 20; PRBS clock 40 of another register and seed) and independent
+// white measurement noise at 10 dB of record 1's noise-free output (white, where the IV-sandwich covariance
+// sigma^2 (Z^T Phi)^-1 Z^T Z (Phi^T Z)^-1 holds; with coloured noise it is too small). CLSRIVC on both records is
+// one estimate at least as accurate as either alone — RMS error below 0.85 of the better record's for every
+// parameter (measured 0.72-0.76 over 100 runs) — and the pooled standard deviation agrees with the Monte Carlo
+// spread within 20 % (100 runs: the sample std has ~7 % relative error; measured 0.98-1.06; with 40 runs the
+// ratio wandered up to 1.39 on one parameter, sampling alone).
+TEST(SrivcClosedLoop, SeveralExperimentsGiveOneEstimateMoreAccurateThanEither) {
+  const TransferFunction G(Eigen::VectorXd{{1.0, 1.0}}, Eigen::VectorXd{{1.0, 0.5, 1.0}});
+  const StateSpace ss = G.to_state_space();
+  const double Ts = 0.005;
+  const int N = 8000, R = 100;
+  const Discretization D = discretize(ss.A(), ss.B(), Ts);
+  const std::vector<Eigen::VectorXd> refs{prbs(N, {.register_length = 10, .clock_period = 20}),
+                                          prbs(N, {.register_length = 9, .clock_period = 40, .initial_state = 77})};
+  auto loop = [&](const Eigen::VectorXd& r, const Eigen::VectorXd& v) {
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(2), u(N), ym(N);
+    double integral = 0;
+    for (int k = 0; k < N; ++k) {
+      ym(k) = (ss.C() * x)(0) + v(k);
+      u(k) = r(k) - (10 * ym(k) + 15 * integral);
+      integral += Ts * ym(k);
+      x = D.Phi * x + D.Gamma0 * u(k);
+    }
+    return IdData(u, ym, Ts);
+  };
+  const IdData clean = loop(refs[0], Eigen::VectorXd::Zero(N));
+  const double sv = std::sqrt((clean.y().array() - clean.y().mean()).square().mean() / 10.0);
+  ClosedLoopOptions o;
+  o.controller = TransferFunction(Eigen::VectorXd{{10.0, 15.0}}, Eigen::VectorXd{{1.0, 0.0}});
+  const Eigen::VectorXd truth{{0.5, 1.0, 1.0, 1.0}};
+  Eigen::MatrixXd e1(R, 4), e2(R, 4), ej(R, 4), sj(R, 4);
+  for (int s = 0; s < R; ++s) {
+    std::vector<IdData> d;
+    for (int e = 0; e < 2; ++e) {
+      d.push_back(loop(refs[e], white_noise(N, sv, 900 + 2 * s + e)));
+    }
+    const auto a = srivc_closed_loop(d[0], refs[0], {2, 2, 0}, o);
+    const auto b = srivc_closed_loop(d[1], refs[1], {2, 2, 0}, o);
+    const auto j = srivc_closed_loop(d, refs, {2, 2, 0}, o);
+    ASSERT_TRUE(j.usable()) << j.why_not_usable();
+    EXPECT_EQ(j.diagnostics.scalars.at("experiments"), 2.0);
+    EXPECT_TRUE(j.diagnostics.warnings.empty()) << j.diagnostics.warnings.front();  // white noise: no caveat
+    e1.row(s) = (a.parameters.values - truth).transpose();
+    e2.row(s) = (b.parameters.values - truth).transpose();
+    ej.row(s) = (j.parameters.values - truth).transpose();
+    sj.row(s) = j.parameters.std.transpose();
+  }
+  for (int i = 0; i < 4; ++i) {
+    auto rmse = [&](const Eigen::MatrixXd& e) { return std::sqrt(e.col(i).squaredNorm() / R); };
+    const double mean = ej.col(i).mean();
+    const double sd = std::sqrt((ej.col(i).array() - mean).square().sum() / (R - 1));
+    std::printf("parameter %d: rmse joint %.4g, record 1 %.4g, record 2 %.4g; reported std / spread %.3f\n", i, rmse(ej),
+                rmse(e1), rmse(e2), sj.col(i).mean() / sd);
+    EXPECT_LT(rmse(ej), 0.85 * std::min(rmse(e1), rmse(e2))) << "parameter " << i;
+    EXPECT_NEAR(sj.col(i).mean() / sd, 1.0, 0.2) << "parameter " << i;
+  }
+  // A record that does not start at rest (the second half of one noise-free run of 2 N samples, 40 s each): the
+  // slow plant mode (damping 0.25 rad/s) leaves the instruments' error in its first seconds; transient_time = 25 s
+  // takes it out of the sums: the error on a1 falls from 7.9e-3 to 1.8e-4 (measured; asserted: above 5e-3
+  // without, below 5e-4 with).
+  {
+    const Eigen::VectorXd rr = prbs(2 * N, {.register_length = 10, .clock_period = 20});
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(2), u(2 * N), ym(2 * N);
+    double integral = 0;
+    for (int k = 0; k < 2 * N; ++k) {
+      ym(k) = (ss.C() * x)(0);
+      u(k) = rr(k) - (10 * ym(k) + 15 * integral);
+      integral += Ts * ym(k);
+      x = D.Phi * x + D.Gamma0 * u(k);
+    }
+    const std::vector<IdData> halves{IdData(u.head(N), ym.head(N), Ts), IdData(u.tail(N), ym.tail(N), Ts, N * Ts)};
+    const std::vector<Eigen::VectorXd> hr{rr.head(N), rr.tail(N)};
+    const double raw = std::abs(srivc_closed_loop(halves, hr, {2, 2, 0}, o).parameters.value("a1") - 0.5);
+    ClosedLoopOptions ot = o;
+    ot.transient_time = 25.0;
+    const double cut = std::abs(srivc_closed_loop(halves, hr, {2, 2, 0}, ot).parameters.value("a1") - 0.5);
+    EXPECT_GT(raw, 5e-3);
+    EXPECT_LT(cut, 5e-4);
+  }
+  // A reference that does not match its record is named by the record's position.
+  EXPECT_NE(test::error_of([&] {
+              srivc_closed_loop(std::vector<IdData>{clean, clean}, {refs[0], refs[1].head(10)}, {2, 2, 0}, o);
+            }).find("srivc_closed_loop (record 2): the reference has 10 samples but the data have 8000"),
+            std::string::npos);
+  EXPECT_THROW(srivc_closed_loop(std::vector<IdData>{clean}, refs, {2, 2, 0}, o), InvalidArgument);
 }
 
 TEST(FrequencyFit, RaoGarnierFrequencyResponse) {
@@ -557,7 +651,7 @@ TEST(OutputError, SeveralExperimentsGiveOneEstimateBetterThanEither) {
     const double combined = 1.0 / std::sqrt(1.0 / (rmse(e1) * rmse(e1)) + 1.0 / (rmse(e2) * rmse(e2)));
     EXPECT_LT(rmse(ej), std::min(rmse(e1), rmse(e2))) << "parameter " << i;
     EXPECT_LT(rmse(ej), 1.15 * combined) << "parameter " << i;
-    EXPECT_NEAR(sj.col(i).mean() / sd, 1.0, 0.35) << "parameter " << i;
+    EXPECT_NEAR(sj.col(i).mean() / sd, 1.0, 0.3) << "parameter " << i;
   }
 }
 

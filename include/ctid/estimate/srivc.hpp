@@ -86,6 +86,10 @@ struct ClosedLoopOptions {
   Intersample reference_intersample = Intersample::Zoh;
   int max_iterations = 50;
   double tolerance = 1e-7;
+  /// Seconds at the start of each record left out of the IV equations and of the fit: a loop that is not at rest
+  /// when the record starts (e.g. the second piece of a long run) has a transient the instruments, built from the
+  /// reference through the loop at rest, do not model.
+  double transient_time = 0.0;
   void validate() const;
 };
 /// The settings of ClosedLoopOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
@@ -100,6 +104,13 @@ const OptionTable<ClosedLoopOptions>& option_table<ClosedLoopOptions>();
 /// with the noise. Strictly proper plant, no delay.
 Result<TransferFunction> srivc_closed_loop(const IdData& data, const Eigen::VectorXd& reference, const TfOrders& orders,
                                            const ClosedLoopOptions& options);
+/// Closed-loop SRIVC on several experiments of one loop (the same controller; each record with its own reference,
+/// references[e] with data[e].size() samples): one parameter set, the instrumental-variable sums of each step over
+/// the records (each filtered from rest), the fit and the sandwich covariance pooled over the records.
+/// Throws InvalidArgument when the counts or lengths differ, a record is not single-input single-output or holds
+/// NaN/Inf.
+Result<TransferFunction> srivc_closed_loop(const std::vector<IdData>& data, const std::vector<Eigen::VectorXd>& references,
+                                           const TfOrders& orders, const ClosedLoopOptions& options);
 
 /// MISO SRIVC, one TfOrders per input. Parameter names: common denominator
 /// "a1".."a<n>", then "u<i>.b<j>"; separate denominators "u<i>.a<k>", "u<i>.b<j>".
