@@ -28,22 +28,40 @@ int whole_samples(const std::string& key, double v) {
 }
 }  // namespace
 
-ModalOptions modal_options(const std::string& method, const std::vector<std::string>& sets, double Ts,
-                           const std::vector<std::string>& own, std::map<std::string, std::string>& own_values) {
-  ModalOptions o;
+namespace {
+// The CLI's shift_samples (whole samples) taken out of `sets` as seconds; the other settings are returned.
+std::vector<std::string> take_shift_samples(const std::vector<std::string>& sets, double Ts, Eigen::VectorXd& shifts) {
   std::vector<std::string> rest;
   std::vector<double> samples;
   for (const auto& [k, v] : parse_sets(sets)) {
     if (k == "shift_samples") samples = to_list(k, v);
-    else if (std::find(own.begin(), own.end(), k) != own.end()) own_values[k] = v;
     else rest.push_back(k + "=" + v);
   }
-  apply_sets(method, rest, o);
-  if (!samples.empty()) {
-    if (o.shifts.size() > 0) throw UsageError("give either shifts (seconds) or shift_samples (samples), not both");
-    o.shifts.resize(static_cast<Eigen::Index>(samples.size()));
-    for (std::size_t i = 0; i < samples.size(); ++i) o.shifts(static_cast<Eigen::Index>(i)) = whole_samples("shift_samples", samples[i]) * Ts;
+  shifts.resize(static_cast<Eigen::Index>(samples.size()));
+  for (std::size_t i = 0; i < samples.size(); ++i)
+    shifts(static_cast<Eigen::Index>(i)) = whole_samples("shift_samples", samples[i]) * Ts;
+  return rest;
+}
+
+void set_shifts(Eigen::VectorXd& shifts, const Eigen::VectorXd& from_samples) {
+  if (from_samples.size() == 0) return;
+  if (shifts.size() > 0) throw UsageError("give either shifts (seconds) or shift_samples (samples), not both");
+  shifts = from_samples;
+}
+}  // namespace
+
+ModalOptions modal_options(const std::string& method, const std::vector<std::string>& sets, double Ts,
+                           const std::vector<std::string>& own, std::map<std::string, std::string>& own_values) {
+  ModalOptions o;
+  Eigen::VectorXd from_samples;
+  std::vector<std::string> rest;
+  for (const auto& kv : take_shift_samples(sets, Ts, from_samples)) {
+    const std::string k = kv.substr(0, kv.find('='));
+    if (std::find(own.begin(), own.end(), k) != own.end()) own_values[k] = kv.substr(kv.find('=') + 1);
+    else rest.push_back(kv);
   }
+  apply_sets(method, rest, o);
+  set_shifts(o.shifts, from_samples);
   return o;
 }
 
@@ -77,58 +95,17 @@ int run_poles(PolesArgs a) {
   const IdData d = a.data.load(false);
   const double Ts = d.ts();
   const Eigen::VectorXd y = d.u().col(0);
-  auto sets = parse_sets(a.sets);
-  FreeResponseOptions o;
-  std::vector<double> shifts, gen = a.generator;
-  int start = -1, interval = -1, spacing = -1, pairs = -1, p_spacing = -1, p_equations = -1, p_start = 0;
-  consume_sets(sets, [&](const std::string& k, const std::string& v) {
-    if (k == "shifts") shifts = to_list(k, v);
-    else if (k == "start") start = whole_samples(k, to_double(k, v));
-    else if (k == "interval") interval = whole_samples(k, to_double(k, v));
-    else if (k == "spacing") spacing = whole_samples(k, to_double(k, v));
-    else if (k == "pairs") pairs = to_int(k, v);
-    else if (k == "generator") gen = to_list(k, v);
-    else if (k == "quadrature") {
-      if (v != "simpson" && v != "trapezoid") throw UsageError("--set quadrature: use simpson or trapezoid (got '" + v + "')");
-      o.quadrature = v == "trapezoid" ? Quadrature::Trapezoid : Quadrature::Simpson;
-    }
-    else if (k == "prony_spacing") p_spacing = whole_samples(k, to_double(k, v));
-    else if (k == "prony_equations") p_equations = to_int(k, v);
-    else if (k == "prony_start") p_start = whole_samples(k, to_double(k, v));
-    else return false;
-    return true;
-  });
-  if (!sets.empty())
-    throw UsageError("--set " + sets.begin()->first + ": not a setting of poles (settings: shifts (samples), start, "
-                     "interval, spacing, pairs, generator (rad/s list), quadrature, prony_spacing, prony_equations, "
-                     "prony_start)");
-  InputGenerator g;
-  for (double w : gen) g = g + (w == 0 ? InputGenerator::constant(1.0) : InputGenerator::sinusoid(w, 1.0));
-  const int n_aug = a.order + g.order();
-  if (shifts.empty()) throw UsageError(detail::format("poles needs --set shifts=S1,..,S{} (samples; one per pole{})", n_aug,
-                                                      g.order() ? " of the system and of the generator" : ""));
-  if (static_cast<int>(shifts.size()) != n_aug)
-    throw UsageError(detail::format("--set shifts has {} values; order {} {} needs {}", shifts.size(), a.order,
-                                    g.order() ? "plus the generator's modes" : "", n_aug));
-  o.shifts.resize(n_aug);
-  int max_shift = 0;
-  for (int i = 0; i < n_aug; ++i) {
-    const int s = whole_samples("shifts", shifts[i]);
-    o.shifts(i) = s * Ts;
-    max_shift = std::max(max_shift, s);
+  PolesOptions o;
+  Eigen::VectorXd from_samples;
+  apply_sets("poles", take_shift_samples(a.sets, Ts, from_samples), o);
+  set_shifts(o.shifts, from_samples);
+  if (!a.generator.empty()) {
+    if (o.generator.size() > 0) throw UsageError("give either --generator or --set generator, not both");
+    o.generator = Eigen::Map<const Eigen::VectorXd>(a.generator.data(), static_cast<Eigen::Index>(a.generator.size()));
   }
-  if (interval < 0) interval = std::max(2, whole_samples("shifts", shifts[0]));
-  if (spacing < 0) spacing = interval;
-  if (start < 0) start = max_shift;
-  if (pairs < 0) pairs = (d.size() - 1 - start - interval) / spacing + 1;
-  o.start = start * Ts;
-  o.interval = interval * Ts;
-  o.spacing = spacing * Ts;
-  o.pairs = pairs;
-  if (g.order()) o.generator = g.characteristic_polynomial();
-  PoleEstimate dm;
+  PolesComparison c;
   try {
-    dm = free_response_poles(y, Ts, o);
+    c = compare_poles(y, Ts, a.order, o);
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }
@@ -139,21 +116,15 @@ int run_poles(PolesArgs a) {
     for (const auto& w : p.warnings) std::printf("  warning: %s\n", w.c_str());
   };
   std::printf("free response: %d samples, Ts = %.6g s, order %d\n", d.size(), Ts, a.order);
-  print("data-matrix method (Theorem 4.3, El-Shafey 1987):", dm);
-  if (g.order()) std::printf("  before deflation by the generator: %s\n", dm.augmented.to_string("s", 6).c_str());
-  if (p_spacing < 0) p_spacing = whole_samples("shifts", shifts[0]);
-  if (p_equations < 0) p_equations = (d.size() - 1 - p_start) / std::max(1, p_spacing) - n_aug + 1;
-  std::optional<PoleEstimate> pr;
-  std::string prony_error;
-  try {
-    pr = prony(y, Ts, {.order = n_aug, .spacing = p_spacing, .equations = p_equations, .start = p_start});
-    print(detail::format("Prony (order {}, T = {} samples, {} equations):", n_aug, p_spacing, p_equations).c_str(), *pr);
-  } catch (const InvalidArgument& e) {
-    prony_error = e.what();
-    std::printf("Prony: not computed (%s)\n", e.what());
-  }
+  print("data-matrix method (Theorem 4.3, El-Shafey 1987):", c.data_matrix);
+  if (o.generator.size() > 0) std::printf("  before deflation by the generator: %s\n", c.data_matrix.augmented.to_string("s", 6).c_str());
+  const PronyOptions& po = c.prony_options;
+  if (c.prony)
+    print(detail::format("Prony (order {}, T = {} samples, {} equations):", po.order, po.spacing, po.equations).c_str(), *c.prony);
+  else
+    std::printf("Prony: not computed (%s)\n", c.prony_problem.c_str());
   if (!a.json.empty()) {
-    write_text_file(a.json, poles_to_json(dm, pr ? &*pr : nullptr, prony_error, a.order, Ts));
+    write_text_file(a.json, poles_to_json(c.data_matrix, c.prony ? &*c.prony : nullptr, c.prony_problem, a.order, Ts));
     std::printf("wrote %s\n", a.json.c_str());
   }
   return kOk;
@@ -267,9 +238,8 @@ void setup_poles(CLI::App& app) {
                  "augmented estimate is deflated by them")
       ->delimiter(',');
   app.add_option("--set", a->sets,
-                 "KEY=VALUE: shifts=S1,..,Sn (samples; n + generator modes), start, interval, spacing (samples), pairs, "
-                 "generator=w1,.. (same as --generator), quadrature=simpson|trapezoid, "
-                 "prony_spacing, prony_equations, prony_start");
+                 "KEY=VALUE; " + settings_help(method_info("poles")) +
+                     "  shift_samples  the shifts counted in samples (instead of shifts)");
   app.add_option("--json", a->json, "Write both estimates (poles, characteristic polynomials, conditions) to this JSON file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
   app.callback([a] { g_run = [a] { return run_poles(*a); }; });

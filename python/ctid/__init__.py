@@ -391,6 +391,14 @@ def free_response_poles(y, ts, **options):
                                      _options(_ctid.FreeResponseOptions, "free_response_poles", options))
 
 
+def compare_poles(y, ts, order, **options):
+    """El-Shafey's data-matrix poles (Theorem 4.3) of a free or generator-forced response beside Prony's — what
+    ``ctid poles`` prints (options: PolesOptions, seconds; ``shifts`` required, one per pole of the system and of the
+    generator). Returns a PolesComparison (data_matrix, prony or None with prony_problem, the settings used)."""
+    return _ctid.compare_poles(_np.asarray(y, dtype=float).ravel(), ts, order,
+                               _options(_ctid.PolesOptions, "poles", options))
+
+
 def fit_physical_step(model, parameters, compressed, **options):
     """Gawthrop & Wang stage 2 against the FSF step response. parameters: {"name": initial} or
     {"name": {"initial": .., "lower": .., "upper": .., "fixed": ..}} (options: PhysicalFitOptions)."""

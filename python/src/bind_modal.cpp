@@ -118,6 +118,15 @@ void bind_modal(py::module_& m) {
   m.def("free_response_poles", &free_response_poles, py::arg("y"), py::arg("ts"), py::arg("options"),
         "Poles from a free-response data matrix (El-Shafey Theorem 4.3).");
   m.def("prony", &prony, py::arg("y"), py::arg("ts"), py::arg("options"), "Prony's method (poles modulo 2 pi / T).");
+  bind_options<PolesOptions>(m, "PolesOptions");
+  py::class_<PolesComparison>(m, "PolesComparison")
+      .def_readonly("data_matrix", &PolesComparison::data_matrix)
+      .def_readonly("prony", &PolesComparison::prony)
+      .def_readonly("prony_problem", &PolesComparison::prony_problem)
+      .def_readonly("free_response", &PolesComparison::free_response)
+      .def_readonly("prony_options", &PolesComparison::prony_options);
+  m.def("compare_poles", &compare_poles, py::arg("y"), py::arg("ts"), py::arg("order"), py::arg("options"),
+        "El-Shafey's data-matrix poles beside Prony's, instants chosen from the record unless given (ctid poles).");
 }
 
 }  // namespace ctid::python

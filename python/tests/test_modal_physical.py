@@ -32,6 +32,27 @@ def test_free_response_poles_theorem_4_3():
     assert sorted(abs(p.poles.imag))[0] == pytest.approx(3, abs=0.01)
 
 
+def test_compare_poles_is_what_ctid_poles_prints():
+    # The same record: compare_poles with the instants chosen from it (start = the largest shift, interval = spacing
+    # = the first shift, as many pairs as fit) gives free_response_poles' estimate with those settings to round-off,
+    # and Prony at spacing 33 samples aliases the 100 rad/s mode (|Im| <= pi/T) where the data matrix does not.
+    tw = 2 * math.pi / 3 / 666
+    t = ctid.time_grid(tw, 2000)
+    y = np.exp(-t) * np.sin(3 * t) + np.cos(100 * t)
+    c = ctid.compare_poles(y, tw, 4, shifts=np.array([33, 66, 99, 132]) * tw)
+    fr = c.free_response
+    assert fr.start == pytest.approx(132 * tw) and fr.interval == pytest.approx(33 * tw)
+    assert fr.pairs == (2000 - 1 - 132 - 33) // 33 + 1
+    direct = ctid.free_response_poles(y, tw, shifts=fr.shifts, start=fr.start, interval=fr.interval,
+                                      spacing=fr.spacing, pairs=fr.pairs)
+    np.testing.assert_allclose(np.sort_complex(c.data_matrix.poles), np.sort_complex(direct.poles), rtol=1e-12)
+    assert max(abs(c.data_matrix.poles.imag)) == pytest.approx(100, abs=0.1)
+    assert c.prony is not None and c.prony_options.spacing == 33
+    assert max(abs(c.prony.poles.imag)) <= math.pi / (33 * tw) + 1e-9
+    with pytest.raises(ctid.InvalidOptions, match="3 shifts; order 4 needs 4"):
+        ctid.compare_poles(y, tw, 4, shifts=np.array([33, 66, 99]) * tw)
+
+
 def test_modal_frequency_response_from_a_square_wave():
     # El-Shafey Ex. 5.1 (as tests/estimate/modal_test.cpp): S3 under a +-1 square wave of period 2 pi, Ts = pi/420;
     # p_0 from the constant-input windows; H(jk) at the odd harmonics within 2e-6 of the truth (C++: same bound).

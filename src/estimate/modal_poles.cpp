@@ -146,4 +146,73 @@ PoleEstimate prony(const Eigen::VectorXd& y, double Ts, const PronyOptions& o) {
   return r;
 }
 
+template <>
+const OptionTable<PolesOptions>& option_table<PolesOptions>() {
+  using O = PolesOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("poles")
+          .reals("shifts", &O::shifts, "s", above(0),
+                 "T_1..T_n', one per pole of the system and of the generator, whole multiples of Ts (the CLI also takes "
+                 "shift_samples)")
+          .real("start", &O::start, "s", or_special(above(0), 0, "the largest shift"), "first instant t_o1")
+          .real("interval", &O::interval, "s", or_special(above(0), 0, "the first shift, at least 2 Ts"),
+                "integration interval t_fk - t_ok")
+          .real("spacing", &O::spacing, "s", or_special(above(0), 0, "the interval"), "t_o(k+1) - t_ok")
+          .integer("pairs", &O::pairs, "", or_special(at_least(1), 0, "as many as the record holds"), "instant pairs")
+          .choice("quadrature", &O::quadrature, {{"simpson", Quadrature::Simpson}, {"trapezoid", Quadrature::Trapezoid}},
+                  "integration rule")
+          .reals("generator", &O::generator, "rad/s", at_least(0),
+                 "frequencies of a known generated input (0 = constant); the augmented estimate is deflated by them")
+          .real("prony_spacing", &O::prony_spacing, "s", or_special(above(0), 0, "the first shift"),
+                "spacing of Prony's samples")
+          .integer("prony_equations", &O::prony_equations, "", or_special(at_least(1), 0, "as many as the record holds"),
+                   "Prony's equations")
+          .real("prony_start", &O::prony_start, "s", at_least(0), "time of Prony's first sample");
+  return t;
+}
+
+void PolesOptions::validate() const { option_table<PolesOptions>().check(*this); }
+
+PolesComparison compare_poles(const Eigen::VectorXd& y, double Ts, int order, const PolesOptions& o) {
+  o.validate();
+  CTID_REQUIRE(std::isfinite(Ts) && Ts > 0, "poles: Ts must be > 0 (got {})", Ts);
+  CTID_REQUIRE_OPTION(order >= 1, "poles: the order must be >= 1 (got {})", order);
+  InputGenerator g;
+  for (Eigen::Index i = 0; i < o.generator.size(); ++i)
+    g = g + (o.generator(i) == 0 ? InputGenerator::constant(1.0) : InputGenerator::sinusoid(o.generator(i), 1.0));
+  const int n_aug = order + g.order();
+  CTID_REQUIRE_OPTION(o.shifts.size() > 0, "poles: give the shifts (shifts=T1,..,T{} in s; one per pole{})", n_aug,
+                      g.order() ? " of the system and of the generator" : "");
+  CTID_REQUIRE_OPTION(o.shifts.size() == n_aug, "poles: {} shifts; order {}{} needs {}", o.shifts.size(), order,
+                      g.order() ? " plus the generator's modes" : "", n_aug);
+  const int N = static_cast<int>(y.size());
+  auto samples = [&](double seconds, const char* what) { return modal_detail::samples_of(seconds, Ts, what); };
+  int max_shift = 0;
+  for (int i = 0; i < n_aug; ++i) max_shift = std::max(max_shift, samples(o.shifts(i), "shift"));
+  const int first = samples(o.shifts(0), "shift");
+  const int interval = o.interval > 0 ? samples(o.interval, "interval") : std::max(2, first);
+  const int spacing = o.spacing > 0 ? samples(o.spacing, "spacing") : interval;
+  const int start = o.start > 0 ? samples(o.start, "start") : max_shift;
+  PolesComparison c;
+  c.free_response.shifts = o.shifts;
+  c.free_response.start = start * Ts;
+  c.free_response.interval = interval * Ts;
+  c.free_response.spacing = spacing * Ts;
+  c.free_response.pairs = o.pairs > 0 ? o.pairs : (N - 1 - start - interval) / spacing + 1;
+  c.free_response.quadrature = o.quadrature;
+  if (g.order()) c.free_response.generator = g.characteristic_polynomial();
+  c.data_matrix = free_response_poles(y, Ts, c.free_response);
+  PronyOptions& p = c.prony_options;
+  p.order = n_aug;
+  p.spacing = o.prony_spacing > 0 ? samples(o.prony_spacing, "prony_spacing") : first;
+  p.start = samples(o.prony_start, "prony_start");
+  p.equations = o.prony_equations > 0 ? o.prony_equations : (N - 1 - p.start) / std::max(1, p.spacing) - n_aug + 1;
+  try {
+    c.prony = prony(y, Ts, p);
+  } catch (const InvalidArgument& e) {
+    c.prony_problem = e.what();
+  }
+  return c;
+}
+
 }  // namespace ctid

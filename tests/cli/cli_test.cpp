@@ -483,15 +483,22 @@ TEST(Cli, ModalFitPolesAndResponses) {
   fr.col(0) = lsim(phase_variable_form(kS3), InputGenerator::constant(0.0), time_grid(kTs320, N), Eigen::Vector3d(1, 0, 0));
   const std::string free = test::temp_path("free.csv");
   write_csv(free, {"y"}, fr);
-  r = ctid_run("poles " + free + " --ts " + ts320() + " --order 3 --set shifts=20,40,60");
+  r = ctid_run("poles " + free + " --ts " + ts320() + " --order 3 --set shift_samples=20,40,60");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("s^3 + 4 s^2 + 30 s + 52"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("Prony"), std::string::npos);
+  // The settings are the library's (compare_poles, seconds): shifts in seconds print the same estimates, and a
+  // setting in samples says so in its name.
+  char shifts_s[128];
+  std::snprintf(shifts_s, sizeof shifts_s, "%.17g,%.17g,%.17g", 20 * kTs320, 40 * kTs320, 60 * kTs320);
+  const CliRun secs = ctid_run("poles " + free + " --ts " + ts320() + " --order 3 --set shifts=" + shifts_s);
+  ASSERT_EQ(secs.code, 0) << secs.err;
+  EXPECT_EQ(secs.out, r.out);
   // --json: the same estimates as numbers. S3 = (s + 2)(s^2 + 2 s + 26): noise-free, the characteristic
   // polynomial to 1e-6 (the printed text has 6 digits).
   const std::string pj = test::temp_path("poles.json");
   fs::remove(pj);
-  r = ctid_run("poles " + free + " --ts " + ts320() + " --order 3 --set shifts=20,40,60 --json " + pj);
+  r = ctid_run("poles " + free + " --ts " + ts320() + " --order 3 --set shift_samples=20,40,60 --json " + pj);
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json pjs = nlohmann::json::parse(read_text_file(pj));
   EXPECT_EQ(pjs.at("type"), "poles");
@@ -506,7 +513,7 @@ TEST(Cli, ModalFitPolesAndResponses) {
   forced.col(0) = lsim(kS3.to_state_space(), InputGenerator::sinusoid(4.0, 1.0), time_grid(kTs320, 600));
   const std::string fp = test::temp_path("forced.csv");
   write_csv(fp, {"y"}, forced);
-  r = ctid_run("poles " + fp + " --ts " + ts320() + " --order 3 --generator 4 --set shifts=30,60,90,120,150");
+  r = ctid_run("poles " + fp + " --ts " + ts320() + " --order 3 --generator 4 --set shift_samples=30,60,90,120,150");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("s^3 + 4 s^2 + 30 s + 52"), std::string::npos) << r.out;
   // A record whose output never moves: refused before any estimation (exit 2), named.
@@ -1079,6 +1086,12 @@ TEST(Cli, MethodHelpListsEveryRegisteredSettingAndSetAcceptsIt) {
   const std::map<std::string, std::pair<std::string, std::string>> through = {
       {"frols", {"narx", ""}}, {"narmax", {"narx", ""}}, {"kia_linear", {"kia", ""}},
       {"kia_quadratic", {"kia", "q"}}, {"kia_cubic", {"kia", "c"}}, {"nde_oe", {"kia", "oe_"}}};
+  // poles is its own command: `ctid poles --help` lists its settings.
+  const CliRun ph = ctid_run("poles --help");
+  ASSERT_EQ(ph.code, 0) << ph.err;
+  for (const auto& s : method_info("poles").settings)
+    EXPECT_NE(ph.out.find("  " + s.name + " "), std::string::npos) << "poles." << s.name << " missing from ctid poles --help";
+  covered.insert("poles");
   for (const auto& m : methods()) {
     if (covered.count(m.name)) continue;
     ASSERT_TRUE(through.count(m.name)) << m.name << " is not reachable from ctid fit";

@@ -16,6 +16,7 @@
 // start; samples before the record count as zero. Times are seconds from the first sample.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -160,6 +161,41 @@ struct PronyOptions {
 /// least squares, poles s = ln(z)/T of z^order + p_1 z^{order-1} + ... . Reports cond(R^T R) and a
 /// warning that imaginary parts are only known modulo 2 pi / T (aliasing band (-pi/T, pi/T]).
 PoleEstimate prony(const Eigen::VectorXd& y, double Ts, const PronyOptions& options);
+
+/// Settings of compare_poles (the `ctid poles` command), in seconds; 0 means "chosen from the record".
+struct PolesOptions {
+  Eigen::VectorXd shifts;      ///< T_1..T_n' (s, distinct whole multiples of Ts): one per pole of the system and of the generator
+  double start = 0.0;          ///< t_o1 (s); 0: the largest shift
+  double interval = 0.0;       ///< t_fk - t_ok (s); 0: the first shift, at least 2 Ts
+  double spacing = 0.0;        ///< t_o(k+1) - t_ok (s); 0: the interval
+  int pairs = 0;               ///< instant pairs; 0: as many as the record holds
+  Quadrature quadrature = Quadrature::Simpson;
+  /// Frequencies (rad/s; 0 = a constant) of a known generated input forcing the response: the augmented estimate
+  /// is deflated by their modes (ES 4.56-4.62). Empty: a free response.
+  Eigen::VectorXd generator;
+  double prony_spacing = 0.0;  ///< spacing of Prony's samples (s, a multiple of Ts); 0: the first shift
+  int prony_equations = 0;     ///< Prony's equations; 0: as many as the record holds
+  double prony_start = 0.0;    ///< time of Prony's first sample (s)
+  void validate() const;
+};
+/// The settings of PolesOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
+template <>
+const OptionTable<PolesOptions>& option_table<PolesOptions>();
+
+/// The two pole estimates of one response, with the settings they used (defaults resolved).
+struct PolesComparison {
+  PoleEstimate data_matrix;           ///< Theorem 4.3 (deflated by the generator)
+  std::optional<PoleEstimate> prony;  ///< Prony of the augmented order; empty when the record cannot hold it
+  std::string prony_problem;          ///< why Prony was not computed ("" when it was)
+  FreeResponseOptions free_response;  ///< the data-matrix settings used
+  PronyOptions prony_options;         ///< Prony's settings used
+};
+
+/// El-Shafey's data-matrix poles (free_response_poles) of a free or generator-forced response y (uniform, Ts s)
+/// next to Prony's (prony) at the augmented order `order` + the generator's modes — the comparison of ES Ex. 4.8,
+/// with every instant chosen from the record unless given. Throws InvalidOptions when the shifts are missing or
+/// their count is not order + generator modes, InvalidArgument when the record cannot hold the instants.
+PolesComparison compare_poles(const Eigen::VectorXd& y, double Ts, int order, const PolesOptions& options);
 
 // ---- Nonparametric responses (ES-C10 .. ES-C12) ----------------------------------------------
 
