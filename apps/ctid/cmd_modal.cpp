@@ -151,74 +151,44 @@ int run_response(const ResponseArgs& a) {
                                             names, tab));
   };
   if (d.nu() != 1 || d.ny() != 1) throw UsageError("response needs one --input and one --output");
-  const double Ts = d.ts();
-  std::map<std::string, std::string> own;
-  ModalOptions mo = modal_options("response --method modal", a.sets, Ts, {"period", "horizon", "harmonics", "window_start"}, own);
-  double period = 0, horizon = 0, window_start = -1;
-  std::vector<double> harmonics_d;
-  for (const auto& [k, v] : own) {
-    if (k == "period") period = to_double(k, v);
-    else if (k == "horizon") horizon = to_double(k, v);
-    else if (k == "harmonics") harmonics_d = to_list(k, v);
-    else window_start = to_double(k, v);
-  }
-  if (!(period > 0)) throw UsageError("response --method modal needs --set period=SECONDS (level period for step/impulse, "
-                                      "input period for frequency)");
-  if (mo.shifts.size() == 0) {  // default: shifts i T (step/impulse) or i Ts * period/(n+1) (frequency)
-    mo.shifts.resize(a.order);
-    const double base = a.kind == "frequency" ? std::round(period / (a.order + 1) / Ts) * Ts : period;
-    for (int i = 0; i < a.order; ++i) mo.shifts(i) = (i + 1) * base;
-  }
-  if (mo.shifts.size() != a.order) throw UsageError(detail::format("{} shifts for --order {}", mo.shifts.size(), a.order));
-  if (!mo.basis) mo.basis = ModalBasis::Discrete;
-  const double Tn = mo.shifts.maxCoeff();
+  ModalResponseOptions ro;
+  ModalOptions mo;
+  Eigen::VectorXd from_samples;
+  apply_sets("modal_response", take_shift_samples(a.sets, d.ts(), from_samples), ro, mo);
+  set_shifts(mo.shifts, from_samples);
+  const ResponseKind kind = a.kind == "frequency" ? ResponseKind::Frequency
+                            : a.kind == "impulse" ? ResponseKind::Impulse
+                                                  : ResponseKind::Step;
+  ModalResponse m;
   try {
-    // p_0 from the constant-input windows (piecewise-constant input).
-    ModalOptions o = mo;
-    o.max_order = 0;
-    if (o.windows.empty()) o.windows = piecewise_constant_windows(d, Tn, Ts);
-    if (o.windows.empty()) throw UsageError("the input never stays constant for longer than T_n: no validity windows");
-    const Result<ModalModel> m = modal_estimate(d, d.u(), o);
-    std::printf("modal parameters p_0:");
-    for (int i = 0; i < a.order; ++i) std::printf(" %.6g", m.model.P()(0, i));
-    std::printf("   (shifts");
-    for (int i = 0; i < a.order; ++i) std::printf(" %.6g", mo.shifts(i));
-    std::printf(" s)");
-    std::printf("   (%zu windows, condition %.3g)\n", o.windows.size(), m.diagnostics.condition_number);
-    if (a.kind == "frequency") {
-      std::vector<int> h;
-      for (double x : harmonics_d.empty() ? std::vector<double>{1, 3, 5, 7, 9} : harmonics_d)
-        h.push_back(whole_samples("harmonics", x));
-      const HarmonicResponse r =
-          modal_frequency_response(d, m.model, period, h, window_start >= 0 ? window_start : Tn, mo.quadrature);
-      const FrequencyData& f = r.response;
-      Eigen::MatrixXd tab(f.size(), 5);
-      for (int i = 0; i < f.size(); ++i) {
-        const auto G = f.response()(i);
-        tab.row(i) << f.w()(i), G.real(), G.imag(), std::abs(G), std::arg(G) * 180 / 3.14159265358979;
-        std::printf("  w = %-10.5g  H = %.6g %+.6gj   |H| = %.6g  phase = %.4g deg\n", f.w()(i), G.real(), G.imag(),
-                    std::abs(G), tab(i, 4));
-      }
-      write({"w", "re", "im", "mag", "phase_deg"}, tab);
-    } else {
-      const double hz = horizon > 0 ? horizon : 10 * period * (a.order + 1);
-      TimeResponse g = modal_step_response(d, m.model, period, hz);
-      const char* name = "step";
-      if (a.kind == "impulse") {
-        // Negative shifts -i T and Fourier functions on the first half of the horizon (ES 5.38-5.42).
-        const Eigen::VectorXd neg = -mo.shifts;
-        const double To = std::floor((hz - Tn) / 2 / Ts) * Ts;
-        g = modal_impulse_from_step(g, neg, To, std::max(6, 2 * ((a.order + 2) / 2)), mo.quadrature).impulse;
-        name = "impulse";
-      }
-      const int K = static_cast<int>(g.t.size());
-      for (int i = 0; i < K; i += std::max(1, K / 20)) std::printf("  t = %-10.5g  %s = %.6g\n", g.t(i), name, g.value(i));
-      Eigen::MatrixXd tab(K, 2);
-      tab << g.t, g.value;
-      write({"t", name}, tab);
-    }
+    m = modal_response(d, a.order, kind, ro, mo);
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
+  }
+  std::printf("modal parameters p_0:");
+  for (int i = 0; i < a.order; ++i) std::printf(" %.6g", m.p0.model.P()(0, i));
+  std::printf("   (shifts");
+  for (int i = 0; i < a.order; ++i) std::printf(" %.6g", m.modal.shifts(i));
+  std::printf(" s)");
+  std::printf("   (%zu windows, condition %.3g)\n", m.modal.windows.size(), m.p0.diagnostics.condition_number);
+  if (kind == ResponseKind::Frequency) {
+    const FrequencyData& f = m.frequency.response;
+    Eigen::MatrixXd tab(f.size(), 5);
+    for (int i = 0; i < f.size(); ++i) {
+      const auto G = f.response()(i);
+      tab.row(i) << f.w()(i), G.real(), G.imag(), std::abs(G), std::arg(G) * 180 / 3.14159265358979;
+      std::printf("  w = %-10.5g  H = %.6g %+.6gj   |H| = %.6g  phase = %.4g deg\n", f.w()(i), G.real(), G.imag(),
+                  std::abs(G), tab(i, 4));
+    }
+    write({"w", "re", "im", "mag", "phase_deg"}, tab);
+  } else {
+    const TimeResponse& g = m.time;
+    const char* name = kind == ResponseKind::Impulse ? "impulse" : "step";
+    const int K = static_cast<int>(g.t.size());
+    for (int i = 0; i < K; i += std::max(1, K / 20)) std::printf("  t = %-10.5g  %s = %.6g\n", g.t(i), name, g.value(i));
+    Eigen::MatrixXd tab(K, 2);
+    tab << g.t, g.value;
+    write({"t", name}, tab);
   }
   for (const std::string* f : {&a.out, &a.json})
     if (!f->empty()) std::printf("wrote %s\n", f->c_str());
@@ -257,9 +227,8 @@ void setup_response(CLI::App& app) {
   a->data.add_to(app, true);
   app.add_option("--order", a->order, "System order n")->required();
   app.add_option("--set", a->sets,
-                 "KEY=VALUE: period (s; level period of a piecewise-constant input, or the input period for "
-                 "frequency), horizon (s), harmonics=1,3,5, window_start (s), and the modal settings (ctid fit --method "
-                 "modal --help; basis default discrete), shift_samples (the shifts in samples)");
+                 "KEY=VALUE; " + settings_help(method_info("modal_response")) +
+                     "  shift_samples  the shifts counted in samples (instead of shifts)");
   app.add_option("--out", a->out, "Write the response to this CSV file");
   app.add_option("--json", a->json, "Write the response to this JSON file (the --out columns, with kind and order)");
   app.add_flag("--force", a->force, "Overwrite an existing output file");

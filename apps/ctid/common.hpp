@@ -88,6 +88,13 @@ using Settings = std::vector<std::pair<std::string, std::string>>;
 /// Applies --set KEY=VALUE pairs to options structs through their tables (estimate/options.hpp): each key goes
 /// to the first struct whose table has it. An unknown key, or a value that does not parse, is a UsageError naming
 /// `method` and the closest valid setting. Ranges are checked by the estimator (validate()).
+/// Where a method's settings are listed: "ctid poles --help", "ctid response --help" or "ctid fit --method M --help".
+inline std::string settings_hint(const std::string& method) {
+  if (method == "poles") return "ctid poles --help";
+  if (method == "modal_response") return "ctid response --help";
+  return "ctid fit --method " + method + " --help";
+}
+
 template <class... O>
 void apply_sets(const std::string& method, const std::vector<std::string>& sets, O&... o) {
   for (const auto& [key, value] : parse_sets(sets)) {
@@ -114,7 +121,7 @@ void apply_sets(const std::string& method, const std::vector<std::string>& sets,
     const std::string near = closest_name(key, names);
     throw UsageError("--set " + key + ": not a setting of " + method +
                      (near.empty() ? std::string() : "; did you mean '" + near + "'?") +
-                     " (ctid fit --method " + method + " --help lists them)");
+                     " (" + settings_hint(method) + " lists them)");
   }
 }
 /// The settings of options structs as NAME/VALUE text pairs (for the report).

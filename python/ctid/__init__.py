@@ -391,6 +391,19 @@ def free_response_poles(y, ts, **options):
                                      _options(_ctid.FreeResponseOptions, "free_response_poles", options))
 
 
+def modal_response(data, order, kind="step", **options):
+    """El-Shafey ch. 5 as one call — what ``ctid response --method modal`` prints: p_0 from the constant-input
+    windows, then the step response, the impulse response from it, or the frequency response at the harmonics
+    (kind "step", "impulse" or "frequency"). options: ModalResponseOptions (period= required, horizon,
+    harmonics, window_start; seconds) and ModalOptions (shifts, basis, windows, ...). Returns a ModalResponse
+    (time or frequency, p0, the modal settings used)."""
+    mine = {k: v for k, v in options.items() if k in _ctid.ModalResponseOptions._names}
+    modal = {k: v for k, v in options.items() if k not in mine}
+    return _ctid.modal_response(data, order, _enum(_ctid.ResponseKind, kind, "modal_response", "kind"),
+                                _options(_ctid.ModalResponseOptions, "modal_response", mine),
+                                _options(_ctid.ModalOptions, "modal_response", modal))
+
+
 def compare_poles(y, ts, order, **options):
     """El-Shafey's data-matrix poles (Theorem 4.3) of a free or generator-forced response beside Prony's — what
     ``ctid poles`` prints (options: PolesOptions, seconds; ``shifts`` required, one per pole of the system and of the

@@ -118,6 +118,24 @@ void bind_modal(py::module_& m) {
   m.def("free_response_poles", &free_response_poles, py::arg("y"), py::arg("ts"), py::arg("options"),
         "Poles from a free-response data matrix (El-Shafey Theorem 4.3).");
   m.def("prony", &prony, py::arg("y"), py::arg("ts"), py::arg("options"), "Prony's method (poles modulo 2 pi / T).");
+  bind_options<ModalResponseOptions>(m, "ModalResponseOptions");
+  py::enum_<ResponseKind>(m, "ResponseKind")
+      .value("step", ResponseKind::Step)
+      .value("impulse", ResponseKind::Impulse)
+      .value("frequency", ResponseKind::Frequency);
+  py::class_<ModalResponse>(m, "ModalResponse")
+      .def_readonly("kind", &ModalResponse::kind)
+      .def_readonly("time", &ModalResponse::time)
+      .def_readonly("frequency", &ModalResponse::frequency)
+      .def_readonly("p0", &ModalResponse::p0)
+      .def_readonly("modal", &ModalResponse::modal);
+  m.def(
+      "modal_response",
+      [](const IdData& d, int order, ResponseKind kind, const ModalResponseOptions& o, const ModalOptions& mo) {
+        return modal_response(d, order, kind, o, mo);
+      },
+      py::arg("data"), py::arg("order"), py::arg("kind"), py::arg("options"), py::arg("modal"),
+      "El-Shafey ch. 5 step, impulse or frequency response (ctid response --method modal).");
   bind_options<PolesOptions>(m, "PolesOptions");
   py::class_<PolesComparison>(m, "PolesComparison")
       .def_readonly("data_matrix", &PolesComparison::data_matrix)

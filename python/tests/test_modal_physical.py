@@ -73,6 +73,14 @@ def test_modal_frequency_response_from_a_square_wave():
         ctid.modal_frequency_response(d, m, 2 * math.pi, [2], 120 * ts)  # even harmonics are not excited
     with pytest.raises(ValueError, match="must be one of"):
         ctid.modal_frequency_response(d, m, 2 * math.pi, [1], 120 * ts, rule="gauss")
+    # The same as one call (ctid response --method modal --kind frequency): the same windows and shifts give the
+    # same response to round-off.
+    one = ctid.modal_response(d, 3, "frequency", period=2 * math.pi, harmonics=[1, 3, 5, 7, 9, 11],
+                              window_start=120 * ts, shifts=shifts)
+    np.testing.assert_allclose(one.frequency.response.response, h.response.response, rtol=1e-12)
+    assert one.p0.usable() and len(one.modal.windows) > 0
+    with pytest.raises(ctid.InvalidOptions, match="give the period"):
+        ctid.modal_response(d, 3, "frequency", shifts=shifts)
 
 
 def test_modal_step_and_impulse_responses_and_the_observer():

@@ -58,6 +58,10 @@ const std::vector<MethodInfo>& methods() {
       entry<ModalOptions>("modal",
                           "El-Shafey (1987) modal functions: transfer function from a generated or piecewise-constant input",
                           {"ModalOptions"}),
+      entry<ModalResponseOptions, ModalOptions>(
+          "modal_response",
+          "El-Shafey (1987) step, impulse or frequency response from a piecewise-constant or periodic input (ctid response)",
+          {"ModalResponseOptions", "ModalOptions"}),
       entry<PolesOptions>("poles", "El-Shafey (1987) data-matrix poles of a free response beside Prony's (ctid poles)",
                           {"PolesOptions"}),
       entry<NarxOptions>("narx", "Billings & Li NARX workflow: candidates from degree and lags, FROLS with a criterion, "

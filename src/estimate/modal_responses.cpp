@@ -201,4 +201,69 @@ ImpulseFromStep modal_impulse_from_step(const TimeResponse& step, const Eigen::V
   return r;
 }
 
+template <>
+const OptionTable<ModalResponseOptions>& option_table<ModalResponseOptions>() {
+  using O = ModalResponseOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("modal_response")
+          .real("period", &O::period, "s", above(0),
+                "level period of a piecewise-constant input (step, impulse) or the input period (frequency); required")
+          .real("horizon", &O::horizon, "s", or_special(above(0), 0, "10 period (order + 1)"),
+                "step/impulse: length of the response")
+          .reals("harmonics", &O::harmonics, "", at_least(1), "frequency: harmonics k of 2 pi / period (none: 1,3,5,7,9)")
+          .real("window_start", &O::window_start, "s", or_special(at_least(0), -1, "the largest shift"),
+                "frequency: start of the one-period window");
+  return t;
+}
+
+void ModalResponseOptions::validate() const {
+  option_table<ModalResponseOptions>().check(*this);
+  for (Eigen::Index i = 0; i < harmonics.size(); ++i)
+    CTID_REQUIRE_OPTION(harmonics(i) == std::round(harmonics(i)) && harmonics(i) <= 1e6,
+                        "modal_response: harmonic {} is not a whole number (got {})", i + 1, harmonics(i));
+}
+
+ModalResponse modal_response(const IdData& d, int order, ResponseKind kind, const ModalResponseOptions& o,
+                             const ModalOptions& modal) {
+  CTID_REQUIRE_OPTION(o.period > 0, "modal_response: give the period (period=SECONDS: the level period for step and "
+                      "impulse responses, the input period for the frequency response)");
+  o.validate();
+  CTID_REQUIRE_OPTION(order >= 1, "modal_response: the order must be >= 1 (got {})", order);
+  CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "modal_response: one input and one output (got {} and {})", d.nu(), d.ny());
+  const double Ts = d.ts();
+  ModalResponse r;
+  r.kind = kind;
+  r.modal = modal;
+  ModalOptions& mo = r.modal;
+  if (mo.shifts.size() == 0) {
+    mo.shifts.resize(order);
+    const double base = kind == ResponseKind::Frequency ? std::round(o.period / (order + 1) / Ts) * Ts : o.period;
+    for (int i = 0; i < order; ++i) mo.shifts(i) = (i + 1) * base;
+  }
+  CTID_REQUIRE_OPTION(mo.shifts.size() == order, "modal_response: {} shifts for order {}", mo.shifts.size(), order);
+  if (!mo.basis) mo.basis = ModalBasis::Discrete;
+  mo.max_order = 0;
+  const double Tn = mo.shifts.maxCoeff();
+  if (mo.windows.empty()) mo.windows = piecewise_constant_windows(d, Tn, Ts);
+  CTID_REQUIRE(!mo.windows.empty(),
+               "modal_response: the input never stays constant for longer than T_n = {} s: no validity windows", Tn);
+  r.p0 = modal_estimate(d, d.u(), mo);
+  if (kind == ResponseKind::Frequency) {
+    std::vector<int> h;
+    if (o.harmonics.size() == 0) h = {1, 3, 5, 7, 9};
+    for (Eigen::Index i = 0; i < o.harmonics.size(); ++i) h.push_back(static_cast<int>(o.harmonics(i)));
+    r.frequency = modal_frequency_response(d, r.p0.model, o.period, h, o.window_start >= 0 ? o.window_start : Tn,
+                                           mo.quadrature);
+    return r;
+  }
+  const double horizon = o.horizon > 0 ? o.horizon : 10 * o.period * (order + 1);
+  r.time = modal_step_response(d, r.p0.model, o.period, horizon);
+  if (kind == ResponseKind::Impulse) {
+    // Negative shifts -T_i and Fourier functions on the first half of the horizon (ES 5.38-5.42).
+    const double To = std::floor((horizon - Tn) / 2 / Ts) * Ts;
+    r.time = modal_impulse_from_step(r.time, -mo.shifts, To, std::max(6, 2 * ((order + 2) / 2)), mo.quadrature).impulse;
+  }
+  return r;
+}
+
 }  // namespace ctid

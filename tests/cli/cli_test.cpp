@@ -1086,12 +1086,16 @@ TEST(Cli, MethodHelpListsEveryRegisteredSettingAndSetAcceptsIt) {
   const std::map<std::string, std::pair<std::string, std::string>> through = {
       {"frols", {"narx", ""}}, {"narmax", {"narx", ""}}, {"kia_linear", {"kia", ""}},
       {"kia_quadratic", {"kia", "q"}}, {"kia_cubic", {"kia", "c"}}, {"nde_oe", {"kia", "oe_"}}};
-  // poles is its own command: `ctid poles --help` lists its settings.
-  const CliRun ph = ctid_run("poles --help");
-  ASSERT_EQ(ph.code, 0) << ph.err;
-  for (const auto& s : method_info("poles").settings)
-    EXPECT_NE(ph.out.find("  " + s.name + " "), std::string::npos) << "poles." << s.name << " missing from ctid poles --help";
-  covered.insert("poles");
+  // poles and modal_response are their own commands: `ctid poles --help` and `ctid response --help` list their
+  // settings.
+  for (const auto& [command, name] : {std::pair<std::string, std::string>{"poles", "poles"}, {"response", "modal_response"}}) {
+    const CliRun ph = ctid_run(command + " --help");
+    ASSERT_EQ(ph.code, 0) << ph.err;
+    for (const auto& s : method_info(name).settings)
+      EXPECT_NE(ph.out.find("  " + s.name + " "), std::string::npos) << name << "." << s.name << " missing from ctid "
+                                                                    << command << " --help";
+    covered.insert(name);
+  }
   for (const auto& m : methods()) {
     if (covered.count(m.name)) continue;
     ASSERT_TRUE(through.count(m.name)) << m.name << " is not reachable from ctid fit";

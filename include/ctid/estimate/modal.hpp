@@ -251,4 +251,39 @@ struct ImpulseFromStep {
 ImpulseFromStep modal_impulse_from_step(const TimeResponse& step, const Eigen::VectorXd& negative_shifts, double To,
                                         int functions = 6, Quadrature rule = Quadrature::Simpson);
 
+/// Which response modal_response estimates.
+enum class ResponseKind { Step, Impulse, Frequency };
+
+/// Settings of modal_response (the `ctid response --method modal` command) besides ModalOptions, in seconds.
+struct ModalResponseOptions {
+  /// Step/impulse: the level period T of the piecewise-constant input (levels change only at multiples of it);
+  /// frequency: the period of the periodic input. Required (> 0).
+  double period = 0.0;
+  double horizon = 0.0;        ///< step/impulse: length of the response (s); 0: 10 period (order + 1)
+  Eigen::VectorXd harmonics;   ///< frequency: the harmonics k (whole numbers >= 1) of 2 pi / period; empty: 1,3,5,7,9
+  double window_start = -1.0;  ///< frequency: start of the one-period window (s); -1: T_n (the largest shift)
+  void validate() const;
+};
+/// The settings of ModalResponseOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
+template <>
+const OptionTable<ModalResponseOptions>& option_table<ModalResponseOptions>();
+
+/// A nonparametric response and what it came from.
+struct ModalResponse {
+  ResponseKind kind = ResponseKind::Step;
+  TimeResponse time;            ///< step or impulse response (kind Step/Impulse)
+  HarmonicResponse frequency;   ///< frequency response at the harmonics (kind Frequency)
+  Result<ModalModel> p0;        ///< the output modal parameters p_0 from the constant-input windows
+  ModalOptions modal;           ///< the modal settings used (defaults resolved: shifts, windows, basis)
+};
+
+/// El-Shafey ch. 5 as one call — the `ctid response --method modal` workflow: p_0 from the windows where the
+/// piecewise-constant input is constant (modal_estimate, max_order 0, basis Discrete unless set), then the step
+/// response (ES-C11), the impulse response from it (ES-C12; negative shifts -T_i, Fourier functions on the first
+/// half of the horizon) or the frequency response at the harmonics (ES-C10). Shifts default to i period
+/// (step/impulse) or i Ts round(period / ((order + 1) Ts)) (frequency). Throws InvalidOptions for bad settings or
+/// a shift count other than `order`, InvalidArgument when the input never stays constant long enough.
+ModalResponse modal_response(const IdData& data, int order, ResponseKind kind, const ModalResponseOptions& options,
+                             const ModalOptions& modal = {});
+
 }  // namespace ctid
