@@ -172,12 +172,10 @@ def _nde_freqresp(self, w):
 
 
 def _nde_step(self, t, amplitude=1.0):
-    """Response from rest to the step amplitude * 1(t) (amplitude matters: the model is nonlinear)."""
+    """Response from rest to the step amplitude * 1(t) (amplitude matters: the model is nonlinear);
+    ctid.step_response on times from t[0]."""
     t = _np.asarray(t, dtype=float)
-    s = self.simulate(_np.full(t.size, float(amplitude)), t - t[0])
-    if not s.ok():
-        raise InvalidArgument(f"NdeModel.step: the simulation escapes ({s.message})")
-    return s.y
+    return step_response(self, t - t[0], amplitude)
 
 
 def _narx_freqresp(self, w, zoh=True):
@@ -186,12 +184,10 @@ def _narx_freqresp(self, w, zoh=True):
 
 
 def _narx_step(self, t, amplitude=1.0):
-    """Free-run response from rest to the step amplitude * 1(t); t must be on the model's grid k * ts."""
+    """Free-run response from rest to the step amplitude * 1(t); t on the model's grid k * ts (ctid.step_response
+    on times from t[0])."""
     t = _np.asarray(t, dtype=float)
-    k = (t - t[0]) / self.ts
-    if _np.max(_np.abs(k - _np.round(k))) > 1e-6 or _np.any(_np.diff(_np.round(k)) != 1):
-        raise InvalidArgument(f"NarxModel.step: t must be consecutive samples of the model's Ts = {self.ts} s")
-    return self.process().simulate(_np.full(t.size, float(amplitude)))
+    return step_response(self, t - t[0], amplitude)
 
 
 NdeModel.freqresp, NdeModel.step = _nde_freqresp, _nde_step
@@ -440,6 +436,28 @@ def rls_svf_recursive(nb, nf, **options):
 
 
 # ---- simulation of any model on a record ----
+
+def _one_column(a):
+    return a[:, 0] if a.shape[1] == 1 else a
+
+
+def step_response(model, t, amplitude=1.0):
+    """Response from rest of any model (or result) to the step amplitude * 1(t) at the times t (s) — the
+    library's model_step_response, which the report plots: one column per input (1-D for one input). Linear
+    models exactly; NARX/NDE models simulated (for a nonlinear model the amplitude matters)."""
+    return _one_column(_ctid.model_step_response(getattr(model, "model", model), _np.asarray(t, dtype=float),
+                                                 float(amplitude)))
+
+
+def impulse_response(model, t):
+    """Impulse response of a linear model (or result) at the times t (s); one column per input (1-D for one)."""
+    return _one_column(_ctid.model_impulse_response(getattr(model, "model", model), _np.asarray(t, dtype=float)))
+
+
+def frequency_response(model, w):
+    """G(jw) of a linear model (or result) at w (rad/s), with its delay; one column per input (1-D for one)."""
+    return _one_column(_ctid.model_frequency_response(getattr(model, "model", model), _np.asarray(w, dtype=float)))
+
 
 def simulate(model, data, initial="rest", x0=None):
     """Simulated output of any model (or result) driven by the inputs of `data` — the library's one

@@ -4,7 +4,8 @@ Every function draws on `ax` (or new axes) and returns the axes it drew on.
 """
 import numpy as np
 
-from . import FsfModel, InvalidArgument, MisoModel, TransferFunction, frequency_grid, input_residual_crosscorrelation, \
+from . import FsfModel, InvalidArgument, MisoModel, TransferFunction, frequency_grid, frequency_response, \
+    impulse_response, input_residual_crosscorrelation, step_response, \
     magnitude_band, residual_autocorrelation, response_horizon, simulate
 
 
@@ -64,8 +65,8 @@ def bode(model, w=None, confidence=True, ax=None):
             w = np.linspace(0.5 * 2 * np.pi / m.T, np.pi / m.delta * 0.95, 400)
         else:
             raise InvalidArgument(f"bode: give w for a {type(m).__name__}")
-    h = m.freqresp(w)
-    axes[0].semilogx(w, 20 * np.log10(np.abs(h)), lw=1.2)  # a multi-input model: a curve per channel
+    h = frequency_response(m, w)  # the library's (the report's): a multi-input model gives a curve per input
+    axes[0].semilogx(w, 20 * np.log10(np.abs(h)), lw=1.2)
     axes[1].semilogx(w, np.degrees(np.unwrap(np.angle(h), axis=0)), lw=1.2)
     if confidence:
         lo = hi = None
@@ -95,7 +96,7 @@ def _response(kind, model, t, ax):
             t = np.linspace(0, response_horizon(m.channels if isinstance(m, MisoModel) else [m], 10.0), 400)
         else:
             raise InvalidArgument(f"{kind}: give t for a {type(m).__name__}")
-    y = m.step(t) if kind == "step" else m.impulse(t)
+    y = step_response(m, t) if kind == "step" else impulse_response(m, t)  # the library's, as the report's
     ax.plot(t, y, lw=1.2)
     if isinstance(m, FsfModel) and m.covariance.size:
         s = m.step_std(t) if kind == "step" else m.impulse_std(t)

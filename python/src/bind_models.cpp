@@ -64,6 +64,12 @@ void bind_models(py::module_& m) {
       py::arg("model"), py::arg("data"), py::arg("initial") = "rest", py::arg("x0") = Eigen::VectorXd(),
       "Simulate any model on a record (simulate/simulate.hpp): initial 'rest', 'measured' or 'estimated'.");
   m.def("model_type_name", &model_type_name, py::arg("model"), "The model's JSON type name.");
+  m.def("model_step_response", &model_step_response, py::arg("model"), py::arg("t"), py::arg("amplitude") = 1.0,
+        "Response from rest to the step amplitude * 1(t) at the times t (s) of any model, one column per input.");
+  m.def("model_impulse_response", &model_impulse_response, py::arg("model"), py::arg("t"),
+        "Impulse response at the times t (s) of a linear model, one column per input.");
+  m.def("model_frequency_response", &model_frequency_response, py::arg("model"), py::arg("w"),
+        "G(jw) at the angular frequencies w (rad/s) of a linear model, one column per input.");
 
   py::class_<ResultFile>(m, "ResultFile", "A result file read back: result (typed by its model), method, bare.")
       .def_property_readonly("result", [](const ResultFile& f) { return typed(f.result); })

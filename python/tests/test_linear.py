@@ -355,3 +355,28 @@ def test_simulate_any_model_with_an_explicit_initial_condition_and_read_back_res
     ss = ctid.StateSpace(np.array([[-1.0]]), np.array([[1.0]]), np.array([[2.0]]), np.array([[0.0]]))
     np.testing.assert_allclose(ctid.simulate(ss, late), ctid.TransferFunction([2.0], [1.0, 1.0]).simulate(
         late.u[:, 0], late.times - late.t0), atol=1e-12)
+
+
+def test_responses_of_any_model_are_the_librarys():
+    # ctid.step_response/impulse_response/frequency_response are model_step_response & co (the report's): for a
+    # transfer function they equal its own methods to 1e-15 relative; a MISO result gives one column per input;
+    # NARX y(k) = 0.6 y(k-1) + u(k-1) steps to (1 - 0.6^k)/0.4 (1e-12); a NARX model has no frequency response.
+    g = ctid.TransferFunction([1.0, 3.0], [1.0, 1.2, 4.0])
+    t = ctid.time_grid(0.05, 100)
+    np.testing.assert_allclose(ctid.step_response(g, t), g.step(t), rtol=1e-15, atol=1e-15)
+    np.testing.assert_allclose(ctid.impulse_response(g, t), g.impulse(t), rtol=1e-15, atol=1e-15)
+    w = np.array([0.1, 1.0, 10.0])
+    np.testing.assert_allclose(ctid.frequency_response(g, w), g.freqresp(w), rtol=1e-15)
+    g2 = ctid.TransferFunction([2.0], [1.0, 1.0])
+    u = np.column_stack([ctid.prbs(800, register_length=9, clock_period=5, initial_state=3),
+                         ctid.prbs(800, register_length=10, clock_period=3, initial_state=9)])
+    tt = ctid.time_grid(0.02, 800)
+    r = ctid.srivc_miso(ctid.IdData.from_arrays(u, g.simulate(u[:, 0], tt) + g2.simulate(u[:, 1], tt), ts=0.02),
+                        [(2, 2, 0), (1, 1, 0)])
+    s = ctid.step_response(r, t)
+    assert s.shape == (100, 2)
+    np.testing.assert_allclose(s[:, 1], g2.step(t), atol=1e-6)
+    narx = ctid.NarxModel(["y(k-1)", "u(k-1)"], [0.6, 1.0], 0.05)
+    np.testing.assert_allclose(ctid.step_response(narx, t), (1 - 0.6 ** np.arange(100)) / 0.4, atol=1e-12)
+    with pytest.raises(ctid.InvalidArgument, match="GFRFs"):
+        ctid.frequency_response(narx, w)

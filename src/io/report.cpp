@@ -410,17 +410,15 @@ void bode(Page& page, const Eigen::VectorXd& w, const std::vector<std::pair<std:
   page.plot({"Bode phase", "frequency (rad/s)", "deg", w, ps, true});
 }
 
-// Step and impulse responses of the given channels over 8 slowest time constants (+ delay).
-void time_responses(Page& page, const std::vector<std::pair<std::string, TransferFunction>>& gs, double fallback) {
+// Step and impulse responses of a linear model (one curve per input, labelled) over `horizon` seconds.
+void time_responses(Page& page, const AnyModel& model, const std::vector<std::string>& labels, double horizon) {
   page.section("Step and impulse responses");
-  std::vector<TransferFunction> models;
-  for (const auto& [label, g] : gs) models.push_back(g);
-  const double horizon = response_horizon(models, fallback);
   const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(400, 0.0, horizon);
+  const Eigen::MatrixXd s = model_step_response(model, t), g = model_impulse_response(model, t);
   std::vector<Series> step, impulse;
-  for (const auto& [label, g] : gs) {
-    step.push_back({gs.size() > 1 ? label : "step", step_response(g, t)});
-    impulse.push_back({gs.size() > 1 ? label : "impulse", impulse_response(g, t)});
+  for (Eigen::Index i = 0; i < s.cols(); ++i) {
+    step.push_back({s.cols() > 1 ? labels[static_cast<size_t>(i)] : "step", s.col(i)});
+    impulse.push_back({s.cols() > 1 ? labels[static_cast<size_t>(i)] : "impulse", g.col(i)});
   }
   page.plot({"Step response", "time (s)", "y", t, step});
   page.plot({"Impulse response", "time (s)", "y", t, impulse});
@@ -470,7 +468,7 @@ std::string html_report(const IdData& d, const Result<TransferFunction>& r, cons
   // 95 % band of |G| from 200 draws of the parameter covariance (seeded: the report is reproducible).
   const MagnitudeBand band = magnitude_band(r, w);
   bode(page, w, {{"G(jw)", h}}, band.empty() ? nullptr : &band.lower, band.empty() ? nullptr : &band.upper);
-  time_responses(page, {{"G", r.model}}, d.duration());
+  time_responses(page, r.model, {"G"}, response_horizon({r.model}, d.duration()));
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }
 
@@ -483,19 +481,14 @@ std::string html_report(const IdData& d, const Result<MisoModel>& r, const Repor
   more_records(page, r.model, o);
   parameters(page, r.parameters);
   diagnostics(page, r.diagnostics);
-  Eigen::VectorXcd poles(0);
+  std::vector<std::string> labels;
+  for (int i = 0; i < r.model.nu(); ++i) labels.push_back("G" + std::to_string(i + 1) + " (" + input_name(d, i) + ")");
+  const Eigen::VectorXd w = frequency_grid(model_poles(r.model), nyquist(d));
+  const Eigen::MatrixXcd h = model_frequency_response(r.model, w);
   std::vector<std::pair<std::string, Eigen::VectorXcd>> hs;
-  std::vector<std::pair<std::string, TransferFunction>> gs;
-  for (int i = 0; i < r.model.nu(); ++i) {
-    const TransferFunction& g = r.model.channels[static_cast<size_t>(i)];
-    poles.conservativeResize(poles.size() + g.order());
-    poles.tail(g.order()) = g.poles();
-    gs.push_back({"G" + std::to_string(i + 1) + " (" + input_name(d, i) + ")", g});
-  }
-  const Eigen::VectorXd w = frequency_grid(poles, nyquist(d));
-  for (const auto& [label, g] : gs) hs.push_back({label, g.frequency_response(w)});
+  for (int i = 0; i < r.model.nu(); ++i) hs.push_back({labels[static_cast<size_t>(i)], h.col(i)});
   bode(page, w, hs);
-  time_responses(page, gs, d.duration());
+  time_responses(page, r.model, labels, response_horizon(r.model.channels, d.duration()));
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }
 

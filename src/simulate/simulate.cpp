@@ -195,4 +195,91 @@ Simulation simulate(const AnyModel& model, const IdData& data, const SimulateOpt
   return s;
 }
 
+namespace {
+// The linear models as one transfer function per input, for their responses; FSF and nonlinear models have none.
+std::vector<TransferFunction> input_channels(const AnyModel& model) {
+  if (const auto* g = std::get_if<TransferFunction>(&model)) return {*g};
+  if (const auto* m = std::get_if<MisoModel>(&model)) return m->channels;
+  if (const auto* ss = std::get_if<StateSpace>(&model)) {
+    CTID_REQUIRE(ss->ny() == 1, "responses: a state-space model with {} outputs (one output so far)", ss->ny());
+    std::vector<TransferFunction> out;
+    for (int i = 0; i < ss->nu(); ++i) out.push_back(ss->to_transfer_function(0, i));
+    return out;
+  }
+  return {};
+}
+
+void require_times(const Eigen::VectorXd& t) {
+  CTID_REQUIRE(t.size() > 0 && t.allFinite() && t(0) >= 0, "responses: the times must be finite and >= 0");
+  for (Eigen::Index k = 1; k < t.size(); ++k)
+    CTID_REQUIRE(t(k) > t(k - 1), "responses: the times must increase (t[{}] = {} after {})", k, t(k), t(k - 1));
+}
+
+const FsfModel* unwindowed_fsf(const AnyModel& model) {
+  const auto* f = std::get_if<FsfModel>(&model);
+  if (f)
+    CTID_REQUIRE(f->shift() == 0.0,
+                 "responses: the FSF model was fitted to exponentially windowed data (shift a = {} 1/s): it describes "
+                 "G(s + a), not the system",
+                 f->shift());
+  return f;
+}
+
+void refuse_nonlinear(const AnyModel& model, const char* what) {
+  CTID_REQUIRE(is_linear(model), "responses: a {} model has no {} (a nonlinear model's response depends on the "
+               "input; use its step response or simulate(), and the GFRFs for the frequency domain)",
+               model_type_name(model), what);
+}
+}  // namespace
+
+Eigen::MatrixXd model_step_response(const AnyModel& model, const Eigen::VectorXd& t, double amplitude) {
+  require_times(t);
+  CTID_REQUIRE(std::isfinite(amplitude), "responses: the step amplitude must be finite (got {})", amplitude);
+  if (const FsfModel* f = unwindowed_fsf(model)) return amplitude * f->step_response(t);
+  const std::vector<TransferFunction> ch = input_channels(model);
+  if (!ch.empty()) {
+    Eigen::MatrixXd out(t.size(), static_cast<Eigen::Index>(ch.size()));
+    for (std::size_t i = 0; i < ch.size(); ++i) out.col(static_cast<Eigen::Index>(i)) = amplitude * step_response(ch[i], t);
+    return out;
+  }
+  // NARX / NDE: simulated from rest under the step on the model's own input(s), one input at a time.
+  if (const auto* n = std::get_if<NarxModel>(&model))
+    for (Eigen::Index k = 0; k < t.size(); ++k)
+      CTID_REQUIRE(std::abs(t(k) - static_cast<double>(k) * n->ts()) <= 1e-6 * n->ts(),
+                   "responses: a NARX model steps on its own grid: t must be consecutive samples k Ts from 0 (Ts = {} s; "
+                   "t[{}] = {} s)",
+                   n->ts(), k, t(k));
+  const int nu = model_inputs(model);
+  Eigen::MatrixXd out(t.size(), nu);
+  for (int i = 0; i < nu; ++i) {
+    Eigen::MatrixXd u = Eigen::MatrixXd::Zero(t.size(), nu);
+    u.col(i).setConstant(amplitude);
+    const IdData d = IdData::from_times(u, Eigen::MatrixXd::Zero(t.size(), 1), t);
+    const Simulation s = simulate(model, d);
+    CTID_REQUIRE(s.ok(), "responses: the step response {}", s.problem);
+    out.col(i) = s.y.col(0);
+  }
+  return out;
+}
+
+Eigen::MatrixXd model_impulse_response(const AnyModel& model, const Eigen::VectorXd& t) {
+  require_times(t);
+  refuse_nonlinear(model, "impulse response");
+  if (const FsfModel* f = unwindowed_fsf(model)) return f->impulse_response(t);
+  const std::vector<TransferFunction> ch = input_channels(model);
+  Eigen::MatrixXd out(t.size(), static_cast<Eigen::Index>(ch.size()));
+  for (std::size_t i = 0; i < ch.size(); ++i) out.col(static_cast<Eigen::Index>(i)) = impulse_response(ch[i], t);
+  return out;
+}
+
+Eigen::MatrixXcd model_frequency_response(const AnyModel& model, const Eigen::VectorXd& w) {
+  CTID_REQUIRE(w.allFinite(), "responses: the frequencies must be finite");
+  refuse_nonlinear(model, "frequency response");
+  if (const FsfModel* f = unwindowed_fsf(model)) return f->frequency_response(w);
+  const std::vector<TransferFunction> ch = input_channels(model);
+  Eigen::MatrixXcd out(w.size(), static_cast<Eigen::Index>(ch.size()));
+  for (std::size_t i = 0; i < ch.size(); ++i) out.col(static_cast<Eigen::Index>(i)) = ch[i].frequency_response(w);
+  return out;
+}
+
 }  // namespace ctid

@@ -123,3 +123,49 @@ TEST(Simulate, DivergenceIsReportedAndMismatchesAreRefused) {
   EXPECT_THROW(initial_condition_from_string("zero"), InvalidArgument);
   EXPECT_EQ(initial_condition_from_string("measured"), InitialCondition::Measured);
 }
+
+// Responses of any model (issue 14, item 1), against closed forms: a two-input state space is its two transfer
+// functions (step to 1e-12 of the model's own; frequency response to 1e-12 of C (jwI - A)^-1 B); MISO columns are
+// the channels' (the delay included: zero before 0.13 s); NARX y(k) = 0.6 y(k-1) + u(k-1) steps to
+// (1 - 0.6^k)/0.4 exactly (to 1e-12); NDE 0.5 Dy + y = u to 1 - e^{-2t} (1e-7, the integrator's tolerance);
+// nonlinear models have no impulse or frequency response and a windowed FSF model no response at all.
+TEST(Simulate, ResponsesOfEveryModelType) {
+  const Eigen::VectorXd t = time_grid(0.1, 60);
+  Eigen::MatrixXd A(2, 2), B(2, 2), C(1, 2), D = Eigen::MatrixXd::Zero(1, 2);
+  A << 0, 1, -4, -1.2;
+  B << 0, 1, 1, 0.5;
+  C << 3, 1;
+  const StateSpace ss(A, B, C, D);
+  const Eigen::MatrixXd s = model_step_response(ss, t);
+  ASSERT_EQ(s.cols(), 2);
+  for (int i = 0; i < 2; ++i)
+    EXPECT_LT((s.col(i) - step_response(ss.to_transfer_function(0, i), t)).cwiseAbs().maxCoeff(), 1e-12);
+  const Eigen::VectorXd w{{0.1, 2.0, 30.0}};
+  const Eigen::MatrixXcd g = model_frequency_response(ss, w);
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::MatrixXcd jw = std::complex<double>(0, w(k)) * Eigen::MatrixXcd::Identity(2, 2) - A.cast<std::complex<double>>();
+    const Eigen::MatrixXcd direct = C.cast<std::complex<double>>() * jw.inverse() * B.cast<std::complex<double>>();
+    for (int i = 0; i < 2; ++i) EXPECT_LT(std::abs(g(k, i) - direct(0, i)), 1e-12 * std::abs(direct(0, i)));
+  }
+  MisoModel miso;
+  miso.channels = {kSecond, kFirst};
+  const Eigen::MatrixXd ms = model_step_response(miso, t), mi = model_impulse_response(miso, t);
+  EXPECT_EQ(ms.col(0), step_response(kSecond, t));
+  EXPECT_EQ(mi.col(1), impulse_response(kFirst, t));
+  EXPECT_EQ(ms(1, 1), 0.0);  // t = 0.1 s < the delay 0.13 s
+  EXPECT_EQ(model_frequency_response(miso, w).col(1), kFirst.frequency_response(w));
+
+  const NarxModel narx({NarxTerm::parse("y(k-1)"), NarxTerm::parse("u(k-1)")}, Eigen::VectorXd{{0.6, 1.0}}, 0.1);
+  const Eigen::MatrixXd ns = model_step_response(narx, t);
+  for (int k = 0; k < t.size(); ++k) EXPECT_NEAR(ns(k, 0), (1 - std::pow(0.6, k)) / 0.4, 1e-12) << k;
+  const NdeModel nde({NdeTerm::parse("Dy"), NdeTerm::parse("y"), NdeTerm::parse("u")}, Eigen::VectorXd{{0.5, 1.0, -1.0}});
+  const Eigen::MatrixXd ds = model_step_response(nde, t);
+  for (int k = 0; k < t.size(); ++k) EXPECT_NEAR(ds(k, 0), 1 - std::exp(-2 * t(k)), 1e-7) << k;
+  EXPECT_NE(message_of([&] { model_impulse_response(narx, t); }).find("a narx model has no impulse response"),
+            std::string::npos);
+  EXPECT_NE(message_of([&] { model_frequency_response(nde, w); }).find("GFRFs"), std::string::npos);
+  const FsfModel windowed(0.1, 40, 3, Eigen::VectorXd{{1.0, 0.2, -0.1}}, {}, 0.5);
+  EXPECT_NE(message_of([&] { model_step_response(windowed, t); }).find("G(s + a)"), std::string::npos);
+  EXPECT_NE(message_of([&] { model_step_response(kSecond, Eigen::VectorXd{{0.0, 0.2, 0.1}}); }).find("increase"),
+            std::string::npos);
+}

@@ -64,4 +64,20 @@ InitialCondition fit_initial_condition(const AnyModel& model, const Diagnostics&
 /// count, sampling period, no outputs where the initial condition needs them, an x0 of the wrong size).
 Simulation simulate(const AnyModel& model, const IdData& data, const SimulateOptions& options = {});
 
+/// Responses of any model (issue 14, item 1), one column per input (MISO: the response to that input alone;
+/// single-input models: one column). Times t in seconds, increasing, >= 0; frequencies w in rad/s.
+///
+/// Response from rest to the step `amplitude` * 1(t). Linear models: exact (transfer functions with their delay);
+/// FSF: its own estimate (FsfModel::step_response). NARX and NDE models: the simulated response — for a
+/// nonlinear model it depends on the amplitude; NARX needs t on its sampling grid from 0. Throws InvalidArgument
+/// for a windowed FSF model (shift a > 0: G(s + a), not the system), a non-finite amplitude, or times the model
+/// cannot be simulated at.
+Eigen::MatrixXd model_step_response(const AnyModel& model, const Eigen::VectorXd& t, double amplitude = 1.0);
+/// Impulse response g(t) of a linear model (a direct term, a Dirac, is left out). Throws InvalidArgument for
+/// NARX/NDE models (no impulse response; see model_step_response) and windowed FSF models.
+Eigen::MatrixXd model_impulse_response(const AnyModel& model, const Eigen::VectorXd& t);
+/// Frequency response G(jw) of a linear model (with its delay). Throws InvalidArgument for NARX/NDE models (their
+/// frequency-domain description is the GFRFs: estimate/gfrf.hpp) and windowed FSF models.
+Eigen::MatrixXcd model_frequency_response(const AnyModel& model, const Eigen::VectorXd& w);
+
 }  // namespace ctid
