@@ -14,6 +14,7 @@
 #include "ctid/model/state_space.hpp"
 #include "ctid/model/transfer_function.hpp"
 #include "ctid/simulate/lsim.hpp"
+#include "ctid/validate/metrics.hpp"
 #include "internal/least_squares.hpp"
 
 namespace ctid {
@@ -178,14 +179,14 @@ Result<FsfModel> fsf(const IdData& data, const FsfOptions& o) {
   }
 
   Result<FsfModel> r = fsf_result(sol, Ts, N, o.n, o.a);
-  r.fit.n_samples = M;
-  r.fit.n_parameters = p;
-  r.fit.mse = sol.rss / std::max(1.0, double(sol.n_rows));
-  // The FSF model predicts the output from the input window: its fit is that of the regression.
-  r.fit.nrmse = sol.tss > 0 ? std::sqrt(sol.rss / sol.tss) : std::numeric_limits<double>::infinity();
-  r.fit.fit_percent = 100.0 * (1.0 - r.fit.nrmse);
+  // fit is the simulation fit on the estimation data, as for every estimator: the FSF model (a finite impulse
+  // response) simulated from rest. The regression's own figure, on the windowed and weighted data, has its own
+  // name. With a window a > 0 the model is G(s + a), which cannot be simulated as the system: no fit.
+  const double regression_nrmse = sol.tss > 0 ? std::sqrt(sol.rss / sol.tss) : std::numeric_limits<double>::infinity();
+  r.diagnostics.scalars["regression_fit_percent"] = 100.0 * (1.0 - regression_nrmse);
   r.diagnostics.scalars["b"] = o.b;
-  r.diagnostics.scalars["residual_rms"] = std::sqrt(r.fit.mse);
+  r.diagnostics.scalars["residual_rms"] = std::sqrt(sol.rss / std::max(1.0, double(sol.n_rows)));
+  if (o.a == 0.0) r.fit = fit_report_or_inf(data.y().col(0), r.model.simulate(data.u().col(0)), p);
   if (o.b > 0 && M > N)
     r.diagnostics.warnings.push_back(detail::format(
         "b = {} > 0 with a record ({} s) longer than T = {} s: the weighting amplifies the FSF truncation errors of late "

@@ -275,7 +275,7 @@ void overview(Page& page, const IdData& d, const Result<M>& r, const ReportOptio
       {"usable", r.usable() ? "yes" : "no: " + r.why_not_usable()},
       {"iterations", std::to_string(r.summary.iterations)},
       {"time", fmt(r.summary.seconds, 3) + " s"},
-      {"fit (simulation)", fmt(r.fit.fit_percent, 4) + " %"},
+      {"fit (simulation)", r.fit.n_samples > 0 ? fmt(r.fit.fit_percent, 4) + " %" : std::string("not computed")},
       {"MSE / AIC / BIC", fmt(r.fit.mse, 4) + " / " + fmt(r.fit.aic, 5) + " / " + fmt(r.fit.bic, 5)},
       {"condition number", fmt(r.diagnostics.condition_number, 3)}};
   page.table({"", ""}, rows);
