@@ -288,17 +288,22 @@ TEST(Cli, ClosedLoopFit) {
   const double Ts = 0.005;
   const int N = 8000;
   const Discretization D = discretize(ss.A(), ss.B(), Ts);
+  // Columns t, r, u, y of the loop run from rest with the reference ref.
+  auto loop_run = [&](const Eigen::VectorXd& ref) {
+    Eigen::MatrixXd out(N, 4);
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(2);
+    double integral = 0;
+    for (int k = 0; k < N; ++k) {
+      const double y = (ss.C() * x)(0);
+      const double u = ref(k) - (10 * y + 15 * integral);
+      integral += Ts * y;
+      out.row(k) << k * Ts, ref(k), u, y;
+      x = D.Phi * x + D.Gamma0 * u;
+    }
+    return out;
+  };
   const Eigen::VectorXd r = prbs(N, {.register_length = 10, .clock_period = 20});
-  Eigen::MatrixXd m(N, 4);
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(2);
-  double integral = 0;
-  for (int k = 0; k < N; ++k) {
-    const double y = (ss.C() * x)(0);
-    const double u = r(k) - (10 * y + 15 * integral);
-    integral += Ts * y;
-    m.row(k) << k * Ts, r(k), u, y;
-    x = D.Phi * x + D.Gamma0 * u;
-  }
+  const Eigen::MatrixXd m = loop_run(r);
   const std::string csv = test::temp_path("loop.csv");
   write_csv(csv, {"t", "r", "u", "y"}, m);
   const std::string c = test::temp_path("pi.json");
@@ -315,19 +320,6 @@ TEST(Cli, ClosedLoopFit) {
   EXPECT_EQ(ctid_run("fit " + csv + " --time t --input u --output y --method srivc --closed-loop-controller /nonexistent.json --reference r").code, 3);
   // Two DATA files are two experiments of the loop (each from rest, with its own reference column): one joint fit,
   // the library's to 1e-9, the plant to 1e-6 (noise-free).
-  auto loop_run = [&](const Eigen::VectorXd& ref) {
-    Eigen::MatrixXd out(N, 4);
-    Eigen::VectorXd xs = Eigen::VectorXd::Zero(2);
-    double in = 0;
-    for (int k = 0; k < N; ++k) {
-      const double y = (ss.C() * xs)(0);
-      const double u = ref(k) - (10 * y + 15 * in);
-      in += Ts * y;
-      out.row(k) << k * Ts, ref(k), u, y;
-      xs = D.Phi * xs + D.Gamma0 * u;
-    }
-    return out;
-  };
   const Eigen::MatrixXd m2 = loop_run(prbs(N, {.register_length = 9, .clock_period = 40, .initial_state = 7}));
   const std::string b_csv = test::temp_path("loop_b.csv");
   write_csv(b_csv, {"t", "r", "u", "y"}, m2);

@@ -35,6 +35,13 @@ IdData record(const NdeModel& m, int n, const Eigen::VectorXd& x0 = {}, unsigned
   EXPECT_TRUE(s.ok());
   return IdData(u, s.y, 0.0025);
 }
+// The record with N(0, 0.01^2) output noise drawn from rng.
+IdData with_noise(const IdData& d, std::mt19937& rng) {
+  std::normal_distribution<double> noise(0.0, 0.01);
+  Eigen::VectorXd y = d.y().col(0);
+  for (Eigen::Index k = 0; k < y.size(); ++k) y(k) += noise(rng);
+  return IdData(d.u(), y, d.ts());
+}
 }  // namespace
 
 TEST(NdeOe, RecoversCoefficientsAndInitialStateFromAPerturbedStart) {
@@ -80,13 +87,7 @@ TEST(NdeOe, SeveralRecordsShareTheCoefficientsAndKeepTheirOwnInitialStates) {
   EXPECT_NEAR(r.diagnostics.vectors.at("x0")(1), -20.0, 1e-3);
   EXPECT_GT(r.fit.fit_percent, 99.99);
   std::mt19937 rng(21);
-  std::normal_distribution<double> noise(0.0, 0.01);
-  auto noisy = [&](const IdData& d) {
-    Eigen::VectorXd y = d.y().col(0);
-    for (Eigen::Index k = 0; k < y.size(); ++k) y(k) += noise(rng);
-    return IdData(d.u(), y, d.ts());
-  };
-  const IdData na = noisy(a), nb = noisy(b);
+  const IdData na = with_noise(a, rng), nb = with_noise(b, rng);
   const auto ja = nde_oe(na, truth), jb = nde_oe(nb, truth), j = nde_oe(std::vector<IdData>{na, nb}, truth);
   ASSERT_TRUE(j.usable()) << j.why_not_usable();
   for (const char* s : {"Dy", "D^2y", "u", "y^2", "y*Dy"}) {
@@ -111,14 +112,8 @@ TEST(NdeOe, SeveralRecordsMonteCarloCovarianceIsTheSpread) {
   const int R = 60, P = static_cast<int>(names.size());
   Eigen::MatrixXd e1(R, P), e2(R, P), ej(R, P), sj(R, P);
   std::mt19937 rng(77);
-  std::normal_distribution<double> noise(0.0, 0.01);
-  auto noisy = [&](const IdData& d) {
-    Eigen::VectorXd y = d.y().col(0);
-    for (Eigen::Index k = 0; k < y.size(); ++k) y(k) += noise(rng);
-    return IdData(d.u(), y, d.ts());
-  };
   for (int r = 0; r < R; ++r) {
-    const IdData na = noisy(a), nb = noisy(b);
+    const IdData na = with_noise(a, rng), nb = with_noise(b, rng);
     const auto ra = nde_oe(na, truth), rb = nde_oe(nb, truth), rj = nde_oe(std::vector<IdData>{na, nb}, truth);
     ASSERT_TRUE(rj.usable()) << rj.why_not_usable();
     for (int i = 0; i < P; ++i) {

@@ -352,6 +352,26 @@ TEST(SrivcMiso, CommonDenominatorNoiseFreeExact) {
   EXPECT_THROW(srivc_miso(d, {{1, 2, 0}, {1, 2, 0}}, o), InvalidOptions);
 }
 
+namespace {
+// Set-up 6's loop: G = (s + 1)/(s^2 + 0.5 s + 1) under the PI controller C = (10 s + 15)/s implemented digitally
+// (u = r - C y computed at each sample and held: the plant input is exactly ZOH), from rest; v is added to the
+// measured output. Returns the record (plant input, measured output) at Ts.
+IdData pi_loop(const Eigen::VectorXd& r, const Eigen::VectorXd& v, double Ts) {
+  const StateSpace ss = TransferFunction(Eigen::VectorXd{{1.0, 1.0}}, Eigen::VectorXd{{1.0, 0.5, 1.0}}).to_state_space();
+  const Discretization D = discretize(ss.A(), ss.B(), Ts);
+  const Eigen::Index N = r.size();
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(2), u(N), ym(N);
+  double integral = 0;
+  for (Eigen::Index k = 0; k < N; ++k) {
+    ym(k) = (ss.C() * x)(0) + v(k);
+    u(k) = r(k) - (10 * ym(k) + 15 * integral);
+    integral += Ts * ym(k);
+    x = D.Phi * x + D.Gamma0 * u(k);
+  }
+  return IdData(u, ym, Ts);
+}
+}  // namespace
+
 TEST(SrivcClosedLoop, ConsistentWhereOpenLoopSrivcIsBiased) {
   // Set-up 6: G = (s + 1)/(s^2 + 0.5 s + 1) under the PI controller C = (10 s + 15)/s,
   // implemented digitally (u = r - C y computed at each sample and held: the plant input is
@@ -359,26 +379,11 @@ TEST(SrivcClosedLoop, ConsistentWhereOpenLoopSrivcIsBiased) {
   // [STAND-IN] noise: AR(1) (pole 0.95) at 10 dB on the measured output — with white noise
   // plain SRIVC is consistent too; coloured noise is what makes u-based instruments biased.
   // Measured over 40 runs: SRIVC b0 mean 0.949 (sd 0.0096), CLSRIVC 0.998 (sd 0.011).
-  const TransferFunction G(Eigen::VectorXd{{1.0, 1.0}}, Eigen::VectorXd{{1.0, 0.5, 1.0}});
-  const StateSpace ss = G.to_state_space();
   const double Ts = 0.005;
   const int N = 20000, R = 30;
-  const Discretization D = discretize(ss.A(), ss.B(), Ts);
   const Eigen::VectorXd r = prbs(N, {.register_length = 10, .clock_period = 20});
-  auto loop = [&](const Eigen::VectorXd& v, Eigen::VectorXd& u, Eigen::VectorXd& ym) {
-    Eigen::VectorXd x = Eigen::VectorXd::Zero(2);
-    double integral = 0;
-    u.resize(N);
-    ym.resize(N);
-    for (int k = 0; k < N; ++k) {
-      ym(k) = (ss.C() * x)(0) + v(k);
-      u(k) = r(k) - (10 * ym(k) + 15 * integral);
-      integral += Ts * ym(k);
-      x = D.Phi * x + D.Gamma0 * u(k);
-    }
-  };
-  Eigen::VectorXd u0, y0;
-  loop(Eigen::VectorXd::Zero(N), u0, y0);
+  const IdData clean = pi_loop(r, Eigen::VectorXd::Zero(N), Ts);
+  const Eigen::VectorXd y0 = clean.y().col(0);
   const double sv = std::sqrt((y0.array() - y0.mean()).square().mean() / 10.0);
   ClosedLoopOptions o;
   o.controller = TransferFunction(Eigen::VectorXd{{10.0, 15.0}}, Eigen::VectorXd{{1.0, 0.0}});
@@ -387,9 +392,7 @@ TEST(SrivcClosedLoop, ConsistentWhereOpenLoopSrivcIsBiased) {
     Eigen::VectorXd v = white_noise(N, 1.0, 500 + s);
     for (int k = 1; k < N; ++k) v(k) += 0.95 * v(k - 1);
     v *= sv / std::sqrt((v.array() - v.mean()).square().mean());
-    Eigen::VectorXd u, ym;
-    loop(v, u, ym);
-    const IdData d(u, ym, Ts);
+    const IdData d = pi_loop(r, v, Ts);
     ol.row(s) = srivc(d, {2, 2, 0}).parameters.values.transpose();
     const auto c = srivc_closed_loop(d, r, {2, 2, 0}, o);
     ASSERT_TRUE(c.usable()) << c.why_not_usable();
@@ -411,7 +414,7 @@ TEST(SrivcClosedLoop, ConsistentWhereOpenLoopSrivcIsBiased) {
   const double sd = std::sqrt((ol.col(2).array() - m).square().sum() / (R - 1));
   EXPECT_GT(std::abs(m - 1.0), 10 * sd / std::sqrt(double(R)));
   // Bad use.
-  EXPECT_THROW(srivc_closed_loop(IdData(u0, y0, Ts), r.head(10), {2, 2, 0}, o), InvalidArgument);
+  EXPECT_THROW(srivc_closed_loop(clean, r.head(10), {2, 2, 0}, o), InvalidArgument);
 }
 
 // Several experiments of one loop (issue 14, item 2): set-up 6's plant and PI controller, two records of 8000
@@ -423,25 +426,11 @@ TEST(SrivcClosedLoop, ConsistentWhereOpenLoopSrivcIsBiased) {
 // spread within 20 % (100 runs: the sample std has ~7 % relative error; measured 0.98-1.06; with 40 runs the
 // ratio wandered up to 1.39 on one parameter, sampling alone).
 TEST(SrivcClosedLoop, SeveralExperimentsGiveOneEstimateMoreAccurateThanEither) {
-  const TransferFunction G(Eigen::VectorXd{{1.0, 1.0}}, Eigen::VectorXd{{1.0, 0.5, 1.0}});
-  const StateSpace ss = G.to_state_space();
   const double Ts = 0.005;
   const int N = 8000, R = 100;
-  const Discretization D = discretize(ss.A(), ss.B(), Ts);
   const std::vector<Eigen::VectorXd> refs{prbs(N, {.register_length = 10, .clock_period = 20}),
                                           prbs(N, {.register_length = 9, .clock_period = 40, .initial_state = 77})};
-  auto loop = [&](const Eigen::VectorXd& r, const Eigen::VectorXd& v) {
-    Eigen::VectorXd x = Eigen::VectorXd::Zero(2), u(N), ym(N);
-    double integral = 0;
-    for (int k = 0; k < N; ++k) {
-      ym(k) = (ss.C() * x)(0) + v(k);
-      u(k) = r(k) - (10 * ym(k) + 15 * integral);
-      integral += Ts * ym(k);
-      x = D.Phi * x + D.Gamma0 * u(k);
-    }
-    return IdData(u, ym, Ts);
-  };
-  const IdData clean = loop(refs[0], Eigen::VectorXd::Zero(N));
+  const IdData clean = pi_loop(refs[0], Eigen::VectorXd::Zero(N), Ts);
   const double sv = std::sqrt((clean.y().array() - clean.y().mean()).square().mean() / 10.0);
   ClosedLoopOptions o;
   o.controller = TransferFunction(Eigen::VectorXd{{10.0, 15.0}}, Eigen::VectorXd{{1.0, 0.0}});
@@ -450,7 +439,7 @@ TEST(SrivcClosedLoop, SeveralExperimentsGiveOneEstimateMoreAccurateThanEither) {
   for (int s = 0; s < R; ++s) {
     std::vector<IdData> d;
     for (int e = 0; e < 2; ++e) {
-      d.push_back(loop(refs[e], white_noise(N, sv, 900 + 2 * s + e)));
+      d.push_back(pi_loop(refs[e], white_noise(N, sv, 900 + 2 * s + e), Ts));
     }
     const auto a = srivc_closed_loop(d[0], refs[0], {2, 2, 0}, o);
     const auto b = srivc_closed_loop(d[1], refs[1], {2, 2, 0}, o);
@@ -478,14 +467,8 @@ TEST(SrivcClosedLoop, SeveralExperimentsGiveOneEstimateMoreAccurateThanEither) {
   // without, below 5e-4 with).
   {
     const Eigen::VectorXd rr = prbs(2 * N, {.register_length = 10, .clock_period = 20});
-    Eigen::VectorXd x = Eigen::VectorXd::Zero(2), u(2 * N), ym(2 * N);
-    double integral = 0;
-    for (int k = 0; k < 2 * N; ++k) {
-      ym(k) = (ss.C() * x)(0);
-      u(k) = rr(k) - (10 * ym(k) + 15 * integral);
-      integral += Ts * ym(k);
-      x = D.Phi * x + D.Gamma0 * u(k);
-    }
+    const IdData run = pi_loop(rr, Eigen::VectorXd::Zero(2 * N), Ts);
+    const Eigen::VectorXd u = run.u().col(0), ym = run.y().col(0);
     const std::vector<IdData> halves{IdData(u.head(N), ym.head(N), Ts), IdData(u.tail(N), ym.tail(N), Ts, N * Ts)};
     const std::vector<Eigen::VectorXd> hr{rr.head(N), rr.tail(N)};
     const double raw = std::abs(srivc_closed_loop(halves, hr, {2, 2, 0}, o).parameters.value("a1") - 0.5);
