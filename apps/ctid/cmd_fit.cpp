@@ -260,29 +260,8 @@ int run_physical_records(const FitArgs& a, const std::vector<IdData>& ds) {
     for (const auto& s : symbols) used = used || n == s;
     if (!used) throw UsageError(detail::format("--param {}: '{}' does not appear in the model \"{}\"", n, n, a.model_expr));
   }
-  // Per-parameter constraints, in the vocabulary of oe: fixed.NAME=VALUE, bounds.NAME=LOWER,UPPER.
-  std::vector<std::string> method_sets;
-  Settings constraints;
-  for (const auto& [k, v] : parse_sets(a.sets)) {
-    const bool fix = k.rfind("fixed.", 0) == 0, bound = k.rfind("bounds.", 0) == 0;
-    if (!fix && !bound) {
-      method_sets.push_back(k + "=" + v);
-      continue;
-    }
-    const std::string name = k.substr(k.find('.') + 1);
-    auto q = std::find_if(ps.begin(), ps.end(), [&](const PhysicalParameter& p) { return p.name == name; });
-    if (q == ps.end()) throw UsageError("--set " + k + ": '" + name + "' is not a --param");
-    const auto value = call_library([&] {
-      return fix ? std::pair{options_detail::parse_real("physical", k, v), 0.0} : options_detail::parse_bounds("physical", k, v);
-    });
-    if (fix) {
-      q->fixed = true;
-      q->initial = value.first;
-    } else {
-      std::tie(q->lower, q->upper) = value;
-    }
-    constraints.emplace_back(k, v);
-  }
+  // fixed.NAME=VALUE and bounds.NAME=LOWER,UPPER are PhysicalFitOptions settings (the vocabulary of oe).
+  const std::vector<std::string>& method_sets = a.sets;
   FsfOptions fo;
   PhysicalFitOptions po;
   apply_sets("physical", method_sets, fo, po);
@@ -308,7 +287,6 @@ int run_physical_records(const FitArgs& a, const std::vector<IdData>& ds) {
   });
   Settings settings = a.via == "raw" ? Settings{{"a", options_detail::format_real(fo.a)}} : settings_of(fo);
   for (auto& s : settings_of(po)) settings.push_back(s);
-  for (auto& s : constraints) settings.push_back(s);
   return finish(r, "physical-" + a.via, d, a, settings, more_records_of(a, ds));
 }
 

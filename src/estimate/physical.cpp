@@ -1,6 +1,7 @@
 // Stage 2 of Gawthrop & Wang (2005); see include/ctid/estimate/physical.hpp.
 #include "ctid/estimate/physical.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <complex>
@@ -21,7 +22,9 @@ const OptionTable<PhysicalFitOptions>& option_table<PhysicalFitOptions>() {
           .integer("max_iterations", &O::max_iterations, "", at_least(1), "Levenberg-Marquardt iterations")
           .real("tolerance", &O::tolerance, "", above(0), "relative cost decrease that stops the search")
           .integer("step_points", &O::step_points, "", at_least(2),
-                   "samples of the compressed step response on [0, T] (route via fsf)");
+                   "samples of the compressed step response on [0, T] (route via fsf)")
+          .named_reals("fixed", &O::fixed, "parameters held at a value, by name (fixed.k=2)")
+          .named_bounds("bounds", &O::bounds, "parameter bounds by name (bounds.k=0,inf)");
   return t;
 }
 
@@ -61,6 +64,29 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
     lo_full(idx) = p.lower;
     hi_full(idx) = p.upper;
     given[idx] = true;
+  }
+  // The options' fixed.NAME and bounds.NAME on top of the declarations.
+  auto index_of = [&](const std::string& name, const char* key) {
+    const auto& names = model.parameter_names();
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end()) {
+      const std::string near = closest_name(name, names);
+      throw InvalidOptions(detail::format("physical: {}.{}: '{}' is not a parameter of \"{}\"{}", key, name, name,
+                                          model.expression(), near.empty() ? "" : "; did you mean '" + near + "'?"));
+    }
+    return static_cast<int>(it - names.begin());
+  };
+  for (const auto& [name, value] : opt.fixed) {
+    const int i = index_of(name, "fixed");
+    full(i) = value;
+    fixed[i] = given[i] = true;
+    lo_full(i) = hi_full(i) = value;
+  }
+  for (const auto& [name, b] : opt.bounds) {
+    const int i = index_of(name, "bounds");
+    lo_full(i) = b.first;
+    hi_full(i) = b.second;
+    if (given[i]) full(i) = std::min(std::max(full(i), b.first), b.second);
   }
   for (int i = 0; i < P; ++i)
     CTID_REQUIRE_OPTION(given[i], "physical: parameter '{}' of \"{}\" needs an initial value", model.parameter_names()[i],

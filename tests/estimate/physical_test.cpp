@@ -150,6 +150,25 @@ TEST(GawthropWang, UnstableCircuitTwoStageReachesThePhysicalParameters) {
   EXPECT_LT((raw.parameters.values.array() - 1.0).abs().maxCoeff(), 1e-6);
   EXPECT_NEAR(raw.diagnostics.scalars.at("max_pole_real_part"), 1.0, 1e-6);  // poles +-1 < a = 2: no window warning
   for (const auto& w : raw.diagnostics.warnings) EXPECT_EQ(w.find("does not exceed"), std::string::npos) << w;
+  // The options' constraint vocabulary (fixed.NAME, bounds.NAME, as for oe) is the declarations': k2 fixed at its
+  // true value 1 leaves k1 = 1 (to 1e-6) with k2's std 0; the same through a PhysicalParameter declaration gives the
+  // same numbers to 1e-12; a bound that excludes the truth holds (k1 <= 0.8: k1 ends at the bound); a name that is
+  // not a parameter is refused with the closest one.
+  PhysicalFitOptions fo;
+  fo.fixed = {{"k2", 1.0}};
+  const auto by_option = fit_physical_raw(m, start, d, 2.0, fo);
+  const auto by_declaration = fit_physical_raw(m, {{"k1", 2.0}, {"k2", 1.0, -INFINITY, INFINITY, true}}, d, 2.0);
+  EXPECT_NEAR(by_option.parameters.value("k1"), 1.0, 1e-6);
+  EXPECT_EQ(by_option.parameters.std(1), 0.0);
+  EXPECT_TRUE(by_option.parameters.fixed[1]);
+  EXPECT_NEAR(by_option.parameters.value("k1"), by_declaration.parameters.value("k1"), 1e-12);
+  PhysicalFitOptions bo;
+  bo.bounds = {{"k1", {0.0, 0.8}}};
+  EXPECT_NEAR(fit_physical_raw(m, start, d, 2.0, bo).parameters.value("k1"), 0.8, 1e-9);
+  PhysicalFitOptions bad;
+  bad.fixed = {{"k3", 1.0}};
+  EXPECT_NE(test::error_of([&] { fit_physical_raw(m, start, d, 2.0, bad); }).find("fixed.k3: 'k3' is not a parameter"),
+            std::string::npos);
 
   // The same plant as a state-space structure gives the same two-stage estimate. Both LM runs stop
   // at the solver tolerance and the state-space Jacobian comes from a defective 4x4 sensitivity
