@@ -22,7 +22,9 @@ const OptionTable<NdeOeOptions>& option_table<NdeOeOptions>() {
                 "relative cost decrease or parameter change that stops the search")
           .flag("estimate_initial_state", &O::estimate_initial_state,
                 "estimate [y, Dy, ..] at the first sample; 0: start from rest")
-          .names("fixed", &O::fixed, "term names whose coefficients are held (the reference term always is)")
+          .named_reals("fixed", &O::fixed,
+                       "coefficients held at a value, by term name (fixed.u=-1.1; the reference term's coefficient is 1)")
+          .named_bounds("bounds", &O::bounds, "bounds on free coefficients by term name (bounds.y^2=0,inf)")
           .real("rtol", &O::rtol, "", between(1e-13, 1e-6), "relative tolerance of the simulations (the Jacobian needs accuracy)");
   return t;
 }
@@ -57,20 +59,39 @@ Result<NdeModel> nde_oe(const std::vector<IdData>& records, const NdeModel& init
   }
   if (ref < 0) ref = top;
   CTID_REQUIRE(ref >= 0, "nde_oe: the model {} has neither y nor a linear highest derivative of y", initial.to_string());
+  // Constraints by term name (fixed.NAME, bounds.NAME), in the scale where the reference coefficient is 1.
+  std::vector<std::string> names;
+  for (const auto& t : terms) names.push_back(t.name());
+  auto term_index = [&](const std::string& name, const char* key) {
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end()) {
+      const std::string near = closest_name(name, names);
+      throw InvalidArgument(detail::format("nde_oe: {}.{}: '{}' is not a term of {}{}", key, name, name, initial.to_string(),
+                                           near.empty() ? "" : "; did you mean '" + near + "'?"));
+    }
+    return static_cast<int>(it - names.begin());
+  };
   std::vector<bool> fixed(static_cast<size_t>(m), false);
   fixed[static_cast<size_t>(ref)] = true;
-  for (const auto& name : opt.fixed) {
-    int hit = -1;
-    for (int i = 0; i < m; ++i)
-      if (terms[static_cast<size_t>(i)].name() == name) hit = i;
-    CTID_REQUIRE(hit >= 0, "nde_oe: fixed term '{}' is not a term of {}", name, initial.to_string());
-    fixed[static_cast<size_t>(hit)] = true;
+  Eigen::VectorXd c_init = initial.coefficients() / initial.coefficients()(ref);
+  for (const auto& [name, value] : opt.fixed) {
+    const int i = term_index(name, "fixed");
+    CTID_REQUIRE(i != ref || value == 1.0, "nde_oe: fixed.{}: the reference term's coefficient is 1 (got {})", name, value);
+    fixed[static_cast<size_t>(i)] = true;
+    c_init(i) = value;
   }
-  const Eigen::VectorXd c_init = initial.coefficients() / initial.coefficients()(ref);
   std::vector<int> free;
   for (int i = 0; i < m; ++i)
     if (!fixed[static_cast<size_t>(i)]) free.push_back(i);
   const int pc = static_cast<int>(free.size());
+  Eigen::VectorXd lo_c = Eigen::VectorXd::Constant(pc, -INFINITY), hi_c = Eigen::VectorXd::Constant(pc, INFINITY);
+  for (const auto& [name, b] : opt.bounds) {
+    const int i = term_index(name, "bounds");
+    const auto at = std::find(free.begin(), free.end(), i);
+    CTID_REQUIRE(at != free.end(), "nde_oe: bounds.{}: the term's coefficient is held (fixed or the reference)", name);
+    lo_c(at - free.begin()) = b.first;
+    hi_c(at - free.begin()) = b.second;
+  }
   // Parameters x = [free coefficients (pc), initial state of record 1 (nx), of record 2, ...]: every record
   // has its own initial state (several experiments of one system, DESIGN.md: per-experiment initial conditions).
   const int nx = opt.estimate_initial_state ? L : 0;
@@ -217,7 +238,9 @@ Result<NdeModel> nde_oe(const std::vector<IdData>& records, const NdeModel& init
   lmo.max_iterations = opt.max_iterations;
   lmo.ftol = opt.tolerance;
   lmo.xtol = opt.tolerance;
-  const Eigen::VectorXd lo = Eigen::VectorXd::Constant(p, -INFINITY), hi = Eigen::VectorXd::Constant(p, INFINITY);
+  Eigen::VectorXd lo = Eigen::VectorXd::Constant(p, -INFINITY), hi = Eigen::VectorXd::Constant(p, INFINITY);
+  lo.head(pc) = lo_c;
+  hi.head(pc) = hi_c;
   const internal::LmResult lm = internal::levenberg_marquardt(evaluate, x0, lo, hi, lmo);
 
   Result<NdeModel> r;

@@ -8,6 +8,7 @@
 #include "ctid/core/error.hpp"
 #include "ctid/estimate/nde_oe.hpp"
 #include "ctid/simulate/lsim.hpp"
+#include "test_util.hpp"
 
 using namespace ctid;
 
@@ -194,13 +195,21 @@ TEST(NdeOe, StartThatEscapesIsShrunkTowardsItsLinearPart) {
 TEST(NdeOe, FixedTermsAreHeld) {
   const NdeModel truth = bl33();
   const IdData d = record(truth, 600);
-  const auto r = nde_oe(d, bl33(-0.006, -1.1), {.estimate_initial_state = false, .fixed = {"u"}});
+  const auto r = nde_oe(d, bl33(-0.006, -1.1), {.estimate_initial_state = false, .fixed = {{"u", -1.1}}});
   ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_DOUBLE_EQ(r.model.coefficient("u"), -1.1);
   EXPECT_EQ(r.parameters.std(r.parameters.index("u")), 0.0);
   EXPECT_EQ(r.parameters.size(), 6);  // no initial-state parameters
   // With the gain held wrong the fit cannot be exact.
   EXPECT_LT(r.fit.fit_percent, 99.0);
+  // Held at another value than the start's: the value given (the vocabulary of oe: fixed.NAME=VALUE); at the true
+  // one the others are recovered (noise-free, to 1e-5). A bound that excludes the truth holds (y^2 <= 0.05, truth
+  // 0.1: the estimate ends on it).
+  const auto at_truth = nde_oe(d, bl33(-0.006, -1.1), {.estimate_initial_state = false, .fixed = {{"u", -1.0}}});
+  EXPECT_DOUBLE_EQ(at_truth.model.coefficient("u"), -1.0);
+  EXPECT_NEAR(at_truth.model.coefficient("y^2"), 0.1, 1e-5);
+  const auto bounded = nde_oe(d, truth, {.estimate_initial_state = false, .bounds = {{"y^2", {0.0, 0.05}}}});
+  EXPECT_NEAR(bounded.model.coefficient("y^2"), 0.05, 1e-12);
 }
 
 TEST(NdeOe, ModelWithoutYIsNormalisedByItsHighestDerivative) {
@@ -216,7 +225,10 @@ TEST(NdeOe, ModelWithoutYIsNormalisedByItsHighestDerivative) {
 
 TEST(NdeOe, BadInputIsRejected) {
   const IdData d = record(bl33(), 200);
-  EXPECT_THROW(nde_oe(d, bl33(), {.fixed = {"y^3"}}), InvalidArgument);
+  EXPECT_NE(test::error_of([&] { nde_oe(d, bl33(), {.fixed = {{"y^3", 1.0}}}); }).find("fixed.y^3: 'y^3' is not a term"),
+            std::string::npos);
+  EXPECT_THROW(nde_oe(d, bl33(), {.fixed = {{"u", -1.0}}, .bounds = {{"u", {-2.0, 0.0}}}}), InvalidArgument);
+  EXPECT_THROW(nde_oe(d, bl33(), {.fixed = {{"y", 2.0}}}), InvalidArgument);  // the reference term's coefficient is 1
   EXPECT_THROW(nde_oe(d, bl33(), {.max_iterations = 0}), InvalidOptions);
   EXPECT_THROW(nde_oe(d, bl33(), {.rtol = 1e-3}), InvalidOptions);
   const IdData mimo(Eigen::MatrixXd::Zero(200, 2), d.y(), 0.0025);

@@ -8,6 +8,7 @@
 // estimate. Covariance sigma^2 (J^T J)^{-1} of the free parameters.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -22,7 +23,11 @@ struct NdeOeOptions {
   int max_iterations = 50;
   double tolerance = 1e-9;             ///< relative cost decrease or parameter change that stops the search
   bool estimate_initial_state = true;  ///< estimate [y, Dy, .., D^{L-1}y] at the first sample; false: from rest
-  std::vector<std::string> fixed;      ///< term names whose coefficients are held (the reference term always is)
+  /// Coefficients held at a value, by term name (fixed.u=-1.1) — the constraint vocabulary of oe, lssvf and
+  /// physical — in the returned model's scale (the reference term's coefficient 1); the reference term always is.
+  std::map<std::string, double> fixed;
+  /// Bounds [lower, upper] on free coefficients by term name (bounds.y^2=0,inf), in the same scale.
+  std::map<std::string, std::pair<double, double>> bounds;
   double rtol = 1e-10;                 ///< relative tolerance of the simulations
   void validate() const;
 };
@@ -39,7 +44,8 @@ const OptionTable<NdeOeOptions>& option_table<NdeOeOptions>();
 /// (initial state), scalars "noise_variance", "start_scale". Termination Converged / MaxIterations, or
 /// NumericalFailure (fit infinite) when no shrunk start can be simulated.
 /// Throws InvalidArgument for data that are not SISO, fewer samples than free parameters, a model that
-/// NdeModel::simulate rejects, unknown names in `fixed`; InvalidOptions for bad options.
+/// NdeModel::simulate rejects, names in `fixed`/`bounds` that are not terms (the closest named), a bound on a
+/// held term; InvalidOptions for bad options.
 Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOeOptions& options = {});
 /// Several experiments of one system: one set of coefficients, each record with its own estimated initial
 /// state (parameters "r<e>.y(0)", ..; diagnostics "x0" of record 1, "x0_<e>" of the others), the output error
