@@ -261,12 +261,11 @@ int run_physical_records(const FitArgs& a, const std::vector<IdData>& ds) {
     if (!used) throw UsageError(detail::format("--param {}: '{}' does not appear in the model \"{}\"", n, n, a.model_expr));
   }
   // fixed.NAME=VALUE and bounds.NAME=LOWER,UPPER are PhysicalFitOptions settings (the vocabulary of oe).
-  const std::vector<std::string>& method_sets = a.sets;
   FsfOptions fo;
   PhysicalFitOptions po;
-  apply_sets("physical", method_sets, fo, po);
+  apply_sets("physical", a.sets, fo, po);
   if (a.via == "raw")
-    for (const auto& s : method_sets)
+    for (const auto& s : a.sets)
       for (const char* k : {"T=", "n=", "b=", "weights=", "step_points="})
         if (s.rfind(k, 0) == 0)
           throw UsageError("--set " + s + ": --via raw fits the record itself (its settings: a, unstable, max_iterations, "

@@ -3,8 +3,6 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
-#include <optional>
-#include <sstream>
 
 #include "common.hpp"
 
@@ -12,11 +10,14 @@ namespace ctid::cli {
 extern std::function<int()> g_run;
 
 namespace {
+// A comma-separated list, parsed by the library's option parser.
 std::vector<double> to_list(const std::string& key, const std::string& value) {
   std::vector<double> out;
-  std::stringstream ss(value);
-  std::string item;
-  while (std::getline(ss, item, ',')) out.push_back(to_double(key, item));
+  try {
+    out = options_detail::parse_reals("--set", key, value);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
   if (out.empty()) throw UsageError("--set " + key + ": give a comma-separated list (got '" + value + "')");
   return out;
 }

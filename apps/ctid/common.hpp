@@ -56,12 +56,6 @@ void check_outputs(const std::vector<std::string>& outputs, const std::vector<st
 
 /// "KEY=VALUE" pairs from --set.
 std::map<std::string, std::string> parse_sets(const std::vector<std::string>& sets);
-/// Apply every KEY=VALUE that `handler(key, value)` recognises (returns true) and erase
-/// it, so that what is left can be reported as unknown.
-template <class F>
-void consume_sets(std::map<std::string, std::string>& sets, F&& handler) {
-  for (auto it = sets.begin(); it != sets.end();) it = handler(it->first, it->second) ? sets.erase(it) : std::next(it);
-}
 /// The result or model file at `path`, whatever its model type (io/json.hpp); a file that cannot be read
 /// or recognised throws InputError naming it.
 ResultFile read_result(const std::string& path);
@@ -85,9 +79,6 @@ void print_result(const Result<FsfModel>& r, const std::string& method, const Id
 /// Method settings as NAME/VALUE text pairs (the report's "settings" section).
 using Settings = std::vector<std::pair<std::string, std::string>>;
 
-/// Applies --set KEY=VALUE pairs to options structs through their tables (estimate/options.hpp): each key goes
-/// to the first struct whose table has it. An unknown key, or a value that does not parse, is a UsageError naming
-/// `method` and the closest valid setting. Ranges are checked by the estimator (validate()).
 /// Where a method's settings are listed: "ctid poles --help", "ctid response --help" or "ctid fit --method M --help".
 inline std::string settings_hint(const std::string& method) {
   if (method == "poles") return "ctid poles --help";
@@ -95,6 +86,9 @@ inline std::string settings_hint(const std::string& method) {
   return "ctid fit --method " + method + " --help";
 }
 
+/// Applies --set KEY=VALUE pairs to options structs through their tables (estimate/options.hpp): each key goes
+/// to the first struct whose table has it. An unknown key, or a value that does not parse, is a UsageError naming
+/// `method` and the closest valid setting. Ranges are checked by the estimator (validate()).
 template <class... O>
 void apply_sets(const std::string& method, const std::vector<std::string>& sets, O&... o) {
   for (const auto& [key, value] : parse_sets(sets)) {

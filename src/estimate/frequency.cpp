@@ -10,6 +10,7 @@
 #include "ctid/core/check.hpp"
 #include "ctid/estimate/lssvf.hpp"
 #include "estimate/tf_common.hpp"
+#include "internal/least_squares.hpp"
 #include "internal/levenberg_marquardt.hpp"
 
 namespace ctid {

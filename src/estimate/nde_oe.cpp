@@ -7,6 +7,7 @@
 
 #include "ctid/core/check.hpp"
 #include "ctid/validate/metrics.hpp"
+#include "internal/least_squares.hpp"
 #include "internal/levenberg_marquardt.hpp"
 #include "internal/ode.hpp"
 

@@ -13,6 +13,7 @@
 #include "ctid/validate/metrics.hpp"
 #include "estimate/svf_common.hpp"
 #include "estimate/tf_common.hpp"
+#include "internal/least_squares.hpp"
 #include "internal/levenberg_marquardt.hpp"
 
 namespace ctid {

@@ -10,6 +10,7 @@
 #include "ctid/model/state_space.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/validate/metrics.hpp"
+#include "internal/least_squares.hpp"
 #include "internal/levenberg_marquardt.hpp"
 
 namespace ctid {

@@ -11,6 +11,7 @@
 #include "ctid/signal/prefilter.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/validate/metrics.hpp"
+#include "ctid/validate/residuals.hpp"
 #include "estimate/svf_common.hpp"
 #include "estimate/tf_common.hpp"
 #include "internal/least_squares.hpp"
@@ -770,9 +771,8 @@ Result<TransferFunction> srivc_closed_loop_in_units(const std::vector<IdData>& d
   // The sandwich assumes white noise. Coloured noise (why CLSRIVC is used) makes it too small, by about
   // sqrt((1 + rho)/(1 - rho)) for AR(1) noise of lag-1 correlation rho: say so when that exceeds 1.5.
   const Eigen::VectorXd err = y_all - sim_all;
-  const Eigen::Index ne = err.size();
   const double e0 = err.squaredNorm();
-  const double rho = ne > 1 && e0 > 0 ? err.head(ne - 1).dot(err.tail(ne - 1)) / e0 : 0.0;
+  const double rho = err.size() > 1 && std::isfinite(e0) && e0 > 0 ? residual_autocorrelation(err, 1).values(1) : 0.0;
   r.diagnostics.scalars["output_error_lag1_correlation"] = rho;
   if (rho > 0.4)
     r.diagnostics.warnings.push_back(detail::format(

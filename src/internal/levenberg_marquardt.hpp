@@ -9,7 +9,6 @@
 #include <Eigen/Dense>
 
 #include "ctid/core/status.hpp"
-#include "internal/least_squares.hpp"
 
 namespace ctid::internal {
 

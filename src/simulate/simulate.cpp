@@ -114,13 +114,18 @@ void require_uniform_at(const IdData& d, double ts, const char* what) {
                d.is_uniform() ? "sampled at " + std::to_string(d.ts()) + " s" : std::string("irregularly sampled"));
 }
 
+// An FSF model fitted to windowed data (a > 0) describes G(s + a): it cannot stand for the system.
+void require_unwindowed(const FsfModel& m, const char* who) {
+  CTID_REQUIRE(m.shift() == 0.0,
+               "{}: the FSF model was fitted to exponentially windowed data (shift a = {} 1/s): it describes "
+               "G(s + a), not the system; fit it with a = 0, or fit the physical parameters",
+               who, m.shift());
+}
+
 Simulation simulate_fsf(const FsfModel& m, const IdData& d, const SimulateOptions& o) {
   CTID_REQUIRE(o.initial == InitialCondition::Rest,
                "simulate: an FSF model is a finite impulse response from rest; its initial condition can only be rest");
-  CTID_REQUIRE(m.shift() == 0.0,
-               "simulate: the FSF model was fitted to exponentially windowed data (shift a = {} 1/s): it describes "
-               "G(s + a), not the system; fit it with a = 0 to simulate it, or fit the physical parameters",
-               m.shift());
+  require_unwindowed(m, "simulate");
   require_uniform_at(d, m.delta(), "FSF");
   return {m.simulate(d.u().col(0)), Eigen::VectorXd(), ""};
 }
@@ -217,11 +222,7 @@ void require_times(const Eigen::VectorXd& t) {
 
 const FsfModel* unwindowed_fsf(const AnyModel& model) {
   const auto* f = std::get_if<FsfModel>(&model);
-  if (f)
-    CTID_REQUIRE(f->shift() == 0.0,
-                 "responses: the FSF model was fitted to exponentially windowed data (shift a = {} 1/s): it describes "
-                 "G(s + a), not the system",
-                 f->shift());
+  if (f) require_unwindowed(*f, "responses");
   return f;
 }
 
