@@ -289,9 +289,14 @@ int run_physical_records(const FitArgs& a, const std::vector<IdData>& ds) {
   return finish(r, "physical-" + a.via, d, a, settings, more_records_of(a, ds));
 }
 
-// El-Shafey: modal functions (modal_fit). Besides the table's settings: shift_samples (the shifts in samples) and
-// frequencies=w1,.. (a generated input: the generator fitted to the measured input); --nk is the input delay.
-int run_modal(const FitArgs& a, const IdData& d) {
+// El-Shafey: modal functions (modal_fit) on one record, or on several with piecewise-constant inputs (jointly).
+// Besides the table's settings: shift_samples (the shifts in samples) and frequencies=w1,.. (a generated input:
+// the generator fitted to the measured input); --nk is the input delay.
+int run_modal_records(const FitArgs& a, const std::vector<IdData>& ds);
+int run_modal(const FitArgs& a, const IdData& d) { return run_modal_records(a, {d}); }
+
+int run_modal_records(const FitArgs& a, const std::vector<IdData>& ds) {
+  const IdData& d = ds.front();
   if (d.nu() != 1) throw UsageError(detail::format("modal needs one input (selected {})", d.nu()));
   if (a.nf.size() != 1 || a.nb.size() > 1 || a.nk.size() != 1) throw UsageError("modal: one --nb, --nf and --nk value");
   const int n = a.nf[0], nb = a.nb.empty() ? n : a.nb[0], nk = a.nk[0];
@@ -309,13 +314,14 @@ int run_modal(const FitArgs& a, const IdData& d) {
   std::vector<double> frequencies;
   if (own.count("frequencies")) frequencies = call_library([&] { return options_detail::parse_reals("modal", "frequencies", own.at("frequencies")); });
   const Result<TransferFunction> r = call_library([&] {
-    if (frequencies.empty()) return modal_fit(d, nb, o);
+    if (frequencies.empty()) return modal_fit(ds, nb, o);
     const InputGenerator g = generator_fitted_to_input(frequencies, d);
-    return modal_fit(d, nb, o, &g);
+    return modal_fit(ds, nb, o, &g);
   });
+  print_experiments(a, ds);
   Settings settings = settings_of(o);
   if (!frequencies.empty()) settings.emplace_back("frequencies", own.at("frequencies"));
-  return finish(r, "modal", d, a, settings);
+  return finish(r, "modal", d, a, settings, more_records_of(a, ds));
 }
 
 // Records 2.. of several DATA files, named by their files (for the report's section per record).
@@ -376,9 +382,9 @@ int run_miso(const FitArgs& a, const std::vector<IdData>& ds) {
 
 int run_experiments(const FitArgs& a) {
   if (a.method != "srivc" && a.method != "oe" && a.method != "tfest" && a.method != "lssvf" && a.method != "ivsvf" &&
-      a.method != "rls-svf" && a.method != "narx" && a.method != "physical")
+      a.method != "rls-svf" && a.method != "narx" && a.method != "physical" && a.method != "modal")
     throw UsageError(detail::format("{} DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, "
-                                    "lssvf, ivsvf, rls-svf, narx, physical --via raw or srivc with "
+                                    "lssvf, ivsvf, rls-svf, narx, modal, physical --via raw or srivc with "
                                     "--closed-loop-controller (got {}; the other estimators take one record so far)",
                                     a.paths.size(), a.method));
   if (a.frequency) throw UsageError("several DATA files: time-domain data only (not --frequency)");
@@ -387,6 +393,7 @@ int run_experiments(const FitArgs& a) {
     throw UsageError(detail::format("several experiments: one --output (selected {})", ds[0].ny()));
   if (ds[0].nu() > 1) return run_miso(a, ds);
   if (a.method == "physical") return run_physical_records(a, ds);
+  if (a.method == "modal") return run_modal_records(a, ds);
   if (a.method == "narx") return run_narx_or_kia(a.method, ds, a.sets, a.narx, a.json, a.report, more_records_of(a, ds));
   if (a.method == "srivc") return fit_experiments<SrivcOptions>(a, ds, &srivc);
   if (a.method == "lssvf") return fit_experiments<LssvfOptions>(a, ds, &lssvf);
@@ -472,7 +479,7 @@ void setup_fit(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
   app.add_option("DATA", a->paths,
                  "CSV/.dat table (header row optional) or .mat file; several files are several experiments of one system, "
-                 "fitted jointly (--method srivc; the same columns in each)")
+                 "fitted jointly (srivc, oe, tfest, lssvf, ivsvf, rls-svf, narx, modal, physical --via raw; the same columns in each)")
       ->required();
   std::vector<std::string> names;
   for (const auto& [name, m] : fit_methods()) names.push_back(name);

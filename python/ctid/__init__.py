@@ -334,7 +334,8 @@ def nde_oe(data, initial, **options):
 
 def modal_fit(data, nb, input=None, **options):
     """El-Shafey (1987) modal-function identification (options: ModalOptions; shifts= is required; input: an
-    InputGenerator for a generated input, None for a piecewise-constant one)."""
+    InputGenerator for a generated input, None for a piecewise-constant one). data: an IdData, or a list of IdData
+    with piecewise-constant inputs (several experiments of one system, each from rest, fitted jointly)."""
     return _ctid.modal_fit(data, nb, _modal_options("modal_fit", options), input)
 
 

@@ -32,6 +32,10 @@ void bind_modal(py::module_& m) {
           return interruptible([&] { return modal_fit(d, nb, o, input); });
         }, py::arg("data"), py::arg("nb"), py::arg("options"), py::arg("input") = nullptr,
         "Transfer function by modal functions (El-Shafey): generated input (Theorems 4.1-4.2) or piecewise-constant input.");
+  m.def("modal_fit", [](const std::vector<IdData>& d, int nb, const ModalOptions& o, const InputGenerator* input) {
+          return interruptible([&] { return modal_fit(d, nb, o, input); });
+        }, py::arg("data"), py::arg("nb"), py::arg("options"), py::arg("input") = nullptr,
+        "Several records (experiments of one system) with piecewise-constant inputs, fitted jointly.");
 
   py::class_<ModalModel>(m, "ModalModel", "Modal parameters p_j (rows of P) and modal-function coefficients q_j (rows of Q).")
       .def(py::init<Eigen::VectorXd, Eigen::MatrixXd, Eigen::MatrixXd>(), py::arg("shifts"), py::arg("P"), py::arg("Q"))

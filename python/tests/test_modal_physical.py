@@ -22,6 +22,26 @@ def test_modal_fit_two_sinusoid_test_recovers_s3():
     np.testing.assert_allclose(r.model.num[1:], S3.num, rtol=1e-3)
 
 
+def test_modal_fit_on_several_records_is_one_joint_estimate():
+    # Issue 14 (item 2): two records of S3 from rest with different piecewise-constant inputs (Ts = pi/320, shifts
+    # 16, 32, 48 samples, Walsh), noise-free: the joint fit is S3 to 1e-6 as in the C++ test ModalFit.SeveralRecords...
+    ts = math.pi / 320
+
+    def record(levels, hold, cycles):
+        u = np.repeat(np.tile(levels, cycles), hold).astype(float)
+        t = ctid.time_grid(ts, len(u))
+        return ctid.IdData.from_arrays(u, S3.simulate(u, t), ts=ts)
+
+    d1, d2 = record([1, 2, -1, -2], 80, 2), record([-1.5, 0.5, 2.5, -0.5], 96, 1)
+    r = ctid.modal_fit([d1, d2], 2, shifts=np.array([16, 32, 48]) * ts, basis="walsh")
+    assert r.usable()
+    np.testing.assert_allclose(r.model.den, S3.den, rtol=1e-6)
+    np.testing.assert_allclose(r.model.num, S3.num, rtol=1e-5)
+    assert r.diagnostics.scalars["experiments"] == 2
+    with pytest.raises(ValueError, match="windows are times of one record"):
+        ctid.modal_fit([d1, d2], 2, shifts=np.array([16, 32, 48]) * ts, windows=[(0.5, 0.2)])
+
+
 def test_free_response_poles_theorem_4_3():
     tw = 2 * math.pi / 3 / 666
     t = ctid.time_grid(tw, 2000)

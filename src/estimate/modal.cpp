@@ -45,7 +45,7 @@ struct Regressor {
 
 
 struct SampleWindow {
-  int i0 = 0, K = 0;  // first sample, number of intervals
+  int rec = 0, i0 = 0, K = 0;  // record, first sample, number of intervals
 };
 
 }  // namespace
@@ -140,39 +140,80 @@ std::vector<ModalWindow> piecewise_constant_windows(const IdData& data, double s
   return out;
 }
 
+namespace {
+// One record of a modal estimation: its data, the input basis at its samples and its validity windows (seconds
+// from its first sample). Several records are several experiments of one system: their equations are pooled.
+struct ModalRecord {
+  const IdData* data;
+  Eigen::MatrixXd basis;
+  std::vector<ModalWindow> windows;
+};
+
+Result<ModalModel> modal_estimate_records(const std::vector<ModalRecord>& records, const ModalOptions& options);
+}  // namespace
+
 Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& input_basis, const ModalOptions& options) {
+  options.validate();
+  CTID_REQUIRE(data.is_uniform(), "modal: needs uniformly sampled data");
+  std::vector<ModalWindow> windows = options.windows;
+  if (windows.empty()) {
+    // One window from T_n to the end of the record.
+    const double Tn = options.shifts(options.shifts.size() - 1), len = (data.size() - 1) * data.ts() - Tn;
+    CTID_REQUIRE(len > 0, "modal: the record ({} s) is not longer than the largest shift T_n = {} s",
+                 (data.size() - 1) * data.ts(), Tn);
+    windows.push_back({Tn, len});
+  }
+  return modal_estimate_records({{&data, input_basis, windows}}, options);
+}
+
+namespace {
+Result<ModalModel> modal_estimate_records(const std::vector<ModalRecord>& records, const ModalOptions& options) {
   const auto t_start = std::chrono::steady_clock::now();
   options.validate();
   CTID_REQUIRE_OPTION(options.delay == 0.0, "modal: delay = {} s applies to modal_fit (delay the input of the record)",
                       options.delay);
   const ModalOptions o = options.resolved(false);
-  CTID_REQUIRE(data.ny() == 1, "modal: needs one output (got {})", data.ny());
-  CTID_REQUIRE(data.is_uniform(), "modal: needs uniformly sampled data");
-  const double Ts = data.ts();
-  const int N = data.size(), n = static_cast<int>(o.shifts.size()), nc = static_cast<int>(input_basis.cols());
-  CTID_REQUIRE(input_basis.rows() == N, "modal: the input basis has {} rows for {} samples", input_basis.rows(), N);
-  CTID_REQUIRE(input_basis.allFinite(), "modal: the input basis has non-finite values");
-  const Eigen::VectorXd y = data.y().col(0);
+  const int E = static_cast<int>(records.size()), n = static_cast<int>(o.shifts.size());
+  const IdData& first = *records.front().data;
+  CTID_REQUIRE(first.is_uniform(), "modal: needs uniformly sampled data");
+  const double Ts = first.ts();
+  const int nc = static_cast<int>(records.front().basis.cols());
+  std::vector<Eigen::VectorXd> ys;
+  for (int e = 0; e < E; ++e) {
+    const IdData& d = *records[e].data;
+    const std::string which = E > 1 ? detail::format(" (record {})", e + 1) : "";
+    CTID_REQUIRE(d.ny() == 1, "modal: needs one output{} (got {})", which, d.ny());
+    CTID_REQUIRE(d.is_uniform(), "modal: needs uniformly sampled data{}", which);
+    CTID_REQUIRE(std::abs(d.ts() - Ts) <= 1e-9 * Ts, "modal: the records are sampled at different periods ({} s and {} s)",
+                 Ts, d.ts());
+    CTID_REQUIRE(records[e].basis.rows() == d.size(), "modal: the input basis has {} rows for {} samples{}",
+                 records[e].basis.rows(), d.size(), which);
+    CTID_REQUIRE(records[e].basis.cols() == nc, "modal: the input bases have {} and {} columns", nc,
+                 records[e].basis.cols());
+    CTID_REQUIRE(records[e].basis.allFinite(), "modal: the input basis has non-finite values{}", which);
+    ys.push_back(d.y().col(0));
+  }
   Eigen::VectorXi lag(n);
   for (int i = 0; i < n; ++i) lag(i) = samples_of(o.shifts(i), Ts, "shift T_" + std::to_string(i + 1));
-  const Regressor reg{y, input_basis, lag};
+  std::vector<Regressor> regs;
+  for (int e = 0; e < E; ++e) regs.push_back(Regressor{ys[e], records[e].basis, lag});
   const int p = n + nc;
 
-  std::vector<ModalWindow> windows = o.windows;
-  if (windows.empty()) {
-    const double len = (N - 1) * Ts - o.shifts(n - 1);
-    CTID_REQUIRE(len > 0, "modal: the record ({} s) is not longer than the largest shift T_n = {} s", (N - 1) * Ts,
-                 o.shifts(n - 1));
-    windows.push_back({o.shifts(n - 1), len});
-  }
   std::vector<SampleWindow> sw;
-  for (size_t w = 0; w < windows.size(); ++w) {
-    const std::string name = "window " + std::to_string(w + 1);
-    SampleWindow s{samples_of(windows[w].start, Ts, name + " start"), samples_of(windows[w].length, Ts, name + " length")};
-    CTID_REQUIRE(s.K >= 1 && s.i0 + s.K <= N - 1, "modal: {} [{} s, {} s] is outside the record [0, {} s]", name,
-                 windows[w].start, windows[w].start + windows[w].length, (N - 1) * Ts);
-    sw.push_back(s);
+  int total_samples = 0;
+  for (int e = 0; e < E; ++e) {
+    const int N = records[e].data->size();
+    total_samples += N;
+    const auto& windows = records[e].windows;
+    for (size_t w = 0; w < windows.size(); ++w) {
+      const std::string name = "window " + std::to_string(w + 1) + (E > 1 ? " of record " + std::to_string(e + 1) : "");
+      SampleWindow s{e, samples_of(windows[w].start, Ts, name + " start"), samples_of(windows[w].length, Ts, name + " length")};
+      CTID_REQUIRE(s.K >= 1 && s.i0 + s.K <= N - 1, "modal: {} [{} s, {} s] is outside the record [0, {} s]", name,
+                   windows[w].start, windows[w].start + windows[w].length, (N - 1) * Ts);
+      sw.push_back(s);
+    }
   }
+  CTID_REQUIRE(!sw.empty(), "modal: no validity window");
   const int J = o.max_order, W = static_cast<int>(sw.size());
   Eigen::MatrixXd P(J + 1, n), Q(J + 1, nc);
   Result<ModalModel> res;
@@ -204,18 +245,20 @@ Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& inp
     internal::InstrumentalVariables iv(p);
     Eigen::VectorXd r(p), z(p);
     long long rows = 0;
-    for (const auto& s : sw)
+    for (const auto& s : sw) {
+      const Regressor& reg = regs[s.rec];
       for (int i = s.i0; i <= s.i0 + s.K; i += o.stride) {
         reg(i, r.data());
         if (ivlag > 0) {
-          if (i - lag(0) + ivlag >= N) continue;  // the instrument y(t - T_1 + iv_shift) is beyond the record
+          if (i - lag(0) + ivlag >= reg.y.size()) continue;  // the instrument y(t - T_1 + iv_shift) is beyond the record
           reg(i, z.data(), ivlag);
-          iv.add(z.data(), r.data(), y(i));
+          iv.add(z.data(), r.data(), reg.y(i));
         } else {
-          ls.add(r.data(), y(i));
+          ls.add(r.data(), reg.y(i));
         }
         ++rows;
       }
+    }
     CTID_REQUIRE(rows >= p, "modal: {} equations in the validity windows for {} unknowns (n = {} shifts + {} input "
                  "modes); lengthen the windows or reduce the stride", rows, p, n, nc);
     // sum p y(t - T_i) - q x_c = -y: the kernel solves r theta' = y with theta' = -theta.
@@ -237,13 +280,14 @@ Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& inp
     Eigen::RowVectorXd row(p);
     int offset = 0;
     for (const auto& s : sw) {
+      const Regressor& reg = regs[s.rec];
       const Eigen::VectorXd wq = quadrature_weights(s.K, Ts, o.quadrature);
       for (int k = 0; k <= s.K; ++k) {
         ff((offset + k) * Ts, f);
         f *= wq(k);
         reg(s.i0 + k, row.data());
         RF.noalias() += f * row;
-        zF += f * y(s.i0 + k);
+        zF += f * reg.y(s.i0 + k);
       }
       offset += s.K;
     }
@@ -268,6 +312,7 @@ Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& inp
     Eigen::VectorXd b(NW * W);
     for (int w = 0; w < W; ++w) {
       const auto& s = sw[w];
+      const Regressor& reg = regs[s.rec];
       CTID_REQUIRE(s.K % NW == 0, "modal: window {} has {} sampling periods, not a multiple of the {} Walsh blocks (each "
                    "block must span a whole number of samples)", w + 1, s.K, NW);
       const int kb = s.K / NW;
@@ -281,7 +326,7 @@ Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& inp
         for (int k = 0; k <= kb; ++k) {
           reg(first + k, row.data());
           RB.row(blk) += wq(k) * row;
-          zB(blk) += wq(k) * y(first + k);
+          zB(blk) += wq(k) * reg.y(first + k);
         }
         Rdiff[w].row(blk) = reg.row(first) - reg.row(first + kb);  // R_d^- - R_d^+ (left minus right edges)
       }
@@ -318,11 +363,12 @@ Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& inp
   }
   res.parameters.covariance = cov;
   res.parameters.fixed.assign((J + 1) * p, false);
-  res.fit.n_samples = N;
+  res.fit.n_samples = total_samples;
   res.fit.n_parameters = p;
   res.diagnostics.condition_number = cond(0);
   res.diagnostics.vectors["condition_by_order"] = cond;
   res.diagnostics.scalars["windows"] = W;
+  if (E > 1) res.diagnostics.scalars["experiments"] = E;
   if (cond.maxCoeff() > 1e8)
     res.diagnostics.warnings.push_back(detail::format(
         "modal regression condition number {} > 1e8: spread the shifts (conditioning of psi) or lengthen the windows",
@@ -331,6 +377,7 @@ Result<ModalModel> modal_estimate(const IdData& data, const Eigen::MatrixXd& inp
   res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return res;
 }
+}  // namespace
 
 Result<ModalModel> modal_estimate(const IdData& data, const InputGenerator& input, const ModalOptions& options) {
   Eigen::VectorXd t(data.size());
@@ -363,68 +410,100 @@ Result<TransferFunction> modal_transfer_function(const IdData& data, const Input
 }
 
 namespace {
-Result<TransferFunction> modal_fit_undelayed(const IdData& data, int nb, ModalOptions o, const InputGenerator* input);
+Result<TransferFunction> modal_fit_undelayed(const std::vector<IdData>& data, int nb, ModalOptions o,
+                                             const InputGenerator* input);
 }  // namespace
 
 Result<TransferFunction> modal_fit(const IdData& data, int nb, ModalOptions o, const InputGenerator* input) {
+  return modal_fit(std::vector<IdData>{data}, nb, std::move(o), input);
+}
+
+Result<TransferFunction> modal_fit(const std::vector<IdData>& data, int nb, ModalOptions o, const InputGenerator* input) {
   o.validate();
-  require_io_data(data, "modal_fit");
+  CTID_REQUIRE(!data.empty(), "modal_fit: no records");
+  CTID_REQUIRE(!input || data.size() == 1,
+               "modal_fit: a generated input belongs to one record (Theorem 4.2's q depend on its generator's state); "
+               "{} records are fitted jointly with piecewise-constant inputs, or one at a time", data.size());
+  for (const IdData& d : data) require_io_data(d, "modal_fit");
   if (o.delay == 0.0) return modal_fit_undelayed(data, nb, o.resolved(input == nullptr), input);
-  CTID_REQUIRE(data.is_uniform(), "modal_fit: a delay needs uniformly sampled data");
-  const double k = o.delay / data.ts();
-  CTID_REQUIRE_OPTION(std::abs(k - std::round(k)) <= 1e-9 * std::max(1.0, k),
-                      "modal_fit: delay = {} s is not a whole multiple of the sampling period {} s", o.delay, data.ts());
-  const int nk = static_cast<int>(std::lround(k));
-  CTID_REQUIRE(nk < data.size(), "modal_fit: the delay {} s is not shorter than the record", o.delay);
-  // The delayed input (zero before the record): the fit sees a delay-free system.
-  Eigen::MatrixXd u = Eigen::MatrixXd::Zero(data.size(), 1);
-  u.bottomRows(data.size() - nk) = data.u().topRows(data.size() - nk);
-  IdData d(u, data.y(), data.ts(), data.t0());
-  d.set_intersample(0, data.intersample(0));
+  // The delayed input (zero before each record): the fit sees a delay-free system.
+  std::vector<IdData> delayed;
+  for (const IdData& d : data) {
+    CTID_REQUIRE(d.is_uniform(), "modal_fit: a delay needs uniformly sampled data");
+    const double k = o.delay / d.ts();
+    CTID_REQUIRE_OPTION(std::abs(k - std::round(k)) <= 1e-9 * std::max(1.0, k),
+                        "modal_fit: delay = {} s is not a whole multiple of the sampling period {} s", o.delay, d.ts());
+    const int nk = static_cast<int>(std::lround(k));
+    CTID_REQUIRE(nk < d.size(), "modal_fit: the delay {} s is not shorter than the record ({} samples)", o.delay, d.size());
+    Eigen::MatrixXd u = Eigen::MatrixXd::Zero(d.size(), 1);
+    u.bottomRows(d.size() - nk) = d.u().topRows(d.size() - nk);
+    delayed.emplace_back(u, d.y(), d.ts(), d.t0());
+    delayed.back().set_intersample(0, d.intersample(0));
+  }
   const double delay = o.delay;
   o.delay = 0.0;
-  Result<TransferFunction> r = modal_fit_undelayed(d, nb, o.resolved(input == nullptr), input);
+  Result<TransferFunction> r = modal_fit_undelayed(delayed, nb, o.resolved(input == nullptr), input);
   r.model.set_io_delay(delay);
   return r;
 }
 
 namespace {
-Result<TransferFunction> modal_fit_undelayed(const IdData& data, int nb, ModalOptions o, const InputGenerator* input) {
+Result<TransferFunction> modal_fit_undelayed(const std::vector<IdData>& data, int nb, ModalOptions o,
+                                             const InputGenerator* input) {
   const auto t_start = std::chrono::steady_clock::now();
   const int n = static_cast<int>(o.shifts.size());
   CTID_REQUIRE(nb >= 1 && nb <= n, "modal_fit: nb = {} numerator coefficients must be in [1, n = {}]", nb, n);
   if (input) {
     CTID_REQUIRE(nb == n, "modal_fit: Theorem 4.2 estimates all n = {} numerator coefficients (nb = {})", n, nb);
-    Result<TransferFunction> r = modal_transfer_function(data, *input, o);
+    Result<TransferFunction> r = modal_transfer_function(data.front(), *input, o);
     r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     return r;
   }
+  const int E = static_cast<int>(data.size());
+  CTID_REQUIRE(o.windows.empty() || E == 1,
+               "modal_fit: windows are times of one record; with {} records they are found from each record's level "
+               "switches (leave windows empty)", E);
+  std::vector<ModalRecord> records;
+  for (const IdData& d : data) records.push_back({&d, d.u(), o.windows});
   if (o.windows.empty()) {
-    // Automatic windows: Walsh blocks must tile each window (trim to a multiple of N sampling periods);
-    // the Fourier recursion needs one window (the longest).
-    const double Ts = data.ts();
-    for (ModalWindow w : piecewise_constant_windows(data, o.shifts(n - 1), Ts)) {
-      if (o.basis == ModalBasis::Walsh) w.length = std::floor(w.length / Ts / o.functions + 1e-9) * o.functions * Ts;
-      if (w.length > 0) o.windows.push_back(w);
+    // Automatic windows in every record: Walsh blocks must tile each window (trim to a multiple of N sampling
+    // periods); the Fourier recursion needs one window (the longest of all records).
+    for (ModalRecord& rec : records) {
+      const double Ts = rec.data->ts();
+      for (ModalWindow w : piecewise_constant_windows(*rec.data, o.shifts(n - 1), Ts)) {
+        if (o.basis == ModalBasis::Walsh) w.length = std::floor(w.length / Ts / o.functions + 1e-9) * o.functions * Ts;
+        if (w.length > 0) rec.windows.push_back(w);
+      }
     }
-    if (o.basis == ModalBasis::Fourier && o.windows.size() > 1) {
-      const auto longest = std::max_element(o.windows.begin(), o.windows.end(),
-                                            [](const ModalWindow& a, const ModalWindow& b) { return a.length < b.length; });
-      o.windows = {*longest};
+    if (o.basis == ModalBasis::Fourier) {
+      std::size_t best = 0, best_w = 0;
+      double longest = -1;
+      for (std::size_t e = 0; e < records.size(); ++e)
+        for (std::size_t w = 0; w < records[e].windows.size(); ++w)
+          if (records[e].windows[w].length > longest) longest = records[e].windows[w].length, best = e, best_w = w;
+      for (std::size_t e = 0; e < records.size(); ++e)
+        records[e].windows = e == best && longest > 0 ? std::vector<ModalWindow>{records[e].windows[best_w]}
+                                                      : std::vector<ModalWindow>{};
     }
   }
-  CTID_REQUIRE(!o.windows.empty(), "modal_fit: the input never stays constant long enough after a switch (T_n = {} s, "
+  int windows = 0;
+  for (const ModalRecord& rec : records) windows += static_cast<int>(rec.windows.size());
+  CTID_REQUIRE(windows > 0, "modal_fit: the input never stays constant long enough after a switch (T_n = {} s, "
                "the largest shift, plus the Walsh blocks): no validity windows", o.shifts(n - 1));
   if (o.basis != ModalBasis::Discrete) o.max_order = std::max(o.max_order, n);
-  const Result<ModalModel> m = modal_estimate(data, data.u(), o);
+  o.windows.clear();
+  const Result<ModalModel> m = modal_estimate_records(records, o);
   Result<TransferFunction> r;
   r.diagnostics = m.diagnostics;
-  r.diagnostics.scalars["windows"] = static_cast<double>(o.windows.size());
   r.summary = m.summary;
+  Eigen::Index total = 0;
+  for (const IdData& d : data) total += d.size();
+  Eigen::VectorXd y(total);
+  for (Eigen::Index e = 0, at = 0; e < E; at += data[e].size(), ++e) y.segment(at, data[e].size()) = data[e].y().col(0);
   auto failed = [&](const std::string& why) {
     r.summary.termination = Termination::RankDeficient;
     r.summary.message = why;
-    r.fit = fit_report_or_inf(data.y().col(0), Eigen::VectorXd::Constant(data.size(), NAN), n + nb);
+    r.fit = fit_report_or_inf(y, Eigen::VectorXd::Constant(total, NAN), n + nb);
     r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     return r;
   };
@@ -451,14 +530,19 @@ Result<TransferFunction> modal_fit_undelayed(const IdData& data, int nb, ModalOp
     }
     den = Polynomial(Eigen::VectorXd(e.real()));
   }
-  // Numerator by linear least squares on the exact responses of s^j / A(s) (j < nb) to the data's input.
-  Eigen::MatrixXd X(data.size(), nb);
-  for (int j = 0; j < nb; ++j) {
-    Eigen::VectorXd num = Eigen::VectorXd::Zero(j + 1);
-    num(0) = 1.0;
-    X.col(j) = lsim(TransferFunction(Polynomial(num), den), data, 0);
+  // Numerator by linear least squares on the exact responses of s^j / A(s) (j < nb) to each record's input, from
+  // rest, stacked over the records.
+  Eigen::MatrixXd X(total, nb);
+  Eigen::Index at = 0;
+  for (const IdData& d : data) {
+    for (int j = 0; j < nb; ++j) {
+      Eigen::VectorXd num = Eigen::VectorXd::Zero(j + 1);
+      num(0) = 1.0;
+      X.col(j).segment(at, d.size()) = lsim(TransferFunction(Polynomial(num), den), d, 0);
+    }
+    at += d.size();
   }
-  const internal::LinearSolution sol = least_squares(X, data.y().col(0));
+  const internal::LinearSolution sol = least_squares(X, y);
   Eigen::VectorXd numc(nb);
   for (int j = 0; j < nb; ++j) numc(j) = sol.theta(nb - 1 - j);
   r.model = TransferFunction(Polynomial(numc), den);
@@ -470,7 +554,8 @@ Result<TransferFunction> modal_fit_undelayed(const IdData& data, int nb, ModalOp
   r.parameters.std.tail(nb) = sol.covariance.diagonal().cwiseMax(0.0).cwiseSqrt().reverse();  // given A(s)
   r.parameters.fixed.assign(n + nb, false);
   if (!r.model.is_stable()) r.diagnostics.warnings.push_back("the estimated model is unstable");
-  r.fit = fit_report_or_inf(data.y().col(0), lsim(r.model, data, 0), n + nb);
+  const auto [measured, simulated] = tf_detail::pooled_outputs(r.model, data, 0.0);
+  r.fit = fit_report_or_inf(measured, simulated, n + nb);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return r;
 }

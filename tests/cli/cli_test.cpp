@@ -450,6 +450,29 @@ TEST(Cli, ModalFitPolesAndResponses) {
   const auto& tf = std::get<TransferFunction>(m);
   EXPECT_LT((tf.den().coefficients() - kS3.den().coefficients()).cwiseAbs().maxCoeff(), 1e-5);
   EXPECT_NEAR(tf.num().coefficient_of_power(0), 52.0, 1e-4);
+  // Two DATA files (issue 14 item 2): the second record holds other levels for 96 samples; the joint fit is the
+  // library's modal_fit of both records (to 1e-9) and S3 (noise-free, to 1e-5).
+  {
+    const int N2 = 384;
+    Eigen::VectorXd u2(N2);
+    const double lv2[4] = {-1.5, 0.5, 2.5, -0.5};
+    for (int i = 0; i < N2; ++i) u2(i) = lv2[(i / 96) % 4];
+    Eigen::MatrixXd m2(N2, 2);
+    m2 << u2, lsim(kS3, u2, time_grid(kTs320, N2));
+    const std::string second = test::temp_path("steps2.csv");
+    write_csv(second, {"u", "y"}, m2);
+    const CliRun j = ctid_run("fit " + data + " " + second + " --ts " + ts320() +
+                              " --method modal --nf 3 --nb 2 --set shift_samples=16,32,48 --force --json " + json);
+    ASSERT_EQ(j.code, 0) << j.err;
+    EXPECT_NE(j.out.find("experiments: 2"), std::string::npos) << j.out;
+    const CsvTable t1 = read_csv(data);
+    const Result<TransferFunction> lib =
+        modal_fit(std::vector<IdData>{IdData(t1.values.col(0), t1.values.col(1), kTs320), IdData(u2, m2.col(1), kTs320)},
+                  2, {.shifts = Eigen::Vector3d(16, 32, 48) * kTs320});
+    const TransferFunction joint = std::get<TransferFunction>(read_model_json(json));
+    EXPECT_LT((joint.den().coefficients() - lib.model.den().coefficients()).cwiseAbs().maxCoeff(), 1e-9 * 52);
+    EXPECT_LT((joint.den().coefficients() - kS3.den().coefficients()).cwiseAbs().maxCoeff(), 1e-5);
+  }
   // response --kind step: the ES-C11 estimate written as CSV equals the true step response.
   const std::string g = test::temp_path("g.csv");
   fs::remove(g);
@@ -1165,7 +1188,7 @@ TEST(Cli, SeveralDataFilesAreFittedJointly) {
   const CliRun o = ctid_run("fit " + files[0] + " " + files[1] + " --time time --input force --output position --method fsf");
   EXPECT_EQ(o.code, 2);
   EXPECT_NE(o.err.find("2 DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, lssvf, "
-                       "ivsvf, rls-svf, narx, physical --via raw or srivc with --closed-loop-controller (got fsf"),
+                       "ivsvf, rls-svf, narx, modal, physical --via raw or srivc with --closed-loop-controller (got fsf"),
             std::string::npos)
       << o.err;
   // NARX on both records (resampled NARX at Ts = 0.02 s): the CLI's file equals the library's joint fit.

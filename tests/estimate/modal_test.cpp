@@ -573,3 +573,64 @@ TEST(ModalEstimate, Tables43And44NoisyPrefilteredRouteLeastSquaresAgainstIv) {
   EXPECT_GT(std::abs(ls - 52.0), 5.0);
   EXPECT_LT(std::abs(iv - 52.0), std::abs(ls - 52.0));
 }
+
+namespace {
+// A piecewise-constant record of S3 from rest (Ts = pi/320): `cycles` cycles of the given levels, each held for
+// `hold` samples; white noise of standard deviation `noise` on the output.
+IdData level_record(const std::vector<double>& levels, int hold, int cycles, double noise = 0.0, unsigned seed = 1) {
+  const double Ts = kPi / 320;
+  const int N = hold * static_cast<int>(levels.size()) * cycles;
+  Eigen::VectorXd u(N);
+  for (int i = 0; i < N; ++i) u(i) = levels[(i / hold) % levels.size()];
+  Eigen::VectorXd y = lsim(kS3, u, time_grid(Ts, N));
+  if (noise > 0) y += white_noise(N, noise, seed);
+  return IdData(u, y, Ts);
+}
+}  // namespace
+
+TEST(ModalFit, SeveralRecordsArePooledIntoOneEstimateMoreAccurateThanEither) {
+  // Issue 14 (several experiments): two records of S3 with different level sequences and hold times, each from
+  // rest. Noise-free, the joint Walsh and Discrete fits give S3 to 1e-6 (as one record does, ModalFit above) and
+  // count the windows of both records.
+  const double Ts = kPi / 320;
+  const Eigen::Vector3d shifts(16 * Ts, 32 * Ts, 48 * Ts);
+  const std::vector<double> levels_a = {1, 2, -1, -2}, levels_b = {-1.5, 0.5, 2.5, -0.5};
+  const IdData a = level_record(levels_a, 80, 2), b = level_record(levels_b, 96, 1);
+  for (auto basis : {ModalBasis::Walsh, ModalBasis::Discrete}) {
+    const auto r = modal_fit(std::vector<IdData>{a, b}, 2, {.shifts = shifts, .basis = basis, .functions = 8});
+    ASSERT_TRUE(r.usable()) << r.why_not_usable();
+    EXPECT_LT(max_rel(r.model.den().coefficients(), kS3.den().coefficients()), 1e-6) << static_cast<int>(basis);
+    EXPECT_NEAR(r.model.num().coefficient_of_power(0), 52.0, 1e-4);
+    EXPECT_GT(r.fit.fit_percent, 99.999);
+    EXPECT_EQ(r.fit.n_samples, a.size() + b.size());
+    EXPECT_EQ(r.diagnostics.scalars.at("experiments"), 2);
+    EXPECT_EQ(r.diagnostics.scalars.at("windows"), 8 + 4);  // one window per level: 8 in a, 4 in b
+  }
+  // Refusals: explicit windows are times of one record; a generated input belongs to one record.
+  EXPECT_THROW(modal_fit(std::vector<IdData>{a, b}, 2, {.shifts = shifts, .windows = {{0.5, 0.2}}}), InvalidArgument);
+  const InputGenerator g = InputGenerator::constant(1.0);
+  EXPECT_THROW(modal_fit(std::vector<IdData>{a, b}, 3, {.shifts = shifts}, &g), InvalidArgument);
+
+  // Monte Carlo (200 seeded runs, output noise of standard deviation 0.002, about 0.15 % of the output's RMS): the
+  // relative RMS error of the denominator coefficients of the joint Walsh fit is below that of either record alone
+  // (measured: a 0.141, b 0.159, joint 0.058; the error scales linearly with the noise, 0.035/0.040/0.014 at 0.0005).
+  const int runs = 200;
+  double se_a = 0, se_b = 0, se_joint = 0;
+  const Eigen::VectorXd den = kS3.den().coefficients();
+  auto err2 = [&](const Result<TransferFunction>& r) {
+    return (r.model.den().coefficients() - den).cwiseQuotient(den).squaredNorm();
+  };
+  const ModalOptions o{.shifts = shifts, .basis = ModalBasis::Walsh, .functions = 8};
+  for (int k = 0; k < runs; ++k) {
+    const IdData na = level_record(levels_a, 80, 2, 0.002, 1000 + k), nb = level_record(levels_b, 96, 1, 0.002, 5000 + k);
+    se_a += err2(modal_fit(na, 2, o));
+    se_b += err2(modal_fit(nb, 2, o));
+    se_joint += err2(modal_fit(std::vector<IdData>{na, nb}, 2, o));
+  }
+  const double rms_a = std::sqrt(se_a / runs), rms_b = std::sqrt(se_b / runs), rms_joint = std::sqrt(se_joint / runs);
+  RecordProperty("rms_a", std::to_string(rms_a));
+  RecordProperty("rms_b", std::to_string(rms_b));
+  RecordProperty("rms_joint", std::to_string(rms_joint));
+  std::printf("modal several records: relative RMS error a %.4g, b %.4g, joint %.4g\n", rms_a, rms_b, rms_joint);
+  EXPECT_LT(rms_joint, 0.8 * std::min(rms_a, rms_b));
+}

@@ -108,6 +108,14 @@ Result<TransferFunction> modal_transfer_function(const IdData& data, const Input
 /// or when nb is outside [1, n], or the shifts are not uniform for the Discrete piecewise route.
 Result<TransferFunction> modal_fit(const IdData& data, int nb, ModalOptions options,
                                   const InputGenerator* input = nullptr);
+/// Several records (experiments of one system, one sampling period, each starting at rest) with piecewise-constant
+/// inputs, fitted jointly: the modal equations of every record's validity windows are pooled (Walsh and Discrete:
+/// all windows; Fourier: the longest window of all records), the numerator's least squares stacks the records, and
+/// fit is the simulation fit over all records (diagnostics "experiments"). options.windows must be empty for more
+/// than one record (each record's windows come from its level switches); a generated input (input != nullptr) takes
+/// one record. Throws InvalidArgument as the one-record form.
+Result<TransferFunction> modal_fit(const std::vector<IdData>& data, int nb, ModalOptions options,
+                                  const InputGenerator* input = nullptr);
 
 /// The generator of the given angular frequencies (rad/s; 0 = a constant level, w > 0 = a sinusoid pair) whose
 /// coefficients are fitted to the measured input of `data` by least squares — the input model of modal_fit for a
