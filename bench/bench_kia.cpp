@@ -36,7 +36,7 @@ void BM_KiaLinear(benchmark::State& state) {
   double iters = 0;
   for (auto _ : state) {
     auto r = ctid::kia_linear(m, {.zoh = false});
-    iters = r.diagnostics.scalars["gls_iterations"];
+    iters = r.diagnostics.get(ctid::diagnostic::gls_iterations);
   }
   state.counters["gls_iterations"] = iters;
 }
@@ -49,7 +49,7 @@ void BM_KiaQuadratic(benchmark::State& state) {
   for (auto _ : state) {
     auto r = ctid::kia_quadratic(
         m, lin.model, {.candidates = {ctid::NdeTerm::parse("y^2"), ctid::NdeTerm::parse("y*Dy")}, .zoh = false});
-    iters = r.diagnostics.scalars["gls_iterations"];
+    iters = r.diagnostics.get(ctid::diagnostic::gls_iterations);
   }
   state.counters["gls_iterations"] = iters;
 }

@@ -26,7 +26,7 @@ int main() {
   std::printf("NARMAX: %d terms, free-run fit %.2f %%\n", narx.parameters.size(), narx.fit.fit_percent);
   for (int i = 0; i < 5; ++i)
     std::printf("  %-16s %10.5f  ERR %6.3f %%\n", narx.parameters.names[i].c_str(), narx.parameters.values(i),
-                narx.diagnostics.vectors.at("err")(i));
+                narx.diagnostics.get(diagnostic::err)(i));
   const NarxModel process = narx.model.process();  // drop the noise terms
   const auto lin = kia_linear(process, {.y_order = 2, .u_order = 0});
   const auto kia = kia_quadratic(process, lin.model, {.candidates = {NdeTerm::parse("y^2"), NdeTerm::parse("y*Dy")}});

@@ -13,7 +13,7 @@ int main() {
 
   const Result<TransferFunction> r = srivc(data, {.nb = 2, .nf = 4});
   std::printf("srivc:  %s   (%d iterations, %.1f ms)\n", r.model.to_string(5).c_str(), r.summary.iterations, 1e3 * r.summary.seconds);
-  const Eigen::MatrixXd bound = crlb(truth, 2, data, r.diagnostics.scalars.at("noise_variance"));
+  const Eigen::MatrixXd bound = crlb(truth, 2, data, r.diagnostics.get(diagnostic::noise_variance));
   for (int i = 0; i < r.parameters.size(); ++i)
     std::printf("  %s = %10.4f +- %8.4f   (CRLB std %8.4f)\n", r.parameters.names[i].c_str(), r.parameters.values(i),
                 r.parameters.std(i), std::sqrt(bound(i, i)));

@@ -14,11 +14,11 @@ extern std::function<int()> g_run;
 namespace {
 void print_narx(const Result<NarxModel>& r) {
   std::printf("selected terms (in order of selection) with their error reduction ratio:\n");
-  const Eigen::VectorXd& err = r.diagnostics.vectors.at("err");
+  const Eigen::VectorXd& err = r.diagnostics.get(diagnostic::err);
   for (int i = 0; i < r.parameters.size(); ++i)
     std::printf("  %-22s %14.6g +- %-11.3g ERR %8.4f %%\n", r.parameters.names[i].c_str(), r.parameters.values(i),
                 r.parameters.std(i), i < err.size() ? err(i) : NAN);
-  std::printf("1 - sum(ERR) = %.3g   free-run fit %.2f %%\n", r.diagnostics.scalars.at("esr"), r.fit.fit_percent);
+  std::printf("1 - sum(ERR) = %.3g   free-run fit %.2f %%\n", r.diagnostics.get(diagnostic::esr), r.fit.fit_percent);
 }
 }  // namespace
 
@@ -79,7 +79,7 @@ int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, co
   }
   const Result<NdeModel>& k = run.reconstructed;
   std::printf("NDE: %s\n", k.model.to_string(5).c_str());
-  const Eigen::VectorXd& err = k.diagnostics.vectors.at("err");
+  const Eigen::VectorXd& err = k.diagnostics.get(diagnostic::err);
   for (int i = 0; i < k.parameters.size(); ++i)
     std::printf("  %-10s %14.6g   ERR %8.4f %%\n", k.parameters.names[i].c_str(), k.parameters.values(i), err(i));
   std::printf("simulated output fit: %.2f %%   (hold factor %s)\n", k.fit.fit_percent, ko.linear.zoh ? "on" : "off");

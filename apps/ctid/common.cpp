@@ -165,9 +165,8 @@ Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, cons
   Simulation s;
   try {
     o.initial = initial.empty() ? fit_initial_condition(r.model, r.diagnostics) : initial_condition_from_string(initial);
-    if (const auto x0 = r.diagnostics.vectors.find("x0");
-        o.initial == InitialCondition::Estimated && x0 != r.diagnostics.vectors.end())
-      o.x0 = x0->second;
+    if (o.initial == InitialCondition::Estimated && r.diagnostics.has(diagnostic::x0))
+      o.x0 = r.diagnostics.get(diagnostic::x0);
     s = simulate(r.model, d, o);
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
@@ -211,8 +210,8 @@ void print_any(const Result<M>& r, const std::string& method, const IdData& d) {
     else
       std::printf("  %-4s = %14.6g\n", r.parameters.names[i].c_str(), r.parameters.values(i));
   }
-  for (const auto& [k, v] : r.diagnostics.scalars)
-    if (k == "tau") std::printf("filter time constant tau = %.6g s\n", v);
+  if (r.diagnostics.has(diagnostic::tau))
+    std::printf("filter time constant tau = %.6g s\n", r.diagnostics.get(diagnostic::tau));
   std::printf("fit: %.2f %%   NRMSE %.4g   MSE %.4g   AIC %.6g   BIC %.6g\n", r.fit.fit_percent, r.fit.nrmse, r.fit.mse,
               r.fit.aic, r.fit.bic);
   if (r.diagnostics.condition_number > 0) std::printf("condition number %.3g   ", r.diagnostics.condition_number);
@@ -230,7 +229,7 @@ void print_result(const Result<FsfModel>& r, const std::string& method, const Id
   std::printf("method: %s   samples: %d   Ts = %g s   T = %g s (N = %d)   n = %d filters   window a = %g\n", method.c_str(),
               d.size(), f.delta(), f.T(), f.N(), f.n(), f.shift());
   std::printf("steady-state gain theta0 = %.6g +- %.3g   residual RMS %.4g   condition number %.3g\n", f.theta()(0),
-              r.parameters.std(0), r.diagnostics.scalars.count("residual_rms") ? r.diagnostics.scalars.at("residual_rms") : NAN,
+              r.parameters.std(0), r.diagnostics.has(diagnostic::residual_rms) ? r.diagnostics.get(diagnostic::residual_rms) : NAN,
               r.diagnostics.condition_number);
   std::printf("compressed step response%s:\n", f.shift() > 0 ? " (of the shifted system G(s + a))" : "");
   for (int i = 0; i <= 10; ++i) {

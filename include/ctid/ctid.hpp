@@ -3,6 +3,7 @@
 
 #include "ctid/core/check.hpp"
 #include "ctid/core/error.hpp"
+#include "ctid/core/diagnostics.hpp"
 #include "ctid/core/progress.hpp"
 #include "ctid/core/status.hpp"
 #include "ctid/core/types.hpp"

@@ -19,7 +19,7 @@ from ._ctid import (  # noqa: F401  (re-exported)
     InvalidOptions, MisoModel, ModalModel, ModalWindow, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm,
     NonlinearCorrelationTests, PhysicalModel, ResultFile, Simulation, StateSpace, TransferFunction, add_noise_snr, fit_percent, frequency_grid,
     generator_fitted_to_input, html_report,
-    input_residual_crosscorrelation, load, magnitude_band, methods, settings, narx_candidates, narx_noise_candidates,
+    input_residual_crosscorrelation, load, magnitude_band, methods, settings, diagnostics, narx_candidates, narx_noise_candidates,
     nonlinear_correlation_tests, one_sided_dft, piecewise_constant_windows, prbs, read_narx_json, read_nde_json,
     read_result, residual_autocorrelation, response_horizon, time_grid, write_result,
 )

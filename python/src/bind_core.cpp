@@ -41,8 +41,8 @@ void bind_core(py::module_& m) {
   py::class_<Diagnostics>(m, "Diagnostics", "Numerical diagnostics: condition number, warnings, method-specific numbers.")
       .def_readonly("condition_number", &Diagnostics::condition_number)
       .def_readonly("warnings", &Diagnostics::warnings)
-      .def_readonly("scalars", &Diagnostics::scalars)
-      .def_readonly("vectors", &Diagnostics::vectors);
+      .def_property_readonly("scalars", &Diagnostics::scalars, "method-specific numbers by name (ctid.diagnostics())")
+      .def_property_readonly("vectors", &Diagnostics::vectors, "method-specific vectors by name (ctid.diagnostics())");
 
   py::class_<IdData>(m, "IdData", "Sampled input/output record (columns = channels).")
       .def(py::init<Eigen::MatrixXd, Eigen::MatrixXd, double, double>(), py::arg("u"), py::arg("y"), py::arg("ts"),

@@ -1,5 +1,6 @@
 // ctid Python module — settings from Python values (one conversion per option kind) and the method registry:
 // ctid.methods() and ctid.settings(name) read estimate/methods.hpp, the list the CLI's help reads.
+#include <optional>
 #include <algorithm>
 #include <cctype>
 
@@ -86,6 +87,28 @@ void bind_registry(py::module_& m) {
       py::arg("method"),
       "The settings of a method: a list of dicts (name, kind, unit, range, default as text, doc) — the keyword "
       "arguments of its function and the CLI's --set names.");
+  m.def(
+      "diagnostics",
+      [](const std::optional<std::string>& method) {
+        py::list out;
+        auto add = [&](const DiagnosticInfo& d) {
+          py::dict x;
+          x["name"] = d.name;
+          x["kind"] = d.vector ? "vector" : "scalar";
+          x["unit"] = d.unit;
+          x["doc"] = d.doc;
+          x["per_record"] = d.per_record;
+          out.append(x);
+        };
+        if (method)
+          for (const auto& name : method_info(*method).diagnostics) add(*find_diagnostic(name));
+        else
+          for (const auto& d : diagnostic_catalogue()) add(d);
+        return out;
+      },
+      py::arg("method") = py::none(),
+      "The declared diagnostics (of one method, or all): a list of dicts (name, kind 'scalar'/'vector', unit, doc, "
+      "per_record) — the keys of a result's diagnostics.scalars and diagnostics.vectors.");
 }
 
 }  // namespace ctid::python

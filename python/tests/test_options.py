@@ -88,6 +88,25 @@ def test_unknown_or_mistyped_settings_name_the_closest_valid_one():
         ctid.settings("srvic")
 
 
+def test_diagnostics_are_declared_per_method():
+    # Issue 14 (item 5): the keys of a result's diagnostics are declared (name, kind, unit, doc) in the library's
+    # catalogue, and each method lists those it can report (the C++ registry, MethodInfo::diagnostics).
+    import numpy as np
+    every = {d["name"]: d for d in ctid.diagnostics()}
+    assert every["noise_variance"]["unit"] == "y^2" and every["noise_variance"]["kind"] == "scalar"
+    assert every["x0"]["per_record"] and every["x0"]["kind"] == "vector"
+    srivc = [d["name"] for d in ctid.diagnostics("srivc")]
+    assert "noise_variance" in srivc and "delay" in srivc and "tau" not in srivc
+    g = ctid.TransferFunction([2.0], [1.0, 1.0])
+    u = ctid.prbs(1000, register_length=8, clock_period=5)
+    d = ctid.IdData.from_arrays(u, g.simulate(u, 0.01 * np.arange(u.size)), ts=0.01)
+    r = ctid.srivc(d, 1, 1)
+    assert set(r.diagnostics.scalars) <= set(srivc)
+    assert r.diagnostics.scalars["noise_variance"] >= 0
+    with pytest.raises(ctid.InvalidOptions, match="'srvic' is not a method"):
+        ctid.diagnostics("srvic")
+
+
 def test_batch_rls_svf_matches_the_recursive_estimator():
     # ctid.rls_svf(data, ...) is the recursion of ctid.rls_svf_recursive run over the record (same final estimate).
     import numpy as np

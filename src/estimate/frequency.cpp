@@ -234,9 +234,9 @@ Result<TransferFunction> tf_from_frequency(const FrequencyData& data, const TfOr
   r.fit.mse = (G - Gm).squaredNorm() / K;
   r.fit.nrmse = den > 0 ? num / den : INFINITY;
   r.fit.fit_percent = 100.0 * (1.0 - r.fit.nrmse);
-  r.diagnostics.scalars["noise_variance"] = sigma2;
-  r.diagnostics.scalars["frequency_scale"] = w0;
-  r.diagnostics.scalars["sk_iterations"] = sk_done;
+  r.diagnostics.set(diagnostic::noise_variance, sigma2);
+  r.diagnostics.set(diagnostic::frequency_scale, w0);
+  r.diagnostics.set(diagnostic::sk_iterations, sk_done);
   internal::set_termination(r.summary, lm);
   if (r.summary.succeeded() && !r.model.is_stable())
     r.diagnostics.warnings.push_back("the fitted model is unstable (frequency data do not constrain stability)");

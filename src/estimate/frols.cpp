@@ -265,11 +265,11 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
   res.parameters.values = theta;
   res.parameters.fixed.assign(k, false);
   res.parameters.set_covariance(cov);
-  res.diagnostics.vectors["err"] = 100.0 * Eigen::Map<const Eigen::VectorXd>(err.data(), k);
+  res.diagnostics.set(diagnostic::err, 100.0 * Eigen::Map<const Eigen::VectorXd>(err.data(), k));
   if (o.criterion != InformationCriterion::None)
-    res.diagnostics.vectors["criterion"] = crit.head(static_cast<Eigen::Index>(sel.size()));
-  res.diagnostics.scalars["esr"] = esr;
-  res.diagnostics.scalars["candidates"] = M;
+    res.diagnostics.set(diagnostic::criterion, crit.head(static_cast<Eigen::Index>(sel.size())));
+  res.diagnostics.set(diagnostic::esr, esr);
+  res.diagnostics.set(diagnostic::candidates, M);
   res.diagnostics.condition_number = Ainv.norm() * A.norm();
   // The fit: each record's free run from its own first L measured outputs, pooled after those L samples.
   const NarxModel process = res.model.process();
@@ -473,8 +473,8 @@ Result<NarxModel> narmax(const std::vector<IdData>& data, const std::vector<Narx
       break;
     }
   }
-  r.diagnostics.scalars["narmax_iterations"] = it;
-  r.diagnostics.scalars["relative_change"] = change;
+  r.diagnostics.set(diagnostic::narmax_iterations, it);
+  r.diagnostics.set(diagnostic::relative_change, change);
   if (!o.noise_candidates.empty() && change > o.tolerance)
     r.diagnostics.warnings.push_back(detail::format(
         "narmax: the extended least-squares iterations did not settle in {} iterations (last relative change {})", it,

@@ -59,8 +59,8 @@ Result<FsfModel> fsf_result(const internal::LinearSolution& sol, double Ts, int 
   r.parameters.set_covariance(sol.covariance);
   r.parameters.fixed.assign(n, false);
   r.diagnostics.condition_number = sol.condition;
-  r.diagnostics.scalars["N"] = N;
-  r.diagnostics.scalars["a"] = a;
+  r.diagnostics.set(diagnostic::fsf_N, N);
+  r.diagnostics.set(diagnostic::fsf_a, a);
   return r;
 }
 }  // namespace
@@ -183,9 +183,9 @@ Result<FsfModel> fsf(const IdData& data, const FsfOptions& o) {
   // response) simulated from rest. The regression's own figure, on the windowed and weighted data, has its own
   // name. With a window a > 0 the model is G(s + a), which cannot be simulated as the system: no fit.
   const double regression_nrmse = sol.tss > 0 ? std::sqrt(sol.rss / sol.tss) : std::numeric_limits<double>::infinity();
-  r.diagnostics.scalars["regression_fit_percent"] = 100.0 * (1.0 - regression_nrmse);
-  r.diagnostics.scalars["b"] = o.b;
-  r.diagnostics.scalars["residual_rms"] = std::sqrt(sol.rss / std::max(1.0, double(sol.n_rows)));
+  r.diagnostics.set(diagnostic::regression_fit_percent, 100.0 * (1.0 - regression_nrmse));
+  r.diagnostics.set(diagnostic::fsf_b, o.b);
+  r.diagnostics.set(diagnostic::residual_rms, std::sqrt(sol.rss / std::max(1.0, double(sol.n_rows))));
   if (o.a == 0.0) r.fit = fit_report_or_inf(data.y().col(0), r.model.simulate(data.u().col(0)), p);
   if (o.b > 0 && M > N)
     r.diagnostics.warnings.push_back(detail::format(

@@ -321,11 +321,11 @@ void fill_parameters(R& res, const std::vector<std::string>& names, const Eigen:
   res.parameters.values = values;
   res.parameters.std = Eigen::VectorXd::Constant(values.size(), std::numeric_limits<double>::quiet_NaN());
   res.parameters.fixed.assign(values.size(), false);
-  res.diagnostics.vectors["err"] = g.err;
-  res.diagnostics.vectors["first_iteration"] = first;
-  res.diagnostics.scalars["gls_iterations"] = g.iterations;
-  res.diagnostics.scalars["gls_order"] = g.order;
-  res.diagnostics.scalars["err_sum"] = g.err.sum();
+  res.diagnostics.set(diagnostic::err, g.err);
+  res.diagnostics.set(diagnostic::first_iteration, first);
+  res.diagnostics.set(diagnostic::gls_iterations, g.iterations);
+  res.diagnostics.set(diagnostic::gls_order, g.order);
+  res.diagnostics.set(diagnostic::err_sum, g.err.sum());
   res.summary.iterations = g.iterations;
   if (g.order > 0) {
     res.summary.termination = g.converged ? Termination::Converged : Termination::MaxIterations;
@@ -485,8 +485,8 @@ KiaRun kia(const IdData& d, const NarxModel& narx, const KiaOptions& o) {
     next.parameters.std = Eigen::VectorXd::Constant(v.size(), NAN);
     next.parameters.fixed.assign(static_cast<size_t>(v.size()), false);
     Eigen::VectorXd e(v.size());
-    e << before.diagnostics.vectors.at("err"), next.diagnostics.vectors.at("err");
-    next.diagnostics.vectors["err"] = e;
+    e << before.diagnostics.get(diagnostic::err), next.diagnostics.get(diagnostic::err);
+    next.diagnostics.set(diagnostic::err, e);
     return next;
   };
   if (!o.quadratic.candidates.empty()) r = stack(r, kia_quadratic(narx, r.model, o.quadratic));

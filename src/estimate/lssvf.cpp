@@ -199,9 +199,9 @@ Result<TransferFunction> make_result(const std::vector<IdData>& data, const TfOr
 
   r.model = tf_from_theta(L, th, delay);
   r.diagnostics.condition_number = sol.condition;
-  r.diagnostics.scalars["tau"] = L.tau;
-  r.diagnostics.scalars["equation_error_variance"] = sol.sigma2;
-  r.diagnostics.vectors["theta_tau"] = svf_transform(L, th);
+  r.diagnostics.set(diagnostic::tau, L.tau);
+  r.diagnostics.set(diagnostic::equation_error_variance, sol.sigma2);
+  r.diagnostics.set(diagnostic::theta_tau, svf_transform(L, th));
   if (sol.rank_deficient) {
     r.summary.termination = Termination::RankDeficient;
     r.summary.message = detail::format(
@@ -214,7 +214,7 @@ Result<TransferFunction> make_result(const std::vector<IdData>& data, const TfOr
   double bscale = 0;
   for (int i = 0; i < L.nb; ++i) bscale += std::abs(th(L.n + L.n - L.nb + i)) * std::pow(std::abs(s0), L.nb - 1 - i);
   const double b_at = r.model.num()(s0);
-  r.diagnostics.scalars["B_at_minus_1_over_tau"] = b_at;
+  r.diagnostics.set(diagnostic::B_at_minus_1_over_tau, b_at);
   if (bscale > 0 && std::abs(b_at) < 1e-2 * bscale)
     r.diagnostics.warnings.push_back(detail::format(
         "B(-1/tau) = {} is nearly zero: a zero of the model is close to -1/tau = {}; the regressor is nearly singular "
@@ -237,7 +237,7 @@ Result<TransferFunction> make_result(const std::vector<IdData>& data, const TfOr
   }
   // Output-error fit of the model on the estimation data.
   r.fit = simulation_fit(r.model, data, static_cast<int>(L.free.size()));
-  if (data.size() > 1) r.diagnostics.scalars["experiments"] = static_cast<double>(data.size());
+  if (data.size() > 1) r.diagnostics.set(diagnostic::experiments, static_cast<double>(data.size()));
   return r;
 }
 
@@ -331,8 +331,8 @@ Result<TransferFunction> lssvf(const std::vector<IdData>& data, const TfOrders& 
   const internal::LinearSolution sol = solve_ls(P, L, options.data_filter);
   Result<TransferFunction> r = make_result(data, orders, L, sol, options.alpha);
   if (grid.size() > 0) {
-    r.diagnostics.vectors["tau_grid"] = grid;
-    r.diagnostics.vectors["tau_grid_fit_percent"] = fits;
+    r.diagnostics.set(diagnostic::tau_grid, grid);
+    r.diagnostics.set(diagnostic::tau_grid_fit_percent, fits);
   }
   r.summary.iterations = 1;
   tf_detail::check_cancellation(r);
@@ -351,7 +351,7 @@ Result<TransferFunction> ivsvf(const std::vector<IdData>& data, const TfOrders& 
   options.validate();
   Result<TransferFunction> r = lssvf(data, orders, options.svf);
   if (!r.usable()) return r;
-  const double tau = r.diagnostics.scalars.at("tau");
+  const double tau = r.diagnostics.get(diagnostic::tau);
   const std::vector<PreparedData> P = prepare_all(data, orders, options.svf, "ivsvf");
   const SvfLayout L = make_layout(orders, tau, options.svf.fixed, "ivsvf");
   Eigen::VectorXd theta = full_theta(L, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(L.free.size())));

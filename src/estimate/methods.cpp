@@ -21,8 +21,10 @@ namespace ctid {
 
 namespace {
 template <class... O>
-MethodInfo entry(std::string name, std::string summary, std::vector<std::string> structs) {
-  MethodInfo m{std::move(name), std::move(summary), std::move(structs), {}};
+MethodInfo entry(std::string name, std::string summary, std::vector<std::string> structs,
+                 std::vector<std::string> diagnostics) {
+  for (const auto& d : diagnostics) CTID_ASSERT(find_diagnostic(d) != nullptr);
+  MethodInfo m{std::move(name), std::move(summary), std::move(structs), {}, std::move(diagnostics)};
   (
       [&] {
         for (auto& i : option_table<O>().info()) {
@@ -33,48 +35,75 @@ MethodInfo entry(std::string name, std::string summary, std::vector<std::string>
       ...);
   return m;
 }
+
+// The names of diagnostic keys (both types).
+template <class... K>
+std::vector<std::string> reports(const K&... keys) {
+  return {std::string(keys.name)...};
+}
 }  // namespace
 
 const std::vector<MethodInfo>& methods() {
+  using namespace diagnostic;  // the keys of what each method reports
   static const std::vector<MethodInfo> all = {
-      entry<LssvfOptions>("lssvf", "Johansson (1986) least squares on state-variable-filtered signals", {"LssvfOptions"}),
+      entry<LssvfOptions>("lssvf", "Johansson (1986) least squares on state-variable-filtered signals",
+                          {"LssvfOptions"},
+                          reports(tau, equation_error_variance, theta_tau, B_at_minus_1_over_tau, tau_grid,
+                                  tau_grid_fit_percent, experiments)),
       entry<IvsvfOptions>("ivsvf", "Johansson's regression with instrumental variables from an auxiliary model",
-                          {"IvsvfOptions"}),
+                          {"IvsvfOptions"},
+                          reports(tau, equation_error_variance, theta_tau, B_at_minus_1_over_tau, tau_grid,
+                                  tau_grid_fit_percent, experiments)),
       entry<RlsSvfOptions>("rls_svf", "recursive least squares on state-variable-filtered signals (RJ 59-60)",
-                           {"RlsSvfOptions"}),
-      entry<SrivcOptions>("srivc", "simplified refined instrumental variables, one input", {"SrivcOptions"}),
+                           {"RlsSvfOptions"}, reports(tau, experiments)),
+      entry<SrivcOptions>("srivc", "simplified refined instrumental variables, one input", {"SrivcOptions"},
+                          reports(delay, noise_variance, delay_grid, delay_grid_mse, time_scale, experiments)),
       entry<SrivcMisoOptions>("srivc_miso", "SRIVC with several inputs (one transfer function per input)",
-                              {"SrivcMisoOptions"}),
-      entry<ClosedLoopOptions>("srivc_closed_loop", "closed-loop SRIVC with a known controller (instruments from the reference)",
-                               {"ClosedLoopOptions"}),
-      entry<OeOptions>("oe", "continuous-time output error (Levenberg-Marquardt)", {"OeOptions"}),
-      entry<OeOptions>("tfest", "SRIVC start, then output-error refinement", {"OeOptions"}),
+                              {"SrivcMisoOptions"}, reports(noise_variance, time_scale, experiments)),
+      entry<ClosedLoopOptions>(
+          "srivc_closed_loop", "closed-loop SRIVC with a known controller (instruments from the reference)",
+          {"ClosedLoopOptions"}, reports(noise_variance, output_error_lag1_correlation, time_scale, experiments)),
+      entry<OeOptions>("oe", "continuous-time output error (Levenberg-Marquardt)", {"OeOptions"},
+                       reports(delay, noise_variance, time_scale, experiments)),
+      entry<OeOptions>("tfest", "SRIVC start, then output-error refinement", {"OeOptions"},
+                       reports(delay, noise_variance, srivc_iterations, srivc_fit_percent, time_scale, experiments)),
       entry<FrequencyFitOptions>("tf_from_frequency", "transfer function from frequency-response data (SK, then OE)",
-                                 {"FrequencyFitOptions"}),
-      entry<FsfOptions>("fsf", "Gawthrop & Wang (2005) frequency-sampling-filter compression", {"FsfOptions"}),
-      entry<FsfOptions, PhysicalFitOptions>("physical",
-                                            "physical parameters of a transfer-function expression (via FSF or raw data)",
-                                            {"FsfOptions", "PhysicalFitOptions"}),
-      entry<ModalOptions>("modal",
-                          "El-Shafey (1987) modal functions: transfer function from a generated or piecewise-constant input",
-                          {"ModalOptions"}),
-      entry<ModalResponseOptions, ModalOptions>(
-          "modal_response",
-          "El-Shafey (1987) step, impulse or frequency response from a piecewise-constant or periodic input (ctid response)",
-          {"ModalResponseOptions", "ModalOptions"}),
+                                 {"FrequencyFitOptions"}, reports(noise_variance, frequency_scale, sk_iterations)),
+      entry<FsfOptions>("fsf", "Gawthrop & Wang (2005) frequency-sampling-filter compression", {"FsfOptions"},
+                        reports(fsf_N, fsf_a, fsf_b, regression_fit_percent, residual_rms)),
+      entry<FsfOptions, PhysicalFitOptions>(
+          "physical", "physical parameters of a transfer-function expression (via FSF or raw data)",
+          {"FsfOptions", "PhysicalFitOptions"}, reports(shift_a, cost, cost_history, max_pole_real_part, experiments)),
+      entry<ModalOptions>(
+          "modal", "El-Shafey (1987) modal functions: transfer function from a generated or piecewise-constant input",
+          {"ModalOptions"}, reports(windows, condition_by_order, experiments)),
+      entry<ModalResponseOptions, ModalOptions>("modal_response",
+                                                "El-Shafey (1987) step, impulse or frequency response from a "
+                                                "piecewise-constant or periodic input (ctid response)",
+                                                {"ModalResponseOptions", "ModalOptions"},
+                                                reports(windows, condition_by_order)),
       entry<PolesOptions>("poles", "El-Shafey (1987) data-matrix poles of a free response beside Prony's (ctid poles)",
-                          {"PolesOptions"}),
-      entry<NarxOptions>("narx", "Billings & Li NARX workflow: candidates from degree and lags, FROLS with a criterion, "
-                                 "NARMAX with noise_terms > 0",
-                         {"NarxOptions"}),
-      entry<FrolsOptions>("frols", "FROLS/ERR selection among given NARX candidate terms", {"FrolsOptions"}),
-      entry<NarmaxOptions>("narmax", "NARMAX: FROLS with noise terms by extended least squares", {"NarmaxOptions"}),
-      entry<KiaOptions>("kia", "Kernel Invariance Algorithm: NDE from a NARX model (stages, stacking, OE refinement)",
-                        {"KiaOptions"}),
-      entry<KiaLinearOptions>("kia_linear", "KIA linear stage", {"KiaLinearOptions"}),
-      entry<KiaQuadraticOptions>("kia_quadratic", "KIA quadratic stage", {"KiaQuadraticOptions"}),
-      entry<KiaCubicOptions>("kia_cubic", "KIA cubic stage", {"KiaCubicOptions"}),
-      entry<NdeOeOptions>("nde_oe", "output-error refinement of a nonlinear differential equation", {"NdeOeOptions"}),
+                          {"PolesOptions"}, {}),
+      entry<NarxOptions>("narx",
+                         "Billings & Li NARX workflow: candidates from degree and lags, FROLS with a criterion, "
+                         "NARMAX with noise_terms > 0",
+                         {"NarxOptions"},
+                         reports(err, criterion, esr, candidates, narmax_iterations, relative_change, experiments)),
+      entry<FrolsOptions>("frols", "FROLS/ERR selection among given NARX candidate terms", {"FrolsOptions"},
+                          reports(err, criterion, esr, candidates, experiments)),
+      entry<NarmaxOptions>("narmax", "NARMAX: FROLS with noise terms by extended least squares", {"NarmaxOptions"},
+                           reports(err, criterion, esr, candidates, narmax_iterations, relative_change, experiments)),
+      entry<KiaOptions>(
+          "kia", "Kernel Invariance Algorithm: NDE from a NARX model (stages, stacking, OE refinement)", {"KiaOptions"},
+          reports(err, first_iteration, gls_iterations, gls_order, err_sum, x0, noise_variance, start_scale)),
+      entry<KiaLinearOptions>("kia_linear", "KIA linear stage", {"KiaLinearOptions"},
+                              reports(err, first_iteration, gls_iterations, gls_order, err_sum)),
+      entry<KiaQuadraticOptions>("kia_quadratic", "KIA quadratic stage", {"KiaQuadraticOptions"},
+                                 reports(err, first_iteration, gls_iterations, gls_order, err_sum)),
+      entry<KiaCubicOptions>("kia_cubic", "KIA cubic stage", {"KiaCubicOptions"},
+                             reports(err, first_iteration, gls_iterations, gls_order, err_sum)),
+      entry<NdeOeOptions>("nde_oe", "output-error refinement of a nonlinear differential equation", {"NdeOeOptions"},
+                          reports(x0, noise_variance, start_scale, experiments)),
   };
   return all;
 }
@@ -104,6 +133,13 @@ std::string settings_help(const MethodInfo& m) {
     if (!s.range.empty()) line += "; " + s.range;
     line += ". " + s.doc + "\n";
     out += line;
+  }
+  if (!m.diagnostics.empty()) {
+    out += "diagnostics " + m.name + " can report (result files: diagnostics; Python: r.diagnostics):\n";
+    for (const auto& name : m.diagnostics) {
+      const DiagnosticInfo& d = *find_diagnostic(name);
+      out += "  " + d.name + (d.unit.empty() ? "" : " [" + d.unit + "]") + ": " + d.doc + "\n";
+    }
   }
   return out;
 }

@@ -366,9 +366,9 @@ Result<ModalModel> modal_estimate_records(const std::vector<ModalRecord>& record
   res.fit.n_samples = total_samples;
   res.fit.n_parameters = p;
   res.diagnostics.condition_number = cond(0);
-  res.diagnostics.vectors["condition_by_order"] = cond;
-  res.diagnostics.scalars["windows"] = W;
-  if (E > 1) res.diagnostics.scalars["experiments"] = E;
+  res.diagnostics.set(diagnostic::condition_by_order, cond);
+  res.diagnostics.set(diagnostic::windows, W);
+  if (E > 1) res.diagnostics.set(diagnostic::experiments, E);
   if (cond.maxCoeff() > 1e8)
     res.diagnostics.warnings.push_back(detail::format(
         "modal regression condition number {} > 1e8: spread the shifts (conditioning of psi) or lengthen the windows",

@@ -271,10 +271,10 @@ Result<NdeModel> nde_oe(const std::vector<IdData>& records, const NdeModel& init
   // The first record's initial state is "x0" (what simulate()'s estimated initial condition takes); further
   // records' are "x0_2", "x0_3", ...
   for (int e = 0; e < E; ++e)
-    r.diagnostics.vectors[e == 0 ? "x0" : "x0_" + std::to_string(e + 1)] = nx ? x0_of(lm.x, e) : Eigen::VectorXd::Zero(L);
-  if (E > 1) r.diagnostics.scalars["experiments"] = E;
-  r.diagnostics.scalars["noise_variance"] = sigma2;
-  r.diagnostics.scalars["start_scale"] = start_scale;
+    r.diagnostics.set(diagnostic::x0, nx ? x0_of(lm.x, e) : Eigen::VectorXd::Zero(L), e);
+  if (E > 1) r.diagnostics.set(diagnostic::experiments, E);
+  r.diagnostics.set(diagnostic::noise_variance, sigma2);
+  r.diagnostics.set(diagnostic::start_scale, start_scale);
   if (start_scale < 1.0)
     r.diagnostics.warnings.push_back(detail::format(
         "the starting model escapes on these data; the search started with its nonlinear coefficients times {}",

@@ -160,9 +160,9 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
   const double sigma2 = 2.0 * lm.cost / double(std::max<Eigen::Index>(1, y_all.size() - p));
   r.parameters.set_covariance(internal::covariance(lm.jtj, sigma2), free);
   r.diagnostics.condition_number = internal::gram_condition(lm.jtj);
-  r.diagnostics.scalars["noise_variance"] = sigma2;
-  r.diagnostics.scalars["delay"] = r.model.io_delay();
-  if (ds.size() > 1) r.diagnostics.scalars["experiments"] = static_cast<double>(ds.size());
+  r.diagnostics.set(diagnostic::noise_variance, sigma2);
+  r.diagnostics.set(diagnostic::delay, r.model.io_delay());
+  if (ds.size() > 1) r.diagnostics.set(diagnostic::experiments, static_cast<double>(ds.size()));
   internal::set_termination(
       r.summary, lm,
       "the simulation of the starting model overflows on this record (its poles are far in the right half plane); "
@@ -287,8 +287,8 @@ Result<TransferFunction> tfest_in_units(const Records& data, const TfOrders& ord
   if (options.initial) so.initial = options.initial;
   const Result<TransferFunction> s = srivc(data, orders, so);
   Result<TransferFunction> r = refine(data, orders, starting_model(s.model, data, options.transient_time), options, t0);
-  r.diagnostics.scalars["srivc_iterations"] = s.summary.iterations;
-  r.diagnostics.scalars["srivc_fit_percent"] = s.fit.fit_percent;
+  r.diagnostics.set(diagnostic::srivc_iterations, s.summary.iterations);
+  r.diagnostics.set(diagnostic::srivc_fit_percent, s.fit.fit_percent);
   return r;
 }
 

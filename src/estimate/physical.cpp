@@ -149,16 +149,16 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
     if (std::isfinite(lm.cost) && evaluate(lm.x, r, nullptr)) res.fit = fit_report_or_inf(target, target + r, p);
     else res.fit = fit_report_or_inf(target, Eigen::VectorXd::Constant(n_data, NAN), p);
   }
-  res.diagnostics.scalars["shift_a"] = a;
-  res.diagnostics.scalars["cost"] = lm.cost;
-  res.diagnostics.vectors["cost_history"] = Eigen::Map<Eigen::VectorXd>(history.data(), static_cast<Eigen::Index>(history.size()));
+  res.diagnostics.set(diagnostic::shift_a, a);
+  res.diagnostics.set(diagnostic::cost, lm.cost);
+  res.diagnostics.set(diagnostic::cost_history, Eigen::Map<Eigen::VectorXd>(history.data(), static_cast<Eigen::Index>(history.size())));
   res.diagnostics.warnings.push_back(detail::format(
       "{} route: parameter standard deviations assume independent residuals; they are indicative", route));
   // The window must make G(s + a) stable: a > max Re(poles) of the fitted plant (GW-A2 step 1).
   const Eigen::VectorXcd poles = res.model.poles();
   double slowest = -INFINITY;
   for (Eigen::Index i = 0; i < poles.size(); ++i) slowest = std::max(slowest, poles(i).real());
-  res.diagnostics.scalars["max_pole_real_part"] = slowest;
+  res.diagnostics.set(diagnostic::max_pole_real_part, slowest);
   if (poles.size() > 0 && !(a > slowest))
     res.diagnostics.warnings.push_back(detail::format(
         "the window a = {} does not exceed the largest real part of the fitted plant's poles ({}): G(s + a) is not "
@@ -283,7 +283,7 @@ Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std:
     }
   };
   Result<TransferFunction> r = fit(model, params, a, opt, res, y, "raw");
-  if (records.size() > 1) r.diagnostics.scalars["experiments"] = static_cast<double>(records.size());
+  if (records.size() > 1) r.diagnostics.set(diagnostic::experiments, static_cast<double>(records.size()));
   return r;
 }
 

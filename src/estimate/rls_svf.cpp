@@ -238,8 +238,8 @@ Result<TransferFunction> rls_svf(const std::vector<IdData>& ds, const TfOrders& 
   r.parameters.std = Eigen::VectorXd::Constant(orders.n_parameters(), std::numeric_limits<double>::quiet_NaN());
   r.parameters.fixed.assign(orders.n_parameters(), false);
   for (int i = 0; i < orders.n_parameters(); ++i) r.parameters.fixed[i] = options.fixed.count(r.parameters.names[i]) > 0;
-  r.diagnostics.scalars["tau"] = options.tau;
-  if (ds.size() > 1) r.diagnostics.scalars["experiments"] = static_cast<double>(ds.size());
+  r.diagnostics.set(diagnostic::tau, options.tau);
+  if (ds.size() > 1) r.diagnostics.set(diagnostic::experiments, static_cast<double>(ds.size()));
   r.summary.iterations = static_cast<int>(rls.n_updates());
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // The simulation fit over all records (each from rest), as one concatenated output.

@@ -391,12 +391,12 @@ Result<TransferFunction> srivc_in_units(const Records& ds, const TfOrders& order
   // (no zz when interrupted before a step)
   r.parameters.set_covariance(run.rank_deficient ? Eigen::MatrixXd() : internal::covariance(run.zz, sigma2));
   r.diagnostics.condition_number = run.sol.condition;
-  r.diagnostics.scalars["delay"] = delay;
-  r.diagnostics.scalars["noise_variance"] = sigma2;
-  if (ds.size() > 1) r.diagnostics.scalars["experiments"] = static_cast<double>(ds.size());
+  r.diagnostics.set(diagnostic::delay, delay);
+  r.diagnostics.set(diagnostic::noise_variance, sigma2);
+  if (ds.size() > 1) r.diagnostics.set(diagnostic::experiments, static_cast<double>(ds.size()));
   if (grid.size() > 0) {
-    r.diagnostics.vectors["delay_grid"] = grid;
-    r.diagnostics.vectors["delay_grid_mse"] = grid_cost;
+    r.diagnostics.set(diagnostic::delay_grid, grid);
+    r.diagnostics.set(diagnostic::delay_grid_mse, grid_cost);
   }
   r.summary.iterations = run.iterations;
   set_termination(r, run.rank_deficient, run.converged, options.tolerance, options.max_iterations,
@@ -611,8 +611,8 @@ Result<MisoModel> srivc_miso_in_units(const Records& ds, const std::vector<TfOrd
   const double sigma2 = r.fit.mse * total / std::max(1, total - p);
   r.parameters.set_covariance(failed ? Eigen::MatrixXd() : internal::covariance(information, sigma2));
   r.diagnostics.condition_number = last.sol.condition;
-  r.diagnostics.scalars["noise_variance"] = sigma2;
-  if (E > 1) r.diagnostics.scalars["experiments"] = E;
+  r.diagnostics.set(diagnostic::noise_variance, sigma2);
+  if (E > 1) r.diagnostics.set(diagnostic::experiments, E);
   r.summary.iterations = std::min(it, opt.max_iterations);
   set_termination(r, failed, converged, opt.tolerance, opt.max_iterations,
                   "the instrumental-variable matrix is singular; the inputs do not excite every parameter");
@@ -766,14 +766,14 @@ Result<TransferFunction> srivc_closed_loop_in_units(const std::vector<IdData>& d
     r.parameters.set_covariance({});
   }
   r.diagnostics.condition_number = run.sol.condition;
-  r.diagnostics.scalars["noise_variance"] = sigma2;
-  if (E > 1) r.diagnostics.scalars["experiments"] = static_cast<double>(E);
+  r.diagnostics.set(diagnostic::noise_variance, sigma2);
+  if (E > 1) r.diagnostics.set(diagnostic::experiments, static_cast<double>(E));
   // The sandwich assumes white noise. Coloured noise (why CLSRIVC is used) makes it too small, by about
   // sqrt((1 + rho)/(1 - rho)) for AR(1) noise of lag-1 correlation rho: say so when that exceeds 1.5.
   const Eigen::VectorXd err = y_all - sim_all;
   const double e0 = err.squaredNorm();
   const double rho = err.size() > 1 && std::isfinite(e0) && e0 > 0 ? residual_autocorrelation(err, 1).values(1) : 0.0;
-  r.diagnostics.scalars["output_error_lag1_correlation"] = rho;
+  r.diagnostics.set(diagnostic::output_error_lag1_correlation, rho);
   if (rho > 0.4)
     r.diagnostics.warnings.push_back(detail::format(
         "the output error is correlated (lag-1 correlation {}): the standard deviations assume white noise and may be "

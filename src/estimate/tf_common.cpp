@@ -165,13 +165,14 @@ void TfNormalisation::restore_common(ParameterSet& p, const Eigen::VectorXd& fac
   fit.aic += lv;
   fit.aicc += lv;
   fit.bic += lv;
-  auto& sc = dg.scalars;
-  if (sc.count("delay")) sc["delay"] *= c;
-  if (sc.count("noise_variance")) sc["noise_variance"] *= v;
-  auto& vs = dg.vectors;
-  if (vs.count("delay_grid")) vs["delay_grid"] *= c;
-  if (vs.count("delay_grid_mse")) vs["delay_grid_mse"] *= v;
-  sc["time_scale"] = c;
+  auto scale = [&dg](const auto& key, double factor) {
+    if (dg.has(key)) dg.set(key, dg.get(key) * factor);
+  };
+  scale(diagnostic::delay, c);
+  scale(diagnostic::noise_variance, v);
+  scale(diagnostic::delay_grid, c);
+  scale(diagnostic::delay_grid_mse, v);
+  dg.set(diagnostic::time_scale, c);
 }
 
 void finish_tf_result(Result<TransferFunction>& r, const IdData& d) {

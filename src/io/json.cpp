@@ -297,9 +297,9 @@ std::string result_json(const Result<M>& r, const std::string& method, int inden
   d["condition_number"] = num(r.diagnostics.condition_number);
   d["warnings"] = r.diagnostics.warnings;
   d["scalars"] = json::object();
-  for (const auto& [k, v] : r.diagnostics.scalars) d["scalars"][k] = num(v);
+  for (const auto& [k, v] : r.diagnostics.scalars()) d["scalars"][k] = num(v);
   d["vectors"] = json::object();
-  for (const auto& [k, v] : r.diagnostics.vectors) d["vectors"][k] = vec(v);
+  for (const auto& [k, v] : r.diagnostics.vectors()) d["vectors"][k] = vec(v);
   j["diagnostics"] = d;
   return j.dump(indent);
 }
@@ -369,8 +369,8 @@ void read_envelope(const json& j, const Reader& rd, Result<M>& r) {
       const json& d = j.at("diagnostics");
       r.diagnostics.condition_number = to_num(d.at("condition_number"));
       r.diagnostics.warnings = d.at("warnings").get<std::vector<std::string>>();
-      for (const auto& [k, v] : d.at("scalars").items()) r.diagnostics.scalars[k] = to_num(v);
-      for (const auto& [k, v] : d.at("vectors").items()) r.diagnostics.vectors[k] = rd.vector(v, "diagnostics.vectors");
+      for (const auto& [k, v] : d.at("scalars").items()) r.diagnostics.set_stored(k, to_num(v));
+      for (const auto& [k, v] : d.at("vectors").items()) r.diagnostics.set_stored(k, rd.vector(v, "diagnostics.vectors"));
     }
   } catch (const json::exception& e) {
     rd.fail(std::string("malformed result: ") + e.what());

@@ -308,29 +308,34 @@ void overview(Page& page, const IdData& d, const Result<M>& r, const ReportOptio
   page.plot({"Output", "time (s)", "y", t, {{"y", pick(d.y().col(0), k)}}});
 }
 
-// Method-specific numbers (Diagnostics::scalars and short vectors), e.g. SRIVC's delay, the LSSVF filter
-// constant, KIA's GLS iterations, and the modal-function diagnostics (condition of each order's regression).
+// Method-specific numbers (the declared diagnostics the fit reported, with their units and meanings), e.g.
+// SRIVC's delay, the LSSVF filter constant, KIA's GLS iterations, and the modal-function diagnostics (condition of
+// each order's regression).
 void diagnostics(Page& page, const Diagnostics& g) {
   std::vector<std::vector<std::string>> rows;
-  for (const auto& [k, v] : g.scalars) rows.push_back({k, fmt(v)});
-  for (const auto& [k, v] : g.vectors) {
+  auto row = [&](const std::string& name, const std::string& value) {
+    const DiagnosticInfo* d = find_diagnostic(name);
+    rows.push_back({name, value, d ? d->unit : "", d ? d->doc : ""});
+  };
+  for (const auto& [k, v] : g.scalars()) row(k, fmt(v));
+  for (const auto& [k, v] : g.vectors()) {
     if (v.size() == 0 || v.size() > 24) continue;
     std::string s;
     for (Eigen::Index i = 0; i < v.size(); ++i) s += (i ? ", " : "") + fmt(v(i), 4);
-    rows.push_back({k, s});
+    row(k, s);
   }
   if (rows.empty()) return;
   page.section("Diagnostics");
-  const auto cond = g.vectors.find("condition_by_order");
-  if (cond != g.vectors.end()) {
+  if (g.has(diagnostic::condition_by_order)) {
+    const Eigen::VectorXd& cond = g.get(diagnostic::condition_by_order);
     page.text("Modal functions (El-Shafey): condition_by_order is the condition number of the modal regression of each "
               "order j = 0, 1, .. (large values: the shifts or windows do not separate the modes; the estimate of that "
               "order is unreliable).");
-    Eigen::VectorXd j = Eigen::VectorXd::LinSpaced(cond->second.size(), 0, static_cast<double>(cond->second.size() - 1));
+    Eigen::VectorXd j = Eigen::VectorXd::LinSpaced(cond.size(), 0, static_cast<double>(cond.size() - 1));
     page.plot({"Modal regressions: log10 of the condition number by order", "order j", "log10 condition", j,
-               {{"log10 cond", cond->second.array().log10().matrix()}}, false, true});
+               {{"log10 cond", cond.array().log10().matrix()}}, false, true});
   }
-  page.table({"diagnostic", "value"}, rows);
+  page.table({"diagnostic", "value", "unit", "meaning"}, rows);
 }
 
 void parameters(Page& page, const ParameterSet& p, const Eigen::VectorXd* err = nullptr) {
@@ -431,9 +436,8 @@ double nyquist(const IdData& d) { return d.is_uniform() ? std::numbers::pi / d.t
 // where it stops being finite, with the reason.
 Eigen::VectorXd simulated(Page& page, const IdData& d, const AnyModel& m, const Diagnostics& g, const ReportOptions& o) {
   SimulateOptions so;
-  const auto x0 = g.vectors.find("x0");
   so.initial = o.initial ? *o.initial : fit_initial_condition(m, g);
-  if (so.initial == InitialCondition::Estimated && x0 != g.vectors.end()) so.x0 = x0->second;
+  if (so.initial == InitialCondition::Estimated && g.has(diagnostic::x0)) so.x0 = g.get(diagnostic::x0);
   const Simulation s = simulate(m, d, so);
   page.text("Simulated from the initial condition: " + std::string(to_string(so.initial)) + ".");
   if (!s.ok()) page.text("<span class=\"warn\">" + escape(s.problem) + "</span>");
@@ -552,11 +556,10 @@ std::string html_report(const IdData& d, const Result<NarxModel>& r, const Repor
   const int L = std::min(p.max_lag(), d.size());
   validation(page, d, simulated(page, d, r.model, r.diagnostics, o), o);
   more_records(page, r.model, o);
-  const auto err = r.diagnostics.vectors.find("err");
   page.section("Selected terms");
   page.text("Terms in the order of selection by forward orthogonal least squares; ERR: the error reduction ratio "
             "(share of the output energy explained by the term).");
-  parameters(page, r.parameters, err == r.diagnostics.vectors.end() ? nullptr : &err->second);
+  parameters(page, r.parameters, r.diagnostics.has(diagnostic::err) ? &r.diagnostics.get(diagnostic::err) : nullptr);
   diagnostics(page, r.diagnostics);
   const bool zoh = d.intersample(0) == Intersample::Zoh;
   const double nyq = std::numbers::pi / p.ts();
@@ -589,9 +592,8 @@ std::string html_report(const IdData& d, const Result<NdeModel>& r, const Report
   const Eigen::VectorXd u = d.u().col(0);
   validation(page, d, simulated(page, d, m, r.diagnostics, o), o);
   more_records(page, m, o);
-  const auto err = r.diagnostics.vectors.find("err");
-  parameters(page, r.parameters,
-             err == r.diagnostics.vectors.end() || err->second.size() != r.parameters.size() ? nullptr : &err->second);
+  const Eigen::VectorXd* err = r.diagnostics.has(diagnostic::err) ? &r.diagnostics.get(diagnostic::err) : nullptr;
+  parameters(page, r.parameters, err && err->size() == r.parameters.size() ? err : nullptr);
   diagnostics(page, r.diagnostics);
   const Eigen::VectorXd w = frequency_grid(m.a().roots(), nyquist(d));
   Eigen::VectorXcd h(w.size());

@@ -26,7 +26,7 @@ InitialCondition initial_condition_from_string(const std::string& name) {
 
 InitialCondition fit_initial_condition(const AnyModel& model, const Diagnostics& diagnostics) {
   if (std::holds_alternative<NarxModel>(model)) return InitialCondition::Measured;
-  return diagnostics.vectors.contains("x0") ? InitialCondition::Estimated : InitialCondition::Rest;
+  return diagnostics.has(diagnostic::x0) ? InitialCondition::Estimated : InitialCondition::Rest;
 }
 
 namespace {

@@ -333,7 +333,7 @@ TEST(Cli, ClosedLoopFit) {
   const auto lib = srivc_closed_loop(std::vector<IdData>{IdData(m.col(2), m.col(3), Ts), IdData(m2.col(2), m2.col(3), Ts)},
                                      {r, m2.col(1)}, {2, 2, 0}, o);
   const auto joint = parse_result_json(read_text_file(json));
-  EXPECT_EQ(joint.diagnostics.scalars.at("experiments"), 2.0);
+  EXPECT_EQ(joint.diagnostics.get(diagnostic::experiments), 2.0);
   for (int i = 0; i < lib.parameters.size(); ++i)
     EXPECT_NEAR(joint.parameters.values(i), lib.parameters.values(i), 1e-9 * std::abs(lib.parameters.values(i)));
   for (const auto& [name, value] : {std::pair{"a1", 0.5}, {"a2", 1.0}, {"b0", 1.0}, {"b1", 1.0}})

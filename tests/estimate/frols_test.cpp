@@ -79,13 +79,13 @@ TEST(Frols, FindsTheTrueStructureOnNoiseFreeData) {
   const auto r = frols(d, narx_candidates(2, 2, 2), {.max_terms = 10, .err_tolerance = 1e-14});
   ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_EQ(names(r.model), names(truth()));
-  EXPECT_LT(r.diagnostics.scalars.at("esr"), 1e-14);
+  EXPECT_LT(r.diagnostics.get(diagnostic::esr), 1e-14);
   for (size_t i = 0; i < r.model.terms().size(); ++i)
     for (size_t j = 0; j < truth().terms().size(); ++j)
       if (r.model.terms()[i] == truth().terms()[j])
         EXPECT_NEAR(r.model.coefficients()(i), truth().coefficients()(j), 1e-10) << r.model.terms()[i].name();
   EXPECT_GT(r.fit.fit_percent, 99.999);
-  EXPECT_NEAR(r.diagnostics.vectors.at("err").sum(), 100.0, 1e-9);
+  EXPECT_NEAR(r.diagnostics.get(diagnostic::err).sum(), 100.0, 1e-9);
 }
 
 TEST(Frols, CoefficientsEqualLeastSquaresOnTheSelectedColumnsAndCriteriaPickTheSize) {
@@ -103,7 +103,7 @@ TEST(Frols, CoefficientsEqualLeastSquaresOnTheSelectedColumnsAndCriteriaPickTheS
     for (int i = 0; i < r.parameters.size(); ++i)
       if (!want.count(r.parameters.names[i]))
         EXPECT_LT(std::abs(r.parameters.values(i)), 4 * r.parameters.std(i)) << r.parameters.names[i];
-    EXPECT_EQ(r.diagnostics.vectors.at("criterion").size(), 15);
+    EXPECT_EQ(r.diagnostics.get(diagnostic::criterion).size(), 15);
     // Least squares on the same columns and rows.
     const Eigen::Index L = 3, Ne = d.size() - L;
     Eigen::MatrixXd P(Ne, r.model.terms().size());

@@ -68,12 +68,12 @@ TEST(Fsf, WithNEqualToNReproducesAnyFirExactly) {
   EXPECT_EQ(r.fit.n_samples, 2000);
   EXPECT_LT(r.fit.nrmse, 1e-9);
   EXPECT_EQ(r.fit.mse, fit_report_or_inf(y, r.model.simulate(u), N).mse);
-  EXPECT_NEAR(r.diagnostics.scalars.at("regression_fit_percent"), 100.0, 1e-7);
+  EXPECT_NEAR(r.diagnostics.get(diagnostic::regression_fit_percent), 100.0, 1e-7);
   // With noise (SNR about 10), the two figures differ only by the regression's scaling (b = 0, no window: the
   // FIR model's prediction is its simulation from rest): equal to 1e-9.
   const Eigen::VectorXd noisy = y + white_noise(2000, 0.3 * std::sqrt(y.squaredNorm() / 2000), 4);
   const auto rn = fsf(IdData(u, noisy, 0.1), {.T = N * 0.1, .n = 11});
-  EXPECT_NEAR(rn.fit.fit_percent, rn.diagnostics.scalars.at("regression_fit_percent"), 1e-9);
+  EXPECT_NEAR(rn.fit.fit_percent, rn.diagnostics.get(diagnostic::regression_fit_percent), 1e-9);
 }
 
 TEST(Fsf, EstimatesEqualThoseFromDirectFirRegressors) {
@@ -171,7 +171,7 @@ TEST(Fsf, UnstableCircuitStandInCompressesToTheShiftedStepResponse) {
     // The model is G(s + a), not the system: no simulation fit (n_samples 0), the windowed regression's figure
     // under its own name (measured 85.4 % for n = 11: the FSF truncation of the windowed record, noise-free).
     EXPECT_EQ(r.fit.n_samples, 0);
-    EXPECT_GT(r.diagnostics.scalars.at("regression_fit_percent"), 80.0);
+    EXPECT_GT(r.diagnostics.get(diagnostic::regression_fit_percent), 80.0);
   }
   EXPECT_NEAR(fsf_settling_time(TransferFunction(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 0.0, -1.0}}), 2.0), 8.0, 2.5);
 }

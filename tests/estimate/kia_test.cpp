@@ -27,7 +27,7 @@ NarxModel bl34() {  // Billings & Li (1999) model (34) as printed (SEEDS-SPEC BL
 
 double value(const Result<NdeModel>& r, const std::string& name) { return r.parameters.value(name); }
 double err(const Result<NdeModel>& r, const std::string& name) {
-  return r.diagnostics.vectors.at("err")(r.parameters.index(name));
+  return r.diagnostics.get(diagnostic::err)(r.parameters.index(name));
 }
 }  // namespace
 
@@ -44,7 +44,7 @@ TEST(Kia, LinearStageReproducesTable2) {
     EXPECT_NEAR(value(r, "u"), -0.96325, 0.01 * 0.96325) << seed;
     EXPECT_GT(err(r, "D^2y"), err(r, "u"));
     EXPECT_GT(err(r, "u"), err(r, "Dy"));
-    EXPECT_GT(r.diagnostics.scalars.at("err_sum"), 99.9);
+    EXPECT_GT(r.diagnostics.get(diagnostic::err_sum), 99.9);
   }
 }
 
@@ -55,7 +55,7 @@ TEST(Kia, OverParameterisedThenPrunedByErr) {
   const auto all = kia_linear(m, {.y_order = 4, .u_order = 2, .zoh = false});
   std::vector<std::pair<double, std::string>> ranked;
   for (int i = 0; i < all.parameters.size(); ++i)
-    ranked.emplace_back(all.diagnostics.vectors.at("err")(i), all.parameters.names[i]);
+    ranked.emplace_back(all.diagnostics.get(diagnostic::err)(i), all.parameters.names[i]);
   std::sort(ranked.rbegin(), ranked.rend());
   EXPECT_EQ(ranked[0].second, "u");
   EXPECT_EQ(ranked[1].second, "D^2y");
@@ -262,9 +262,9 @@ TEST(Kia, ErrChoosesTheGlsFilterOrder) {
   const NarxModel m = bl34();
   const auto chosen = kia_linear(m, {.y_order = 2, .u_order = 0, .gls_order = -1, .zoh = false});
   const auto ten = kia_linear(m, {.y_order = 2, .u_order = 0, .zoh = false});
-  const double G = chosen.diagnostics.scalars.at("gls_order");
+  const double G = chosen.diagnostics.get(diagnostic::gls_order);
   EXPECT_GE(G, 8);
   EXPECT_LE(G, 12);
-  EXPECT_GE(chosen.diagnostics.scalars.at("err_sum"), 99.99);
+  EXPECT_GE(chosen.diagnostics.get(diagnostic::err_sum), 99.99);
   for (const char* s : {"D^2y", "Dy", "u"}) EXPECT_NEAR(value(chosen, s), value(ten, s), 0.01 * std::abs(value(ten, s))) << s;
 }

@@ -63,16 +63,16 @@ TEST(Lssvf, NoiseFreeRecoveryConvergesAsTsSquared) {
   EXPECT_GT(fine.fit.fit_percent, 99.99);
   EXPECT_LT(fine.diagnostics.condition_number, 100.0);
   // theta_tau reported in diagnostics is the exact transform of the estimate.
-  const Eigen::VectorXd tt = fine.diagnostics.vectors.at("theta_tau");
+  const Eigen::VectorXd tt = fine.diagnostics.get(diagnostic::theta_tau);
   EXPECT_NEAR(tt(0), -(1.2 * 0.5 - 2), 1e-4);  // -alpha_1 = -(a1 tau - 2)
 }
 
 TEST(Lssvf, AutomaticTauAndWeightsAndExtraFilter) {
   const IdData d = simulate(kG, 0.001, 60);
   const auto autotau = lssvf(d, {2, 2, 0});
-  EXPECT_GT(autotau.diagnostics.scalars.at("tau"), 0.002);
+  EXPECT_GT(autotau.diagnostics.get(diagnostic::tau), 0.002);
   EXPECT_LT(max_rel_error(autotau, kTruth), 3e-6);
-  EXPECT_EQ(autotau.diagnostics.vectors.at("tau_grid").size(), 12);
+  EXPECT_EQ(autotau.diagnostics.get(diagnostic::tau_grid).size(), 12);
   LssvfOptions o;
   o.tau = 0.3;
   o.weights = SvfWeights::Trapezoidal;
@@ -224,7 +224,7 @@ TEST(RlsSvf, SeveralRecordsInTurnGiveOneEstimate) {
   o.p0 = 1e8;
   const auto exact = rls_svf(std::vector<IdData>{IdData(ua, xa, Ts), IdData(ub, xb, Ts)}, {2, 2, 0}, o);
   EXPECT_LT(max_rel_error(exact, kTruth), 2e-4);
-  EXPECT_EQ(exact.diagnostics.scalars.at("experiments"), 2);
+  EXPECT_EQ(exact.diagnostics.get(diagnostic::experiments), 2);
   const int R = 30;
   Eigen::MatrixXd e1(R, 4), e2(R, 4), ej(R, 4);
   for (int run = 0; run < R; ++run) {

@@ -603,8 +603,8 @@ TEST(ModalFit, SeveralRecordsArePooledIntoOneEstimateMoreAccurateThanEither) {
     EXPECT_NEAR(r.model.num().coefficient_of_power(0), 52.0, 1e-4);
     EXPECT_GT(r.fit.fit_percent, 99.999);
     EXPECT_EQ(r.fit.n_samples, a.size() + b.size());
-    EXPECT_EQ(r.diagnostics.scalars.at("experiments"), 2);
-    EXPECT_EQ(r.diagnostics.scalars.at("windows"), 8 + 4);  // one window per level: 8 in a, 4 in b
+    EXPECT_EQ(r.diagnostics.get(diagnostic::experiments), 2);
+    EXPECT_EQ(r.diagnostics.get(diagnostic::windows), 8 + 4);  // one window per level: 8 in a, 4 in b
   }
   // Refusals: explicit windows are times of one record; a generated input belongs to one record.
   EXPECT_THROW(modal_fit(std::vector<IdData>{a, b}, 2, {.shifts = shifts, .windows = {{0.5, 0.2}}}), InvalidArgument);

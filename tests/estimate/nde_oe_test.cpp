@@ -62,7 +62,7 @@ TEST(NdeOe, RecoversCoefficientsAndInitialStateFromAPerturbedStart) {
   EXPECT_TRUE(r.parameters.fixed[static_cast<size_t>(r.parameters.index("y"))]);
   EXPECT_EQ(r.parameters.std(r.parameters.index("y")), 0.0);
   EXPECT_GT(r.fit.fit_percent, 99.99);
-  EXPECT_DOUBLE_EQ(r.diagnostics.scalars.at("start_scale"), 1.0);
+  EXPECT_DOUBLE_EQ(r.diagnostics.get(diagnostic::start_scale), 1.0);
   EXPECT_TRUE(r.diagnostics.warnings.empty());
 }
 
@@ -84,8 +84,8 @@ TEST(NdeOe, SeveralRecordsShareTheCoefficientsAndKeepTheirOwnInitialStates) {
   EXPECT_NEAR(r.parameters.value("r1.y(0)"), 0.3, 1e-6);
   EXPECT_NEAR(r.parameters.value("r2.y(0)"), -0.2, 1e-6);
   EXPECT_NEAR(r.parameters.value("r2.Dy(0)"), 15.0, 1e-3);
-  EXPECT_NEAR(r.diagnostics.vectors.at("x0_2")(1), 15.0, 1e-3);
-  EXPECT_NEAR(r.diagnostics.vectors.at("x0")(1), -20.0, 1e-3);
+  EXPECT_NEAR(r.diagnostics.get(diagnostic::x0, 1)(1), 15.0, 1e-3);
+  EXPECT_NEAR(r.diagnostics.get(diagnostic::x0)(1), -20.0, 1e-3);
   EXPECT_GT(r.fit.fit_percent, 99.99);
   std::mt19937 rng(21);
   const IdData na = with_noise(a, rng), nb = with_noise(b, rng);
@@ -168,7 +168,7 @@ TEST(NdeOe, SensitivitiesAgreeWithFiniteDifferences) {
     b(j) -= h;
     J.col(j) = (sim(a) - sim(b)) / (2 * h);
   }
-  const double sigma2 = r.diagnostics.scalars.at("noise_variance");
+  const double sigma2 = r.diagnostics.get(diagnostic::noise_variance);
   const Eigen::MatrixXd C = sigma2 * (J.transpose() * J).inverse();
   for (int i = 0; i < p; ++i)
     for (int j = 0; j < p; ++j)  // covariances, not just variances: a column with the wrong sign changes only these
@@ -186,7 +186,7 @@ TEST(NdeOe, StartThatEscapesIsShrunkTowardsItsLinearPart) {
   ASSERT_FALSE(bad.ok());
   const auto r = nde_oe(d, bl33(-0.06), {.estimate_initial_state = false});
   ASSERT_TRUE(r.usable()) << r.why_not_usable();
-  EXPECT_LT(r.diagnostics.scalars.at("start_scale"), 1.0);
+  EXPECT_LT(r.diagnostics.get(diagnostic::start_scale), 1.0);
   ASSERT_EQ(r.diagnostics.warnings.size(), 1u);
   EXPECT_NEAR(r.model.coefficient("y*Dy"), -0.006, 1e-4 * 0.006);
   EXPECT_NEAR(r.model.coefficient("y^2"), 0.1, 1e-4 * 0.1);

@@ -1,4 +1,6 @@
 // The options tables (estimate/options.hpp) and the method registry (estimate/methods.hpp), issue 14 item 3.
+#include <array>
+#include <numbers>
 #include <functional>
 #include <set>
 
@@ -133,4 +135,70 @@ TEST(Options, ValidateUsesTheTableAndKeepsCrossFieldRules) {
   s.delay_min = 2;
   s.delay_max = 1;
   EXPECT_NE(error_of([&] { s.validate(); }).find("the delay range [2, 1] s is empty"), std::string::npos);
+}
+
+// Issue 14 (item 5, typed diagnostics): every method-specific diagnostic a method's result reports is one the
+// registry declares for that method (MethodInfo::diagnostics), every declared name is in the catalogue, and a
+// result file's diagnostics are read back only under declared names.
+TEST(Options, EveryReportedDiagnosticIsDeclaredForItsMethod) {
+  for (const auto& m : methods())
+    for (const auto& d : m.diagnostics) EXPECT_NE(find_diagnostic(d), nullptr) << m.name << ": " << d;
+  std::set<std::string> names;
+  for (const auto& d : diagnostic_catalogue()) EXPECT_TRUE(names.insert(d.name).second) << "twice: " << d.name;
+  EXPECT_NE(find_diagnostic("x0_3"), nullptr);  // per record
+  EXPECT_EQ(find_diagnostic("tau_2"), nullptr);  // tau is one value per fit
+  EXPECT_EQ(find_diagnostic("taus"), nullptr);
+
+  // Two records of 3/(s^2 + 1.2 s + 4) (PRBS and two sines, 0.02 s, 600 samples, noise 0.02).
+  const TransferFunction g(Eigen::VectorXd{{3.0}}, Eigen::VectorXd{{1.0, 1.2, 4.0}});
+  const int N = 600;
+  const Eigen::VectorXd t = time_grid(0.02, N);
+  const Eigen::VectorXd u1 = prbs(N, {.register_length = 7, .clock_period = 5});
+  Eigen::VectorXd u2(N);
+  for (int k = 0; k < N; ++k) u2(k) = std::sin(1.1 * t(k)) + 0.5 * std::sin(3.7 * t(k));
+  const IdData a(u1, lsim(g, u1, t) + white_noise(N, 0.02, 1), 0.02), b(u2, lsim(g, u2, t) + white_noise(N, 0.02, 2), 0.02);
+  const std::vector<IdData> ab{a, b};
+  const TfOrders o{1, 2, 0};
+  auto check = [](const std::string& method, const Diagnostics& dg) {
+    const auto& declared = method_info(method).diagnostics;
+    auto has = [&](const std::string& k) {
+      const DiagnosticInfo* d = find_diagnostic(k);
+      return d && std::find(declared.begin(), declared.end(), d->name) != declared.end();
+    };
+    for (const auto& [k, v] : dg.scalars()) EXPECT_TRUE(has(k)) << method << " reports undeclared scalar " << k;
+    for (const auto& [k, v] : dg.vectors()) EXPECT_TRUE(has(k)) << method << " reports undeclared vector " << k;
+    return dg.scalars().size() + dg.vectors().size();
+  };
+  EXPECT_GE(check("lssvf", lssvf(ab, o).diagnostics), 4u);
+  EXPECT_GE(check("ivsvf", ivsvf(a, o).diagnostics), 3u);
+  EXPECT_GE(check("rls_svf", rls_svf(ab, o).diagnostics), 2u);
+  EXPECT_GE(check("srivc", srivc(ab, o, {.estimate_delay = true}).diagnostics), 5u);
+  EXPECT_GE(check("oe", oe(ab, o).diagnostics), 3u);
+  EXPECT_GE(check("tfest", tfest(a, o).diagnostics), 4u);
+  const Eigen::MatrixXd u12 = (Eigen::MatrixXd(N, 2) << u1, u2).finished();
+  const IdData miso(u12, lsim(g, u1, t) + lsim(g, u2, t) + white_noise(N, 0.02, 3), 0.02);
+  EXPECT_GE(check("srivc_miso", srivc_miso(miso, {o, o}).diagnostics), 1u);
+  EXPECT_GE(check("fsf", fsf(a, {.T = 6.0, .n = 21}).diagnostics), 4u);
+  const PhysicalModel pm("k/(s^2 + c*s + k)", {"k", "c"});
+  EXPECT_GE(check("physical", fit_physical_raw(pm, {{"k", 3.0}, {"c", 1.0}}, ab).diagnostics), 3u);
+  NarxOptions no;
+  no.degree = 1;
+  EXPECT_GE(check("narx", narx(ab, no).diagnostics), 2u);
+  // modal on a piecewise-constant record of S3 (El-Shafey Ex. 5.2 levels).
+  const TransferFunction s3(Eigen::VectorXd{{13.0, 52.0}}, Eigen::VectorXd{{1.0, 4.0, 30.0, 52.0}});
+  const double Ts = std::numbers::pi / 320;
+  Eigen::VectorXd us(1280);
+  for (int i = 0; i < 1280; ++i) us(i) = std::array<double, 4>{1, 2, -1, -2}[(i / 80) % 4];
+  const IdData steps(us, lsim(s3, us, time_grid(Ts, 1280)), Ts);
+  EXPECT_GE(check("modal", modal_fit(std::vector<IdData>{steps, steps}, 2, {.shifts = Eigen::Vector3d(16, 32, 48) * Ts})
+                               .diagnostics),
+            3u);
+
+  // Reading back: a result file with an undeclared diagnostic is refused by name.
+  Diagnostics dg;
+  EXPECT_THROW(dg.set_stored("taus", 1.0), InvalidArgument);
+  EXPECT_THROW(dg.set_stored("tau", Eigen::VectorXd::Ones(2)), InvalidArgument);  // declared as a scalar
+  dg.set_stored("x0_2", Eigen::VectorXd::Ones(2));
+  EXPECT_EQ(dg.get(diagnostic::x0, 1).size(), 2);
+  EXPECT_EQ(error_of([&] { dg.get(diagnostic::tau); }), "diagnostic 'tau' was not reported by this fit");
 }

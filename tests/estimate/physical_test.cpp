@@ -148,7 +148,7 @@ TEST(GawthropWang, UnstableCircuitTwoStageReachesThePhysicalParameters) {
   }
   const auto raw = fit_physical_raw(m, start, d, 2.0);
   EXPECT_LT((raw.parameters.values.array() - 1.0).abs().maxCoeff(), 1e-6);
-  EXPECT_NEAR(raw.diagnostics.scalars.at("max_pole_real_part"), 1.0, 1e-6);  // poles +-1 < a = 2: no window warning
+  EXPECT_NEAR(raw.diagnostics.get(diagnostic::max_pole_real_part), 1.0, 1e-6);  // poles +-1 < a = 2: no window warning
   for (const auto& w : raw.diagnostics.warnings) EXPECT_EQ(w.find("does not exceed"), std::string::npos) << w;
   // The options' constraint vocabulary (fixed.NAME, bounds.NAME, as for oe) is the declarations': k2 fixed at its
   // true value 1 leaves k1 = 1 (to 1e-6) with k2's std 0; the same through a PhysicalParameter declaration gives the
@@ -205,7 +205,7 @@ TEST(GawthropWang, RawRouteOnSeveralRecordsIsOneFitMoreAccurateThanEither) {
   const Eigen::VectorXd xa = lsim(g, ua, t), xb = lsim(g, ub, t);
   const auto exact = fit_physical_raw(m, start, std::vector<IdData>{IdData(ua, xa, 0.02), IdData(ub, xb, 0.02)});
   EXPECT_LT((exact.parameters.values - truth).cwiseAbs().maxCoeff(), 1e-6);
-  EXPECT_EQ(exact.diagnostics.scalars.at("experiments"), 2);
+  EXPECT_EQ(exact.diagnostics.get(diagnostic::experiments), 2);
   const int R = 100;
   Eigen::MatrixXd e1(R, 3), e2(R, 3), ej(R, 3), sj(R, 3);
   for (int run = 0; run < R; ++run) {
@@ -256,7 +256,7 @@ TEST(GawthropWang, BallAndBeamWithinOnePercentAndBPositiveDegrades) {
   EXPECT_NEAR(r0.parameters.value("K"), 2.5, 0.025);
   // Linear in K: the paper reports one LM step; LM needs a few more to meet its stopping test.
   EXPECT_LE(r0.summary.iterations, 6);
-  EXPECT_NEAR(r0.diagnostics.vectors.at("cost_history")(1), r0.diagnostics.scalars.at("cost"), 1e-3 * r0.diagnostics.vectors.at("cost_history")(0));
+  EXPECT_NEAR(r0.diagnostics.get(diagnostic::cost_history)(1), r0.diagnostics.get(diagnostic::cost), 1e-3 * r0.diagnostics.get(diagnostic::cost_history)(0));
   const auto c9 = fsf(data, {.T = 10.0, .n = 21, .a = 1.0, .b = 0.9});
   ASSERT_FALSE(c9.diagnostics.warnings.empty());
   const auto r9 = fit_physical_step(m, {{"K", 1.0}}, c9.model);

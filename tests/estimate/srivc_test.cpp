@@ -142,7 +142,7 @@ TEST(Srivc, MonteCarloMatchesTheCramerRaoBound) {
 TEST(Srivc, ReportedStdAgreesWithCrlbAndTfestMatchesSrivcAtTenDb) {
   const IdData d = rao_data(10.0, 7);
   const auto r = srivc(d, {2, 4, 0});
-  const double sigma2 = r.diagnostics.scalars.at("noise_variance");
+  const double sigma2 = r.diagnostics.get(diagnostic::noise_variance);
   const Eigen::MatrixXd bound = crlb(r.model, 2, d, sigma2);
   for (int i = 0; i < 6; ++i) EXPECT_NEAR(r.parameters.std(i) / std::sqrt(bound(i, i)), 1.0, 0.05) << i;
   // SRIVC is (asymptotically) the OE optimum: the LM refinement moves it by a fraction of a std.
@@ -300,7 +300,7 @@ TEST(SrivcMiso, SeveralExperimentsGiveOneEstimateMoreAccurateThanEither) {
   const auto exact = srivc_miso(std::vector<IdData>{IdData(u1, x1, Ts), IdData(u2, x2, Ts)}, orders);
   ASSERT_EQ(exact.summary.termination, Termination::Converged) << exact.summary.message;
   EXPECT_LT(max_rel(exact.parameters.values, truth), 1e-6);
-  EXPECT_EQ(exact.diagnostics.scalars.at("experiments"), 2);
+  EXPECT_EQ(exact.diagnostics.get(diagnostic::experiments), 2);
   const int R = 30;
   Eigen::MatrixXd e1(R, 6), e2(R, 6), ej(R, 6), sj(R, 6);
   std::mt19937_64 rng(99);
@@ -400,7 +400,7 @@ TEST(SrivcClosedLoop, ConsistentWhereOpenLoopSrivcIsBiased) {
     // for this pole): the result says so.
     ASSERT_EQ(c.diagnostics.warnings.size(), 1u);
     EXPECT_NE(c.diagnostics.warnings[0].find("the standard deviations assume white noise"), std::string::npos);
-    EXPECT_NEAR(c.diagnostics.scalars.at("output_error_lag1_correlation"), 0.95, 0.03);
+    EXPECT_NEAR(c.diagnostics.get(diagnostic::output_error_lag1_correlation), 0.95, 0.03);
     cl.row(s) = c.parameters.values.transpose();
   }
   const Eigen::VectorXd truth{{0.5, 1.0, 1.0, 1.0}};
@@ -445,7 +445,7 @@ TEST(SrivcClosedLoop, SeveralExperimentsGiveOneEstimateMoreAccurateThanEither) {
     const auto b = srivc_closed_loop(d[1], refs[1], {2, 2, 0}, o);
     const auto j = srivc_closed_loop(d, refs, {2, 2, 0}, o);
     ASSERT_TRUE(j.usable()) << j.why_not_usable();
-    EXPECT_EQ(j.diagnostics.scalars.at("experiments"), 2.0);
+    EXPECT_EQ(j.diagnostics.get(diagnostic::experiments), 2.0);
     EXPECT_TRUE(j.diagnostics.warnings.empty()) << j.diagnostics.warnings.front();  // white noise: no caveat
     e1.row(s) = (a.parameters.values - truth).transpose();
     e2.row(s) = (b.parameters.values - truth).transpose();
@@ -563,7 +563,7 @@ struct TwoRecords {
       const auto [a, b] = draw();
       const auto r1 = fit(std::vector<IdData>{a}), r2 = fit(std::vector<IdData>{b}), rj = fit(std::vector<IdData>{a, b});
       EXPECT_TRUE(r1.usable() && r2.usable() && rj.usable()) << s << ": " << rj.why_not_usable();
-      EXPECT_EQ(rj.diagnostics.scalars.at("experiments"), 2.0);
+      EXPECT_EQ(rj.diagnostics.get(diagnostic::experiments), 2.0);
       m.e1.row(s) = (r1.parameters.values - truth).transpose();
       m.e2.row(s) = (r2.parameters.values - truth).transpose();
       m.ej.row(s) = (rj.parameters.values - truth).transpose();

@@ -107,8 +107,8 @@ TEST(Json, ModelAndResultRoundTrip) {
   r.summary = Summary{Termination::Converged, "ok", 12, 0.004};
   r.diagnostics.condition_number = 12.5;
   r.diagnostics.warnings = {"w1"};
-  r.diagnostics.scalars["tau"] = 0.5;
-  r.diagnostics.vectors["theta_tau"] = Eigen::VectorXd{{1.0, 2.0}};
+  r.diagnostics.set(diagnostic::tau, 0.5);
+  r.diagnostics.set(diagnostic::theta_tau, Eigen::VectorXd{{1.0, 2.0}});
   const std::string text = result_to_json(r, "lssvf");
   const Result<TransferFunction> q = parse_result_json(text);
   EXPECT_EQ(q.parameters.names, r.parameters.names);
@@ -119,8 +119,8 @@ TEST(Json, ModelAndResultRoundTrip) {
   EXPECT_EQ(q.fit.n_parameters, 6);
   EXPECT_EQ(q.summary.termination, Termination::Converged);
   EXPECT_EQ(q.summary.iterations, 12);
-  EXPECT_EQ(q.diagnostics.scalars.at("tau"), 0.5);
-  EXPECT_EQ(q.diagnostics.vectors.at("theta_tau"), r.diagnostics.vectors.at("theta_tau"));
+  EXPECT_EQ(q.diagnostics.get(diagnostic::tau), 0.5);
+  EXPECT_EQ(q.diagnostics.get(diagnostic::theta_tau), r.diagnostics.get(diagnostic::theta_tau));
   EXPECT_EQ(q.diagnostics.warnings, r.diagnostics.warnings);
   EXPECT_NE(text.find("\"method\": \"lssvf\""), std::string::npos);
   // The envelope is accepted where a model is expected.

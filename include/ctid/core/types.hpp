@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 
+#include "ctid/core/diagnostics.hpp"
 #include "ctid/core/status.hpp"
 
 namespace ctid {
@@ -54,13 +55,6 @@ struct FitReport {
   int n_parameters = 0;
 };
 
-/// Numerical diagnostics of a fit.
-struct Diagnostics {
-  double condition_number = 0.0;             ///< of the column-scaled regressor / information matrix
-  std::vector<std::string> warnings;         ///< things the user should look at; empty when none
-  std::map<std::string, double> scalars;     ///< method-specific numbers (e.g. "tau")
-  std::map<std::string, Eigen::VectorXd> vectors;  ///< method-specific vectors (e.g. "theta_tau")
-};
 
 /// The rules every estimator's result is judged by (docs/guide.md, "When is a fit usable").
 /// Returns "" when all hold, otherwise the first that fails, worded for the user:
