@@ -5,11 +5,6 @@
 namespace ctid::python {
 
 namespace {
-template <class M>
-Result<AnyModel> to_any(const Result<M>& r) {
-  return {AnyModel(r.model), r.parameters, r.fit, r.summary, r.diagnostics};
-}
-
 // The typed Python result (TransferFunctionResult, MisoResult, ...) of a Result<AnyModel>.
 py::object typed(const Result<AnyModel>& r) {
   return std::visit(

@@ -269,12 +269,11 @@ AnyModel any_model_from(const json& root, const Reader& rd) {
 NdeModel read_nde_json(const std::string& path) { return parse_nde_json(read_text_file(path), path); }
 
 namespace {
-template <class M>
-std::string result_json(const Result<M>& r, const std::string& method, int indent) {
+std::string result_json(const Result<AnyModel>& r, const std::string& method, int indent) {
   json j;
   j["ctid_version"] = version();
   j["method"] = method;
-  j["model"] = any_model_json(AnyModel(r.model));
+  j["model"] = any_model_json(r.model);
   json params = json::array();
   for (int i = 0; i < r.parameters.size(); ++i)
     params.push_back({{"name", r.parameters.names[i]},
@@ -304,35 +303,6 @@ std::string result_json(const Result<M>& r, const std::string& method, int inden
   return j.dump(indent);
 }
 }  // namespace
-
-std::string result_to_json(const Result<TransferFunction>& r, const std::string& method, int indent) {
-  return result_json(r, method, indent);
-}
-std::string result_to_json(const Result<MisoModel>& r, const std::string& method, int indent) {
-  return result_json(r, method, indent);
-}
-void write_result_json(const std::string& path, const Result<MisoModel>& r, const std::string& method) {
-  write_text_file(path, result_to_json(r, method) + "\n");
-}
-std::string result_to_json(const Result<FsfModel>& r, const std::string& method, int indent) {
-  return result_json(r, method, indent);
-}
-void write_result_json(const std::string& path, const Result<FsfModel>& r, const std::string& method) {
-  write_text_file(path, result_to_json(r, method) + "\n");
-}
-
-std::string result_to_json(const Result<NarxModel>& r, const std::string& method, int indent) {
-  return result_json(r, method, indent);
-}
-void write_result_json(const std::string& path, const Result<NarxModel>& r, const std::string& method) {
-  write_text_file(path, result_to_json(r, method) + "\n");
-}
-std::string result_to_json(const Result<NdeModel>& r, const std::string& method, int indent) {
-  return result_json(r, method, indent);
-}
-void write_result_json(const std::string& path, const Result<NdeModel>& r, const std::string& method) {
-  write_text_file(path, result_to_json(r, method) + "\n");
-}
 
 namespace {
 // Parameters, fit, summary and diagnostics of a result file (the envelope around its model).
@@ -444,9 +414,6 @@ Result<MisoModel> parse_miso_result_json(const std::string& text, const std::str
   return parse_linear_result<MisoModel>(text, source, "a multi-input (miso) model");
 }
 
-void write_result_json(const std::string& path, const Result<TransferFunction>& r, const std::string& method) {
-  write_text_file(path, result_to_json(r, method) + "\n");
-}
 
 std::string order_selection_to_json(const std::vector<OrderCandidate>& candidates, OrderCriterion rank_by,
                                     bool interrupted, int indent) {

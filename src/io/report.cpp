@@ -457,9 +457,8 @@ void more_records(Page& page, const AnyModel& m, const ReportOptions& o) {
   }
 }
 
-}  // namespace
 
-std::string html_report(const IdData& d, const Result<TransferFunction>& r, const ReportOptions& o) {
+std::string report_of(const IdData& d, const Result<TransferFunction>& r, const ReportOptions& o) {
   CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "html_report: needs one input and one output (got {}, {})", d.nu(), d.ny());
   Page page;
   overview(page, d, r, o, describe(r.model));
@@ -476,7 +475,7 @@ std::string html_report(const IdData& d, const Result<TransferFunction>& r, cons
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }
 
-std::string html_report(const IdData& d, const Result<MisoModel>& r, const ReportOptions& o) {
+std::string report_of(const IdData& d, const Result<MisoModel>& r, const ReportOptions& o) {
   CTID_REQUIRE(d.ny() == 1 && d.nu() == r.model.nu(), "html_report: the model has {} inputs and 1 output (data: {}, {})",
                r.model.nu(), d.nu(), d.ny());
   Page page;
@@ -496,7 +495,7 @@ std::string html_report(const IdData& d, const Result<MisoModel>& r, const Repor
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }
 
-std::string html_report(const IdData& d, const Result<FsfModel>& r, const ReportOptions& o) {
+std::string report_of(const IdData& d, const Result<FsfModel>& r, const ReportOptions& o) {
   CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "html_report: needs one input and one output (got {}, {})", d.nu(), d.ny());
   Page page;
   const FsfModel& m = r.model;
@@ -530,7 +529,6 @@ std::string html_report(const IdData& d, const Result<FsfModel>& r, const Report
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }
 
-namespace {
 // |H_2(j w1, j w2)| on a grid (w1, w2 in (0, wmax]) of a kernel function.
 template <class F>
 Heatmap h2_map(F h2, double wmax, const std::string& what) {
@@ -545,9 +543,8 @@ Heatmap h2_map(F h2, double wmax, const std::string& what) {
     }
   return m;
 }
-}  // namespace
 
-std::string html_report(const IdData& d, const Result<NarxModel>& r, const ReportOptions& o) {
+std::string report_of(const IdData& d, const Result<NarxModel>& r, const ReportOptions& o) {
   CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "html_report: needs one input and one output (got {}, {})", d.nu(), d.ny());
   Page page;
   const NarxModel p = r.model.process();
@@ -584,7 +581,7 @@ std::string html_report(const IdData& d, const Result<NarxModel>& r, const Repor
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }
 
-std::string html_report(const IdData& d, const Result<NdeModel>& r, const ReportOptions& o) {
+std::string report_of(const IdData& d, const Result<NdeModel>& r, const ReportOptions& o) {
   CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "html_report: needs one input and one output (got {}, {})", d.nu(), d.ny());
   Page page;
   const NdeModel& m = r.model;
@@ -613,6 +610,8 @@ std::string html_report(const IdData& d, const Result<NdeModel>& r, const Report
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }
 
+}  // namespace
+
 std::string html_report(const IdData& data, const Result<AnyModel>& result, const ReportOptions& options) {
   return std::visit(
       [&](const auto& m) {
@@ -623,12 +622,12 @@ std::string html_report(const IdData& data, const Result<AnyModel>& result, cons
                        "html_report: a state_space model with {} inputs and {} outputs has no report (one input and "
                        "one output only)",
                        m.nu(), m.ny());
-          return html_report(data,
+          return report_of(data,
                              Result<TransferFunction>{m.to_transfer_function(), result.parameters, result.fit,
                                                       result.summary, result.diagnostics},
                              options);
         } else {
-          return html_report(data, Result<M>{m, result.parameters, result.fit, result.summary, result.diagnostics},
+          return report_of(data, Result<M>{m, result.parameters, result.fit, result.summary, result.diagnostics},
                              options);
         }
       },

@@ -37,29 +37,11 @@ LinearModel parse_model_json(const std::string& text, const std::string& source 
 LinearModel read_model_json(const std::string& path);
 void write_model_json(const std::string& path, const LinearModel& model);
 
-std::string result_to_json(const Result<TransferFunction>& result, const std::string& method, int indent = 2);
 /// A result written by result_to_json read back (model, parameters, covariance, fit, summary, diagnostics).
 /// Throws FileError naming `source` when the model is of another type or a member is malformed.
 Result<TransferFunction> parse_result_json(const std::string& text, const std::string& source = "<json>");
 /// The same for a multi-input result (model type "miso").
 Result<MisoModel> parse_miso_result_json(const std::string& text, const std::string& source = "<json>");
-/// Atomic write (temporary file, then rename). Throws FileError.
-void write_result_json(const std::string& path, const Result<TransferFunction>& result, const std::string& method);
-std::string result_to_json(const Result<MisoModel>& result, const std::string& method, int indent = 2);
-void write_result_json(const std::string& path, const Result<MisoModel>& result, const std::string& method);
-/// FSF results: model {"type": "fsf", "delta", "N", "n", "shift", "theta": [...]} (real parameterisation).
-std::string result_to_json(const Result<FsfModel>& result, const std::string& method, int indent = 2);
-void write_result_json(const std::string& path, const Result<FsfModel>& result, const std::string& method);
-
-/// NARX/NARMAX models: {"type": "narx", "ts": s, "terms": [{"name": "y(k-1)*u(k-2)", "value": c}, ...]}.
-/// NDE models: {"type": "nde", "terms": [{"name": "D^2y", "value": 1e-4}, {"name": "y*Dy", ...}]}, written
-/// normalised so that the coefficient of y is +1 when the model has a y term (DESIGN.md §8).
-std::string result_to_json(const Result<NarxModel>& result, const std::string& method, int indent = 2);
-void write_result_json(const std::string& path, const Result<NarxModel>& result, const std::string& method);
-std::string result_to_json(const Result<NdeModel>& result, const std::string& method, int indent = 2);
-void write_result_json(const std::string& path, const Result<NdeModel>& result, const std::string& method);
-/// Read a NARX (or NDE) model from a bare model object or a result envelope. Throws FileError naming the
-/// file and the problem (wrong type, a malformed or unknown term name with its position, a missing member).
 /// Order selection (ctid order --json): {"type": "order_selection", "rank_by": "yic", "interrupted": false,
 /// "candidates": [{"nb", "nf", "nk", "yic", "rt2", "aic", "bic", "fit_percent", "usable", "termination"}, ...]} in
 /// rank order (non-finite numbers as null).
@@ -76,10 +58,22 @@ std::string poles_to_json(const PoleEstimate& data_matrix, const PoleEstimate* p
 std::string table_to_json(const std::string& type, const std::vector<std::pair<std::string, std::string>>& fields,
                           const std::vector<std::string>& names, const Eigen::MatrixXd& values, int indent = 2);
 /// Any result ctid writes, or a bare model object: Result<AnyModel> in the envelope above, model "type"
-/// one of model_type_name()'s. The one writer and reader of result files (the typed functions above are
-/// shorthands of it).
+/// one of model_type_name()'s — the one writer and reader of result files. Model forms besides the linear ones:
+/// FSF {"type": "fsf", "delta", "N", "n", "shift", "theta": [...]} (real parameterisation); NARX/NARMAX
+/// {"type": "narx", "ts": s, "terms": [{"name": "y(k-1)*u(k-2)", "value": c}, ...]}; NDE {"type": "nde", "terms":
+/// [{"name": "D^2y", "value": 1e-4}, ...]}, written normalised so that the coefficient of y is +1 when the model
+/// has a y term (DESIGN.md §8). write_result_json writes atomically (temporary file, then rename); throws FileError.
 std::string result_to_json(const Result<AnyModel>& result, const std::string& method, int indent = 2);
 void write_result_json(const std::string& path, const Result<AnyModel>& result, const std::string& method);
+/// Shorthands for a typed result (Result<TransferFunction>, Result<NarxModel>, ...): the same file.
+template <class M>
+std::string result_to_json(const Result<M>& result, const std::string& method, int indent = 2) {
+  return result_to_json(to_any(result), method, indent);
+}
+template <class M>
+void write_result_json(const std::string& path, const Result<M>& result, const std::string& method) {
+  write_result_json(path, to_any(result), method);
+}
 /// A file read back: the result (a bare model gets its term coefficients as parameters, without
 /// uncertainty, and no fit), the method that wrote it ("" for a bare model) and whether it was bare.
 struct ResultFile {
@@ -90,6 +84,8 @@ struct ResultFile {
 /// Recognises the model type from the file. Throws FileError naming `source` and what is malformed.
 ResultFile parse_result_file(const std::string& text, const std::string& source = "<json>");
 ResultFile read_result_file(const std::string& path);
+/// Read a NARX (or NDE) model from a bare model object or a result envelope. Throws FileError naming the
+/// file and the problem (wrong type, a malformed or unknown term name with its position, a missing member).
 NarxModel read_narx_json(const std::string& path);
 NdeModel read_nde_json(const std::string& path);
 NarxModel parse_narx_json(const std::string& text, const std::string& source = "<json>");

@@ -41,16 +41,16 @@ struct ReportOptions {
   std::vector<std::pair<std::string, IdData>> more_records;
 };
 
-/// Report of a result on the record `data` (single input and output — for a MisoModel one input per channel;
-/// the model is simulated on it). Throws InvalidArgument for data that do not match the model or are too
-/// short for the correlation lags.
-std::string html_report(const IdData& data, const Result<TransferFunction>& result, const ReportOptions& options);
-std::string html_report(const IdData& data, const Result<MisoModel>& result, const ReportOptions& options);
-std::string html_report(const IdData& data, const Result<FsfModel>& result, const ReportOptions& options);
-std::string html_report(const IdData& data, const Result<NarxModel>& result, const ReportOptions& options);
-std::string html_report(const IdData& data, const Result<NdeModel>& result, const ReportOptions& options);
-/// Any result (e.g. read back by read_result_file): the report of its model type.
+/// Report of a result on the record `data` (single input and output — for a MisoModel one input per channel,
+/// a state-space model with one input and output as its transfer function; the model is simulated on it): the
+/// report of its model type. Throws InvalidArgument for data that do not match the model or are too short for the
+/// correlation lags.
 std::string html_report(const IdData& data, const Result<AnyModel>& result, const ReportOptions& options);
+/// Shorthand for a typed result (Result<TransferFunction>, Result<NarxModel>, ...): the same report.
+template <class M>
+std::string html_report(const IdData& data, const Result<M>& result, const ReportOptions& options) {
+  return html_report(data, to_any(result), options);
+}
 
 /// Whether the plotting library was found at build time (scripts/install-deps.sh fetches it); without it
 /// a report still holds every table and says that its plots are missing.

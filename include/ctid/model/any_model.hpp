@@ -12,6 +12,7 @@
 #include <variant>
 #include <vector>
 
+#include "ctid/core/types.hpp"
 #include "ctid/model/fsf.hpp"
 #include "ctid/model/miso.hpp"
 #include "ctid/model/narx.hpp"
@@ -23,6 +24,12 @@ namespace ctid {
 
 /// Every model type ctid fits, simulates and writes. The JSON "type" of each is model_type_name().
 using AnyModel = std::variant<TransferFunction, MisoModel, StateSpace, FsfModel, NarxModel, NdeModel>;
+
+/// A typed result as a result of any model (the same parameters, fit, summary and diagnostics).
+template <class M>
+Result<AnyModel> to_any(const Result<M>& r) {
+  return {AnyModel(r.model), r.parameters, r.fit, r.summary, r.diagnostics};
+}
 
 /// The JSON type name: "transfer_function", "miso", "state_space", "fsf", "narx", "nde".
 const char* model_type_name(const AnyModel& model);
