@@ -81,7 +81,7 @@ int parameter_index(const TfOrders& o, const std::string& name, const char* who)
   throw InvalidOptions(detail::format("{}: '{}' is not a coefficient of this structure ({})", who, name, known));
 }
 
-SvfLayout make_layout(const TfOrders& o, double tau, const std::map<std::string, double>& fixed, const char* who) {
+SvfLayout make_layout(const TfOrders& o, double tau, const FixedValues& fixed, const char* who) {
   SvfLayout L;
   L.n = o.nf;
   L.nb = o.nb;
@@ -91,11 +91,14 @@ SvfLayout make_layout(const TfOrders& o, double tau, const std::map<std::string,
   L.fixed.assign(2 * L.n, false);
   L.theta_fixed = Eigen::VectorXd::Zero(2 * L.n);
   for (int i = 0; i < L.n - L.nb; ++i) L.fixed[L.n + i] = true;  // leading b's are zero
-  for (const auto& [name, value] : fixed) {
-    const int idx = parameter_index(o, name, who);
+  const std::vector<std::string> names = tf_parameter_names(o);
+  const ParameterConstraints c = resolve_constraints(fixed, {}, names, who, "a coefficient of this structure (" +
+                                                     options_detail::format_names(names) + ")");
+  for (int idx = 0; idx < static_cast<int>(names.size()); ++idx) {
+    if (!c.held[static_cast<std::size_t>(idx)]) continue;
     const int t = L.theta_index(idx);
     L.fixed[t] = true;
-    L.theta_fixed(t) = idx < L.n ? -value : value;
+    L.theta_fixed(t) = idx < L.n ? -c.value(idx) : c.value(idx);
   }
   for (int t = 0; t < 2 * L.n; ++t)
     if (!L.fixed[t]) L.free.push_back(t);

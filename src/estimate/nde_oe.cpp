@@ -63,35 +63,23 @@ Result<NdeModel> nde_oe(const std::vector<IdData>& records, const NdeModel& init
   // Constraints by term name (fixed.NAME, bounds.NAME), in the scale where the reference coefficient is 1.
   std::vector<std::string> names;
   for (const auto& t : terms) names.push_back(t.name());
-  auto term_index = [&](const std::string& name, const char* key) {
-    const auto it = std::find(names.begin(), names.end(), name);
-    if (it == names.end()) {
-      const std::string near = closest_name(name, names);
-      throw InvalidArgument(detail::format("nde_oe: {}.{}: '{}' is not a term of {}{}", key, name, name, initial.to_string(),
-                                           near.empty() ? "" : "; did you mean '" + near + "'?"));
-    }
-    return static_cast<int>(it - names.begin());
-  };
-  std::vector<bool> fixed(static_cast<size_t>(m), false);
-  fixed[static_cast<size_t>(ref)] = true;
+  if (const auto f = opt.fixed.find(names[static_cast<size_t>(ref)]); f != opt.fixed.end())
+    CTID_REQUIRE_OPTION(f->second == 1.0, "nde_oe: fixed.{}: the reference term's coefficient is 1 (got {})", f->first,
+                        f->second);
+  std::vector<bool> held(static_cast<size_t>(m), false);
+  held[static_cast<size_t>(ref)] = true;
+  const ParameterConstraints cons =
+      resolve_constraints(opt.fixed, opt.bounds, names, "nde_oe", "a term of " + initial.to_string(), held);
+  const std::vector<bool>& fixed = cons.held;
   Eigen::VectorXd c_init = initial.coefficients() / initial.coefficients()(ref);
-  for (const auto& [name, value] : opt.fixed) {
-    const int i = term_index(name, "fixed");
-    CTID_REQUIRE(i != ref || value == 1.0, "nde_oe: fixed.{}: the reference term's coefficient is 1 (got {})", name, value);
-    fixed[static_cast<size_t>(i)] = true;
-    c_init(i) = value;
-  }
-  std::vector<int> free;
   for (int i = 0; i < m; ++i)
-    if (!fixed[static_cast<size_t>(i)]) free.push_back(i);
+    if (std::isfinite(cons.value(i))) c_init(i) = cons.value(i);
+  const std::vector<int> free = cons.free();
   const int pc = static_cast<int>(free.size());
-  Eigen::VectorXd lo_c = Eigen::VectorXd::Constant(pc, -INFINITY), hi_c = Eigen::VectorXd::Constant(pc, INFINITY);
-  for (const auto& [name, b] : opt.bounds) {
-    const int i = term_index(name, "bounds");
-    const auto at = std::find(free.begin(), free.end(), i);
-    CTID_REQUIRE(at != free.end(), "nde_oe: bounds.{}: the term's coefficient is held (fixed or the reference)", name);
-    lo_c(at - free.begin()) = b.first;
-    hi_c(at - free.begin()) = b.second;
+  Eigen::VectorXd lo_c(pc), hi_c(pc);
+  for (int j = 0; j < pc; ++j) {
+    lo_c(j) = cons.lower(free[j]);
+    hi_c(j) = cons.upper(free[j]);
   }
   // Parameters x = [free coefficients (pc), initial state of record 1 (nx), of record 2, ...]: every record
   // has its own initial state (several experiments of one system, DESIGN.md: per-experiment initial conditions).

@@ -86,22 +86,11 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
   full.head(nt) = tf_detail::params_of(start, o);
   if (opt.estimate_delay) full(nt) = start.io_delay();
   const double fixed_delay = start.io_delay();
-  std::vector<bool> is_fixed(np, false);
-  for (const auto& [k, v] : opt.fixed) {
-    int idx = -1;
-    for (int i = 0; i < np; ++i)
-      if (names[i] == k) idx = i;
-    if (idx < 0) {
-      std::string known;
-      for (const auto& nm : names) known += (known.empty() ? "" : ", ") + nm;
-      throw InvalidOptions(detail::format("oe: '{}' is not a parameter of this structure ({})", k, known));
-    }
-    is_fixed[idx] = true;
-    full(idx) = v;
-  }
-  std::vector<int> free;
+  const ParameterConstraints c = resolve_constraints(
+      opt.fixed, opt.bounds, names, "oe", "a parameter of this structure (" + options_detail::format_names(names) + ")");
   for (int i = 0; i < np; ++i)
-    if (!is_fixed[i]) free.push_back(i);
+    if (c.held[i]) full(i) = c.value(i);
+  const std::vector<int> free = c.free();
   CTID_REQUIRE_OPTION(!free.empty(), "oe: every parameter is fixed; nothing to estimate");
   const int p = static_cast<int>(free.size());
   Eigen::VectorXd lo = Eigen::VectorXd::Constant(p, -INFINITY), hi = Eigen::VectorXd::Constant(p, INFINITY), x0(p);
@@ -114,16 +103,8 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
       hi(j) = delay_hi;
       x0(j) = std::clamp(x0(j), lo(j), hi(j));
     }
-    const auto b = opt.bounds.find(names[free[j]]);
-    if (b != opt.bounds.end()) {
-      lo(j) = std::max(lo(j), b->second.first);
-      hi(j) = std::min(hi(j), b->second.second);
-    }
-  }
-  for (const auto& [k, b] : opt.bounds) {
-    bool found = false;
-    for (const auto& nm : names) found = found || nm == k;
-    CTID_REQUIRE_OPTION(found, "oe: bounds given for '{}', which is not a parameter", k);
+    lo(j) = std::max(lo(j), c.lower(free[j]));
+    hi(j) = std::min(hi(j), c.upper(free[j]));
   }
   auto model_of = [&](const Eigen::VectorXd& x) {
     Eigen::VectorXd f = full;
@@ -154,7 +135,7 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
   r.parameters.names = names;
   r.parameters.values = full;
   for (int j = 0; j < p; ++j) r.parameters.values(free[j]) = lm.x(j);
-  r.parameters.fixed = is_fixed;
+  r.parameters.fixed = c.held;
   const auto [y_all, sim_all] = tf_detail::pooled_outputs(r.model, ds, opt.transient_time);
   r.fit = fit_report_or_inf(y_all, sim_all, p);
   const double sigma2 = 2.0 * lm.cost / double(std::max<Eigen::Index>(1, y_all.size() - p));

@@ -58,6 +58,47 @@ OptionRange or_special(OptionRange r, double v, std::string doc) {
   return r;
 }
 
+std::vector<int> ParameterConstraints::free() const {
+  std::vector<int> f;
+  for (std::size_t i = 0; i < held.size(); ++i)
+    if (!held[i]) f.push_back(static_cast<int>(i));
+  return f;
+}
+
+ParameterConstraints resolve_constraints(const FixedValues& fixed, const ParameterBounds& bounds,
+                                         const std::vector<std::string>& names, const std::string& method,
+                                         const std::string& of, std::vector<bool> held) {
+  const auto n = static_cast<Eigen::Index>(names.size());
+  ParameterConstraints c;
+  c.held = held.empty() ? std::vector<bool>(names.size(), false) : std::move(held);
+  CTID_ASSERT(c.held.size() == names.size());
+  c.value = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::quiet_NaN());
+  c.lower = Eigen::VectorXd::Constant(n, -std::numeric_limits<double>::infinity());
+  c.upper = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity());
+  auto index = [&](const std::string& name, const char* key) {
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end()) {
+      const std::string near = closest_name(name, names);
+      throw InvalidOptions(detail::format("{}: {}.{}: '{}' is not {}{}", method, key, name, name, of,
+                                          near.empty() ? std::string() : "; did you mean '" + near + "'?"));
+    }
+    return it - names.begin();
+  };
+  for (const auto& [name, v] : fixed) {
+    const auto i = index(name, "fixed");
+    c.held[static_cast<std::size_t>(i)] = true;
+    c.value(i) = v;
+  }
+  for (const auto& [name, b] : bounds) {
+    const auto i = index(name, "bounds");
+    CTID_REQUIRE_OPTION(!c.held[static_cast<std::size_t>(i)], "{}: bounds.{}: '{}' is held ({}), so it cannot be bounded",
+                        method, name, name, fixed.count(name) ? "fixed" : "by the method");
+    c.lower(i) = b.first;
+    c.upper(i) = b.second;
+  }
+  return c;
+}
+
 std::string closest_name(const std::string& key, const std::vector<std::string>& names) {
   auto distance = [](const std::string& a, const std::string& b) {
     std::vector<std::size_t> row(b.size() + 1);

@@ -46,8 +46,10 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
   opt.validate();
   const int P = model.n_parameters();
   Eigen::VectorXd full(P);
-  std::vector<bool> fixed(P, false), given(P, false);
-  Eigen::VectorXd lo_full(P), hi_full(P);
+  std::vector<bool> given(P, false);
+  // The declarations' fixed/lower/upper, then the options' fixed.NAME and bounds.NAME on top, in one vocabulary.
+  FixedValues fixed_values;
+  ParameterBounds bounds;
   for (const auto& p : params) {
     int idx = -1;
     for (int i = 0; i < P; ++i)
@@ -61,40 +63,31 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
     CTID_REQUIRE_OPTION(std::isfinite(p.initial), "physical: parameter '{}' has no (finite) initial value", p.name);
     CTID_REQUIRE_OPTION(!(p.lower > p.upper), "physical: bounds of '{}' are empty ([{}, {}])", p.name, p.lower, p.upper);
     full(idx) = std::min(std::max(p.initial, p.lower), p.upper);
-    fixed[idx] = p.fixed;
-    lo_full(idx) = p.lower;
-    hi_full(idx) = p.upper;
     given[idx] = true;
+    if (p.fixed) fixed_values[p.name] = full(idx);
+    else if (p.lower > -INFINITY || p.upper < INFINITY) bounds[p.name] = {p.lower, p.upper};
   }
-  // The options' fixed.NAME and bounds.NAME on top of the declarations.
-  auto index_of = [&](const std::string& name, const char* key) {
-    const auto& names = model.parameter_names();
-    const auto it = std::find(names.begin(), names.end(), name);
-    if (it == names.end()) {
-      const std::string near = closest_name(name, names);
-      throw InvalidOptions(detail::format("physical: {}.{}: '{}' is not a parameter of \"{}\"{}", key, name, name,
-                                          model.expression(), near.empty() ? "" : "; did you mean '" + near + "'?"));
-    }
-    return static_cast<int>(it - names.begin());
-  };
   for (const auto& [name, value] : opt.fixed) {
-    const int i = index_of(name, "fixed");
-    full(i) = value;
-    fixed[i] = given[i] = true;
-    lo_full(i) = hi_full(i) = value;
+    fixed_values[name] = value;
+    bounds.erase(name);  // the option holds what the declaration bounded
   }
-  for (const auto& [name, b] : opt.bounds) {
-    const int i = index_of(name, "bounds");
-    lo_full(i) = b.first;
-    hi_full(i) = b.second;
-    if (given[i]) full(i) = std::min(std::max(full(i), b.first), b.second);
+  for (const auto& [name, b] : opt.bounds) bounds[name] = b;
+  const ParameterConstraints c = resolve_constraints(fixed_values, bounds, model.parameter_names(), "physical",
+                                                     "a parameter of \"" + model.expression() + "\"");
+  const std::vector<bool>& fixed = c.held;
+  Eigen::VectorXd lo_full = c.lower, hi_full = c.upper;
+  for (int i = 0; i < P; ++i) {
+    if (fixed[i]) {
+      full(i) = lo_full(i) = hi_full(i) = c.value(i);
+      given[i] = true;
+    } else if (given[i]) {
+      full(i) = std::min(std::max(full(i), lo_full(i)), hi_full(i));
+    }
   }
   for (int i = 0; i < P; ++i)
     CTID_REQUIRE_OPTION(given[i], "physical: parameter '{}' of \"{}\" needs an initial value", model.parameter_names()[i],
                         model.expression());
-  std::vector<int> free;
-  for (int i = 0; i < P; ++i)
-    if (!fixed[i]) free.push_back(i);
+  const std::vector<int> free = c.free();
   CTID_REQUIRE_OPTION(!free.empty(), "physical: every parameter is fixed; nothing to estimate");
   const int p = static_cast<int>(free.size());
   CTID_REQUIRE(n_data > p, "physical: {} residuals cannot determine {} parameters", n_data, p);

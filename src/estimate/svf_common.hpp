@@ -71,7 +71,7 @@ struct PreparedData {
 
 /// Index of a parameter name (a1.., b0..) for the orders; InvalidOptions listing the names.
 int parameter_index(const TfOrders& o, const std::string& name, const char* who);
-SvfLayout make_layout(const TfOrders& o, double tau, const std::map<std::string, double>& fixed, const char* who);
+SvfLayout make_layout(const TfOrders& o, double tau, const FixedValues& fixed, const char* who);
 PreparedData prepare(const IdData& data, const TfOrders& o, double transient_time, double alpha, SvfWeights weights,
                      const char* who);
 /// Least squares (and instrumental variables, aux: the auxiliary model's output per record) with the normal

@@ -89,6 +89,45 @@ TEST(Options, ErrorsNameTheSettingTheRangeAndTheClosestName) {
   EXPECT_EQ(closest_name("xyz_unrelated", {"tau", "alpha"}), "");
 }
 
+// One constraint vocabulary (issue 14, item 5): fixed.NAME / bounds.NAME resolve the same way for every estimator —
+// an unknown name names the closest parameter, a bound on a held parameter is refused, the rest lands per name.
+TEST(Options, ConstraintsResolveByNameForEveryEstimator) {
+  const std::vector<std::string> names = {"a1", "a2", "b0"};
+  const ParameterConstraints c = resolve_constraints({{"a2", 4.0}}, {{"a1", {0.0, 10.0}}}, names, "oe", "a parameter");
+  EXPECT_EQ(c.held, (std::vector<bool>{false, true, false}));
+  EXPECT_EQ(c.value(1), 4.0);
+  EXPECT_TRUE(std::isnan(c.value(0)));
+  EXPECT_EQ(c.lower(0), 0.0);
+  EXPECT_EQ(c.upper(0), 10.0);
+  EXPECT_EQ(c.lower(2), -std::numeric_limits<double>::infinity());
+  EXPECT_EQ(c.free(), (std::vector<int>{0, 2}));
+  EXPECT_EQ(error_of([&] { resolve_constraints({{"a3", 1.0}}, {}, names, "oe", "a parameter of this structure"); }),
+            "oe: fixed.a3: 'a3' is not a parameter of this structure; did you mean 'a1'?");
+  EXPECT_EQ(error_of([&] { resolve_constraints({{"a2", 1.0}}, {{"a2", {0, 1}}}, names, "oe", "a parameter"); }),
+            "oe: bounds.a2: 'a2' is held (fixed), so it cannot be bounded");
+  EXPECT_EQ(error_of([&] { resolve_constraints({}, {{"a1", {0, 1}}}, names, "nde_oe", "a term", {true, false, false}); }),
+            "nde_oe: bounds.a1: 'a1' is held (by the method), so it cannot be bounded");
+  // The estimators use it: oe, lssvf, physical (declarations and options together) and nde_oe name the same way.
+  const TransferFunction g(Eigen::VectorXd{{3.0}}, Eigen::VectorXd{{1.0, 1.2, 4.0}});
+  const Eigen::VectorXd u = prbs(400, {.register_length = 7, .clock_period = 5});
+  const IdData d(u, lsim(g, u, time_grid(0.02, 400)), 0.02);
+  EXPECT_EQ(error_of([&] { oe(d, {1, 2, 0}, {.fixed = {{"a2", 4.0}}, .bounds = {{"a2", {0.0, 5.0}}}}); }),
+            "oe: bounds.a2: 'a2' is held (fixed), so it cannot be bounded");
+  EXPECT_NE(error_of([&] { lssvf(d, {1, 2, 0}, {.fixed = {{"b1", 3.0}}}); }).find("lssvf: fixed.b1: 'b1' is not a coefficient"),
+            std::string::npos);
+  const PhysicalModel pm("3/(s^2 + c*s + k)", {"k", "c"});  // the true system at k = 4, c = 1.2
+  PhysicalFitOptions po;
+  po.bounds = {{"k", {0.0, 10.0}}};
+  EXPECT_EQ(error_of([&] { fit_physical_raw(pm, {{"k", 4.0, -INFINITY, INFINITY, true}, {"c", 1.0}}, d, 0.0, po); }),
+            "physical: bounds.k: 'k' is held (fixed), so it cannot be bounded");
+  // Held by the option, bounded by the declaration: the option wins (the value is held, the bound is dropped).
+  po.bounds.clear();
+  po.fixed = {{"k", 4.0}};
+  const auto r = fit_physical_raw(pm, {{"k", 3.0, 0.0, 3.5}, {"c", 1.0}}, d, 0.0, po);
+  EXPECT_EQ(r.parameters.value("k"), 4.0);
+  EXPECT_NEAR(r.parameters.value("c"), 1.2, 1e-6);  // noise-free: c = 1.2 of the true system
+}
+
 // The registry: names unique, every setting documented with its default, and the defaults are those of a
 // default-constructed options struct (read through the table, checked here against the struct members).
 TEST(Options, RegistryListsEachMethodOnceWithDocumentedDefaults) {

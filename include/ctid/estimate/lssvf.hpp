@@ -43,7 +43,7 @@ struct LssvfOptions {
   /// Seconds at the start excluded from the criterion (filter/system transients).
   double transient_time = 0.0;
   /// Known coefficients held fixed, by parameter name (e.g. {"a2", 1.0}).
-  std::map<std::string, double> fixed;
+  FixedValues fixed;
   /// Optional extra data filter F(s) applied to both sides (stable, proper, no delay).
   std::optional<TransferFunction> data_filter;
   /// Number of tau candidates for the automatic choice, in [2, kMaxTauGrid].

@@ -25,9 +25,9 @@ struct NdeOeOptions {
   bool estimate_initial_state = true;  ///< estimate [y, Dy, .., D^{L-1}y] at the first sample; false: from rest
   /// Coefficients held at a value, by term name (fixed.u=-1.1) — the constraint vocabulary of oe, lssvf and
   /// physical — in the returned model's scale (the reference term's coefficient 1); the reference term always is.
-  std::map<std::string, double> fixed;
+  FixedValues fixed;
   /// Bounds [lower, upper] on free coefficients by term name (bounds.y^2=0,inf), in the same scale.
-  std::map<std::string, std::pair<double, double>> bounds;
+  ParameterBounds bounds;
   double rtol = 1e-10;                 ///< relative tolerance of the simulations
   void validate() const;
 };

@@ -29,9 +29,9 @@ struct OeOptions {
   /// Starting model; empty: LSSVF with an automatic filter (oe) or SRIVC (tfest).
   std::optional<TransferFunction> initial;
   /// Parameters held at a value, by name ("a1", "b0", "delay").
-  std::map<std::string, double> fixed;
+  FixedValues fixed;
   /// Bounds by name: {lower, upper}; absent = unbounded (the delay is always >= 0).
-  std::map<std::string, std::pair<double, double>> bounds;
+  ParameterBounds bounds;
   bool estimate_delay = false;   ///< add the input delay T (s) as a parameter "delay"
   double delay = 0.0;            ///< initial / fixed delay (s), added to nk Ts
   SrivcOptions srivc;            ///< options of the SRIVC start (tfest); its delay search is used when estimate_delay

@@ -79,6 +79,27 @@ using OptionValue = std::variant<double, int, bool, std::string, std::vector<dou
 /// The closest of `names` to `key` by edit distance ("" when none is within half of key's length + 2).
 std::string closest_name(const std::string& key, const std::vector<std::string>& names);
 
+/// Parameters held at a value, by name: the `fixed` setting of every estimator with constraints (fixed.NAME=VALUE;
+/// Python fixed={"a2": 4}), in the unit and scale of the returned model's parameter of that name.
+using FixedValues = std::map<std::string, double>;
+/// Ranges by parameter name: the `bounds` setting (bounds.NAME=LOWER,UPPER; Python bounds={"a1": (0, 10)}).
+using ParameterBounds = std::map<std::string, std::pair<double, double>>;
+
+/// fixed and bounds resolved against an estimator's parameter names (one entry per name, in their order).
+struct ParameterConstraints {
+  std::vector<bool> held;  ///< held at `value` (fixed by the user, or held by the method, e.g. a reference term)
+  Eigen::VectorXd value;   ///< the held values (NaN where not given by `fixed`)
+  Eigen::VectorXd lower, upper;  ///< the bounds (-inf/+inf where none is given)
+  std::vector<int> free() const;  ///< indices of the parameters not held, in order
+};
+/// The one resolution of the constraint vocabulary. `held`: parameters the method holds already (empty: none).
+/// Throws InvalidOptions "METHOD: fixed.NAME: 'NAME' is not OF; did you mean 'X'?" for a name outside `names`
+/// (`of` e.g. "a parameter of \"k/(s + c)\"") and "METHOD: bounds.NAME: ... is held" for a bound on a held
+/// parameter.
+ParameterConstraints resolve_constraints(const FixedValues& fixed, const ParameterBounds& bounds,
+                                         const std::vector<std::string>& names, const std::string& method,
+                                         const std::string& of, std::vector<bool> held = {});
+
 namespace options_detail {
 double parse_real(const std::string& method, const std::string& key, const std::string& text);
 int parse_int(const std::string& method, const std::string& key, const std::string& text);
@@ -234,7 +255,7 @@ class OptionTable {
                });
   }
   /// Values by name (e.g. fixed coefficients); CLI: NAME.KEY=V, one per key. Values must be finite.
-  OptionTable& named_reals(const char* name, std::map<std::string, double> O::*m, const char* doc) {
+  OptionTable& named_reals(const char* name, FixedValues O::*m, const char* doc) {
     const std::string n = name;
     return add({n, OptionKind::NamedReals, "", "finite", doc, {}, {}},
                [m, n](O& o, const std::string& method, const std::string& key, const std::string& t) {
@@ -254,7 +275,7 @@ class OptionTable {
                });
   }
   /// Intervals by name; CLI: NAME.KEY=LO,HI. Each needs lo <= hi (not NaN).
-  OptionTable& named_bounds(const char* name, std::map<std::string, std::pair<double, double>> O::*m, const char* doc) {
+  OptionTable& named_bounds(const char* name, ParameterBounds O::*m, const char* doc) {
     const std::string n = name;
     return add({n, OptionKind::NamedBounds, "", "lower <= upper", doc, {}, {}},
                [m, n](O& o, const std::string& method, const std::string& key, const std::string& t) {

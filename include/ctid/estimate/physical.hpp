@@ -32,9 +32,9 @@ struct PhysicalFitOptions {
   int step_points = 1000;   ///< samples of the compressed step response on [0, T] (step route)
   /// Parameters held at a value, by name — the constraint vocabulary of every estimator (oe, lssvf, rls_svf):
   /// applied on top of the PhysicalParameter declarations (a parameter fixed here needs no declaration).
-  std::map<std::string, double> fixed;
+  FixedValues fixed;
   /// Bounds [lower, upper] by name, on top of the declarations' lower/upper.
-  std::map<std::string, std::pair<double, double>> bounds;
+  ParameterBounds bounds;
   void validate() const;
 };
 /// The settings of PhysicalFitOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.

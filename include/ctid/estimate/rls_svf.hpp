@@ -33,7 +33,7 @@ struct RlsSvfOptions {
   double alpha = 0.0;               ///< exponential weighting rate (1/s) >= 0; multiplies lambda by e^{-2 alpha dt}
   double regression_interval = 0.0; ///< h (s) between regression updates; 0 = every sample
   Intersample input_intersample = Intersample::Zoh;
-  std::map<std::string, double> fixed;  ///< known coefficients by name (a1.., b0..)
+  FixedValues fixed;  ///< known coefficients by name (a1.., b0..)
   Eigen::VectorXd theta0;           ///< initial parameter values [a1..an, b0..]; empty = 0
   void validate() const;
 };
