@@ -280,7 +280,7 @@ int run_physical_records(const FitArgs& a, const std::vector<IdData>& ds) {
     require_fsf_window(fo);
     const Result<FsfModel> c = fsf(d, fo);
     Result<TransferFunction> q =
-        a.via == "frequency" ? fit_physical_frequency(model, ps, c.model, po) : fit_physical_step(model, ps, c.model, po);
+        a.via == "frequency" ? fit_physical_frequency(model, ps, c.model, po, &d) : fit_physical_step(model, ps, c.model, po, &d);
     for (const auto& w : c.diagnostics.warnings) q.diagnostics.warnings.push_back("fsf: " + w);
     return q;
   });

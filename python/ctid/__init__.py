@@ -409,17 +409,19 @@ def compare_poles(y, ts, order, **options):
                                _options(_ctid.PolesOptions, "poles", options))
 
 
-def fit_physical_step(model, parameters, compressed, **options):
+def fit_physical_step(model, parameters, compressed, data=None, **options):
     """Gawthrop & Wang stage 2 against the FSF step response. parameters: {"name": initial} or
-    {"name": {"initial": .., "lower": .., "upper": .., "fixed": ..}} (options: PhysicalFitOptions)."""
+    {"name": {"initial": .., "lower": .., "upper": .., "fixed": ..}} (options: PhysicalFitOptions). data: the record
+    the compressed model was fitted to; with it, fit is the simulation fit on the record (else none is computed);
+    diagnostics.scalars["compressed_fit_percent"] is the match to the compressed response."""
     return _ctid.fit_physical_step(model, parameters, getattr(compressed, "model", compressed),
-                                   _options(_ctid.PhysicalFitOptions, "fit_physical_step", options))
+                                   _options(_ctid.PhysicalFitOptions, "fit_physical_step", options), data)
 
 
-def fit_physical_frequency(model, parameters, compressed, **options):
-    """Gawthrop & Wang stage 2 against the FSF frequency samples (GW 30)."""
+def fit_physical_frequency(model, parameters, compressed, data=None, **options):
+    """Gawthrop & Wang stage 2 against the FSF frequency samples (GW 30); data and fit as fit_physical_step."""
     return _ctid.fit_physical_frequency(model, parameters, getattr(compressed, "model", compressed),
-                                        _options(_ctid.PhysicalFitOptions, "fit_physical_frequency", options))
+                                        _options(_ctid.PhysicalFitOptions, "fit_physical_frequency", options), data)
 
 
 def fit_physical_raw(model, parameters, data, a=0.0, **options):

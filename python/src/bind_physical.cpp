@@ -36,15 +36,18 @@ void bind_physical(py::module_& m) {
   py::class_<PhysicalModel>(m, "PhysicalModel", "G(s; Theta) from an expression such as 'k/(s*(J*s + b))'.")
       .def(py::init<const std::string&, std::vector<std::string>>(), py::arg("expression"), py::arg("parameters"));
   bind_options<PhysicalFitOptions>(m, "PhysicalFitOptions");
-  m.def("fit_physical_step", [](const PhysicalModel& pm, const py::dict& p, const FsfModel& c, const PhysicalFitOptions& o) {
+  m.def("fit_physical_step", [](const PhysicalModel& pm, const py::dict& p, const FsfModel& c, const PhysicalFitOptions& o,
+                                const IdData* d) {
           const auto ps = parameters_of(p);
-          return interruptible([&] { return fit_physical_step(pm, ps, c, o); });
-        }, py::arg("model"), py::arg("parameters"), py::arg("compressed"), py::arg("options") = PhysicalFitOptions{});
+          return interruptible([&] { return fit_physical_step(pm, ps, c, o, d); });
+        }, py::arg("model"), py::arg("parameters"), py::arg("compressed"), py::arg("options") = PhysicalFitOptions{},
+        py::arg("data") = nullptr);
   m.def("fit_physical_frequency", [](const PhysicalModel& pm, const py::dict& p, const FsfModel& c,
-                                     const PhysicalFitOptions& o) {
+                                     const PhysicalFitOptions& o, const IdData* d) {
           const auto ps = parameters_of(p);
-          return interruptible([&] { return fit_physical_frequency(pm, ps, c, o); });
-        }, py::arg("model"), py::arg("parameters"), py::arg("compressed"), py::arg("options") = PhysicalFitOptions{});
+          return interruptible([&] { return fit_physical_frequency(pm, ps, c, o, d); });
+        }, py::arg("model"), py::arg("parameters"), py::arg("compressed"), py::arg("options") = PhysicalFitOptions{},
+        py::arg("data") = nullptr);
   m.def("fit_physical_raw", [](const PhysicalModel& pm, const py::dict& p, const IdData& d, double a,
                                const PhysicalFitOptions& o) {
           const auto ps = parameters_of(p);

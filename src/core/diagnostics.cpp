@@ -39,6 +39,7 @@ const std::vector<DiagnosticInfo>& diagnostic_catalogue() {
       info(diagnostic::fsf_b),
       info(diagnostic::regression_fit_percent),
       info(diagnostic::residual_rms),
+      info(diagnostic::compressed_fit_percent),
       info(diagnostic::shift_a),
       info(diagnostic::max_pole_real_part),
       info(diagnostic::windows),

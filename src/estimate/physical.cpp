@@ -164,49 +164,6 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
 
 }  // namespace
 
-Result<TransferFunction> fit_physical_step(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
-                                           const FsfModel& fsf, const PhysicalFitOptions& opt) {
-  opt.validate();
-  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(opt.step_points, 0.0, fsf.T());
-  const Eigen::VectorXd target = fsf.step_response(t);
-  ResidualFn res = [&](const TransferFunction& g, const std::vector<TransferFunction>* sens, Eigen::VectorXd& r,
-                       Eigen::MatrixXd* J) {
-    r = step_response(g, t) - target;  // e = y_model - y_s (GW 22)
-    if (J) {
-      J->resize(t.size(), static_cast<Eigen::Index>(sens->size()));
-      for (std::size_t j = 0; j < sens->size(); ++j) J->col(static_cast<Eigen::Index>(j)) = step_response((*sens)[j], t);
-    }
-  };
-  return fit(model, params, fsf.shift(), opt, res, target, "step");
-}
-
-Result<TransferFunction> fit_physical_frequency(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
-                                                const FsfModel& fsf, const PhysicalFitOptions& opt) {
-  const int m = fsf.m();
-  Eigen::VectorXd w(m + 1);
-  Eigen::VectorXcd target(m + 1);
-  for (int k = 0; k <= m; ++k) {
-    w(k) = k * fsf.omega();
-    target(k) = fsf.theta_k(k);
-  }
-  ResidualFn res = [&](const TransferFunction& g, const std::vector<TransferFunction>* sens, Eigen::VectorXd& r,
-                       Eigen::MatrixXd* J) {
-    const Eigen::VectorXcd e = g.frequency_response(w) - target;  // E(jw) of GW 30, real and imaginary parts
-    r.resize(2 * (m + 1));
-    r << e.real(), e.imag();
-    if (J) {
-      J->resize(2 * (m + 1), static_cast<Eigen::Index>(sens->size()));
-      for (std::size_t j = 0; j < sens->size(); ++j) {
-        const Eigen::VectorXcd d = (*sens)[j].frequency_response(w);
-        J->col(static_cast<Eigen::Index>(j)) << d.real(), d.imag();
-      }
-    }
-  };
-  Eigen::VectorXd stacked(2 * (m + 1));
-  stacked << target.real(), target.imag();
-  return fit(model, params, fsf.shift(), opt, res, stacked, "frequency");
-}
-
 namespace {
 // Exact response of g (already shifted to G(s + a)) to the windowed held input
 // u_a(t) = e^{-a t} u_k on [t_k, t_{k+1}): the input's generator v' = -a v is appended to the
@@ -229,7 +186,103 @@ Eigen::VectorXd windowed_zoh_response(const TransferFunction& g, const Eigen::Ve
   }
   return y;
 }
+
+// Records (experiments of one system) as the raw route measures them: the outputs stacked, windowed by e^{-at} from
+// each record's start when a > 0, and a model G(s + a) simulated from rest on each record's (windowed) input.
+struct WindowedRecords {
+  const std::vector<IdData>& records;
+  double a;
+  Eigen::VectorXd y;
+
+  WindowedRecords(const std::vector<IdData>& ds, double window) : records(ds), a(window) {
+    Eigen::Index n = 0;
+    for (std::size_t e = 0; e < records.size(); ++e) {
+      const IdData& d = records[e];
+      const std::string who = records.size() > 1 ? "physical (record " + std::to_string(e + 1) + ")" : "physical";
+      require_io_data(d, who.c_str());
+      CTID_REQUIRE(a == 0.0 || (d.is_uniform() && d.intersample(0) == Intersample::Zoh),
+                   "{}: the windowed raw route (a > 0) needs uniformly sampled data with a held (ZOH) input", who);
+      n += d.size();
+    }
+    y.resize(n);
+    for (Eigen::Index e = 0, at = 0; e < static_cast<Eigen::Index>(records.size()); at += records[e].size(), ++e) {
+      const IdData& d = records[e];
+      const Eigen::VectorXd t = d.times();
+      y.segment(at, d.size()) = d.y().col(0);
+      if (a > 0) y.segment(at, d.size()).array() *= (-a * (t.array() - t(0))).exp();  // y_a = e^{-at} y
+    }
+  }
+  // Model output for the (windowed) input: exact for the held input in both cases.
+  Eigen::VectorXd simulate(const TransferFunction& shifted) const {
+    Eigen::VectorXd out(y.size());
+    for (Eigen::Index e = 0, at = 0; e < static_cast<Eigen::Index>(records.size()); at += records[e].size(), ++e) {
+      const IdData& d = records[e];
+      out.segment(at, d.size()) = a > 0 ? windowed_zoh_response(shifted, d.u().col(0), d.ts(), a) : lsim(shifted, d, 0);
+    }
+    return out;
+  }
+};
+
+// An FSF route's result: its fit to the compressed response becomes diagnostics compressed_fit_percent; fit is the
+// simulation fit on the record (as the raw route measures it) when the record is given, else not computed.
+Result<TransferFunction> with_simulation_fit(Result<TransferFunction> r, const PhysicalModel& model, double a,
+                                             const IdData* data) {
+  r.diagnostics.set(diagnostic::compressed_fit_percent, r.fit.fit_percent);
+  const int p = r.fit.n_parameters;
+  r.fit = FitReport{};
+  r.fit.n_parameters = p;
+  if (!data) return r;
+  const std::vector<IdData> one{*data};
+  const WindowedRecords w(one, a);
+  r.fit = fit_report_or_inf(w.y, w.simulate(model.shifted(r.parameters.values, a)), p);
+  return r;
+}
 }  // namespace
+
+
+Result<TransferFunction> fit_physical_step(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
+                                           const FsfModel& fsf, const PhysicalFitOptions& opt, const IdData* data) {
+  opt.validate();
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(opt.step_points, 0.0, fsf.T());
+  const Eigen::VectorXd target = fsf.step_response(t);
+  ResidualFn res = [&](const TransferFunction& g, const std::vector<TransferFunction>* sens, Eigen::VectorXd& r,
+                       Eigen::MatrixXd* J) {
+    r = step_response(g, t) - target;  // e = y_model - y_s (GW 22)
+    if (J) {
+      J->resize(t.size(), static_cast<Eigen::Index>(sens->size()));
+      for (std::size_t j = 0; j < sens->size(); ++j) J->col(static_cast<Eigen::Index>(j)) = step_response((*sens)[j], t);
+    }
+  };
+  return with_simulation_fit(fit(model, params, fsf.shift(), opt, res, target, "step"), model, fsf.shift(), data);
+}
+
+Result<TransferFunction> fit_physical_frequency(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
+                                                const FsfModel& fsf, const PhysicalFitOptions& opt, const IdData* data) {
+  const int m = fsf.m();
+  Eigen::VectorXd w(m + 1);
+  Eigen::VectorXcd target(m + 1);
+  for (int k = 0; k <= m; ++k) {
+    w(k) = k * fsf.omega();
+    target(k) = fsf.theta_k(k);
+  }
+  ResidualFn res = [&](const TransferFunction& g, const std::vector<TransferFunction>* sens, Eigen::VectorXd& r,
+                       Eigen::MatrixXd* J) {
+    const Eigen::VectorXcd e = g.frequency_response(w) - target;  // E(jw) of GW 30, real and imaginary parts
+    r.resize(2 * (m + 1));
+    r << e.real(), e.imag();
+    if (J) {
+      J->resize(2 * (m + 1), static_cast<Eigen::Index>(sens->size()));
+      for (std::size_t j = 0; j < sens->size(); ++j) {
+        const Eigen::VectorXcd d = (*sens)[j].frequency_response(w);
+        J->col(static_cast<Eigen::Index>(j)) << d.real(), d.imag();
+      }
+    }
+  };
+  Eigen::VectorXd stacked(2 * (m + 1));
+  stacked << target.real(), target.imag();
+  return with_simulation_fit(fit(model, params, fsf.shift(), opt, res, stacked, "frequency"), model, fsf.shift(),
+                             data);
+}
 
 Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
                                           const IdData& data, double a, const PhysicalFitOptions& opt) {
@@ -242,40 +295,17 @@ Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std:
   CTID_REQUIRE(std::isfinite(a) && a >= 0, "physical: the window a must be >= 0 (got {})", a);
   // Several records (experiments of one system): their residuals stacked, each record simulated from rest and
   // windowed from its own start.
-  Eigen::Index n = 0;
-  for (std::size_t e = 0; e < records.size(); ++e) {
-    const IdData& d = records[e];
-    const std::string who = records.size() > 1 ? "physical (record " + std::to_string(e + 1) + ")" : "physical";
-    require_io_data(d, who.c_str());
-    CTID_REQUIRE(a == 0.0 || (d.is_uniform() && d.intersample(0) == Intersample::Zoh),
-                 "{}: the windowed raw route (a > 0) needs uniformly sampled data with a held (ZOH) input", who);
-    n += d.size();
-  }
-  Eigen::VectorXd y(n);
-  for (Eigen::Index e = 0, at = 0; e < static_cast<Eigen::Index>(records.size()); at += records[e].size(), ++e) {
-    const IdData& d = records[e];
-    const Eigen::VectorXd t = d.times();
-    y.segment(at, d.size()) = d.y().col(0);
-    if (a > 0) y.segment(at, d.size()).array() *= (-a * (t.array() - t(0))).exp();  // y_a = e^{-at} y
-  }
-  // Model output for the (windowed) input: exact for the held input in both cases.
-  auto simulate = [&](const TransferFunction& g) -> Eigen::VectorXd {
-    Eigen::VectorXd out(n);
-    for (Eigen::Index e = 0, at = 0; e < static_cast<Eigen::Index>(records.size()); at += records[e].size(), ++e) {
-      const IdData& d = records[e];
-      out.segment(at, d.size()) = a > 0 ? windowed_zoh_response(g, d.u().col(0), d.ts(), a) : lsim(g, d, 0);
-    }
-    return out;
-  };
+  const WindowedRecords w(records, a);
+  const Eigen::Index n = w.y.size();
   ResidualFn res = [&](const TransferFunction& g, const std::vector<TransferFunction>* sens, Eigen::VectorXd& r,
                        Eigen::MatrixXd* J) {
-    r = simulate(g) - y;
+    r = w.simulate(g) - w.y;
     if (J) {
       J->resize(n, static_cast<Eigen::Index>(sens->size()));
-      for (std::size_t j = 0; j < sens->size(); ++j) J->col(static_cast<Eigen::Index>(j)) = simulate((*sens)[j]);
+      for (std::size_t j = 0; j < sens->size(); ++j) J->col(static_cast<Eigen::Index>(j)) = w.simulate((*sens)[j]);
     }
   };
-  Result<TransferFunction> r = fit(model, params, a, opt, res, y, "raw");
+  Result<TransferFunction> r = fit(model, params, a, opt, res, w.y, "raw");
   if (records.size() > 1) r.diagnostics.set(diagnostic::experiments, static_cast<double>(records.size()));
   return r;
 }

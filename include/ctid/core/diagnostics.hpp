@@ -66,6 +66,8 @@ inline constexpr ScalarDiagnostic fsf_b{"b", "1/s", "FSF filter pole shift b"};
 inline constexpr ScalarDiagnostic regression_fit_percent{"regression_fit_percent", "%",
                                                          "fit of the FSF regression (one-step, on the filtered data)"};
 inline constexpr ScalarDiagnostic residual_rms{"residual_rms", "y", "RMS of the FSF regression residual"};
+inline constexpr ScalarDiagnostic compressed_fit_percent{
+    "compressed_fit_percent", "%", "fit of a physical FSF-route model to the compressed (FSF) response it was fitted to"};
 inline constexpr ScalarDiagnostic shift_a{"shift_a", "1/s", "exponential window a of the physical fit"};
 inline constexpr ScalarDiagnostic max_pole_real_part{"max_pole_real_part", "1/s",
                                                      "largest real part of the fitted plant's poles (a must exceed it)"};

@@ -40,7 +40,8 @@ struct ParameterSet {
 ///   fpe = V (1 + d/N)/(1 - d/N),  aic = N ln V + 2 d,  aicc = aic + 2 d (d+1)/(N-d-1),
 ///   bic = N ln V + d ln N.
 /// fit is the simulation fit on the estimation data for every estimator that yields a model of the system; a
-/// regression's own figure goes into Diagnostics under its own name (fsf: "regression_fit_percent"). Estimators of
+/// regression's own figure goes into Diagnostics under its own name (fsf: "regression_fit_percent"; the physical
+/// FSF routes: "compressed_fit_percent", their fit is on the record when it is given). Estimators of
 /// intermediate quantities (modal_estimate's modal parameters) report the fit of their regression. n_samples = 0:
 /// no fit was computed (e.g. an FSF model of the exponentially windowed system G(s + a)).
 struct FitReport {

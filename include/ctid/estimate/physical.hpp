@@ -45,11 +45,16 @@ const OptionTable<PhysicalFitOptions>& option_table<PhysicalFitOptions>();
 /// model). `parameters` gives every parameter of `model` (same names, any order). Throws
 /// InvalidArgument / InvalidOptions for a missing or unknown parameter, a missing initial
 /// value, or empty bounds. The model returned is the unshifted G(s; Theta).
+/// data: the record `compressed` was fitted to. When given, fit is the simulation fit on it (from rest; windowed by
+/// e^{-at} for a > 0, as the raw route measures it); otherwise no fit is computed (fit.n_samples = 0). The model's
+/// match to the compressed response itself is diagnostics "compressed_fit_percent".
 Result<TransferFunction> fit_physical_step(const PhysicalModel& model, const std::vector<PhysicalParameter>& parameters,
-                                           const FsfModel& compressed, const PhysicalFitOptions& options = {});
-/// Fit to the compressed frequency response theta_k = G(jk Omega + a), k = 0..m (GW 30).
+                                           const FsfModel& compressed, const PhysicalFitOptions& options = {},
+                                           const IdData* data = nullptr);
+/// Fit to the compressed frequency response theta_k = G(jk Omega + a), k = 0..m (GW 30); data and fit as above.
 Result<TransferFunction> fit_physical_frequency(const PhysicalModel& model, const std::vector<PhysicalParameter>& parameters,
-                                                const FsfModel& compressed, const PhysicalFitOptions& options = {});
+                                                const FsfModel& compressed, const PhysicalFitOptions& options = {},
+                                                const IdData* data = nullptr);
 /// Output error on the raw record, windowed by e^{-at} when a > 0: the shifted model
 /// G(s + a) is fitted to y_a = e^{-at} y, simulated exactly for the windowed held input
 /// e^{-at} u_k (the window's generator is part of the simulated state). a > 0 needs uniform
