@@ -457,13 +457,38 @@ void more_records(Page& page, const AnyModel& m, const ReportOptions& o) {
   }
 }
 
-
-std::string report_of(const IdData& d, const Result<TransferFunction>& r, const ReportOptions& o) {
+void require_siso(const IdData& d) {
   CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "html_report: needs one input and one output (got {}, {})", d.nu(), d.ny());
-  Page page;
+}
+
+// What every report opens with: the summary, then (where the model describes the system) its simulation on the
+// record and on each further record.
+template <class M>
+void opening(Page& page, const IdData& d, const Result<M>& r, const ReportOptions& o, bool simulate_on_records = true) {
   overview(page, d, r, o, describe(r.model));
+  if (!simulate_on_records) return;
   validation(page, d, simulated(page, d, r.model, r.diagnostics, o), o);
   more_records(page, r.model, o);
+}
+
+// A nonlinear model's response from rest to a step of the input's RMS level (it depends on the amplitude).
+void step_at_input_level(Page& page, const AnyModel& m, const IdData& d, const Eigen::VectorXd& t) {
+  page.section("Step response");
+  const Eigen::VectorXd u = d.u().col(0);
+  const double level = std::sqrt(u.squaredNorm() / std::max<Eigen::Index>(1, u.size()));
+  try {
+    page.plot({"Response to a step of the input's RMS level (" + fmt(level, 3) + ")", "time (s)", "y", t,
+               {{"step", model_step_response(m, t, level).col(0)}}});
+  } catch (const InvalidArgument& e) {
+    page.text("<span class=\"warn\">" + escape(e.what()) + "</span>");
+  }
+}
+
+
+std::string report_of(const IdData& d, const Result<TransferFunction>& r, const ReportOptions& o) {
+  require_siso(d);
+  Page page;
+  opening(page, d, r, o);
   parameters(page, r.parameters);
   diagnostics(page, r.diagnostics);
   const Eigen::VectorXd w = frequency_grid(r.model.poles(), nyquist(d));
@@ -479,9 +504,7 @@ std::string report_of(const IdData& d, const Result<MisoModel>& r, const ReportO
   CTID_REQUIRE(d.ny() == 1 && d.nu() == r.model.nu(), "html_report: the model has {} inputs and 1 output (data: {}, {})",
                r.model.nu(), d.nu(), d.ny());
   Page page;
-  overview(page, d, r, o, describe(r.model));
-  validation(page, d, simulated(page, d, r.model, r.diagnostics, o), o);
-  more_records(page, r.model, o);
+  opening(page, d, r, o);
   parameters(page, r.parameters);
   diagnostics(page, r.diagnostics);
   std::vector<std::string> labels;
@@ -496,14 +519,11 @@ std::string report_of(const IdData& d, const Result<MisoModel>& r, const ReportO
 }
 
 std::string report_of(const IdData& d, const Result<FsfModel>& r, const ReportOptions& o) {
-  CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "html_report: needs one input and one output (got {}, {})", d.nu(), d.ny());
+  require_siso(d);
   Page page;
   const FsfModel& m = r.model;
-  overview(page, d, r, o, describe(m));
-  if (m.shift() == 0.0) {
-    validation(page, d, simulated(page, d, m, r.diagnostics, o), o);
-    more_records(page, m, o);
-  } else
+  opening(page, d, r, o, m.shift() == 0.0);
+  if (m.shift() != 0.0)
     page.text("The model was fitted to exponentially windowed data (a = " + fmt(m.shift()) +
               " 1/s): it describes G(s + a), not the system, and is not simulated against the record.");
   parameters(page, r.parameters);
@@ -545,14 +565,10 @@ Heatmap h2_map(F h2, double wmax, const std::string& what) {
 }
 
 std::string report_of(const IdData& d, const Result<NarxModel>& r, const ReportOptions& o) {
-  CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "html_report: needs one input and one output (got {}, {})", d.nu(), d.ny());
+  require_siso(d);
   Page page;
   const NarxModel p = r.model.process();
-  overview(page, d, r, o, describe(r.model));
-  const Eigen::VectorXd u = d.u().col(0);
-  const int L = std::min(p.max_lag(), d.size());
-  validation(page, d, simulated(page, d, r.model, r.diagnostics, o), o);
-  more_records(page, r.model, o);
+  opening(page, d, r, o);
   page.section("Selected terms");
   page.text("Terms in the order of selection by forward orthogonal least squares; ERR: the error reduction ratio "
             "(share of the output energy explained by the term).");
@@ -572,23 +588,15 @@ std::string report_of(const IdData& d, const Result<NarxModel>& r, const ReportO
       page.heatmap(h2_map([&](auto a, auto b) { return narx_gfrf_ct(p, {a, b}, zoh); }, 0.5 * nyq, "NARX model"));
     }
   }
-  page.section("Step response");
-  const double level = std::sqrt(u.squaredNorm() / std::max<Eigen::Index>(1, u.size()));
-  const int n = std::max(4 * L, 200);
-  const Eigen::VectorXd ys = p.simulate(Eigen::VectorXd::Constant(n, level));
-  page.plot({"Response to a step of the input's RMS level (" + fmt(level, 3) + ")", "time (s)", "y",
-             time_grid(p.ts(), n), {{"step", ys}}});
+  step_at_input_level(page, p, d, time_grid(p.ts(), std::max(4 * std::min(p.max_lag(), d.size()), 200)));
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }
 
 std::string report_of(const IdData& d, const Result<NdeModel>& r, const ReportOptions& o) {
-  CTID_REQUIRE(d.nu() == 1 && d.ny() == 1, "html_report: needs one input and one output (got {}, {})", d.nu(), d.ny());
+  require_siso(d);
   Page page;
   const NdeModel& m = r.model;
-  overview(page, d, r, o, describe(m));
-  const Eigen::VectorXd u = d.u().col(0);
-  validation(page, d, simulated(page, d, m, r.diagnostics, o), o);
-  more_records(page, m, o);
+  opening(page, d, r, o);
   const Eigen::VectorXd* err = r.diagnostics.has(diagnostic::err) ? &r.diagnostics.get(diagnostic::err) : nullptr;
   parameters(page, r.parameters, err && err->size() == r.parameters.size() ? err : nullptr);
   diagnostics(page, r.diagnostics);
@@ -602,11 +610,8 @@ std::string report_of(const IdData& d, const Result<NdeModel>& r, const ReportOp
     page.section("Second-order GFRF (harmonic probing)");
     page.heatmap(h2_map([&](auto a, auto b) { return m.h2(a, b); }, w(w.size() - 1) / 4, "equation"));
   }
-  page.section("Step response");
-  const double level = std::sqrt(u.squaredNorm() / std::max<Eigen::Index>(1, u.size()));
-  const Eigen::VectorXd ts = Eigen::VectorXd::LinSpaced(400, 0.0, std::min(d.duration(), 20 * 2 * std::numbers::pi / w(w.size() / 2)));
-  const NdeSimulation st = m.simulate(Eigen::VectorXd::Constant(400, level), ts);
-  page.plot({"Response to a step of the input's RMS level (" + fmt(level, 3) + ")", "time (s)", "y", ts, {{"step", st.y}}});
+  step_at_input_level(page, m, d,
+                      Eigen::VectorXd::LinSpaced(400, 0.0, std::min(d.duration(), 20 * 2 * std::numbers::pi / w(w.size() / 2))));
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }
 
