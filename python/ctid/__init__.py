@@ -37,17 +37,23 @@ def _enum(enum_cls, value, who, key):
     return members[value.lower()]
 
 
+def _check_names(who, keys, names):
+    """A TypeError naming the closest of `names` for the first key that is not one of them."""
+    for key in keys:
+        if key not in names:
+            near = _difflib.get_close_matches(key, names, n=1, cutoff=0.6)
+            hint = f"; did you mean '{near[0]}'?" if near else ""
+            raise TypeError(f"{who}: unknown option '{key}'{hint} (options: {', '.join(names)})")
+
+
 def _options(cls, who, kwargs):
     """An options struct of type cls from keyword arguments. Structs with a settings table (``cls._names``) convert
     each value in C++ by the setting's kind; the others take nested structs from dicts and enums from names."""
     o = cls()
     names = getattr(cls, "_names", None)
     if names is not None:
+        _check_names(who, kwargs, names)
         for key, value in kwargs.items():
-            if key not in names:
-                near = _difflib.get_close_matches(key, names, n=1, cutoff=0.6)
-                hint = f"; did you mean '{near[0]}'?" if near else ""
-                raise TypeError(f"{who}: unknown option '{key}'{hint} (options: {', '.join(names)})")
             setattr(o, key, value)
         return o
     for key, value in kwargs.items():
@@ -394,6 +400,7 @@ def modal_response(data, order, kind="step", **options):
     (kind "step", "impulse" or "frequency"). options: ModalResponseOptions (period= required, horizon,
     harmonics, window_start; seconds) and ModalOptions (shifts, basis, windows, ...). Returns a ModalResponse
     (time or frequency, p0, the modal settings used)."""
+    _check_names("modal_response", options, list(_ctid.ModalResponseOptions._names) + list(_ctid.ModalOptions._names))
     mine = {k: v for k, v in options.items() if k in _ctid.ModalResponseOptions._names}
     modal = {k: v for k, v in options.items() if k not in mine}
     return _ctid.modal_response(data, order, _enum(_ctid.ResponseKind, kind, "modal_response", "kind"),

@@ -101,6 +101,11 @@ def test_modal_frequency_response_from_a_square_wave():
     assert one.p0.usable() and len(one.modal.windows) > 0
     with pytest.raises(ctid.InvalidOptions, match="give the period"):
         ctid.modal_response(d, 3, "frequency", shifts=shifts)
+    # A misspelt keyword names the closest setting of either table (ModalResponseOptions or ModalOptions).
+    with pytest.raises(TypeError, match="unknown option 'horizn'; did you mean 'horizon'"):
+        ctid.modal_response(d, 3, "step", period=1.0, horizn=2.0, shifts=shifts)
+    with pytest.raises(TypeError, match="unknown option 'shifs'; did you mean 'shifts'"):
+        ctid.modal_response(d, 3, "step", period=1.0, shifs=shifts)
 
 
 def test_modal_step_and_impulse_responses_and_the_observer():
