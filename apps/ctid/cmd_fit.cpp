@@ -382,9 +382,9 @@ int run_miso(const FitArgs& a, const std::vector<IdData>& ds) {
 
 int run_experiments(const FitArgs& a) {
   if (a.method != "srivc" && a.method != "oe" && a.method != "tfest" && a.method != "lssvf" && a.method != "ivsvf" &&
-      a.method != "rls-svf" && a.method != "narx" && a.method != "physical" && a.method != "modal")
+      a.method != "rls-svf" && a.method != "narx" && a.method != "kia" && a.method != "physical" && a.method != "modal")
     throw UsageError(detail::format("{} DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, "
-                                    "lssvf, ivsvf, rls-svf, narx, modal, physical --via raw or srivc with "
+                                    "lssvf, ivsvf, rls-svf, narx, kia, modal, physical --via raw or srivc with "
                                     "--closed-loop-controller (got {}; the other estimators take one record so far)",
                                     a.paths.size(), a.method));
   if (a.frequency) throw UsageError("several DATA files: time-domain data only (not --frequency)");
@@ -394,7 +394,8 @@ int run_experiments(const FitArgs& a) {
   if (ds[0].nu() > 1) return run_miso(a, ds);
   if (a.method == "physical") return run_physical_records(a, ds);
   if (a.method == "modal") return run_modal_records(a, ds);
-  if (a.method == "narx") return run_narx_or_kia(a.method, ds, a.sets, a.narx, a.json, a.report, more_records_of(a, ds));
+  if (a.method == "narx" || a.method == "kia")
+    return run_narx_or_kia(a.method, ds, a.sets, a.narx, a.json, a.report, more_records_of(a, ds));
   if (a.method == "srivc") return fit_experiments<SrivcOptions>(a, ds, &srivc);
   if (a.method == "lssvf") return fit_experiments<LssvfOptions>(a, ds, &lssvf);
   if (a.method == "ivsvf") return fit_experiments<IvsvfOptions>(a, ds, &ivsvf);
@@ -479,7 +480,7 @@ void setup_fit(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
   app.add_option("DATA", a->paths,
                  "CSV/.dat table (header row optional) or .mat file; several files are several experiments of one system, "
-                 "fitted jointly (srivc, oe, tfest, lssvf, ivsvf, rls-svf, narx, modal, physical --via raw; the same columns in each)")
+                 "fitted jointly (srivc, oe, tfest, lssvf, ivsvf, rls-svf, narx, kia, modal, physical --via raw; the same columns in each)")
       ->required();
   std::vector<std::string> names;
   for (const auto& [name, m] : fit_methods()) names.push_back(name);

@@ -51,10 +51,6 @@ int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, co
     write_report(report, d, r, "narx", settings_of(no), "", more_records);
     return r.usable() ? kOk : kNotUsable;
   }
-  if (ds.size() > 1)
-    throw UsageError(detail::format("kia takes one record ({} DATA files given); fit the NARX model on all of them with "
-                                    "--method narx --json N.json, then --method kia --narx N.json on one record",
-                                    ds.size()));
   // kia: the NARX model from --narx, or identified here with the narx settings; then the library's workflow (kia()).
   KiaOptions ko;
   ko.linear.zoh = ko.quadratic.zoh = ko.cubic.zoh = d.intersample(0) == Intersample::Zoh;
@@ -67,13 +63,13 @@ int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, co
       throw InputError(narx_file + ": --narx needs a NARX model; this is a " + model_type_name(m) + " model");
     narx = std::get<NarxModel>(m).process();
   } else {
-    const Result<NarxModel> r = run_narx({d}, no);
+    const Result<NarxModel> r = run_narx(ds, no);
     print_narx(r);
     narx = r.model.process();
   }
   KiaRun run;
   try {
-    run = kia(d, narx, ko);
+    run = kia(ds, narx, ko);
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }
@@ -83,7 +79,7 @@ int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, co
   for (int i = 0; i < k.parameters.size(); ++i)
     std::printf("  %-10s %14.6g   ERR %8.4f %%\n", k.parameters.names[i].c_str(), k.parameters.values(i), err(i));
   std::printf("simulated output fit: %.2f %%   (hold factor %s)\n", k.fit.fit_percent, ko.linear.zoh ? "on" : "off");
-  std::printf("NARX model's free-run fit on the same record: %.2f %%\n", run.narx_fit_percent);
+  std::printf("NARX model's free-run fit on the same record%s: %.2f %%\n", ds.size() > 1 ? "s" : "", run.narx_fit_percent);
   if (run.refined && run.refined->usable()) {
     const Result<NdeModel>& oe = *run.refined;
     std::printf("refined by output error (%d iterations): %s\n", oe.summary.iterations, oe.model.to_string(5).c_str());
@@ -104,7 +100,7 @@ int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, co
   Settings settings = settings_of(ko);
   if (narx_file.empty())
     for (auto& x : settings_of(no)) settings.push_back(x);
-  write_report(report, d, r, ko.refine ? "kia+oe" : "kia", settings, narx_file);
+  write_report(report, d, r, ko.refine ? "kia+oe" : "kia", settings, narx_file, more_records);
   if (!r.usable()) {
     std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", r.why_not_usable().c_str());
     return kNotUsable;

@@ -328,7 +328,8 @@ def kia(data, narx, **options):
     """The whole Kernel Invariance workflow (as `ctid fit --method kia`): stages, stacking, the check that the
     equation reproduces its NARX model, and the output-error refinement. Options: KiaOptions with the CLI's names,
     e.g. y_order=2, quadratic=['y^2', 'y*Dy'], cubic=['y^3'], qpoints=70, refine=True (ctid.settings('kia')).
-    Returns a KiaRun; its result() is the answer."""
+    data: an IdData, or a list of IdData (several experiments of one system: the NARX model should come from all of
+    them, e.g. ctid.narx([a, b], ...)). Returns a KiaRun; its result() is the answer."""
     return _ctid.kia(data, narx, _options(_ctid.KiaOptions, "kia", options))
 
 

@@ -131,6 +131,10 @@ void bind_nonlinear(py::module_& m) {
   m.def("kia", [](const IdData& d, const NarxModel& narx, const KiaOptions& o) {
           return interruptible([&] { return kia(d, narx, o); }, OnInterrupt::Raise);
         }, py::arg("data"), py::arg("narx"), py::arg("options") = KiaOptions{});
+  m.def("kia", [](const std::vector<IdData>& d, const NarxModel& narx, const KiaOptions& o) {
+          return interruptible([&] { return kia(d, narx, o); }, OnInterrupt::Raise);
+        }, py::arg("data"), py::arg("narx"), py::arg("options") = KiaOptions{},
+        "Several records (experiments of one system): pooled fits, one refinement with an initial state per record.");
 }
 
 }  // namespace ctid::python

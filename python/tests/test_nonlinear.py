@@ -29,6 +29,11 @@ def test_narx_kia_and_refinement_reconstruct_bl33(bl33):
         q.model.normalized().coefficient("y^2"), rel=1e-12)
     assert run.result().model.coefficient("y*Dy") == pytest.approx(refined.model.coefficient("y*Dy"), rel=1e-9)
     assert run.narx_fit_percent < 0  # this NARX model escapes in free run (above): the fidelity check is skipped
+    # Several records (issue 14): a list is several experiments; the refinement estimates an initial state each.
+    joint = ctid.kia([d, d], r.model, y_order=2, u_order=0, quadratic=["y^2", "y*Dy"])
+    assert joint.reconstructed.diagnostics.scalars["experiments"] == 2
+    assert joint.result().model.coefficient("y*Dy") == pytest.approx(refined.model.coefficient("y*Dy"), rel=1e-6)
+    assert "x0_2" in joint.result().diagnostics.vectors
     # The point range defaults to 1.25/T (500 rad/s at T = 2.5 ms); beyond pi/T = 1256.6 rad/s it is refused.
     assert ctid.kia_linear(r.model, y_order=2, u_order=0, max=500).parameters.values.tolist() == lin.parameters.values.tolist()
     with pytest.raises(ValueError, match="Nyquist frequency pi/T = 1256.6"):

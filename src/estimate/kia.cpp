@@ -468,9 +468,18 @@ Result<NdeModel> kia_cubic(const NarxModel& narx, const NdeModel& model_in, cons
 }
 
 KiaRun kia(const IdData& d, const NarxModel& narx, const KiaOptions& o) {
-  require_io_data(d, "kia");
-  CTID_REQUIRE(std::abs(narx.ts() - d.ts()) <= 1e-9 * d.ts(),
-               "kia: the NARX model was identified at Ts = {} s, the data have {} s", narx.ts(), d.ts());
+  return kia(std::vector<IdData>{d}, narx, o);
+}
+
+KiaRun kia(const std::vector<IdData>& ds, const NarxModel& narx, const KiaOptions& o) {
+  CTID_REQUIRE(!ds.empty(), "kia: no records");
+  const int E = static_cast<int>(ds.size());
+  for (int e = 0; e < E; ++e) {
+    const std::string who = E > 1 ? detail::format("kia (record {})", e + 1) : "kia";
+    require_io_data(ds[e], who.c_str());
+    CTID_REQUIRE(std::abs(narx.ts() - ds[e].ts()) <= 1e-9 * ds[e].ts(),
+                 "{}: the NARX model was identified at Ts = {} s, the data have {} s", who, narx.ts(), ds[e].ts());
+  }
   o.validate();
   KiaRun run;
   Result<NdeModel>& r = run.reconstructed;
@@ -491,25 +500,43 @@ KiaRun kia(const IdData& d, const NarxModel& narx, const KiaOptions& o) {
   };
   if (!o.quadratic.candidates.empty()) r = stack(r, kia_quadratic(narx, r.model, o.quadratic));
   if (!o.cubic.candidates.empty()) r = stack(r, kia_cubic(narx, r.model, o.cubic));
-  // The equation's simulated output on the record.
-  const Eigen::VectorXd t = (d.times().array() - d.t0()).matrix();
-  const NdeSimulation sim = r.model.simulate(d.u().col(0), t, d.intersample(0));
-  if (!sim.ok()) {
-    r.summary.termination = sim.termination;
-    r.summary.message = "the NDE simulation failed: " + sim.message;
-    r.fit = fit_report_or_inf(d.y().col(0), Eigen::VectorXd::Constant(d.size(), NAN), r.parameters.size());
-  } else {
-    r.fit = fit_report_or_inf(d.y().col(0), sim.y, r.parameters.size());
+  // The equation's simulated output on each record (from rest), pooled.
+  Eigen::Index total = 0;
+  for (const IdData& d : ds) total += d.size();
+  Eigen::VectorXd y(total), ysim(total);
+  bool sim_ok = true;
+  for (Eigen::Index e = 0, at = 0; e < E; at += ds[e].size(), ++e) {
+    const IdData& d = ds[e];
+    y.segment(at, d.size()) = d.y().col(0);
+    const NdeSimulation sim = r.model.simulate(d.u().col(0), (d.times().array() - d.t0()).matrix(), d.intersample(0));
+    if (sim.ok()) {
+      ysim.segment(at, d.size()) = sim.y;
+    } else if (sim_ok) {
+      sim_ok = false;
+      r.summary.termination = sim.termination;
+      r.summary.message = "the NDE simulation failed" + (E > 1 ? detail::format(" on record {}", e + 1) : "") + ": " +
+                          sim.message;
+    }
   }
-  // Kernel invariance means the equation reproduces its NARX model.
+  r.fit = fit_report_or_inf(y, sim_ok ? ysim : Eigen::VectorXd::Constant(total, NAN), r.parameters.size());
+  if (E > 1) r.diagnostics.set(diagnostic::experiments, E);
+  // Kernel invariance means the equation reproduces its NARX model: its free run on each record after the first
+  // max_lag samples, pooled.
   const int L = narx.max_lag();
-  if (d.size() > L + 2) {
-    bool escaped = false;
+  std::vector<double> measured, free_run;
+  bool escaped = false;
+  for (const IdData& d : ds) {
+    if (d.size() <= L + 2) continue;
     const Eigen::VectorXd yn = narx.simulate(d.u().col(0), d.y().col(0).head(L), &escaped);
-    if (!escaped)
-      run.narx_fit_percent = fit_report_or_inf(d.y().col(0).tail(d.size() - L), yn.tail(d.size() - L), 0).fit_percent;
+    if (escaped) break;
+    measured.insert(measured.end(), d.y().col(0).data() + L, d.y().col(0).data() + d.size());
+    free_run.insert(free_run.end(), yn.data() + L, yn.data() + d.size());
   }
-  if (sim.ok() && run.narx_fit_percent > 0 && r.fit.fit_percent < 0.5 * run.narx_fit_percent) {
+  if (!escaped && !measured.empty())
+    run.narx_fit_percent = fit_report_or_inf(Eigen::Map<const Eigen::VectorXd>(measured.data(), Eigen::Index(measured.size())),
+                                             Eigen::Map<const Eigen::VectorXd>(free_run.data(), Eigen::Index(free_run.size())), 0)
+                               .fit_percent;
+  if (sim_ok && run.narx_fit_percent > 0 && r.fit.fit_percent < 0.5 * run.narx_fit_percent) {
     r.summary.termination = Termination::Unidentifiable;
     r.summary.message = detail::format(
         "the continuous-time equation does not reproduce its NARX model (simulated fit {} % against the NARX "
@@ -517,7 +544,7 @@ KiaRun kia(const IdData& d, const NarxModel& narx, const KiaOptions& o) {
         "or the sampling is too slow for kernel invariance",
         std::round(r.fit.fit_percent * 100) / 100, std::round(run.narx_fit_percent * 100) / 100);
   }
-  if (o.refine) run.refined = nde_oe(d, r.model, o.refinement);
+  if (o.refine) run.refined = nde_oe(ds, r.model, o.refinement);
   return run;
 }
 

@@ -95,7 +95,7 @@ const std::vector<MethodInfo>& methods() {
                            reports(err, criterion, esr, candidates, narmax_iterations, relative_change, experiments)),
       entry<KiaOptions>(
           "kia", "Kernel Invariance Algorithm: NDE from a NARX model (stages, stacking, OE refinement)", {"KiaOptions"},
-          reports(err, first_iteration, gls_iterations, gls_order, err_sum, x0, noise_variance, start_scale)),
+          reports(err, first_iteration, gls_iterations, gls_order, err_sum, x0, noise_variance, start_scale, experiments)),
       entry<KiaLinearOptions>("kia_linear", "KIA linear stage", {"KiaLinearOptions"},
                               reports(err, first_iteration, gls_iterations, gls_order, err_sum)),
       entry<KiaQuadraticOptions>("kia_quadratic", "KIA quadratic stage", {"KiaQuadraticOptions"},

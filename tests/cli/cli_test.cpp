@@ -1188,7 +1188,7 @@ TEST(Cli, SeveralDataFilesAreFittedJointly) {
   const CliRun o = ctid_run("fit " + files[0] + " " + files[1] + " --time time --input force --output position --method fsf");
   EXPECT_EQ(o.code, 2);
   EXPECT_NE(o.err.find("2 DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, lssvf, "
-                       "ivsvf, rls-svf, narx, modal, physical --via raw or srivc with --closed-loop-controller (got fsf"),
+                       "ivsvf, rls-svf, narx, kia, modal, physical --via raw or srivc with --closed-loop-controller (got fsf"),
             std::string::npos)
       << o.err;
   // NARX on both records (resampled NARX at Ts = 0.02 s): the CLI's file equals the library's joint fit.
@@ -1203,9 +1203,22 @@ TEST(Cli, SeveralDataFilesAreFittedJointly) {
   ASSERT_EQ(file_n.parameters.size(), lib_n.parameters.size());
   for (int i = 0; i < lib_n.parameters.size(); ++i)
     EXPECT_NEAR(file_n.parameters.values(i), lib_n.parameters.values(i), 1e-9 * std::abs(lib_n.parameters.values(i)));
-  EXPECT_EQ(ctid_run("fit " + files[0] + " " + files[1] + " --time time --input force --output position --method kia")
-                .code,
-            2);
+  // KIA on both records from that joint NARX model (--narx): the CLI's answer is the library's kia(records) (to 1e-9).
+  const std::string kj = test::temp_path("joint_kia.json");
+  fs::remove(kj);
+  const CliRun k = ctid_run("fit " + files[0] + " " + files[1] + " --time time --input force --output position --method kia --narx " +
+                            json + " --set y_order=2 --json " + kj);
+  ASSERT_NE(k.code, 2) << k.err;
+  EXPECT_NE(k.out.find("free-run fit on the same records"), std::string::npos) << k.out;
+  KiaOptions ko;
+  ko.linear.y_order = 2;
+  const KiaRun lib_k = kia(ds, lib_n.model.process(), ko);
+  const Result<AnyModel> file_k = read_result_file(kj).result;
+  EXPECT_EQ(k.code == 0, lib_k.result().usable());
+  ASSERT_EQ(file_k.parameters.size(), lib_k.result().parameters.size());
+  for (int i = 0; i < file_k.parameters.size(); ++i)
+    EXPECT_NEAR(file_k.parameters.values(i), lib_k.result().parameters.values(i),
+                1e-9 * std::abs(lib_k.result().parameters.values(i)));
   // Validation and reports show each record: validate --json lists both (the fit of each equals a fit_report of the
   // library's simulation of the joint SRIVC model on that record, to 1e-6 %), the report has a section per record.
   const std::string cols = " --time time --input force --output position", vj = test::temp_path("joint_val.json"),

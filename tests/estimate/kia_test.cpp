@@ -268,3 +268,42 @@ TEST(Kia, ErrChoosesTheGlsFilterOrder) {
   EXPECT_GE(chosen.diagnostics.get(diagnostic::err_sum), 99.99);
   for (const char* s : {"D^2y", "Dy", "u"}) EXPECT_NEAR(value(chosen, s), value(ten, s), 0.01 * std::abs(value(ten, s))) << s;
 }
+
+// Issue 14 (item 2): KIA on several records of one system. Two noise-free records of the BL 3.3 equation (1000 +-1
+// samples each at 400 Hz, different inputs), the NARX model by FROLS on both (degree 2, lags 1..6, AIC): the workflow
+// pools the equation's and the NARX model's fits over the records, and its output-error refinement fits one equation
+// to both (an initial state each) — every coefficient within 0.1 % as from one record (EndToEndFromSimulatedData).
+TEST(Kia, SeveralRecordsGiveOneEquation) {
+  const double T = 0.0025;
+  const NdeModel truth = bl33();
+  std::vector<IdData> ds;
+  for (unsigned seed : {21u, 22u}) {
+    std::mt19937 rng(seed);
+    std::bernoulli_distribution coin(0.5);
+    Eigen::VectorXd u(1000);
+    for (int i = 0; i < 1000; ++i) u(i) = coin(rng) ? 1.0 : -1.0;
+    ds.emplace_back(u, truth.simulate(u, time_grid(T, 1000), Intersample::Zoh, {}, 1e-11).y, T);
+  }
+  const NarxModel narx =
+      frols(ds, narx_candidates(2, 6, 6), {.max_terms = 20, .criterion = InformationCriterion::Aic}).model.process();
+  KiaOptions ko;
+  ko.linear = {.y_order = 2, .u_order = 0};
+  ko.quadratic.candidates = {NdeTerm::parse("y^2"), NdeTerm::parse("y*Dy")};
+  const KiaRun run = kia(ds, narx, ko);
+  EXPECT_TRUE(run.reconstructed.usable()) << run.reconstructed.why_not_usable();
+  EXPECT_EQ(run.reconstructed.diagnostics.get(diagnostic::experiments), 2.0);
+  EXPECT_EQ(run.reconstructed.fit.n_samples, 2000);
+  EXPECT_GT(run.reconstructed.fit.fit_percent, 0.9 * run.narx_fit_percent);
+  ASSERT_TRUE(run.refined.has_value());
+  const Result<NdeModel>& refined = *run.refined;
+  ASSERT_TRUE(refined.usable()) << refined.why_not_usable();
+  EXPECT_EQ(refined.diagnostics.get(diagnostic::experiments), 2.0);
+  EXPECT_TRUE(refined.diagnostics.has(diagnostic::x0, 1));
+  for (const char* s : {"Dy", "D^2y", "u", "y^2", "y*Dy"})
+    EXPECT_LT(std::abs(refined.model.coefficient(s) / truth.coefficient(s) - 1), 1e-3) << s;
+  // A record at another sampling period is named.
+  const IdData slow(ds[1].u(), ds[1].y(), 2 * T);
+  EXPECT_NE(test::error_of([&] { kia(std::vector<IdData>{ds[0], slow}, narx, ko); })
+                .find("kia (record 2): the NARX model was identified at Ts = 0.0025 s"),
+            std::string::npos);
+}

@@ -137,5 +137,10 @@ struct KiaRun {
 /// Throws InvalidArgument for a record that is not SISO, a NARX model identified at another sampling period,
 /// and the stages' errors (kia_linear, kia_quadratic, kia_cubic).
 KiaRun kia(const IdData& data, const NarxModel& narx, const KiaOptions& options = {});
+/// Several records (experiments of one system; the NARX model identified from all of them, e.g. narx(records)):
+/// the equation's fit and the NARX model's free-run fit are pooled over the records, and the refinement fits one
+/// equation to all of them, each record with its own initial state (nde_oe on the records; diagnostics
+/// "experiments"). Throws as the one-record form, naming the record.
+KiaRun kia(const std::vector<IdData>& data, const NarxModel& narx, const KiaOptions& options = {});
 
 }  // namespace ctid
