@@ -424,7 +424,8 @@ Result<TransferFunction> modal_fit(const std::vector<IdData>& data, int nb, Moda
   CTID_REQUIRE(!input || data.size() == 1,
                "modal_fit: a generated input belongs to one record (Theorem 4.2's q depend on its generator's state); "
                "{} records are fitted jointly with piecewise-constant inputs, or one at a time", data.size());
-  for (const IdData& d : data) require_io_data(d, "modal_fit");
+  for (std::size_t e = 0; e < data.size(); ++e)
+    require_io_data(data[e], data.size() > 1 ? detail::format("modal_fit (record {})", e + 1).c_str() : "modal_fit");
   if (o.delay == 0.0) return modal_fit_undelayed(data, nb, o.resolved(input == nullptr), input);
   // The delayed input (zero before each record): the fit sees a delay-free system.
   std::vector<IdData> delayed;
