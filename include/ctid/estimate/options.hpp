@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "ctid/core/error.hpp"
+#include "ctid/core/names.hpp"
 #include "ctid/model/transfer_function.hpp"
 
 namespace ctid {
@@ -76,8 +77,6 @@ using OptionValue = std::variant<double, int, bool, std::string, std::vector<dou
                                  std::map<std::string, std::pair<double, double>>, std::optional<TransferFunction>,
                                  std::vector<std::string>>;
 
-/// The closest of `names` to `key` by edit distance ("" when none is within half of key's length + 2).
-std::string closest_name(const std::string& key, const std::vector<std::string>& names);
 
 /// Parameters held at a value, by name: the `fixed` setting of every estimator with constraints (fixed.NAME=VALUE;
 /// Python fixed={"a2": 4}), in the unit and scale of the returned model's parameter of that name.

@@ -1,0 +1,59 @@
+// ctid — the grey-box model language (issue 15): a scalar expression of named variables (states, inputs,
+// parameters, t), parsed once and compiled to a stack program that evaluates without allocation, with exact first
+// derivatives by forward-mode differentiation of the same program.
+//
+// Grammar (precedence low to high; ^ is right-associative and binds tighter than unary minus: -x^2 = -(x^2)):
+//   expr    := term (('+' | '-') term)*
+//   term    := unary (('*' | '/') unary)*
+//   unary   := '-' unary | power
+//   power   := primary ('^' unary)?
+//   primary := number | name | name '(' expr (',' expr)* ')' | '(' expr ')'
+// Numbers: 2, 0.5, 1e-3. Functions: exp log sqrt abs sign tanh sin cos atan (one argument), min max pow (two),
+// sat(x, lo, hi) (three) = min(max(x, lo), hi).
+// Derivatives at the kinks (a set of measure zero along a trajectory): d sign = 0; d abs(x) = sign(x) dx;
+// min/max follow the argument that is taken (the first on a tie); sat passes dx strictly inside (lo, hi) and the
+// derivative of the active bound outside. sqrt, log, pow and / have their usual derivatives where defined; at
+// sqrt(0) the derivative is +inf (the caller decides: max(x, 0) before sqrt is the usual guard).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace ctid {
+
+class Expression {
+ public:
+  Expression() = default;
+  /// Parses `text` over `variables` (the names it may use, in the order of the value arrays). Throws
+  /// InvalidArgument naming the expression, the column and the problem: an unknown name (with the closest
+  /// variable or function), a wrong number of arguments, a misplaced token, an unbalanced parenthesis.
+  Expression(const std::string& text, const std::vector<std::string>& variables);
+
+  const std::string& text() const { return text_; }
+  int n_variables() const { return n_vars_; }
+  /// Whether the expression reads variable i (its derivative with respect to the others is 0).
+  const std::vector<bool>& uses() const { return uses_; }
+
+  /// The value at x (x[i] = the value of variable i).
+  double operator()(const double* x) const;
+  /// The value at x; grad[i] = its derivative with respect to variable i (n_variables() entries).
+  double gradient(const double* x, double* grad) const;
+
+ private:
+  enum class Code : unsigned char {
+    Number, Variable, Add, Sub, Mul, Div, Pow, Neg, Exp, Log, Sqrt, Abs, Sign, Tanh, Sin, Cos, Atan, Min, Max, Sat
+  };
+  struct Op {
+    Code code;
+    int index = 0;       // Variable: which one
+    double value = 0.0;  // Number
+  };
+  friend struct ExpressionParser;
+  std::string text_;
+  int n_vars_ = 0;
+  std::vector<bool> uses_;
+  std::vector<Op> program_;  // postfix
+  int depth_ = 0;            // the largest stack the program needs
+};
+
+}  // namespace ctid
