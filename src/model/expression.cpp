@@ -10,6 +10,7 @@
 #include "ctid/core/check.hpp"
 #include "ctid/core/error.hpp"
 #include "ctid/core/names.hpp"
+#include "model/text_cursor.hpp"
 
 namespace ctid {
 
@@ -25,27 +26,13 @@ constexpr std::array<Function, 13> kFunctions = {{{"exp", 1}, {"log", 1}, {"sqrt
                                                    {"max", 2}, {"pow", 2}, {"sat", 3}}};
 }  // namespace
 
-struct ExpressionParser {
+struct ExpressionParser : model_detail::TextCursor {
   Expression& e;
   const std::vector<std::string>& vars;
-  const std::string& s;
-  std::size_t pos = 0;
   int depth = 0;
 
-  [[noreturn]] void fail(const std::string& what) const {
-    throw InvalidArgument(detail::format("expression \"{}\": {} at column {}", s, what, pos + 1));
-  }
-  void skip() {
-    while (pos < s.size() && std::isspace(static_cast<unsigned char>(s[pos]))) ++pos;
-  }
-  bool accept(char c) {
-    skip();
-    if (pos < s.size() && s[pos] == c) {
-      ++pos;
-      return true;
-    }
-    return false;
-  }
+  ExpressionParser(const std::string& t, Expression& expression, const std::vector<std::string>& variables)
+      : TextCursor{t}, e(expression), vars(variables) {}
   // Emits an op and tracks the stack height: `pops` operands replaced by one result.
   void emit(Expression::Code c, int pops, int index = 0, double value = 0.0) {
     e.program_.push_back({c, index, value});
@@ -87,21 +74,16 @@ struct ExpressionParser {
   }
   void primary() {
     skip();
-    if (pos >= s.size()) fail("unexpected end of expression");
-    const char c = s[pos];
-    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') {
-      const char* begin = s.c_str() + pos;
-      char* end = nullptr;
-      const double v = std::strtod(begin, &end);
-      if (end == begin) fail("malformed number");
-      pos += static_cast<std::size_t>(end - begin);
-      emit(Expression::Code::Number, 0, 0, v);
+    if (pos >= text.size()) fail("unexpected end of expression");
+    const char c = text[pos];
+    if (const auto v = number()) {
+      emit(Expression::Code::Number, 0, 0, *v);
       return;
     }
     if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
       const std::size_t start = pos;
-      while (pos < s.size() && (std::isalnum(static_cast<unsigned char>(s[pos])) || s[pos] == '_')) ++pos;
-      const std::string name = s.substr(start, pos - start);
+      while (pos < text.size() && (std::isalnum(static_cast<unsigned char>(text[pos])) || text[pos] == '_')) ++pos;
+      const std::string name = text.substr(start, pos - start);
       if (accept('(')) return call(name, start);
       for (std::size_t i = 0; i < vars.size(); ++i)
         if (vars[i] == name) {
@@ -155,7 +137,7 @@ struct ExpressionParser {
 
 Expression::Expression(const std::string& text, const std::vector<std::string>& variables)
     : text_(text), n_vars_(static_cast<int>(variables.size())), uses_(variables.size(), false) {
-  ExpressionParser p{*this, variables, text_};
+  ExpressionParser p(text_, *this, variables);
   p.expr();
   p.skip();
   if (p.pos != text_.size()) p.fail(detail::format("unexpected '{}'", text_[p.pos]));

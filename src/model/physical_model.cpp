@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "ctid/core/check.hpp"
+#include "model/text_cursor.hpp"
 
 namespace ctid {
 
@@ -22,32 +23,18 @@ struct Node {
   std::unique_ptr<Node> a, b;
 };
 
-class Parser {
+class Parser : model_detail::TextCursor {
  public:
-  Parser(const std::string& text, const std::vector<std::string>* params, std::vector<std::string>* seen)
-      : t_(text), params_(params), seen_(seen) {}
+  Parser(const std::string& t, const std::vector<std::string>* params, std::vector<std::string>* seen)
+      : TextCursor{t}, params_(params), seen_(seen) {}
   std::unique_ptr<Node> parse() {
     auto n = expr();
     skip();
-    if (pos_ < t_.size()) fail(detail::format("unexpected '{}'", t_[pos_]));
+    if (pos < text.size()) fail(detail::format("unexpected '{}'", text[pos]));
     return n;
   }
 
  private:
-  [[noreturn]] void fail(const std::string& what) const {
-    throw InvalidArgument(detail::format("expression \"{}\": {} at column {}", t_, what, pos_ + 1));
-  }
-  void skip() {
-    while (pos_ < t_.size() && std::isspace(static_cast<unsigned char>(t_[pos_]))) ++pos_;
-  }
-  bool accept(char c) {
-    skip();
-    if (pos_ < t_.size() && t_[pos_] == c) {
-      ++pos_;
-      return true;
-    }
-    return false;
-  }
   static std::unique_ptr<Node> make(Node::Kind k, std::unique_ptr<Node> a = nullptr, std::unique_ptr<Node> b = nullptr) {
     auto n = std::make_unique<Node>();
     n->kind = k;
@@ -75,12 +62,12 @@ class Parser {
     auto n = unary();
     if (accept('^')) {
       skip();
-      const std::size_t start = pos_;
-      while (pos_ < t_.size() && std::isdigit(static_cast<unsigned char>(t_[pos_]))) ++pos_;
-      if (start == pos_) fail("expected a non-negative integer exponent after '^'");
-      if (pos_ - start > 3) fail("exponent larger than 64");
+      const std::size_t start = pos;
+      while (pos < text.size() && std::isdigit(static_cast<unsigned char>(text[pos]))) ++pos;
+      if (start == pos) fail("expected a non-negative integer exponent after '^'");
+      if (pos - start > 3) fail("exponent larger than 64");
       auto p = make(Node::Pow, std::move(n));
-      p->value = std::stod(t_.substr(start, pos_ - start));
+      p->value = std::stod(text.substr(start, pos - start));
       if (p->value > 64) fail("exponent larger than 64");
       return p;
     }
@@ -93,28 +80,23 @@ class Parser {
   }
   std::unique_ptr<Node> primary() {
     skip();
-    if (pos_ >= t_.size()) fail("unexpected end of expression");
-    const char c = t_[pos_];
+    if (pos >= text.size()) fail("unexpected end of expression");
+    const char c = text[pos];
     if (c == '(') {
-      ++pos_;
+      ++pos;
       auto n = expr();
       if (!accept(')')) fail("expected ')'");
       return n;
     }
-    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') {
-      const char* begin = t_.c_str() + pos_;
-      char* end = nullptr;
-      const double v = std::strtod(begin, &end);
-      if (end == begin) fail("malformed number");
-      pos_ += static_cast<std::size_t>(end - begin);
+    if (const auto v = number()) {
       auto n = make(Node::Number);
-      n->value = v;
+      n->value = *v;
       return n;
     }
     if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
-      const std::size_t start = pos_;
-      while (pos_ < t_.size() && (std::isalnum(static_cast<unsigned char>(t_[pos_])) || t_[pos_] == '_')) ++pos_;
-      const std::string name = t_.substr(start, pos_ - start);
+      const std::size_t start = pos;
+      while (pos < text.size() && (std::isalnum(static_cast<unsigned char>(text[pos])) || text[pos] == '_')) ++pos;
+      const std::string name = text.substr(start, pos - start);
       if (name == "s") return make(Node::S);
       if (seen_) {
         bool known = false;
@@ -128,7 +110,7 @@ class Parser {
         if (n->symbol < 0) {
           std::string list;
           for (const auto& p : *params_) list += (list.empty() ? "" : ", ") + p;
-          pos_ = start;
+          pos = start;
           fail(detail::format("unknown symbol '{}' (parameters: {})", name, list.empty() ? "none" : list));
         }
       }
@@ -137,10 +119,8 @@ class Parser {
     fail(detail::format("unexpected '{}'", c));
   }
 
-  const std::string& t_;
   const std::vector<std::string>* params_;
   std::vector<std::string>* seen_;
-  std::size_t pos_ = 0;
 };
 
 // ---- values: polynomials in s with coefficients carrying gradients ----------------------
