@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <complex>
+#include <span>
 
 #include "ctid/core/check.hpp"
 #include "ctid/model/state_space.hpp"
@@ -190,11 +191,11 @@ Eigen::VectorXd windowed_zoh_response(const TransferFunction& g, const Eigen::Ve
 // Records (experiments of one system) as the raw route measures them: the outputs stacked, windowed by e^{-at} from
 // each record's start when a > 0, and a model G(s + a) simulated from rest on each record's (windowed) input.
 struct WindowedRecords {
-  const std::vector<IdData>& records;
+  std::span<const IdData> records;
   double a;
   Eigen::VectorXd y;
 
-  WindowedRecords(const std::vector<IdData>& ds, double window) : records(ds), a(window) {
+  WindowedRecords(std::span<const IdData> ds, double window) : records(ds), a(window) {
     Eigen::Index n = 0;
     for (std::size_t e = 0; e < records.size(); ++e) {
       const IdData& d = records[e];
@@ -232,8 +233,7 @@ Result<TransferFunction> with_simulation_fit(Result<TransferFunction> r, const P
   r.fit = FitReport{};
   r.fit.n_parameters = p;
   if (!data) return r;
-  const std::vector<IdData> one{*data};
-  const WindowedRecords w(one, a);
+  const WindowedRecords w(std::span<const IdData>(data, 1), a);
   r.fit = fit_report_or_inf(w.y, w.simulate(model.shifted(r.parameters.values, a)), p);
   return r;
 }
