@@ -50,11 +50,12 @@ void reject_flags_that_do_not_apply(const FitArgs& a) {
   if (has("narx") && m != "kia") refuse("narx", "gives KIA its NARX model: it needs --method kia (got " + m + ")");
   if (has("via") && m != "physical") refuse("via", "chooses the route of --method physical (got " + m + ")");
   if (a.via != "fsf" && a.via != "frequency" && a.via != "raw") refuse("via", "must be fsf, frequency or raw (got '" + a.via + "')");
-  for (const char* f : {"model", "param"})
-    if (has(f) && m != "physical") refuse(f, "describes the model of --method physical (got " + m + ")");
+  if (has("model") && m != "physical" && m != "greybox")
+    refuse("model", "describes the model of --method physical or greybox (got " + m + ")");
+  if (has("param") && m != "physical") refuse("param", "describes the model of --method physical (got " + m + ")");
   if (has("delay") && !tf_data) refuse("delay", "(delay estimation) needs --method srivc, oe or tfest (got " + m + ")");
   for (const char* f : {"nb", "nf", "nk"})
-    if (has(f) && (m == "narx" || m == "kia" || m == "fsf" || m == "physical"))
+    if (has(f) && (m == "narx" || m == "kia" || m == "fsf" || m == "physical" || m == "greybox"))
       refuse(f, "sets transfer-function orders; " + m + " has its own structure settings (--set)");
   if (!a.frequency)
     for (const char* f : {"w", "re", "im", "u-re", "u-im", "y-re", "y-im"})
@@ -289,6 +290,31 @@ int run_physical_records(const FitArgs& a, const std::vector<IdData>& ds) {
   return finish(r, "physical-" + a.via, d, a, settings, more_records_of(a, ds));
 }
 
+// A grey-box model file fitted to one record or several (one parameter set, an initial state per record). The
+// model's input and output names are the data columns unless --input/--output map them (in the model's order).
+int run_greybox(const FitArgs& a) {
+  if (a.model_expr.empty()) throw UsageError("--method greybox needs --model FILE.json (the grey-box model file)");
+  if (a.frequency) throw UsageError("--method greybox fits time-domain records (not --frequency)");
+  GreyboxModel model;
+  try {
+    model = read_greybox_json(a.model_expr);
+  } catch (const FileError& e) {
+    throw InputError(e.what());
+  }
+  const DataArgs da = columns_of(a.data, model);
+  if (static_cast<int>(da.inputs.size()) != model.nu() || static_cast<int>(da.outputs.size()) != model.ny())
+    throw UsageError(detail::format("--input/--output name {} and {} columns; the model has {} inputs ({}) and {} outputs ({})",
+                                    da.inputs.size(), da.outputs.size(), model.nu(),
+                                    options_detail::format_names(model.spec().inputs), model.ny(),
+                                    options_detail::format_names(model.output_names())));
+  const std::vector<IdData> ds = a.paths.size() > 1 ? da.load_each(a.paths, true) : std::vector<IdData>{da.load(true)};
+  GreyboxOptions o;
+  apply_sets("greybox", a.sets, o);
+  const Result<GreyboxModel> r = call_library([&] { return greybox(ds, model, o); });
+  print_experiments(a, ds);
+  return finish(r, "greybox", ds.front(), a, settings_of(o), more_records_of(a, ds));
+}
+
 // El-Shafey: modal functions (modal_fit) on one record, or on several with piecewise-constant inputs (jointly).
 // Besides the table's settings: shift_samples (the shifts in samples) and frequencies=w1,.. (a generated input:
 // the generator fitted to the measured input); --nk is the input delay.
@@ -407,11 +433,12 @@ int run_experiments(const FitArgs& a) {
 int run(const FitArgs& a) {
   reject_flags_that_do_not_apply(a);
   std::vector<std::string> inputs = a.paths;
-  inputs.insert(inputs.end(), {a.narx, a.controller});
+  inputs.insert(inputs.end(), {a.narx, a.controller, a.method == "greybox" ? a.model_expr : ""});
   check_outputs({a.json, a.report, a.responses.empty() ? "" : a.responses + "_time.csv",
                  a.responses.empty() ? "" : a.responses + "_freq.csv"},
                 inputs, a.force);
   if (!a.controller.empty()) return run_closed_loop(a);
+  if (a.method == "greybox") return run_greybox(a);
   if (a.paths.size() > 1) return run_experiments(a);
   if (a.frequency && !a.report.empty()) throw UsageError("--report needs time-domain data (not --frequency)");
   if (a.frequency) return run_frequency(a);
@@ -437,6 +464,7 @@ const std::map<std::string, FitMethod>& fit_methods() {
       {"tfest", {{"tfest", "tf_from_frequency"}, [](const FitArgs& a, const IdData& d) { return run_tf(a, d, &tfest); }}},
       {"fsf", {{"fsf"}, run_fsf}},
       {"physical", {{"physical"}, run_physical}},
+      {"greybox", {{"greybox"}, [](const FitArgs& a, const IdData&) { return run_greybox(a); }}},
       {"modal", {{"modal"}, run_modal}},
       {"narx",
        {{"narx"},
@@ -480,12 +508,12 @@ void setup_fit(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
   app.add_option("DATA", a->paths,
                  "CSV/.dat table (header row optional) or .mat file; several files are several experiments of one system, "
-                 "fitted jointly (srivc, oe, tfest, lssvf, ivsvf, rls-svf, narx, kia, modal, physical --via raw; the same columns in each)")
+                 "fitted jointly (srivc, oe, tfest, lssvf, ivsvf, rls-svf, narx, kia, modal, physical --via raw, greybox; the same columns in each)")
       ->required();
   std::vector<std::string> names;
   for (const auto& [name, m] : fit_methods()) names.push_back(name);
   app.add_option("--method", a->method,
-                 "Estimator: srivc, tfest, oe, lssvf, ivsvf, rls-svf, fsf, physical, modal, narx or kia (with --help: "
+                 "Estimator: srivc, tfest, oe, lssvf, ivsvf, rls-svf, fsf, physical, greybox, modal, narx or kia (with --help: "
                  "its settings)")
       ->check(CLI::IsMember(names))
       ->capture_default_str();
@@ -518,7 +546,9 @@ void setup_fit(CLI::App& app) {
   app.add_option("--u-im", a->u_im, "Input spectrum, imaginary part");
   app.add_option("--y-re", a->y_re, "Output spectrum, real part");
   app.add_option("--y-im", a->y_im, "Output spectrum, imaginary part");
-  app.add_option("--model", a->model_expr, "physical: transfer-function expression in s, e.g. \"k1/(s^2-k2)\"");
+  app.add_option("--model", a->model_expr,
+                 "physical: transfer-function expression in s, e.g. \"k1/(s^2-k2)\"; greybox: the model file (JSON: inputs, "
+                 "states, outputs, parameters, equations, initial; docs/methods/greybox.md)");
   app.add_option("--param", a->params, "physical: NAME=INITIAL for each parameter of --model (repeatable)");
   app.add_option("--via", a->via, "physical: fit to the FSF step response (fsf), the FSF frequency response (frequency), "
                                   "or the raw data (raw)")

@@ -41,7 +41,7 @@ int run(const ReportArgs& a) {
   inputs.push_back(a.result);
   check_outputs({a.out}, inputs, a.force);
   ResultFile file = read_result(a.result);
-  const std::vector<IdData> ds = a.data.load_each(a.paths, true);
+  const std::vector<IdData> ds = columns_of(a.data, file.result.model).load_each(a.paths, true);
   const IdData& d = ds.front();
   if (d.ny() != 1 || d.nu() != model_inputs(file.result.model))
     throw UsageError(detail::format("report needs one --output and one --input per model input (the {} model has {})",

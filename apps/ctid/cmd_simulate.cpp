@@ -15,7 +15,8 @@ struct SimArgs {
   std::string out;
   double snr = std::numeric_limits<double>::quiet_NaN();
   unsigned long long seed = 1;
-  std::string initial = "rest";
+  std::string initial;  // "": initial_or_default()
+  int initial_samples = 0;
   bool force = false;
 };
 
@@ -23,9 +24,12 @@ struct SimArgs {
 int run(const SimArgs& a) {
   check_outputs({a.out}, {a.data.path, a.model}, a.force);
   const ResultFile f = read_result(a.model);
-  const InitialCondition initial = initial_condition_from_string(a.initial);
-  const IdData d = a.data.load(initial != InitialCondition::Rest);
-  Eigen::MatrixXd y = simulate_result(f.result, d, a.initial);
+  // The record's output is read where the initial condition needs it (a fitted x0 does not).
+  const std::string how = initial_or_default(a.initial, f);
+  const InitialCondition initial = initial_condition_from_string(how);
+  const bool fitted_x0 = initial == InitialCondition::Estimated && a.initial_samples == 0 && f.result.diagnostics.has(diagnostic::x0);
+  const IdData d = columns_of(a.data, f.result.model).load(initial != InitialCondition::Rest && !fitted_x0);
+  Eigen::MatrixXd y = simulate_result(f.result, d, how, a.initial_samples);
   std::vector<std::string> ynames;
   for (Eigen::Index j = 0; j < y.cols(); ++j) ynames.push_back(y.cols() == 1 ? "y" : "y" + std::to_string(j + 1));
   if (!std::isnan(a.snr)) {
@@ -60,7 +64,7 @@ void setup_simulate(CLI::App& app) {
   a->data.add_to(app, true);  // --output: the record's output, read for --initial measured|estimated
   app.add_option("--out", a->out, "Write t, inputs and simulated outputs to this CSV (default: stdout)");
   app.add_option("--snr", a->snr, "Add white Gaussian noise at this signal-to-noise ratio (dB)");
-  add_initial_option(app, a->initial);
+  add_initial_option(app, a->initial, &a->initial_samples, "rest; a grey-box result: its fitted initial state");
   app.add_option("--seed", a->seed, "Seed of the noise")->capture_default_str();
   app.add_flag("--force", a->force, "Overwrite an existing output file");
   app.callback([a] { g_run = [a] { return run(*a); }; });

@@ -17,11 +17,12 @@ struct ValArgs {
   DataArgs data;
   std::string json;
   int lags = 25;
-  std::string initial = "rest";
+  std::string initial;  // "": initial_or_default()
+  int initial_samples = 0;
   bool force = false;
 };
 
-nlohmann::json corr_json(const CorrelationTest& c) {
+nlohmann::ordered_json corr_json(const CorrelationTest& c) {
   return {{"lags", std::vector<int>(c.lags.begin(), c.lags.end())},
           {"values", std::vector<double>(c.values.begin(), c.values.end())},
           {"bound_99", c.bound},
@@ -30,11 +31,11 @@ nlohmann::json corr_json(const CorrelationTest& c) {
 }
 
 // One record's fit and residual tests, printed and as JSON.
-nlohmann::json validate_record(const ValArgs& a, const ResultFile& file, const IdData& d, const std::string& path) {
+nlohmann::ordered_json validate_record(const ValArgs& a, const ResultFile& file, const IdData& d, const std::string& path) {
   if (d.ny() != 1) throw UsageError(detail::format("validate compares one output; {} were selected", d.ny()));
   if (a.lags < 1 || a.lags >= d.size())
     throw UsageError(detail::format("--lags must be in [1, {}] for {}", d.size() - 1, path));
-  const Eigen::VectorXd yhat = simulate_result(file.result, d, a.initial).col(0);
+  const Eigen::VectorXd yhat = simulate_result(file.result, d, initial_or_default(a.initial, file), a.initial_samples).col(0);
   const Eigen::VectorXd y = d.y().col(0);
   FitReport f;
   try {
@@ -52,11 +53,11 @@ nlohmann::json validate_record(const ValArgs& a, const ResultFile& file, const I
   for (int i = 0; i < d.nu(); ++i)
     std::printf("input %s - residual independence (lags -%d..%d): %d outside -> %s\n", d.input_names()[i].c_str(), a.lags,
                 a.lags, xcs[i].n_outside, xcs[i].passed() ? "passed" : "correlated (unmodelled dynamics)");
-  nlohmann::json j;
+  nlohmann::ordered_json j;
   j["data"] = path;
   j["fit"] = {{"fit_percent", f.fit_percent}, {"nrmse", f.nrmse}, {"mse", f.mse}, {"n_samples", f.n_samples}};
   j["residual_autocorrelation"] = corr_json(ac);
-  j["input_residual_crosscorrelation"] = nlohmann::json::array();
+  j["input_residual_crosscorrelation"] = nlohmann::ordered_json::array();
   for (const auto& xc : xcs) j["input_residual_crosscorrelation"].push_back(corr_json(xc));
   return j;
 }
@@ -68,23 +69,23 @@ int run(const ValArgs& a) {
   const ResultFile file = read_result(a.model);
   const AnyModel& model = file.result.model;
   if (model_outputs(model) != 1) throw UsageError("validate compares one output; the model has " + std::to_string(model_outputs(model)));
-  const std::vector<IdData> ds = a.data.load_each(a.paths, true);
+  const std::vector<IdData> ds = columns_of(a.data, model).load_each(a.paths, true);
   std::printf("model:  %s\n", describe(model).c_str());
   // Finite on these records, but growing: the numbers below say little beyond them.
   if (const std::string unstable = unstable_poles_note(model); !unstable.empty())
     std::printf("note: the model is unstable%s\n", unstable.c_str());
-  nlohmann::json records = nlohmann::json::array();
+  nlohmann::ordered_json records = nlohmann::ordered_json::array();
   for (std::size_t e = 0; e < ds.size(); ++e) {
     if (ds.size() > 1) std::printf("record %zu (%s):\n", e + 1, a.paths[e].c_str());
     records.push_back(validate_record(a, file, ds[e], a.paths[e]));
   }
   if (!a.json.empty()) {
     // The first record's numbers at the top level; every record's under "experiments".
-    nlohmann::json j = records.front();
+    nlohmann::ordered_json j = records.front();
     j.erase("data");
     j["ctid_version"] = version();
-    j["model"] = nlohmann::json::parse(result_to_json(file.result, file.method))["model"];
-    j["initial"] = a.initial;
+    j["model"] = nlohmann::ordered_json::parse(result_to_json(file.result, file.method))["model"];
+    j["initial"] = initial_or_default(a.initial, file);
     j["experiments"] = records;
     write_text_file(a.json, j.dump(2) + "\n");
     std::printf("wrote %s\n", a.json.c_str());
@@ -98,7 +99,7 @@ void setup_validate(CLI::App& app) {
   app.add_option("MODEL", a->model, "Model JSON (a result file or a bare model)")->required();
   app.add_option("DATA", a->paths, "Measured data table(s) or .mat file(s); several: each validated")->required();
   a->data.add_to(app, true);
-  add_initial_option(app, a->initial);
+  add_initial_option(app, a->initial, &a->initial_samples, "rest; a grey-box result: its fitted initial state");
   app.add_option("--lags", a->lags, "Lags of the residual correlation tests")->capture_default_str();
   app.add_option("--json", a->json, "Write fit and residual tests to this JSON file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");

@@ -151,22 +151,49 @@ ResultFile read_result(const std::string& path) {
   }
 }
 
-void add_initial_option(CLI::App& app, std::string& initial) {
-  auto* o = app.add_option("--initial", initial,
-                           "Initial condition of the simulation: rest (zero state), measured (NARX: the first measured "
-                           "outputs; NDE: y(0)) or estimated (linear: least-squares initial state; NDE: the fitted x0)" +
-                               std::string(initial.empty() ? "; default: the one the result's own fit used" : ""))
-                ->check(CLI::IsMember({"rest", "measured", "estimated"}));
-  if (!initial.empty()) o->capture_default_str();
+DataArgs columns_of(const DataArgs& given, const AnyModel& model) {
+  DataArgs d = given;
+  if (const auto* g = std::get_if<GreyboxModel>(&model)) {
+    if (d.inputs.empty()) d.inputs = g->spec().inputs;
+    if (d.outputs.empty()) d.outputs = g->output_names();
+  }
+  return d;
 }
 
-Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, const std::string& initial) {
+std::string initial_or_default(const std::string& given, const ResultFile& file) {
+  if (!given.empty()) return given;
+  return std::holds_alternative<GreyboxModel>(file.result.model)
+             ? to_string(fit_initial_condition(file.result.model, file.result.diagnostics))
+             : "rest";
+}
+
+void add_initial_option(CLI::App& app, std::string& initial, int* initial_samples, const char* default_doc) {
+  auto* o = app.add_option("--initial", initial,
+                           "Initial condition of the simulation: rest (zero state), measured (NARX: the first measured "
+                           "outputs; NDE: y(0); grey-box: outputs that are a state give it) or estimated (linear: "
+                           "least-squares initial state; NDE, grey-box: the fitted x0)" +
+                               std::string(initial.empty() ? std::string("; default: ") + default_doc : ""))
+                ->check(CLI::IsMember({"rest", "measured", "estimated"}));
+  if (!initial.empty()) o->capture_default_str();
+  if (!initial_samples) return;
+  app.add_option("--initial-samples", *initial_samples,
+                 "With --initial estimated, grey-box models: estimate the initial state from the first N samples of "
+                 "this record only (the nonlinear-benchmark protocol), not the fitted x0")
+      ->check(CLI::PositiveNumber);
+}
+
+Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, const std::string& initial, int initial_samples) {
   SimulateOptions o;
   Simulation s;
   try {
     o.initial = initial.empty() ? fit_initial_condition(r.model, r.diagnostics) : initial_condition_from_string(initial);
-    if (o.initial == InitialCondition::Estimated && r.diagnostics.has(diagnostic::x0))
+    if (initial_samples > 0) {
+      if (o.initial != InitialCondition::Estimated || !std::holds_alternative<GreyboxModel>(r.model))
+        throw UsageError("--initial-samples needs --initial estimated and a grey-box model");
+      o.initial_samples = initial_samples;
+    } else if (o.initial == InitialCondition::Estimated && r.diagnostics.has(diagnostic::x0)) {
       o.x0 = r.diagnostics.get(diagnostic::x0);
+    }
     s = simulate(r.model, d, o);
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
@@ -195,10 +222,10 @@ int to_int(const std::string& key, const std::string& value) {
 
 namespace {
 template <class M>
-void print_any(const Result<M>& r, const std::string& method, const IdData& d) {
+void print_any(const Result<M>& r, const std::string& method, const IdData& d, const std::string& model) {
   std::printf("method: %s   samples: %d   %s\n", method.c_str(), d.size(),
               d.is_uniform() ? ("Ts = " + detail::format("{}", d.ts()) + " s").c_str() : "irregular sampling");
-  std::printf("model:  %s%s\n", std::is_same_v<M, MisoModel> ? "y = " : "G(s) = ", r.model.to_string(6).c_str());
+  std::printf("model:  %s\n", model.c_str());
   std::printf("parameters (value +- one standard deviation):\n");
   for (int i = 0; i < r.parameters.size(); ++i) {
     const bool fixed = r.parameters.fixed[i];
@@ -221,8 +248,18 @@ void print_any(const Result<M>& r, const std::string& method, const IdData& d) {
 }
 }  // namespace
 
-void print_result(const Result<TransferFunction>& r, const std::string& method, const IdData& d) { print_any(r, method, d); }
-void print_result(const Result<MisoModel>& r, const std::string& method, const IdData& d) { print_any(r, method, d); }
+void print_result(const Result<TransferFunction>& r, const std::string& method, const IdData& d) {
+  print_any(r, method, d, "G(s) = " + r.model.to_string(6));
+}
+void print_result(const Result<MisoModel>& r, const std::string& method, const IdData& d) {
+  print_any(r, method, d, "y = " + r.model.to_string(6));
+}
+void print_result(const Result<GreyboxModel>& r, const std::string& method, const IdData& d) {
+  std::string text = r.model.to_string();
+  for (std::size_t i = text.find('\n'); i != std::string::npos && i + 1 < text.size(); i = text.find('\n', i + 1))
+    text.insert(i + 1, "        ");
+  print_any(r, method, d, text.substr(0, text.size() - 1));
+}
 
 void print_result(const Result<FsfModel>& r, const std::string& method, const IdData& d) {
   const FsfModel& f = r.model;

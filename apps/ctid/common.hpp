@@ -61,11 +61,21 @@ std::map<std::string, std::string> parse_sets(const std::vector<std::string>& se
 ResultFile read_result(const std::string& path);
 /// `--initial rest|measured|estimated` (simulate/simulate.hpp) on a command, defaulting to `initial`'s value
 /// ("" = fit_initial_condition(): the one the result's own fit used).
-void add_initial_option(CLI::App& app, std::string& initial);
+/// With `initial_samples` (not null) also `--initial-samples N`: the estimated initial state of a grey-box model from
+/// the record's first N samples only (the nonlinear-benchmark protocol; the result's fitted x0 is then not used).
+/// With `initial` empty the help states `default_doc` (what the command does without --initial).
+void add_initial_option(CLI::App& app, std::string& initial, int* initial_samples = nullptr,
+                        const char* default_doc = "the one the result's own fit used");
+/// The initial condition simulate and validate use without --initial: rest, except for a grey-box result: the one its
+/// fit used (the fitted initial state of its first record). `given` (non-empty) wins.
+std::string initial_or_default(const std::string& given, const ResultFile& file);
+/// A grey-box model's inputs and outputs are data columns of the same names unless --input/--output map them.
+DataArgs columns_of(const DataArgs& given, const AnyModel& model);
 /// The result's model simulated on d from `initial` ("" = fit_initial_condition(); Estimated takes the result's diagnostics "x0" where it
 /// has one). Data that do not fit the model throw UsageError; a simulation that stops being finite throws
 /// NotUsable naming where and why (e.g. the unstable poles): a diverging simulation is never written or scored.
-Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, const std::string& initial);
+Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, const std::string& initial,
+                                int initial_samples = 0);
 
 /// A --set value as a finite number / a whole number, parsed by the library's option parsers; UsageError otherwise.
 double to_double(const std::string& key, const std::string& value);
@@ -75,6 +85,7 @@ int to_int(const std::string& key, const std::string& value);
 void print_result(const Result<TransferFunction>& r, const std::string& method, const IdData& data);
 void print_result(const Result<MisoModel>& r, const std::string& method, const IdData& data);
 void print_result(const Result<FsfModel>& r, const std::string& method, const IdData& data);
+void print_result(const Result<GreyboxModel>& r, const std::string& method, const IdData& data);
 
 /// Method settings as NAME/VALUE text pairs (the report's "settings" section).
 using Settings = std::vector<std::pair<std::string, std::string>>;

@@ -15,13 +15,13 @@ import numpy as _np
 
 from . import _ctid
 from ._ctid import (  # noqa: F401  (re-exported)
-    CorrelationTest, DeadbeatObserver, FileError, FrequencyData, FsfModel, IdData, InputGenerator, InvalidArgument,
+    CorrelationTest, DeadbeatObserver, FileError, FrequencyData, FsfModel, GreyboxModel, GreyboxSimulation, IdData, InputGenerator, InvalidArgument,
     InvalidOptions, MisoModel, ModalModel, ModalWindow, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm,
     NonlinearCorrelationTests, PhysicalModel, ResultFile, Simulation, StateSpace, TransferFunction, add_noise_snr, fit_percent, frequency_grid,
     generator_fitted_to_input, html_report,
     input_residual_crosscorrelation, load, magnitude_band, methods, settings, diagnostics, narx_candidates, narx_noise_candidates,
     nonlinear_correlation_tests, one_sided_dft, piecewise_constant_windows, prbs, read_narx_json, read_nde_json,
-    read_result, residual_autocorrelation, response_horizon, time_grid, write_result,
+    greybox_initial_state, read_result, residual_autocorrelation, response_horizon, time_grid, write_result,
 )
 
 __version__ = _ctid.__version__
@@ -337,6 +337,28 @@ def nde_oe(data, initial, **options):
     """Output-error refinement of an NDE model's coefficients and initial state (options: NdeOeOptions). data: an
     IdData or a list of IdData (several experiments: shared coefficients, each record's own initial state)."""
     return _ctid.nde_oe(data, initial, _options(_ctid.NdeOeOptions, "nde_oe", options))
+
+
+def greybox_model(model):
+    """A GreyboxModel from a dict with the model file's members (type, inputs, states, outputs, parameters,
+    equations, initial; docs/methods/greybox.md), a path to such a JSON file, or a GreyboxModel (returned as is)."""
+    import json as _json
+    import os as _os
+    if isinstance(model, _ctid.GreyboxModel):
+        return model
+    if isinstance(model, dict):
+        return _ctid.parse_greybox_json(_json.dumps({"type": "greybox", **model}), "<dict>")
+    if isinstance(model, (str, _os.PathLike)):
+        return _ctid.read_greybox_json(_os.fspath(model))
+    raise TypeError(f"greybox: the model must be a dict, a path or a GreyboxModel (got {type(model).__name__})")
+
+
+def greybox(data, model, **options):
+    """Nonlinear grey-box identification by output error with exact sensitivities (as `ctid fit --method greybox`).
+    data: an IdData whose inputs and outputs are the model's, in its order, or a list of IdData (several experiments:
+    one parameter set, each record's own initial state). model: a dict, a JSON path or a GreyboxModel. Options:
+    GreyboxOptions (ctid.settings('greybox')), e.g. starts=8, seed=1, fixed={'g': 9.81}, bounds={'k1': (0, 1)}."""
+    return _ctid.greybox(data, greybox_model(model), _options(_ctid.GreyboxOptions, "greybox", options))
 
 
 def modal_fit(data, nb, input=None, **options):

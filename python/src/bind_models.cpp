@@ -78,6 +78,7 @@ void bind_models(py::module_& m) {
   def_write_result<FsfModel>(m);
   def_write_result<NarxModel>(m);
   def_write_result<NdeModel>(m);
+  def_write_result<GreyboxModel>(m);
 }
 
 }  // namespace ctid::python

@@ -121,6 +121,47 @@ void bind_nonlinear(py::module_& m) {
           return interruptible([&] { return nde_oe(d, initial, o); });
         }, py::arg("data"), py::arg("initial"), py::arg("options") = NdeOeOptions{});
 
+  py::class_<GreyboxSimulation>(m, "GreyboxSimulation", "Outputs y (N x ny) and states x (N x nx) of a grey-box simulation.")
+      .def_readonly("y", &GreyboxSimulation::y)
+      .def_readonly("x", &GreyboxSimulation::x)
+      .def_readonly("message", &GreyboxSimulation::message)
+      .def("ok", &GreyboxSimulation::ok);
+  py::class_<GreyboxModel>(m, "GreyboxModel",
+                           "Nonlinear continuous-time grey-box model dx/dt = f(x, u, theta, t), y = h(x, u, theta, t) "
+                           "(ctid.greybox_model(dict or path) builds one).")
+      .def_property_readonly("inputs", [](const GreyboxModel& g) { return g.spec().inputs; })
+      .def_property_readonly("states", [](const GreyboxModel& g) { return g.spec().states; })
+      .def_property_readonly("outputs", &GreyboxModel::output_names)
+      .def_property_readonly("parameter_names", &GreyboxModel::parameter_names)
+      .def_property_readonly("parameter_values", &GreyboxModel::parameter_values)
+      .def("parameter", [](const GreyboxModel& g, const std::string& name) {
+             return g.parameter_values()(g.parameter_index(name));
+           }, py::arg("name"))
+      .def_property_readonly("initial_state", &GreyboxModel::initial_state,
+                             "x0 at the parameters (NaN: an estimated state without a value)")
+      .def("with_parameters", &GreyboxModel::with_parameters, py::arg("values"))
+      .def("simulate", [](const GreyboxModel& g, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
+                          const std::string& intersample, const Eigen::VectorXd& x0, double rtol) {
+             return g.simulate(u, t, intersample_from_string(intersample), x0, rtol);
+           }, py::arg("u"), py::arg("t"), py::arg("intersample") = "zoh", py::arg("x0") = Eigen::VectorXd(),
+           py::arg("rtol") = 1e-8, "Simulate from x0 (default: the model's initial state); u is N x nu.")
+      .def("to_json", [](const GreyboxModel& g) { return greybox_to_json(g); }, "The model file's text.")
+      .def("__eq__", [](const GreyboxModel& a, const GreyboxModel& b) { return a == b; })
+      .def("__repr__", &GreyboxModel::to_string);
+  bind_result<GreyboxModel>(m, "GreyboxResult");
+  def_report<GreyboxModel>(m);
+  m.def("parse_greybox_json", &parse_greybox_json, py::arg("text"), py::arg("source") = "<json>");
+  m.def("read_greybox_json", &read_greybox_json, py::arg("path"));
+  m.def("greybox_initial_state", &greybox_initial_state, py::arg("model"), py::arg("data"), py::arg("samples") = 0,
+        py::arg("rtol") = 1e-8);
+  bind_options<GreyboxOptions>(m, "GreyboxOptions");
+  m.def("greybox", [](const IdData& d, const GreyboxModel& g, const GreyboxOptions& o) {
+          return interruptible([&] { return greybox(d, g, o); });
+        }, py::arg("data"), py::arg("model"), py::arg("options") = GreyboxOptions{});
+  m.def("greybox", [](const std::vector<IdData>& d, const GreyboxModel& g, const GreyboxOptions& o) {
+          return interruptible([&] { return greybox(d, g, o); });
+        }, py::arg("data"), py::arg("model"), py::arg("options") = GreyboxOptions{});
+
   bind_options<KiaOptions>(m, "KiaOptions");
   py::class_<KiaRun>(m, "KiaRun", "The KIA workflow's stages: reconstructed, narx_fit_percent, refined, result().")
       .def_readonly("reconstructed", &KiaRun::reconstructed)

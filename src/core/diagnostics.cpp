@@ -54,7 +54,8 @@ const std::vector<DiagnosticInfo>& diagnostic_catalogue() {
       info(diagnostic::gls_order),
       info(diagnostic::err_sum),
       info(diagnostic::x0),
-      info(diagnostic::start_scale)};
+      info(diagnostic::start_scale),
+      info(diagnostic::starts_cost)};
   return all;
 }
 

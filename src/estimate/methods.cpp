@@ -7,6 +7,7 @@
 #include "ctid/core/error.hpp"
 #include "ctid/estimate/frequency.hpp"
 #include "ctid/estimate/frols.hpp"
+#include "ctid/estimate/greybox.hpp"
 #include "ctid/estimate/fsf.hpp"
 #include "ctid/estimate/kia.hpp"
 #include "ctid/estimate/lssvf.hpp"
@@ -104,6 +105,8 @@ const std::vector<MethodInfo>& methods() {
                              reports(err, first_iteration, gls_iterations, gls_order, err_sum)),
       entry<NdeOeOptions>("nde_oe", "output-error refinement of a nonlinear differential equation", {"NdeOeOptions"},
                           reports(x0, noise_variance, start_scale, experiments)),
+      entry<GreyboxOptions>("greybox", "nonlinear grey-box model (state equations with named parameters) by output error",
+                            {"GreyboxOptions"}, reports(x0, noise_variance, starts_cost, experiments)),
   };
   return all;
 }

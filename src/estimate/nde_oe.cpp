@@ -150,7 +150,8 @@ Result<NdeModel> nde_oe(const std::vector<IdData>& records, const NdeModel& init
   auto record_sensitivities = [&](const Eigen::VectorXd& x, int e, Eigen::VectorXd& yhat, Eigen::MatrixXd& S) {
     const Eigen::VectorXd c = coefficients(x);
     const double ctop = c(top);
-    internal::OdeRhs rhs = [&](const Eigen::VectorXd& z, double uu, Eigen::VectorXd& dz) {
+    internal::OdeRhs rhs = [&](double, const Eigen::VectorXd& z, const double* ui, Eigen::VectorXd& dz) {
+      const double uu = ui[0];
       grad.setZero();
       double sum = 0;
       for (int i = 0; i < m; ++i) {

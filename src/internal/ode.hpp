@@ -1,8 +1,11 @@
-// ctid internal — adaptive Dormand-Prince 5(4) integration of x' = f(x, u) over a sample grid, the input
+// ctid internal — adaptive Dormand-Prince 5(4) integration of x' = f(t, x, u) over a sample grid, the inputs
 // held (ZOH) or interpolated linearly (FOH) between samples (Dormand & Prince 1980; Hairer, Norsett &
 // Wanner, Solving ODEs I, II.4-5: FSAL, error estimate of the embedded 4th-order solution, step-size
-// control h *= clamp(0.9 err^{-1/5}, 0.2, 5)). Used by NdeModel::simulate and the sensitivity
-// simulations of nde_oe.
+// control h *= clamp(0.9 err^{-1/5}, 0.2, 5)). Every sample instant ends a step (a held input jumps there).
+// A kink of f inside a sample interval (sign, abs, min, max of a grey-box model) is not stepped over blindly:
+// the embedded error estimate of a step across it is large, so the step is rejected and shrunk until the kink
+// is passed within the tolerance (step control rather than event location; Hairer, Norsett & Wanner II.6).
+// Used by NdeModel::simulate, GreyboxModel::simulate and the sensitivity simulations of nde_oe and greybox.
 #pragma once
 
 #include <functional>
@@ -11,8 +14,8 @@
 
 namespace ctid::internal {
 
-/// dx = f(x, u) for the input value u at that instant.
-using OdeRhs = std::function<void(const Eigen::VectorXd& x, double u, Eigen::VectorXd& dx)>;
+/// dx = f(t, x, u) for the input values u[0 .. nu-1] at the time t (the scale of the times given).
+using OdeRhs = std::function<void(double t, const Eigen::VectorXd& x, const double* u, Eigen::VectorXd& dx)>;
 /// Called with the sample index k and the state at t(k), for k = 0 .. N-1.
 using OdeSample = std::function<void(Eigen::Index k, const Eigen::VectorXd& x)>;
 
@@ -22,10 +25,11 @@ struct OdeOutcome {
   double xmax = 0.0;  ///< max |x| there
 };
 
-/// Integrates from x0 at t(0) through the increasing times t, calling sample at each of them. The error is
+/// Integrates from x0 at t(0) through the increasing times t, the inputs u (N x nu, one row per time) held
+/// (hold) or linear between samples, calling sample at each time. The error is
 /// controlled on the first n_control components (the rest — e.g. sensitivities — ride along on the same
 /// steps); rtol relative, atol absolute tolerance.
-OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::VectorXd& u, const Eigen::VectorXd& t,
+OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
                    bool hold, double rtol, double atol, Eigen::Index n_control, const OdeSample& sample);
 
 }  // namespace ctid::internal

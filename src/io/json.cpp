@@ -1,5 +1,6 @@
 #include "ctid/io/json.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <cmath>
 #include <limits>
@@ -8,11 +9,13 @@
 #include <nlohmann/json.hpp>
 
 #include "ctid/core/check.hpp"
+#include "ctid/core/names.hpp"
 #include "ctid/io/file.hpp"
 
 namespace ctid {
 
-using nlohmann::json;
+// Ordered: object members keep the file's order (a grey-box model's outputs and parameters are declared in order).
+using json = nlohmann::ordered_json;
 
 const char* version() { return CTID_VERSION_STRING; }
 
@@ -163,6 +166,32 @@ json nde_json(const NdeModel& m0) {
   return {{"type", "nde"}, {"terms", terms_json(m.terms(), m.coefficients())}};
 }
 
+json greybox_json(const GreyboxModel& g) {
+  const GreyboxSpec& s = g.spec();
+  json outputs = json::object(), params = json::object(), eqs = json::object(), init = json::object();
+  for (const auto& [name, e] : s.outputs) outputs[name] = e;
+  for (const auto& p : s.parameters) {
+    json q = {{"value", p.value}};
+    if (p.lower > -INFINITY) q["lower"] = p.lower;
+    if (p.upper < INFINITY) q["upper"] = p.upper;
+    if (p.fixed) q["fixed"] = true;
+    params[p.name] = q;
+  }
+  for (size_t i = 0; i < s.states.size(); ++i) {
+    eqs[s.states[i]] = s.equations[i];
+    const GreyboxInitial& in = s.initial[i];
+    // A number is written as a number; an estimated state with its start (or estimate) as {"estimate": true, "value"}.
+    char* end = nullptr;
+    const double v = std::strtod(in.expression.c_str(), &end);
+    const json value = !in.expression.empty() && end && *end == '\0' ? json(v) : json(in.expression);
+    if (!in.estimate) init[s.states[i]] = value;
+    else if (in.expression.empty()) init[s.states[i]] = "estimate";
+    else init[s.states[i]] = {{"estimate", true}, {"value", value}};
+  }
+  return {{"type", "greybox"}, {"inputs", s.inputs}, {"states", s.states},   {"outputs", outputs},
+          {"parameters", params},  {"equations", eqs},   {"initial", init}};
+}
+
 // The model object of a bare model or an envelope, of the given type.
 const json& typed_model(const json& j, const char* type, const Reader& rd) {
   const json& m = j.contains("model") ? j.at("model") : j;
@@ -205,6 +234,101 @@ NarxModel narx_from(const json& m, const Reader& rd) {
   }
 }
 
+GreyboxModel greybox_from(const json& m, const Reader& rd) {
+  GreyboxSpec s;
+  auto names = [&](const char* key, bool required) {
+    std::vector<std::string> v;
+    if (!m.contains(key)) {
+      if (required) rd.fail(detail::format("the grey-box model has no member \"{}\" (an array of names)", key));
+      return v;
+    }
+    const json& a = m.at(key);
+    if (!a.is_array()) rd.fail(detail::format("\"{}\" must be an array of names", key));
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      if (!a[i].is_string()) rd.fail(detail::format("\"{}\"[{}] must be a name (a string)", key, i));
+      v.push_back(a[i].get<std::string>());
+    }
+    return v;
+  };
+  auto text = [&](const json& j, const std::string& where) {
+    if (j.is_string()) return j.get<std::string>();
+    if (j.is_number()) return detail::round_trip(j.get<double>());
+    rd.fail(where + " must be an expression (a string) or a number");
+  };
+  auto object = [&](const char* key) -> const json& {
+    const json& o = rd.member(m, key, "the grey-box model");
+    if (!o.is_object()) rd.fail(detail::format("\"{}\" must be an object", key));
+    return o;
+  };
+  s.inputs = names("inputs", false);
+  s.states = names("states", true);
+  for (const auto& [name, e] : object("outputs").items()) s.outputs.emplace_back(name, text(e, "outputs." + name));
+  if (m.contains("parameters"))
+    for (const auto& [name, q] : object("parameters").items()) {
+      GreyboxParameter p;
+      p.name = name;
+      if (q.is_number()) p.value = q.get<double>();
+      else if (q.is_object()) {
+        for (const auto& [k, v] : q.items()) {
+          if (k == "fixed") {
+            if (!v.is_boolean()) rd.fail("parameters." + name + ".fixed must be true or false");
+            p.fixed = v.get<bool>();
+            continue;
+          }
+          if (k != "value" && k != "lower" && k != "upper")
+            rd.fail(detail::format("parameters.{}: unknown member \"{}\" (value, lower, upper, fixed)", name, k));
+          if (!v.is_number() && !v.is_null()) rd.fail(detail::format("parameters.{}.{} must be a number", name, k));
+          const double x = v.is_null() ? (k == "lower" ? -INFINITY : k == "upper" ? INFINITY : kNaN) : v.get<double>();
+          (k == "value" ? p.value : k == "lower" ? p.lower : p.upper) = x;
+        }
+        if (!q.contains("value")) rd.fail("parameters." + name + " has no \"value\"");
+      } else {
+        rd.fail("parameters." + name + " must be a number or {\"value\", \"lower\", \"upper\", \"fixed\"}");
+      }
+      s.parameters.push_back(p);
+    }
+  const json& eqs = object("equations");
+  const json init = m.contains("initial") ? m.at("initial") : json::object();
+  if (!init.is_object()) rd.fail("\"initial\" must be an object: state -> number, expression or \"estimate\"");
+  for (const auto& [name, e] : eqs.items())
+    if (std::find(s.states.begin(), s.states.end(), name) == s.states.end())
+      rd.fail(detail::format("equations.{}: '{}' is not a state{}", name, name,
+                             closest_name(name, s.states).empty() ? "" : "; did you mean '" + closest_name(name, s.states) + "'?"));
+  for (const auto& [name, e] : init.items())
+    if (std::find(s.states.begin(), s.states.end(), name) == s.states.end())
+      rd.fail(detail::format("initial.{}: '{}' is not a state", name, name));
+  for (const auto& x : s.states) {
+    if (!eqs.contains(x)) rd.fail(detail::format("\"equations\" has no equation for the state {} (dx/dt)", x));
+    s.equations.push_back(text(eqs.at(x), "equations." + x));
+    GreyboxInitial in;
+    if (init.contains(x)) {
+      const json& v = init.at(x);
+      if (v.is_string() && v.get<std::string>() == "estimate") {
+        in.estimate = true;
+        in.expression.clear();
+      } else if (v.is_object()) {
+        if (!v.contains("estimate") || !v.at("estimate").is_boolean())
+          rd.fail("initial." + x + " must be a number, an expression, \"estimate\" or {\"estimate\": true, \"value\": start}");
+        in.estimate = v.at("estimate").get<bool>();
+        in.expression = v.contains("value") ? text(v.at("value"), "initial." + x + ".value") : std::string(in.estimate ? "" : "0");
+      } else {
+        in.expression = text(v, "initial." + x);
+      }
+    }
+    s.initial.push_back(in);
+  }
+  for (const auto& [k, v] : m.items())
+    if (k != "type" && k != "inputs" && k != "states" && k != "outputs" && k != "parameters" && k != "equations" &&
+        k != "initial")
+      rd.fail(detail::format("the grey-box model has an unknown member \"{}\" (type, inputs, states, outputs, parameters, "
+                             "equations, initial)", k));
+  try {
+    return GreyboxModel(std::move(s));
+  } catch (const InvalidArgument& e) {
+    rd.fail(e.what());
+  }
+}
+
 NdeModel nde_from(const json& m, const Reader& rd) {
   auto [terms, c] = read_terms<NdeTerm>(m, rd);
   try {
@@ -227,11 +351,19 @@ NdeModel parse_nde_json(const std::string& text, const std::string& source) {
 
 NarxModel read_narx_json(const std::string& path) { return parse_narx_json(read_text_file(path), path); }
 
+GreyboxModel parse_greybox_json(const std::string& text, const std::string& source) {
+  const Reader rd{source};
+  return greybox_from(typed_model(parse_text(text, rd), "greybox", rd), rd);
+}
+GreyboxModel read_greybox_json(const std::string& path) { return parse_greybox_json(read_text_file(path), path); }
+std::string greybox_to_json(const GreyboxModel& model, int indent) { return greybox_json(model).dump(indent); }
+
 namespace {
 json any_model_json(const AnyModel& m) {
   if (const auto* f = std::get_if<FsfModel>(&m)) return fsf_json(*f);
   if (const auto* n = std::get_if<NarxModel>(&m)) return narx_json(*n);
   if (const auto* e = std::get_if<NdeModel>(&m)) return nde_json(*e);
+  if (const auto* g = std::get_if<GreyboxModel>(&m)) return greybox_json(*g);
   if (const auto* t = std::get_if<TransferFunction>(&m)) return model_json(*t);
   if (const auto* i = std::get_if<MisoModel>(&m)) return model_json(*i);
   return model_json(std::get<StateSpace>(m));
@@ -260,9 +392,10 @@ AnyModel any_model_from(const json& root, const Reader& rd) {
   if (t == "fsf") return fsf_from(m, rd);
   if (t == "narx") return narx_from(m, rd);
   if (t == "nde") return nde_from(m, rd);
+  if (t == "greybox") return greybox_from(m, rd);
   if (t == "transfer_function" || t == "miso" || t == "state_space")
     return std::visit([](const auto& x) { return AnyModel(x); }, model_from(m, rd));
-  rd.fail(detail::format("model type \"{}\" is not one ctid knows (transfer_function, miso, state_space, fsf, narx, nde)",
+  rd.fail(detail::format("model type \"{}\" is not one ctid knows (transfer_function, miso, state_space, fsf, narx, nde, greybox)",
                          t));
 }
 }  // namespace

@@ -615,6 +615,17 @@ std::string report_of(const IdData& d, const Result<NdeModel>& r, const ReportOp
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }
 
+std::string report_of(const IdData& d, const Result<GreyboxModel>& r, const ReportOptions& o) {
+  CTID_REQUIRE(d.ny() == 1, "html_report: a grey-box report shows one output (the record has {})", d.ny());
+  Page page;
+  opening(page, d, r, o);
+  page.section("Equations");
+  page.text("<pre>" + escape(r.model.to_string()) + "</pre>");
+  parameters(page, r.parameters);
+  diagnostics(page, r.diagnostics);
+  return page.render(o.title.empty() ? o.method + " fit" : o.title);
+}
+
 }  // namespace
 
 std::string html_report(const IdData& data, const Result<AnyModel>& result, const ReportOptions& options) {

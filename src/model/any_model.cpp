@@ -26,22 +26,26 @@ const char* model_type_name(const AnyModel& model) {
                               [](const StateSpace&) { return "state_space"; },
                               [](const FsfModel&) { return "fsf"; },
                               [](const NarxModel&) { return "narx"; },
-                              [](const NdeModel&) { return "nde"; }},
+                              [](const NdeModel&) { return "nde"; },
+                              [](const GreyboxModel&) { return "greybox"; }},
                     model);
 }
 
 int model_inputs(const AnyModel& model) {
   return std::visit(Overloads{[](const MisoModel& m) { return m.nu(); }, [](const StateSpace& m) { return m.nu(); },
-                              [](const auto&) { return 1; }},
+                              [](const GreyboxModel& m) { return m.nu(); }, [](const auto&) { return 1; }},
                     model);
 }
 
 int model_outputs(const AnyModel& model) {
-  return std::visit(Overloads{[](const StateSpace& m) { return m.ny(); }, [](const auto&) { return 1; }}, model);
+  return std::visit(Overloads{[](const StateSpace& m) { return m.ny(); }, [](const GreyboxModel& m) { return m.ny(); },
+                              [](const auto&) { return 1; }},
+                    model);
 }
 
 bool is_linear(const AnyModel& model) {
-  return !std::holds_alternative<NarxModel>(model) && !std::holds_alternative<NdeModel>(model);
+  return !std::holds_alternative<NarxModel>(model) && !std::holds_alternative<NdeModel>(model) &&
+         !std::holds_alternative<GreyboxModel>(model);
 }
 
 int model_coefficient_count(const AnyModel& model) {
@@ -54,6 +58,7 @@ int model_coefficient_count(const AnyModel& model) {
                               },
                               [](const StateSpace& m) { return (m.nx() + m.ny()) * (m.nx() + m.nu()); },
                               [](const FsfModel& m) { return m.n(); },
+                              [](const GreyboxModel& m) { return m.np(); },
                               [](const auto& m) { return static_cast<int>(m.terms().size()); }},
                     model);
 }
@@ -71,6 +76,12 @@ std::string describe(const AnyModel& model, int precision) {
                          " filters, T = " + t + " s";
                 },
                 [&](const NarxModel& m) { return m.process().to_string(precision); },
+                [&](const GreyboxModel& m) {
+                  std::string s = m.to_string();
+                  for (auto& ch : s)
+                    if (ch == '\n') ch = ';';
+                  return "grey-box model: " + s.substr(0, s.size() - 1);
+                },
                 [&](const auto& m) { return m.to_string(precision); }},
       model);
 }

@@ -26,6 +26,12 @@ constexpr std::array<Function, 13> kFunctions = {{{"exp", 1}, {"log", 1}, {"sqrt
                                                    {"max", 2}, {"pow", 2}, {"sat", 3}}};
 }  // namespace
 
+bool Expression::is_function(const std::string& name) {
+  for (const auto& f : kFunctions)
+    if (name == f.name) return true;
+  return false;
+}
+
 struct ExpressionParser : model_detail::TextCursor {
   Expression& e;
   const std::vector<std::string>& vars;
@@ -246,19 +252,25 @@ double Expression::gradient(const double* x, double* grad) const {
       case Code::Neg: v[top] = -v[top], scale(top, -1.0); break;
       case Code::Exp: v[top] = std::exp(v[top]), scale(top, v[top]); break;
       case Code::Log: scale(top, 1.0 / v[top]), v[top] = std::log(v[top]); break;
-      case Code::Sqrt: v[top] = std::sqrt(v[top]), scale(top, 0.5 / v[top]); break;
+      case Code::Sqrt: {  // a zero partial stays zero at sqrt(0) (no 0 * inf)
+        v[top] = std::sqrt(v[top]);
+        double* a = g(top);
+        for (int i = 0; i < n; ++i) a[i] = a[i] == 0.0 ? 0.0 : a[i] * (0.5 / v[top]);
+        break;
+      }
       case Code::Abs: scale(top, sign_of(v[top])), v[top] = std::abs(v[top]); break;
       case Code::Sign: v[top] = sign_of(v[top]), scale(top, 0.0); break;
       case Code::Tanh: v[top] = std::tanh(v[top]), scale(top, 1.0 - v[top] * v[top]); break;
       case Code::Sin: scale(top, std::cos(v[top])), v[top] = std::sin(v[top]); break;
       case Code::Cos: scale(top, -std::sin(v[top])), v[top] = std::cos(v[top]); break;
       case Code::Atan: scale(top, 1.0 / (1.0 + v[top] * v[top])), v[top] = std::atan(v[top]); break;
-      case Code::Min: --top; if (!(v[top] <= v[top + 1])) take(top, top + 1); break;
-      case Code::Max: --top; if (!(v[top] >= v[top + 1])) take(top, top + 1); break;
+      // On a tie the second argument is taken (its partials): max(x, 0) at x = 0 has derivative 0.
+      case Code::Min: --top; if (!(v[top] < v[top + 1])) take(top, top + 1); break;
+      case Code::Max: --top; if (!(v[top] > v[top + 1])) take(top, top + 1); break;
       case Code::Sat:
         top -= 2;
-        if (!(v[top] >= v[top + 1])) take(top, top + 1);  // max(x, lo)
-        if (!(v[top] <= v[top + 2])) take(top, top + 2);  // min(., hi)
+        if (!(v[top] > v[top + 1])) take(top, top + 1);  // max(x, lo)
+        if (!(v[top] < v[top + 2])) take(top, top + 2);  // min(., hi)
         break;
     }
   }

@@ -200,7 +200,8 @@ NdeSimulation NdeModel::simulate(const Eigen::VectorXd& u, const Eigen::VectorXd
     CTID_REQUIRE(t(k) > t(k - 1), "NdeModel::simulate: times must increase (t[{}] = {}, t[{}] = {})", k - 1, t(k - 1), k,
                  t(k));
   const double ctop = c_(top);
-  auto f = [&](const Eigen::VectorXd& x, double uu, Eigen::VectorXd& dx) {
+  auto f = [&](double, const Eigen::VectorXd& x, const double* ui, Eigen::VectorXd& dx) {
+    const double uu = ui[0];
     double s = 0;
     for (size_t i = 0; i < terms_.size(); ++i) {
       if (static_cast<int>(i) == top) continue;

@@ -174,6 +174,34 @@ Simulation simulate_nde(const NdeModel& m, const IdData& d, const SimulateOption
   return s;
 }
 
+// Grey-box models: rest = zero state; measured = the model's initial state with each state that an output reads
+// alone taken from that output's first sample; estimated = `x0`, else the state that best explains the record's first
+// initial_samples samples (model/greybox.hpp).
+Simulation simulate_greybox(const GreyboxModel& m, const IdData& d, const SimulateOptions& o) {
+  Simulation s;
+  if (o.initial == InitialCondition::Rest) {
+    s.x0 = Eigen::VectorXd::Zero(m.nx());
+  } else {
+    CTID_REQUIRE(d.ny() == m.ny(), "simulate: the {} initial condition of a grey-box model needs the record's {} output(s) "
+                 "(got {})", to_string(o.initial), m.ny(), d.ny());
+    if (o.initial == InitialCondition::Measured) {
+      s.x0 = m.initial_state_guess(d);
+      for (int i = 0; i < m.nx(); ++i)
+        if (m.spec().initial[i].estimate && m.output_of_state(i) >= 0) s.x0(i) = d.y()(0, m.output_of_state(i));
+    } else {
+      CTID_REQUIRE(o.x0.size() == 0 || o.x0.size() == m.nx(), "simulate: x0 has {} values, the grey-box model has {} states",
+                   o.x0.size(), m.nx());
+      s.x0 = o.x0.size() ? o.x0 : greybox_initial_state(m, d, o.initial_samples);
+    }
+  }
+  bool zoh = true;
+  for (int i = 0; i < d.nu(); ++i) zoh = zoh && d.intersample(i) == Intersample::Zoh;
+  const GreyboxSimulation r = m.simulate(d.u(), d.times(), zoh ? Intersample::Zoh : Intersample::Foh, s.x0);
+  s.y = r.y;
+  if (!r.ok()) s.problem = r.message;
+  return s;
+}
+
 }  // namespace
 
 Simulation simulate(const AnyModel& model, const IdData& data, const SimulateOptions& options) {
@@ -183,6 +211,7 @@ Simulation simulate(const AnyModel& model, const IdData& data, const SimulateOpt
   if (const auto* f = std::get_if<FsfModel>(&model)) s = simulate_fsf(*f, data, options);
   else if (const auto* n = std::get_if<NarxModel>(&model)) s = simulate_narx(*n, data, options);
   else if (const auto* e = std::get_if<NdeModel>(&model)) s = simulate_nde(*e, data, options);
+  else if (const auto* g = std::get_if<GreyboxModel>(&model)) s = simulate_greybox(*g, data, options);
   else s = simulate_linear(model, data, options);
   if (!s.ok()) return s;
   // Diverged: a non-finite sample, or samples so large that their squares overflow (then every fit

@@ -1076,7 +1076,7 @@ TEST(Cli, MethodHelpListsEveryRegisteredSettingAndSetAcceptsIt) {
       {"lssvf", {"lssvf"}}, {"ivsvf", {"ivsvf"}}, {"rls-svf", {"rls_svf"}},
       {"srivc", {"srivc", "srivc_miso", "srivc_closed_loop"}}, {"oe", {"oe", "tf_from_frequency"}},
       {"tfest", {"tfest", "tf_from_frequency"}}, {"fsf", {"fsf"}}, {"physical", {"physical"}},
-      {"modal", {"modal"}}, {"narx", {"narx"}}, {"kia", {"kia", "narx"}}};
+      {"modal", {"modal"}}, {"narx", {"narx"}}, {"kia", {"kia", "narx"}}, {"greybox", {"greybox"}}};
   std::set<std::string> covered;
   for (const auto& [cli, entries] : cli_methods) {
     const CliRun h = ctid_run("fit --method " + cli + " --help");
@@ -1309,4 +1309,64 @@ TEST(Cli, EveryResultFileIsReadBackAndTheInitialConditionIsExplicit) {
   r = ctid_run("simulate " + tf + " " + late + cols + " --initial measured");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("no output history"), std::string::npos) << r.err;
+}
+
+// Issue 15: `ctid fit --method greybox --model FILE` is the library's greybox() on the columns the model names;
+// simulate starts from the fitted initial state by default; --initial estimated --initial-samples N estimates it
+// from the record's first N samples only; misuse is named.
+TEST(Cli, GreyboxModelFileFitSimulateAndValidate) {
+  const std::string model = write("spring.json", R"json({"type": "greybox", "inputs": ["force"], "states": ["q", "v"],
+    "outputs": {"position": "q"},
+    "parameters": {"k": 2.0, "c": {"value": 0.4, "lower": 0}, "fc": {"value": 0.3, "lower": 0}, "m": {"value": 1, "fixed": true}},
+    "equations": {"q": "v", "v": "(force - k*q - c*v - fc*tanh(v/0.05))/m"},
+    "initial": {"q": "estimate", "v": 0}})json");
+  const GreyboxModel truth = read_greybox_json(model).with_parameters(Eigen::Vector4d(2.5, 0.3, 0.2, 1.0));
+  const int N = 1500;
+  const Eigen::VectorXd t = time_grid(0.01, N);
+  Eigen::MatrixXd u(N, 1);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> level(-3, 3);
+  for (int k = 0; k < N; ++k) u(k, 0) = k % 100 == 0 ? level(rng) : u(k - 1, 0);
+  Eigen::VectorXd y = truth.simulate(u, t, Intersample::Zoh, Eigen::Vector2d(0.4, 0.0), 1e-11).y.col(0);
+  std::normal_distribution<double> noise(0.0, 0.005);
+  for (int k = 0; k < N; ++k) y(k) += noise(rng);
+  Eigen::MatrixXd m(N, 4);
+  m << t, Eigen::VectorXd::Zero(N), u, y;
+  const std::string csv = test::temp_path("spring.csv");
+  write_csv(csv, {"t", "other", "force", "position"}, m);
+  const std::string json = test::temp_path("spring_fit.json");
+  const CliRun r = ctid_run("fit " + csv + " --time t --method greybox --model " + model + " --json " + json + " --force");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("dv/dt = (force - k*q - c*v - fc*tanh(v/0.05))/m"), std::string::npos) << r.out;
+  const Result<GreyboxModel> lib = greybox(IdData(u, y, 0.01), read_greybox_json(model));
+  const ResultFile file = read_result_file(json);
+  ASSERT_EQ(file.result.parameters.size(), lib.parameters.size());
+  for (int i = 0; i < lib.parameters.size(); ++i)
+    EXPECT_NEAR(file.result.parameters.values(i), lib.parameters.values(i), 1e-9 * std::abs(lib.parameters.values(i)))
+        << lib.parameters.names[i];
+  EXPECT_NEAR(file.result.parameters.value("q(0)"), 0.4, 0.01);  // the noise 0.005 over the first samples
+  // simulate: from the fitted initial state by default (the fit's own simulation, to the integration tolerance).
+  const std::string sim = test::temp_path("spring_sim.csv");
+  const CliRun s = ctid_run("simulate " + json + " " + csv + " --time t --out " + sim + " --force");
+  ASSERT_EQ(s.code, 0) << s.err;
+  const Eigen::VectorXd ys = read_csv(sim).values.col(2);
+  SimulateOptions so{InitialCondition::Estimated, lib.diagnostics.get(diagnostic::x0)};
+  EXPECT_LT((ys - simulate(lib.model, IdData(u, y, 0.01), so).y.col(0)).cwiseAbs().maxCoeff(), 1e-7);
+  // validate with the state estimated from the first 50 samples only: the fit is that of the model (noise 0.005).
+  const CliRun v = ctid_run("validate " + json + " " + csv + " --time t --initial estimated --initial-samples 50");
+  ASSERT_EQ(v.code, 0) << v.out << v.err;
+  EXPECT_NE(v.out.find("fit"), std::string::npos) << v.out;
+  // Misuse, each named.
+  const CliRun a = ctid_run("validate " + json + " " + csv + " --time t --initial rest --initial-samples 50");
+  EXPECT_EQ(a.code, 2);
+  EXPECT_NE(a.err.find("--initial-samples needs --initial estimated"), std::string::npos) << a.err;
+  const CliRun b = ctid_run("fit " + csv + " --time t --method greybox");
+  EXPECT_EQ(b.code, 2);
+  EXPECT_NE(b.err.find("--method greybox needs --model FILE.json"), std::string::npos) << b.err;
+  const CliRun c = ctid_run("fit " + csv + " --time t --method greybox --model " + model + " --nf 2");
+  EXPECT_EQ(c.code, 2);
+  EXPECT_NE(c.err.find("--nf sets transfer-function orders"), std::string::npos) << c.err;
+  const CliRun d = ctid_run("fit " + csv + " --time t --method greybox --model " + model + " --json " + model + " --force");
+  EXPECT_EQ(d.code, 2);  // the model file is an input: never overwritten
+  EXPECT_EQ(read_greybox_json(model).parameter_values()(0), 2.0);
 }

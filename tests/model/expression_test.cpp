@@ -80,6 +80,14 @@ TEST(Expression, GradientsAreExact) {
   EXPECT_EQ(g[1], 0.0);
   EXPECT_EQ(g[0], 1.0);  // sat passes dx1; max(x1, 0) takes 0 for x1 < 0
   EXPECT_EQ(g[4], 0.0);  // sign(0) * k2 = 0
+  // Ties take the second argument: the guarded square root of an empty tank has a finite (zero) derivative.
+  const std::vector<double> empty = {0.0, 1.0, 2.0, 0.05, 3.0, 0.0};
+  EXPECT_EQ(Expression("k1*sqrt(max(x1, 0))", kVars).gradient(empty.data(), g.data()), 0.0);
+  EXPECT_EQ(g[0], 0.0);
+  EXPECT_EQ(g[3], 0.0);
+  Expression("sat(x1, 0, 1) + min(x2, 1)", kVars).gradient(empty.data(), g.data());
+  EXPECT_EQ(g[0], 0.0);  // at the lower bound: the bound's derivative
+  EXPECT_EQ(g[1], 0.0);  // min(1, 1): the constant
 }
 
 TEST(Expression, ErrorsNameTheColumnAndTheClosestName) {

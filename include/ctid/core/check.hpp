@@ -8,6 +8,7 @@
 // formatter is provided here so the public headers do not depend on fmt).
 #pragma once
 
+#include <charconv>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -38,6 +39,13 @@ std::string format(std::string_view f, const Args&... args) {
   os.precision(10);
   format_into(os, f, args...);
   return os.str();
+}
+
+/// The shortest text that reads back as exactly `v` ("0.1", "1e-300", "inf", "nan").
+inline std::string round_trip(double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
 }
 
 [[noreturn]] inline void assert_fail(const char* cond, const char* file, int line) {

@@ -90,6 +90,9 @@ inline constexpr ScalarDiagnostic err_sum{"err_sum", "%", "sum of the ERR of a K
 inline constexpr VectorDiagnostic x0{"x0", "", "fitted initial state of each record", true};
 inline constexpr ScalarDiagnostic start_scale{"start_scale", "",
                                               "factor the NDE start was shrunk by until its simulation was finite"};
+// Grey-box output error.
+inline constexpr VectorDiagnostic starts_cost{"starts_cost", "",
+                                              "final cost 1/2 sum of squared (weighted) errors of each start of a multi-start search"};
 }  // namespace diagnostic
 
 /// One declared diagnostic, untyped (for listings).

@@ -62,7 +62,7 @@ std::string table_to_json(const std::string& type, const std::vector<std::pair<s
 /// FSF {"type": "fsf", "delta", "N", "n", "shift", "theta": [...]} (real parameterisation); NARX/NARMAX
 /// {"type": "narx", "ts": s, "terms": [{"name": "y(k-1)*u(k-2)", "value": c}, ...]}; NDE {"type": "nde", "terms":
 /// [{"name": "D^2y", "value": 1e-4}, ...]}, written normalised so that the coefficient of y is +1 when the model
-/// has a y term (DESIGN.md §8). write_result_json writes atomically (temporary file, then rename); throws FileError.
+/// has a y term (DESIGN.md §8); grey-box models as parse_greybox_json reads them. write_result_json writes atomically (temporary file, then rename); throws FileError.
 std::string result_to_json(const Result<AnyModel>& result, const std::string& method, int indent = 2);
 void write_result_json(const std::string& path, const Result<AnyModel>& result, const std::string& method);
 /// Shorthands for a typed result (Result<TransferFunction>, Result<NarxModel>, ...): the same file.
@@ -89,6 +89,16 @@ ResultFile read_result_file(const std::string& path);
 NarxModel read_narx_json(const std::string& path);
 NdeModel read_nde_json(const std::string& path);
 NarxModel parse_narx_json(const std::string& text, const std::string& source = "<json>");
+/// A grey-box model file (model/greybox.hpp), bare or in a result envelope:
+///   {"type": "greybox", "inputs": [names], "states": [names], "outputs": {name: expression, ..},
+///    "parameters": {name: value | {"value", "lower", "upper", "fixed"}, ..}, "equations": {state: dx/dt, ..},
+///    "initial": {state: number | expression of parameters | "estimate" | {"estimate": true, "value": start}, ..}}
+/// Members keep their order (outputs and parameters in the order declared); a state without "initial" starts at 0.
+/// Throws FileError naming `source` and the problem (a missing equation, an unknown member, a parse error with the
+/// expression, its column and the closest name).
+GreyboxModel parse_greybox_json(const std::string& text, const std::string& source = "<json>");
+GreyboxModel read_greybox_json(const std::string& path);
+std::string greybox_to_json(const GreyboxModel& model, int indent = 2);
 NdeModel parse_nde_json(const std::string& text, const std::string& source = "<json>");
 
 }  // namespace ctid

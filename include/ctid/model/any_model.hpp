@@ -14,6 +14,7 @@
 
 #include "ctid/core/types.hpp"
 #include "ctid/model/fsf.hpp"
+#include "ctid/model/greybox.hpp"
 #include "ctid/model/miso.hpp"
 #include "ctid/model/narx.hpp"
 #include "ctid/model/nde.hpp"
@@ -23,7 +24,7 @@
 namespace ctid {
 
 /// Every model type ctid fits, simulates and writes. The JSON "type" of each is model_type_name().
-using AnyModel = std::variant<TransferFunction, MisoModel, StateSpace, FsfModel, NarxModel, NdeModel>;
+using AnyModel = std::variant<TransferFunction, MisoModel, StateSpace, FsfModel, NarxModel, NdeModel, GreyboxModel>;
 
 /// A typed result as a result of any model (the same parameters, fit, summary and diagnostics).
 template <class M>
@@ -31,7 +32,7 @@ Result<AnyModel> to_any(const Result<M>& r) {
   return {AnyModel(r.model), r.parameters, r.fit, r.summary, r.diagnostics};
 }
 
-/// The JSON type name: "transfer_function", "miso", "state_space", "fsf", "narx", "nde".
+/// The JSON type name: "transfer_function", "miso", "state_space", "fsf", "narx", "nde", "greybox".
 const char* model_type_name(const AnyModel& model);
 /// Number of inputs the model is driven by.
 int model_inputs(const AnyModel& model);
@@ -41,7 +42,7 @@ int model_outputs(const AnyModel& model);
 bool is_linear(const AnyModel& model);
 /// Number of coefficients of the model (the parameter count of fit criteria such as AIC): transfer
 /// functions num + den without the leading 1 (summed over MISO channels), all entries of A, B, C, D, FSF
-/// parameters, NARX/NDE terms.
+/// parameters, NARX/NDE terms, grey-box parameters (held ones included).
 int model_coefficient_count(const AnyModel& model);
 /// One-line text of the model with `precision` significant digits.
 std::string describe(const AnyModel& model, int precision = 6);

@@ -11,9 +11,10 @@
 // Numbers: 2, 0.5, 1e-3. Functions: exp log sqrt abs sign tanh sin cos atan (one argument), min max pow (two),
 // sat(x, lo, hi) (three) = min(max(x, lo), hi).
 // Derivatives at the kinks (a set of measure zero along a trajectory): d sign = 0; d abs(x) = sign(x) dx;
-// min/max follow the argument that is taken (the first on a tie); sat passes dx strictly inside (lo, hi) and the
-// derivative of the active bound outside. sqrt, log, pow and / have their usual derivatives where defined; at
-// sqrt(0) the derivative is +inf (the caller decides: max(x, 0) before sqrt is the usual guard).
+// min/max follow the argument that is taken, the second on a tie (max(x, 0) at x = 0: 0, the ReLU convention);
+// sat passes dx strictly inside (lo, hi) and the derivative of the bound otherwise. sqrt, log, pow and / have their
+// usual derivatives where defined; at sqrt(0) a partial that is zero stays zero and any other is infinite — so
+// sqrt(max(x, 0)) (the usual guard) has derivative 0 at x = 0 and is finite everywhere.
 #pragma once
 
 #include <string>
@@ -28,6 +29,9 @@ class Expression {
   /// InvalidArgument naming the expression, the column and the problem: an unknown name (with the closest
   /// variable or function), a wrong number of arguments, a misplaced token, an unbalanced parenthesis.
   Expression(const std::string& text, const std::vector<std::string>& variables);
+
+  /// Whether `name` is one of the language's functions (a name no variable may take).
+  static bool is_function(const std::string& name);
 
   const std::string& text() const { return text_; }
   int n_variables() const { return n_vars_; }

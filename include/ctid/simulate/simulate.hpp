@@ -14,8 +14,10 @@
 //  - Estimated: the state that fits the record best. `x0` when given (e.g. the initial state an NDE
 //    output-error fit estimated, its diagnostics "x0"); otherwise, for linear continuous-time models, the
 //    least-squares initial state (the output is affine in it: y = y_rest + O x0); NARX models: the
-//    measured history (their state is their past outputs); FSF and NDE models without `x0`:
-//    InvalidArgument.
+//    measured history (their state is their past outputs); grey-box models: the state that best explains the
+//    first initial_samples samples (greybox_initial_state); FSF and NDE models without `x0`: InvalidArgument.
+//  Grey-box models: Rest is the zero state; Measured their declared initial state, the states marked "estimate"
+//    that an output reads alone taken from its first sample.
 #pragma once
 
 #include <string>
@@ -40,6 +42,9 @@ struct SimulateOptions {
   /// Initial state for Estimated (empty: estimate it where the model allows). Linear models: the state of
   /// their realisation (MISO: the channels' states stacked); NDE: [y, Dy, .., D^{L-1} y].
   Eigen::VectorXd x0;
+  /// Estimated without x0, grey-box models: the initial state is estimated from the record's first
+  /// initial_samples samples only (0: all) — the nonlinear-benchmark protocol for a test record.
+  int initial_samples = 0;
 };
 
 /// A simulation: the outputs (N x ny) at the record's sample times, the initial state used (empty for

@@ -1,0 +1,53 @@
+// ctid — nonlinear continuous-time grey-box identification (issue 15): the parameters and the estimated initial
+// states of a GreyboxModel (model/greybox.hpp) that minimise the simulation (output) error
+//     V(theta, x0_1..x0_E) = sum_e sum_k sum_j w_j^2 (y_j,e(t_k) - yhat_j,e(t_k; theta, x0_e))^2
+// over one record or several experiments of one system (one parameter set, an initial state per experiment),
+// by Levenberg-Marquardt (Marquardt's scaling by diag(J^T J): invariant to the parameters' units) within the
+// bounds, with the Jacobian from the exact forward sensitivities of the model (Ljung 1999 §7.3, the
+// prediction-error estimate for white output noise; Bohlin 2006, "Practical grey-box process identification").
+// With several outputs w_j = 1 / (RMS deviation of output j from its mean over all records), else w = 1.
+// Multi-start (`starts` > 1): the model's values, then starts - 1 points drawn (seeded) uniformly within finite
+// bounds, or log-uniformly within a decade of the value where a bound is open; the lowest cost wins.
+// Covariance sigma^2 (J^T J)^{-1} with sigma^2 = V / (N ny - p); a combination of parameters the data cannot
+// separate makes the result not usable, naming the parameters (ParameterSet rules, core/types.hpp).
+#pragma once
+
+#include <vector>
+
+#include "ctid/core/types.hpp"
+#include "ctid/data/iddata.hpp"
+#include "ctid/estimate/options.hpp"
+#include "ctid/model/greybox.hpp"
+
+namespace ctid {
+
+struct GreyboxOptions {
+  int max_iterations = 100;      ///< Levenberg-Marquardt iterations per start
+  double tolerance = 1e-8;       ///< relative cost decrease or parameter change that stops a search
+  int starts = 1;                ///< multi-start: the model's values plus starts - 1 drawn within the bounds
+  int seed = 1;                  ///< seed of the drawn starts
+  double rtol = 1e-8;            ///< relative tolerance of the simulations (absolute: 1e-3 rtol)
+  bool estimate_initial_state = true;  ///< false: states marked "estimate" are held at their start values
+  /// Parameters held at a value by name (fixed.k1=0.05), on top of the model's own "fixed".
+  FixedValues fixed;
+  /// Bounds by name (bounds.k1=0,inf), replacing the model's own.
+  ParameterBounds bounds;
+  void validate() const;
+};
+template <>
+const OptionTable<GreyboxOptions>& option_table<GreyboxOptions>();
+
+/// Fits `model` to one record: its inputs are the model's inputs in order, its outputs the model's outputs in
+/// order (the caller maps column names). The returned model carries the estimates and, for estimated initial
+/// states, the first record's estimate. parameters: every model parameter (held ones flagged fixed), then the
+/// estimated initial states "x1(0)", .. (with several records "r<e>.x1(0)"). diagnostics: x0 per record,
+/// noise_variance, starts_cost (the final cost of each start), experiments. Termination Converged / MaxIterations,
+/// NumericalFailure when the model cannot be simulated from any start (the message names where it escaped).
+/// Throws InvalidArgument for data whose input or output count differs from the model's, records with fewer
+/// samples than free quantities, names in fixed/bounds that are not parameters (the closest named); InvalidOptions
+/// for bad options.
+Result<GreyboxModel> greybox(const IdData& data, const GreyboxModel& model, const GreyboxOptions& options = {});
+/// Several experiments of one system: one parameter set, an initial state per record, the output errors stacked.
+Result<GreyboxModel> greybox(const std::vector<IdData>& data, const GreyboxModel& model, const GreyboxOptions& options = {});
+
+}  // namespace ctid
