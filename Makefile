@@ -2,7 +2,7 @@
 #   make demo   install dependencies, build, run `ctid demo` on the bundled data
 #   make test   install dependencies, build, run every test (ctest), then the sanitizer build's tests
 #               (AddressSanitizer + UBSan, Debug with -O1: assertions on; the long Monte Carlo tests, ctest label
-#               montecarlo, run in the Release build only)
+#               montecarlo, and the real-data gallery, label realdata, run in the Release build only)
 #               (between the two: each libFuzzer target for FUZZ_SECONDS under ASan + UBSan, `make fuzz`, clang)
 #   make bench  build and run the benchmarks (numbers go to docs/benchmarks.md by hand)
 BUILD      ?= build
@@ -31,7 +31,7 @@ test-asan: deps
 	@cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=Debug "-DCMAKE_CXX_FLAGS_DEBUG=-O1 -g" -DCTID_SANITIZE=ON \
 		-DCTID_BUILD_BENCHMARKS=OFF >/dev/null
 	@cmake --build $(ASAN_BUILD) -j $(JOBS)
-	@cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ctest --output-on-failure -j $(JOBS) -LE montecarlo
+	@cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ctest --output-on-failure -j $(JOBS) -LE 'montecarlo|realdata'
 
 fuzz: deps
 	@CXX=clang++ cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=Debug "-DCMAKE_CXX_FLAGS_DEBUG=-O1 -g" -DCTID_BUILD_FUZZ=ON \

@@ -46,11 +46,18 @@ LmResult levenberg_marquardt(const LmEvaluate& evaluate, Eigen::VectorXd x, cons
     const Eigen::MatrixXd A = J.transpose() * J;
     const Eigen::VectorXd g = J.transpose() * r;  // gradient of the cost
     Eigen::VectorXd d = A.diagonal().cwiseMax(1e-300);
+    // Active bounds: a parameter at a bound whose gradient pushes it outward stays there this iteration (its row and
+    // column are decoupled), so the others move as if it were fixed instead of being projected back every time.
+    Eigen::VectorXd keep = Eigen::VectorXd::Ones(p);
+    for (Eigen::Index i = 0; i < p; ++i)
+      if ((x(i) <= lo(i) && g(i) > 0) || (x(i) >= hi(i) && g(i) < 0)) keep(i) = 0.0;
+    const Eigen::MatrixXd Ak = keep.asDiagonal() * A * keep.asDiagonal();
+    const Eigen::VectorXd gk = keep.cwiseProduct(g);
     bool accepted = false;
     for (int tries = 0; tries < 30 && !accepted; ++tries) {
-      Eigen::MatrixXd M = A;
+      Eigen::MatrixXd M = Ak;
       M.diagonal() += lambda * d;
-      const Eigen::VectorXd step = -M.ldlt().solve(g);
+      const Eigen::VectorXd step = -M.ldlt().solve(gk);
       const Eigen::VectorXd xt = (x + step).cwiseMax(lo).cwiseMin(hi);
       if (!step.allFinite()) { lambda *= 10; continue; }
       if (evaluate(xt, rt, nullptr) && rt.allFinite()) {

@@ -1,6 +1,8 @@
 // ctid internal — Levenberg-Marquardt for small dense nonlinear least squares
 // min 1/2 ||r(x)||^2 with simple bounds, driven by exact Jacobians supplied by the caller
-// (Marquardt scaling by diag(J^T J); bounds by projection of each trial step).
+// (Marquardt scaling by diag(J^T J); bounds by projection of each trial step, with the parameters at a bound whose
+// gradient points outward held there for the iteration — an active set, as in projected Gauss-Newton methods,
+// Kelley 1999, "Iterative methods for optimization" §5.5).
 #pragma once
 
 #include <functional>

@@ -6,7 +6,8 @@
 namespace ctid::internal {
 
 OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
-                   bool hold, double rtol, double atol, Eigen::Index n_control, const OdeSample& sample) {
+                   bool hold, double rtol, double atol, Eigen::Index n_control, const OdeSample& sample,
+                   long max_steps) {
   static const double c2 = 1. / 5, c3 = 3. / 10, c4 = 4. / 5, c5 = 8. / 9;
   static const double a21 = 1. / 5, a31 = 3. / 40, a32 = 9. / 40, a41 = 44. / 45, a42 = -56. / 15, a43 = 32. / 9,
                       a51 = 19372. / 6561, a52 = -25360. / 2187, a53 = 64448. / 6561, a54 = -212. / 729,
@@ -21,6 +22,8 @@ OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::Matr
   Eigen::VectorXd x = x0, k1(n), k2(n), k3(n), k4(n), k5(n), k6(n), k7(n), xt(n), xn(n), errv(n);
   sample(0, x);
   double h = (t.size() > 1 ? t(1) - t(0) : 1.0) / 4;
+  long steps = 0;
+  const long budget = max_steps > 0 ? max_steps : 1000000L + 1000L * static_cast<long>(t.size());
   for (Eigen::Index k = 0; k + 1 < t.size(); ++k) {
     const double ta = t(k), tb = t(k + 1);
     // The inputs at a time inside [ta, tb] (into ui; the same values for every stage when held).
@@ -32,7 +35,6 @@ OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::Matr
     double tt = ta;
     h = std::min(h, tb - ta);
     f(tt, x, uin(tt), k1);
-    long steps = 0;
     while (tt < tb) {
       if (tt + h > tb) h = tb - tt;
       xt = x + h * a21 * k1;
@@ -52,8 +54,14 @@ OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::Matr
       for (Eigen::Index i = 0; i < n_control; ++i)
         err = std::max(err, std::abs(errv(i)) / (atol + rtol * std::max(std::abs(x(i)), std::abs(xn(i)))));
       const double xmax = xn.head(n_control).cwiseAbs().maxCoeff();
-      if (!std::isfinite(err) || !xn.allFinite() || xmax > 1e12 || ++steps > 1000000 ||
-          h < 1e-14 * std::max(1.0, std::abs(tt))) {
+      if (++steps > budget) {
+        out.ok = false;
+        out.budget = true;
+        out.t = tt;
+        out.xmax = xmax;
+        return out;
+      }
+      if (!std::isfinite(err) || !xn.allFinite() || xmax > 1e12 || h < 1e-14 * std::max(1.0, std::abs(tt))) {
         out.ok = false;
         out.t = tt;
         out.xmax = xmax;

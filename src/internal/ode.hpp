@@ -21,6 +21,7 @@ using OdeSample = std::function<void(Eigen::Index k, const Eigen::VectorXd& x)>;
 
 struct OdeOutcome {
   bool ok = true;     ///< false: the solution escaped (|x| > 1e12, non-finite, or the step size collapsed)
+  bool budget = false;  ///< false with ok false: it escaped; true: it needed more than max_steps steps (stiff)
   double t = 0.0;     ///< where it escaped
   double xmax = 0.0;  ///< max |x| there
 };
@@ -28,8 +29,10 @@ struct OdeOutcome {
 /// Integrates from x0 at t(0) through the increasing times t, the inputs u (N x nu, one row per time) held
 /// (hold) or linear between samples, calling sample at each time. The error is
 /// controlled on the first n_control components (the rest — e.g. sensitivities — ride along on the same
-/// steps); rtol relative, atol absolute tolerance.
+/// steps); rtol relative, atol absolute tolerance. At most max_steps accepted and rejected steps in all (0: 10^6 plus
+/// 1000 per sample) — an explicit method on a stiff system stops there instead of creeping on.
 OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
-                   bool hold, double rtol, double atol, Eigen::Index n_control, const OdeSample& sample);
+                   bool hold, double rtol, double atol, Eigen::Index n_control, const OdeSample& sample,
+                   long max_steps = 0);
 
 }  // namespace ctid::internal

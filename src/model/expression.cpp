@@ -244,8 +244,11 @@ double Expression::gradient(const double* x, double* grad) const {
         const double* gb = g(top + 1);
         bool exponent_varies = false;
         for (int i = 0; i < n; ++i) exponent_varies = exponent_varies || gb[i] != 0.0;
-        // d a^b = b a^(b-1) da + a^b ln(a) db (the second term only where the exponent depends on a variable).
-        combine(top, b == 0.0 ? 0.0 : b * std::pow(a, b - 1.0), exponent_varies ? p * std::log(a) : 0.0);
+        // d a^b = b a^(b-1) da + a^b ln(a) db (the second term only where the exponent depends on a variable; 0 where
+        // a^b = 0). At a = 0 with b < 1 the first factor is infinite: a zero partial stays zero (as for sqrt).
+        const double fa = b == 0.0 ? 0.0 : b * std::pow(a, b - 1.0), fb = exponent_varies && p != 0.0 ? p * std::log(a) : 0.0;
+        double* ga = g(top);
+        for (int i = 0; i < n; ++i) ga[i] = (ga[i] == 0.0 ? 0.0 : fa * ga[i]) + (gb[i] == 0.0 ? 0.0 : fb * gb[i]);
         v[top] = p;
         break;
       }

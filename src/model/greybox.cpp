@@ -239,7 +239,14 @@ class Point {
   int n_, m_;
 };
 
+// Greybox integrations give up after 200 steps per sample on average (a stiff system or parameters that make it
+// so, e.g. a drawn start of a multi-start search): far beyond what a model at the data's time scale needs.
+long step_budget(const Eigen::VectorXd& t) { return 10000L + 200L * static_cast<long>(t.size()); }
+
 std::string escape_message(const internal::OdeOutcome& o) {
+  if (o.budget)
+    return detail::format("the integration needed more than 200 steps per sample on average (stopped at t = {} s): "
+                          "the model is stiff at these parameters (time constants far below the sampling period)", o.t);
   return detail::format("the solution escapes at t = {} s (|x| = {}): the model is unstable for this input, or its "
                         "parameters are far from the data's", o.t, o.xmax);
 }
@@ -263,7 +270,7 @@ GreyboxSimulation GreyboxModel::simulate(const Eigen::MatrixXd& u, const Eigen::
         const double* v = z.at(t(k), x.data(), u.row(k).eval().data());
         out.x.row(k) = x.transpose();
         for (int j = 0; j < ny(); ++j) out.y(k, j) = c.h[j](v);
-      });
+      }, step_budget(t));
   if (!o.ok) {
     out.termination = Termination::NumericalFailure;
     out.message = escape_message(o);
@@ -282,17 +289,20 @@ GreyboxSensitivities GreyboxModel::sensitivities(const Eigen::MatrixXd& u, const
   const int nf = static_cast<int>(free.size()), q = nf + static_cast<int>(free_x0.size());
   Point z(*this, c.nz);
   std::vector<double> g(static_cast<size_t>(c.nz));
-  // Augmented state [x; S(:,0); ..; S(:,q-1)]: dS_j/dt = (df/dx) S_j + df/dtheta_{free[j]} (0 for initial states).
+  // The derivative along column j of S of the expression whose gradient g holds: dh/dx . S_j + dh/dtheta_{free[j]}
+  // (no direct term for an initial state).
+  auto chain = [&](const double* S, int j) {
+    double d = j < nf ? g[static_cast<size_t>(n + m + free[static_cast<size_t>(j)])] : 0.0;
+    for (int k = 0; k < n; ++k) d += g[static_cast<size_t>(k)] * S[k];
+    return d;
+  };
+  auto column = [&](const Eigen::VectorXd& a, int j) { return a.data() + n + static_cast<Eigen::Index>(n) * j; };
+  // Augmented state [x; S(:,0); ..; S(:,q-1)]: dS_j/dt = (df/dx) S_j + df/dtheta_{free[j]}.
   const internal::OdeRhs f = [&](double tt, const Eigen::VectorXd& a, const double* ui, Eigen::VectorXd& da) {
     const double* v = z.at(tt, a.data(), ui);
     for (int i = 0; i < n; ++i) {
       da(i) = c.f[i].gradient(v, g.data());
-      for (int j = 0; j < q; ++j) {
-        const double* S = a.data() + n + static_cast<Eigen::Index>(n) * j;
-        double v = j < nf ? g[static_cast<size_t>(n + m + free[static_cast<size_t>(j)])] : 0.0;
-        for (int k = 0; k < n; ++k) v += g[static_cast<size_t>(k)] * S[k];
-        da(n + static_cast<Eigen::Index>(n) * j + i) = v;
-      }
+      for (int j = 0; j < q; ++j) da(n + static_cast<Eigen::Index>(n) * j + i) = chain(column(a, j), j);
     }
   };
   Eigen::VectorXd a0 = Eigen::VectorXd::Zero(n + static_cast<Eigen::Index>(n) * q);
@@ -308,14 +318,9 @@ GreyboxSensitivities GreyboxModel::sensitivities(const Eigen::MatrixXd& u, const
         const double* v = z.at(t(k), a.data(), u.row(k).eval().data());
         for (int o2 = 0; o2 < ny_; ++o2) {
           out.y(k, o2) = c.h[o2].gradient(v, g.data());
-          for (int j = 0; j < q; ++j) {
-            const double* S = a.data() + n + static_cast<Eigen::Index>(n) * j;
-            double v = j < nf ? g[static_cast<size_t>(n + m + free[static_cast<size_t>(j)])] : 0.0;
-            for (int i = 0; i < n; ++i) v += g[static_cast<size_t>(i)] * S[i];
-            out.dy[static_cast<size_t>(o2)](k, j) = v;
-          }
+          for (int j = 0; j < q; ++j) out.dy[static_cast<size_t>(o2)](k, j) = chain(column(a, j), j);
         }
-      });
+      }, step_budget(t));
   if (!o.ok) {
     out.ok = false;
     out.message = escape_message(o);

@@ -88,6 +88,9 @@ TEST(Expression, GradientsAreExact) {
   Expression("sat(x1, 0, 1) + min(x2, 1)", kVars).gradient(empty.data(), g.data());
   EXPECT_EQ(g[0], 0.0);  // at the lower bound: the bound's derivative
   EXPECT_EQ(g[1], 0.0);  // min(1, 1): the constant
+  // An orifice law with a fitted exponent, at an empty tank: value 0, every derivative 0 (no 0 * inf, no 0 * log 0).
+  EXPECT_EQ(Expression("k1*pow(max(x1, 0), k2)", kVars).gradient(empty.data(), g.data()), 0.0);
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(g[static_cast<std::size_t>(i)], 0.0) << i;
 }
 
 TEST(Expression, ErrorsNameTheColumnAndTheClosestName) {

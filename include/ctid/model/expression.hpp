@@ -13,8 +13,8 @@
 // Derivatives at the kinks (a set of measure zero along a trajectory): d sign = 0; d abs(x) = sign(x) dx;
 // min/max follow the argument that is taken, the second on a tie (max(x, 0) at x = 0: 0, the ReLU convention);
 // sat passes dx strictly inside (lo, hi) and the derivative of the bound otherwise. sqrt, log, pow and / have their
-// usual derivatives where defined; at sqrt(0) a partial that is zero stays zero and any other is infinite — so
-// sqrt(max(x, 0)) (the usual guard) has derivative 0 at x = 0 and is finite everywhere.
+// usual derivatives where defined; at sqrt(0) and pow(0, b < 1) a partial that is zero stays zero and any other is
+// infinite — so sqrt(max(x, 0)) and pow(max(x, 0), b) (the usual guards) have derivative 0 at x = 0; d pow(0, b)/db = 0.
 #pragma once
 
 #include <string>
