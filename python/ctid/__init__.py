@@ -492,19 +492,21 @@ def frequency_response(model, w):
     return _one_column(_ctid.model_frequency_response(getattr(model, "model", model), _np.asarray(w, dtype=float)))
 
 
-def simulate(model, data, initial="rest", x0=None):
+def simulate(model, data, initial="rest", x0=None, initial_samples=0):
     """Simulated output of any model (or result) driven by the inputs of `data` — the library's one
     simulate() (the CLI's simulate, validate and report use it too). initial: "rest" (zero state),
     "measured" (NARX: the first measured outputs; NDE: y(0)) or "estimated" (linear models: the
-    least-squares initial state; NARX: the measured history; NDE: x0, by default the x0 an output-error
-    fit estimated). Returns a 1-D array for a single-output model (N x ny otherwise); a simulation that
+    least-squares initial state; NARX: the measured history; NDE and grey box: x0, by default the x0 an
+    output-error fit estimated; grey box with initial_samples=N: the state from the record's first N samples
+    only). Returns a 1-D array for a single-output model (N x ny otherwise); a simulation that
     stops being finite warns with the reason and returns NaN from there."""
     diagnostics = getattr(model, "diagnostics", None)
     model = getattr(model, "model", model)
     if x0 is None:
         vectors = diagnostics.vectors if diagnostics is not None else {}
-        x0 = vectors["x0"] if initial == "estimated" and "x0" in vectors else _np.zeros(0)
-    s = _ctid.simulate_model(model, data, initial, _np.asarray(x0, dtype=float))
+        use_fit = initial == "estimated" and "x0" in vectors and not initial_samples
+        x0 = vectors["x0"] if use_fit else _np.zeros(0)
+    s = _ctid.simulate_model(model, data, initial, _np.asarray(x0, dtype=float), int(initial_samples))
     if not s.ok():
         import warnings
         warnings.warn(s.problem, RuntimeWarning, stacklevel=2)

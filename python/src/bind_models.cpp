@@ -50,13 +50,15 @@ void bind_models(py::module_& m) {
       .def("ok", &Simulation::ok);
   m.def(
       "simulate_model",
-      [](const AnyModel& model, const IdData& d, const std::string& initial, const Eigen::VectorXd& x0) {
+      [](const AnyModel& model, const IdData& d, const std::string& initial, const Eigen::VectorXd& x0, int initial_samples) {
         SimulateOptions o;
         o.initial = initial_condition_from_string(initial);
         o.x0 = x0;
+        o.initial_samples = initial_samples;
         return simulate(model, d, o);
       },
       py::arg("model"), py::arg("data"), py::arg("initial") = "rest", py::arg("x0") = Eigen::VectorXd(),
+      py::arg("initial_samples") = 0,
       "Simulate any model on a record (simulate/simulate.hpp): initial 'rest', 'measured' or 'estimated'.");
   m.def("model_type_name", &model_type_name, py::arg("model"), "The model's JSON type name.");
   m.def("model_step_response", &model_step_response, py::arg("model"), py::arg("t"), py::arg("amplitude") = 1.0,

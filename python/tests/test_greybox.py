@@ -48,3 +48,11 @@ def test_options_and_errors_are_named():
     with pytest.raises(TypeError, match="dict, a path or a GreyboxModel"):
         ctid.greybox(d, 3)
     assert "starts" in [s["name"] for s in ctid.settings("greybox")]
+
+
+def test_simulate_from_the_first_samples_only():
+    d = record(x0=0.5)
+    m = ctid.greybox_model(MODEL).with_parameters([0.7, 1.5])
+    # The state from the first 20 samples (the benchmark protocol): the whole record reproduced (noise-free data).
+    y = ctid.simulate(m, d, "estimated", initial_samples=20)
+    np.testing.assert_allclose(y, d.y[:, 0], atol=1e-6)

@@ -63,6 +63,7 @@ OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::Matr
       }
       if (!std::isfinite(err) || !xn.allFinite() || xmax > 1e12 || h < 1e-14 * std::max(1.0, std::abs(tt))) {
         out.ok = false;
+        out.collapsed = std::isfinite(err) && xn.allFinite() && xmax <= 1e12;
         out.t = tt;
         out.xmax = xmax;
         return out;

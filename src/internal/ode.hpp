@@ -22,6 +22,7 @@ using OdeSample = std::function<void(Eigen::Index k, const Eigen::VectorXd& x)>;
 struct OdeOutcome {
   bool ok = true;     ///< false: the solution escaped (|x| > 1e12, non-finite, or the step size collapsed)
   bool budget = false;  ///< false with ok false: it escaped; true: it needed more than max_steps steps (stiff)
+  bool collapsed = false;  ///< the step size collapsed with the state finite (a discontinuity it cannot pass)
   double t = 0.0;     ///< where it escaped
   double xmax = 0.0;  ///< max |x| there
 };

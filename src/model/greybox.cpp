@@ -244,9 +244,12 @@ class Point {
 long step_budget(const Eigen::VectorXd& t) { return 10000L + 200L * static_cast<long>(t.size()); }
 
 std::string escape_message(const internal::OdeOutcome& o) {
-  if (o.budget)
-    return detail::format("the integration needed more than 200 steps per sample on average (stopped at t = {} s): "
-                          "the model is stiff at these parameters (time constants far below the sampling period)", o.t);
+  if (o.budget || o.collapsed)
+    return detail::format("the integration stalled at t = {} s ({}) with the state finite: the model is stiff at these "
+                          "parameters, or its right-hand side switches back and forth across a discontinuity (e.g. "
+                          "sign(v) friction at rest: a sliding mode this integrator cannot follow; smooth it, e.g. "
+                          "tanh(v/0.01) for sign(v))",
+                          o.t, o.budget ? "more than 200 steps per sample" : "the step size collapsed");
   return detail::format("the solution escapes at t = {} s (|x| = {}): the model is unstable for this input, or its "
                         "parameters are far from the data's", o.t, o.xmax);
 }

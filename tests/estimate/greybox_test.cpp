@@ -146,7 +146,7 @@ TEST(Greybox, RecoversTheTanksAndTheirInitialLevelsFromNoiseFreeData) {
 
 TEST(Greybox, NoisyFrictionFitHasHonestUncertaintyAndMultiStartFindsTheMinimum) {
   const GreyboxModel m = friction_model();
-  const IdData clean = record(m, levels(3000, 150, -3, 3, 11), 0.01, Eigen::Vector2d(0.1, 0.0));
+  const IdData clean = record(m, levels(2000, 100, -3, 3, 11), 0.01, Eigen::Vector2d(0.1, 0.0));
   // 200 seeded records with N(0, 0.01^2) noise would give the spread; one record checks the coverage of 3 std
   // (a failure has probability < 1 % per parameter).
   std::mt19937 rng(4);
@@ -157,14 +157,14 @@ TEST(Greybox, NoisyFrictionFitHasHonestUncertaintyAndMultiStartFindsTheMinimum) 
   GreyboxSpec far = m.spec();
   far.parameters = {{"k", 0.5}, {"c", 2.0}, {"fc", 0.05, 0.0}, {"m", 3.0, 0.01, 100.0}};
   GreyboxOptions o;
-  o.starts = 4;
+  o.starts = 3;
   const Result<GreyboxModel> r = greybox(d, GreyboxModel(far), o);
   ASSERT_TRUE(r.usable()) << r.why_not_usable();
   const Eigen::VectorXd want = m.parameter_values();
   for (int i = 0; i < 4; ++i)
     EXPECT_LT(std::abs(r.parameters.values(i) - want(i)), 3 * r.parameters.std(i)) << r.parameters.names[i];
-  EXPECT_NEAR(std::sqrt(r.diagnostics.get(diagnostic::noise_variance)), 0.01, 0.0005);  // 3000 samples: +-1.3 %
-  EXPECT_EQ(r.diagnostics.get(diagnostic::starts_cost).size(), 4);
+  EXPECT_NEAR(std::sqrt(r.diagnostics.get(diagnostic::noise_variance)), 0.01, 0.0005);  // 2000 samples: +-1.6 % (one std)
+  EXPECT_EQ(r.diagnostics.get(diagnostic::starts_cost).size(), 3);
 }
 
 TEST(Greybox, SeveralRecordsShareParametersEachWithItsInitialState) {
@@ -222,4 +222,21 @@ TEST(Greybox, InitialStateFromTheFirstSamplesOnlyAndBadDataNamed) {
   o.fixed["mass"] = 1.0;
   const std::string name = error_of([&] { greybox(d, m, o); });
   EXPECT_NE(name.find("did you mean 'm'"), std::string::npos) << name;
+}
+
+TEST(Greybox, ASlidingModeIsNamedNotIntegratedForever) {
+  // Coulomb friction sign(v) with the force below the friction level: the mass sticks, the right-hand side switches
+  // at every step (a Filippov sliding mode). The explicit integrator stops and says how to smooth the law.
+  GreyboxSpec s;
+  s.inputs = {"u"};
+  s.states = {"q", "v"};
+  s.outputs = {{"y", "q"}};
+  s.parameters = {{"fc", 1.0}};
+  s.equations = {"v", "u - fc*sign(v)"};
+  s.initial = {{"0", false}, {"0", false}};
+  const GreyboxModel m(s);
+  const GreyboxSimulation r = m.simulate(Eigen::MatrixXd::Constant(100, 1, 0.5), time_grid(0.01, 100));
+  EXPECT_FALSE(r.ok());
+  EXPECT_NE(r.message.find("sliding mode"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("tanh(v/0.01)"), std::string::npos) << r.message;
 }
