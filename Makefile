@@ -3,14 +3,15 @@
 #   make test   install dependencies, build, run every test (ctest), then the sanitizer build's tests
 #               (AddressSanitizer + UBSan, Debug with -O1: assertions on; the long Monte Carlo tests, ctest label
 #               montecarlo, and the real-data gallery, label realdata, run in the Release build only)
-#               (between the two: each libFuzzer target for FUZZ_SECONDS under ASan + UBSan, `make fuzz`, clang)
+#               (between the two: each libFuzzer target for FUZZ_SECONDS (30 s; longer: make fuzz FUZZ_SECONDS=600)
+#               under ASan + UBSan, `make fuzz`, clang)
 #   make bench  build and run the benchmarks (numbers go to docs/benchmarks.md by hand)
 BUILD      ?= build
 ASAN_BUILD ?= build-asan
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_ARGS ?=
 FUZZ_BUILD ?= build-fuzz
-FUZZ_SECONDS ?= 60
+FUZZ_SECONDS ?= 30
 
 .PHONY: deps build demo test test-fast test-asan fuzz bench clean
 
