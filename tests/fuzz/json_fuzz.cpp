@@ -1,5 +1,5 @@
 // libFuzzer target for the JSON model and result readers (linear models, TF and MISO results, NARX and NDE models;
-// issue 7). Any input must either be read or throw ctid::FileError / ctid::InvalidArgument.
+// issue 7; grey-box model files and any result file, issue 15). Any input must either be read or throw ctid::FileError / ctid::InvalidArgument.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -21,5 +21,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   guarded([&] { (void)ctid::parse_miso_result_json(text, "<fuzz>"); });
   guarded([&] { (void)ctid::parse_narx_json(text, "<fuzz>"); });
   guarded([&] { (void)ctid::parse_nde_json(text, "<fuzz>"); });
+  guarded([&] { (void)ctid::parse_greybox_json(text, "<fuzz>"); });
+  guarded([&] { (void)ctid::parse_result_file(text, "<fuzz>"); });
   return 0;
 }
