@@ -233,6 +233,13 @@ class Point {
     z_.back() = t;
     return z_.data();
   }
+  // At sample k of the inputs u (N x nu), read in place (no temporary row per sample).
+  const double* at(double t, const double* x, const Eigen::MatrixXd& u, Eigen::Index k) {
+    std::copy(x, x + n_, z_.begin());
+    for (int i = 0; i < m_; ++i) z_[static_cast<size_t>(n_ + i)] = u(k, i);
+    z_.back() = t;
+    return z_.data();
+  }
 
  private:
   std::vector<double> z_;
@@ -270,7 +277,7 @@ GreyboxSimulation GreyboxModel::simulate(const Eigen::MatrixXd& u, const Eigen::
   out.x = Eigen::MatrixXd::Constant(t.size(), n, NAN);
   const internal::OdeOutcome o = internal::dopri45(
       f, start, u, t, intersample == Intersample::Zoh, rtol, 1e-3 * rtol, n, [&](Eigen::Index k, const Eigen::VectorXd& x) {
-        const double* v = z.at(t(k), x.data(), u.row(k).eval().data());
+        const double* v = z.at(t(k), x.data(), u, k);
         out.x.row(k) = x.transpose();
         for (int j = 0; j < ny(); ++j) out.y(k, j) = c.h[j](v);
       }, step_budget(t));
@@ -318,7 +325,7 @@ GreyboxSensitivities GreyboxModel::sensitivities(const Eigen::MatrixXd& u, const
   out.dy.assign(static_cast<size_t>(ny_), Eigen::MatrixXd::Constant(t.size(), q, NAN));
   const internal::OdeOutcome o = internal::dopri45(
       f, a0, u, t, intersample == Intersample::Zoh, rtol, 1e-3 * rtol, n, [&](Eigen::Index k, const Eigen::VectorXd& a) {
-        const double* v = z.at(t(k), a.data(), u.row(k).eval().data());
+        const double* v = z.at(t(k), a.data(), u, k);
         for (int o2 = 0; o2 < ny_; ++o2) {
           out.y(k, o2) = c.h[o2].gradient(v, g.data());
           for (int j = 0; j < q; ++j) out.dy[static_cast<size_t>(o2)](k, j) = chain(column(a, j), j);
