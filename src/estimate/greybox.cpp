@@ -104,11 +104,7 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
     if (p.fixed) fixed_values[p.name] = p.value;
     else if (p.lower > -INFINITY || p.upper < INFINITY) bounds[p.name] = {p.lower, p.upper};
   }
-  for (const auto& [name, value] : opt.fixed) {
-    fixed_values[name] = value;
-    bounds.erase(name);
-  }
-  for (const auto& [name, b] : opt.bounds) bounds[name] = b;
+  overlay_constraints(fixed_values, bounds, opt.fixed, opt.bounds);
   const ParameterConstraints cons =
       resolve_constraints(fixed_values, bounds, model.parameter_names(), "greybox", "a parameter of the model");
   Eigen::VectorXd theta0 = model.parameter_values();

@@ -65,6 +65,15 @@ std::vector<int> ParameterConstraints::free() const {
   return f;
 }
 
+void overlay_constraints(FixedValues& fixed, ParameterBounds& bounds, const FixedValues& option_fixed,
+                         const ParameterBounds& option_bounds) {
+  for (const auto& [name, value] : option_fixed) {
+    fixed[name] = value;
+    bounds.erase(name);  // the option holds what the declaration bounded
+  }
+  for (const auto& [name, b] : option_bounds) bounds[name] = b;
+}
+
 ParameterConstraints resolve_constraints(const FixedValues& fixed, const ParameterBounds& bounds,
                                          const std::vector<std::string>& names, const std::string& method,
                                          const std::string& of, std::vector<bool> held) {

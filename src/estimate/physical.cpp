@@ -68,11 +68,7 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
     if (p.fixed) fixed_values[p.name] = full(idx);
     else if (p.lower > -INFINITY || p.upper < INFINITY) bounds[p.name] = {p.lower, p.upper};
   }
-  for (const auto& [name, value] : opt.fixed) {
-    fixed_values[name] = value;
-    bounds.erase(name);  // the option holds what the declaration bounded
-  }
-  for (const auto& [name, b] : opt.bounds) bounds[name] = b;
+  overlay_constraints(fixed_values, bounds, opt.fixed, opt.bounds);
   const ParameterConstraints c = resolve_constraints(fixed_values, bounds, model.parameter_names(), "physical",
                                                      "a parameter of \"" + model.expression() + "\"");
   const std::vector<bool>& fixed = c.held;

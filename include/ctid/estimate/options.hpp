@@ -99,6 +99,12 @@ ParameterConstraints resolve_constraints(const FixedValues& fixed, const Paramet
                                          const std::vector<std::string>& names, const std::string& method,
                                          const std::string& of, std::vector<bool> held = {});
 
+/// A model's own declarations (its parameters' fixed values and bounds, in `fixed` and `bounds`) with the options on
+/// top: an option's fixed value holds the parameter (dropping its declared bound), an option's bound replaces the
+/// declared one. Used by the estimators whose models declare constraints (physical, greybox).
+void overlay_constraints(FixedValues& fixed, ParameterBounds& bounds, const FixedValues& option_fixed,
+                         const ParameterBounds& option_bounds);
+
 namespace options_detail {
 double parse_real(const std::string& method, const std::string& key, const std::string& text);
 int parse_int(const std::string& method, const std::string& key, const std::string& text);
