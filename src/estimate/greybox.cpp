@@ -40,48 +40,6 @@ Result<GreyboxModel> greybox(const IdData& data, const GreyboxModel& model, cons
 }
 
 namespace {
-// Identifiability at the estimate (never a +- 0): the information matrix J^T J scaled to unit diagonal; an
-// eigenvalue below 1e-11 of the largest is a direction the output does not see. Its parameters are named with their
-// relative changes along that direction (e.g. a*b: "+1 a, -1 b": a and b scaled oppositely leave the output unchanged),
-// a parameter without any influence (zero column) by itself. "" when every direction is determined.
-std::string not_separable(const Eigen::MatrixXd& jtj, const Eigen::VectorXd& x, const std::vector<std::string>& names) {
-  const Eigen::Index p = jtj.rows();
-  for (Eigen::Index i = 0; i < p; ++i)
-    if (!(jtj(i, i) > 0))
-      return detail::format("the output does not depend on {} at the estimate: the data cannot determine it; fix it or "
-                            "remove it from the model", names[static_cast<size_t>(i)]);
-  if (p < 2) return "";
-  const Eigen::VectorXd d = jtj.diagonal().cwiseSqrt().cwiseInverse();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(d.asDiagonal() * jtj * d.asDiagonal());
-  const double ratio = es.eigenvalues()(0) / es.eigenvalues()(p - 1);
-  if (es.info() != Eigen::Success || ratio >= 1e-11) return "";
-  // The direction in relative units of each parameter (absolute where the value is 0).
-  Eigen::VectorXd rel = es.eigenvectors().col(0).cwiseProduct(d);
-  for (Eigen::Index i = 0; i < p; ++i) rel(i) /= std::max(std::abs(x(i)), 1e-300);
-  Eigen::Index big = 0;
-  rel.cwiseAbs().maxCoeff(&big);
-  rel /= rel(big);  // the largest change +1; the first named parameter then leads with +
-  for (Eigen::Index i = 0; i < p; ++i)
-    if (std::abs(rel(i)) > 0.05) {
-      if (rel(i) < 0 && std::abs(rel(i)) > 0.05 && std::all_of(rel.data(), rel.data() + i, [](double v) { return std::abs(v) <= 0.05; }))
-        rel = -rel;
-      break;
-    }
-  std::string which, along;
-  std::vector<std::string> involved;
-  for (Eigen::Index i = 0; i < p; ++i)
-    if (std::abs(rel(i)) > 0.05) {
-      involved.push_back(names[static_cast<size_t>(i)]);
-      along += (along.empty() ? "" : ", ") + std::string(rel(i) > 0 ? "+" : "-") +
-               detail::format("{} {}", std::round(std::abs(rel(i)) * 100) / 100, names[static_cast<size_t>(i)]);
-    }
-  for (size_t k = 0; k < involved.size(); ++k)
-    which += (k == 0 ? "" : k + 1 == involved.size() ? " and " : ", ") + involved[k];
-  return detail::format("the data cannot separate {}: changing them together by the relative amounts ({}) leaves the "
-                        "output unchanged (information ratio {}); fix one of them or reparameterise the model",
-                        which, along, ratio);
-}
-
 // One record as the search sees it.
 struct Record {
   Eigen::MatrixXd u;
@@ -270,7 +228,7 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
   std::vector<std::string> free_names;
   for (int j : slot) free_names.push_back(r.parameters.names[static_cast<size_t>(j)]);
   const std::string unidentifiable =
-      std::isfinite(best.cost) ? not_separable(best.jtj, best.x, free_names) : std::string();
+      std::isfinite(best.cost) ? internal::unidentifiable(best.jtj, best.x, free_names) : std::string();
   if (std::isfinite(best.cost) && unidentifiable.empty())
     r.parameters.set_covariance(internal::covariance(best.jtj, sigma2), slot);
   else r.parameters.set_covariance({}, slot);
@@ -281,11 +239,7 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
   if (opt.starts > 1) r.diagnostics.set(diagnostic::starts_cost, start_costs);
   const std::string failure = "the model cannot be simulated on these data from its start" +
                               std::string(opt.starts > 1 ? "s" : "") + (escape.empty() ? "" : ": " + escape);
-  internal::set_termination(r.summary, best, failure);
-  if (!unidentifiable.empty() && r.summary.succeeded()) {
-    r.summary.termination = Termination::Unidentifiable;
-    r.summary.message = unidentifiable;
-  }
+  internal::set_termination(r.summary, best, failure, unidentifiable);
   // The fit: all outputs of all records stacked, each weighted (one output: the output itself).
   Eigen::VectorXd rr;
   Eigen::VectorXd yfit = Eigen::VectorXd::Constant(y.size(), NAN);

@@ -255,7 +255,10 @@ Result<NdeModel> nde_oe(const std::vector<IdData>& records, const NdeModel& init
   std::vector<int> slot(free);
   for (int k = 0; k < E * nx; ++k) slot.push_back(m + k);
   const double sigma2 = 2.0 * lm.cost / std::max(1, N - p);
-  r.parameters.set_covariance(internal::covariance(lm.jtj, sigma2), slot);
+  std::vector<std::string> free_names;
+  for (int j : slot) free_names.push_back(r.parameters.names[static_cast<size_t>(j)]);
+  const std::string unidentifiable = internal::unidentifiable(lm.jtj, lm.x, free_names);
+  r.parameters.set_covariance(unidentifiable.empty() ? internal::covariance(lm.jtj, sigma2) : Eigen::MatrixXd(), slot);
   r.diagnostics.condition_number = internal::gram_condition(lm.jtj);
   // The first record's initial state is "x0" (what simulate()'s estimated initial condition takes); further
   // records' are "x0_2", "x0_3", ...
@@ -269,7 +272,7 @@ Result<NdeModel> nde_oe(const std::vector<IdData>& records, const NdeModel& init
         "the starting model escapes on these data; the search started with its nonlinear coefficients times {}",
         start_scale));
   const std::string failure = "the model cannot be simulated on these data, even with its nonlinear terms removed";
-  internal::set_termination(r.summary, lm, failure);
+  internal::set_termination(r.summary, lm, failure, unidentifiable);
   Eigen::VectorXd yfit;
   if (!std::isfinite(lm.cost) || !simulate(lm.x, yfit)) {
     r.summary.termination = Termination::NumericalFailure;

@@ -139,7 +139,10 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
   const auto [y_all, sim_all] = tf_detail::pooled_outputs(r.model, ds, opt.transient_time);
   r.fit = fit_report_or_inf(y_all, sim_all, p);
   const double sigma2 = 2.0 * lm.cost / double(std::max<Eigen::Index>(1, y_all.size() - p));
-  r.parameters.set_covariance(internal::covariance(lm.jtj, sigma2), free);
+  std::vector<std::string> free_names;
+  for (int j : free) free_names.push_back(names[static_cast<size_t>(j)]);
+  const std::string unidentifiable = internal::unidentifiable(lm.jtj, lm.x, free_names);
+  r.parameters.set_covariance(unidentifiable.empty() ? internal::covariance(lm.jtj, sigma2) : Eigen::MatrixXd(), free);
   r.diagnostics.condition_number = internal::gram_condition(lm.jtj);
   r.diagnostics.set(diagnostic::noise_variance, sigma2);
   r.diagnostics.set(diagnostic::delay, r.model.io_delay());
@@ -147,7 +150,8 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
   internal::set_termination(
       r.summary, lm,
       "the simulation of the starting model overflows on this record (its poles are far in the right half plane); "
-      "fix or bound the coefficients (--set fixed.NAME=VALUE, bounds.NAME=LOWER,UPPER)");
+      "fix or bound the coefficients (--set fixed.NAME=VALUE, bounds.NAME=LOWER,UPPER)",
+      unidentifiable);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }

@@ -132,7 +132,10 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
   res.parameters.values = th;
   res.parameters.fixed = fixed;
   const double sigma2 = 2.0 * lm.cost / std::max(1, n_data - p);
-  res.parameters.set_covariance(internal::covariance(lm.jtj, sigma2), free);
+  std::vector<std::string> free_names;
+  for (int j : free) free_names.push_back(res.parameters.names[static_cast<size_t>(j)]);
+  const std::string unidentifiable = internal::unidentifiable(lm.jtj, lm.x, free_names);
+  res.parameters.set_covariance(unidentifiable.empty() ? internal::covariance(lm.jtj, sigma2) : Eigen::MatrixXd(), free);
   res.diagnostics.condition_number = internal::gram_condition(lm.jtj);
   {
     Eigen::VectorXd r;
@@ -154,7 +157,7 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
         "the window a = {} does not exceed the largest real part of the fitted plant's poles ({}): G(s + a) is not "
         "stable and the compressed response is not meaningful; increase a",
         a, slowest));
-  internal::set_termination(res.summary, lm, "the model cannot be evaluated at the initial parameters");
+  internal::set_termination(res.summary, lm, "the model cannot be evaluated at the initial parameters", unidentifiable);
   res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return res;
 }

@@ -189,11 +189,6 @@ SrivcRun iv_step(const std::vector<IvRecord>& records, int n, const Eigen::Vecto
   return run;
 }
 
-SrivcRun iv_step(const Eigen::VectorXd& y, const Eigen::VectorXd& t, const std::vector<IvChannel>& ch, int n,
-                 const Eigen::VectorXd& theta) {
-  return iv_step(std::vector<IvRecord>{{&y, &t, &ch}}, n, theta);
-}
-
 }  // namespace srivc_detail
 
 using srivc_detail::IvChannel;

@@ -1,7 +1,10 @@
 #include "internal/least_squares.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
@@ -187,5 +190,43 @@ double gram_condition(const Eigen::MatrixXd& jtj) {
           .eigenvalues();
   return ev(0) > 0 ? std::sqrt(ev(p - 1) / ev(0)) : INFINITY;
 }
+
+std::string unidentifiable(const Eigen::MatrixXd& jtj, const Eigen::VectorXd& x, const std::vector<std::string>& names) {
+  const Eigen::Index p = jtj.rows();
+  for (Eigen::Index i = 0; i < p; ++i)
+    if (!(jtj(i, i) > 0))
+      return detail::format("the output does not depend on {} at the estimate: the data cannot determine it; fix it or "
+                            "remove it from the model", names[static_cast<size_t>(i)]);
+  if (p < 2) return "";
+  const Eigen::VectorXd d = jtj.diagonal().cwiseSqrt().cwiseInverse();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(d.asDiagonal() * jtj * d.asDiagonal());
+  const double ratio = es.eigenvalues()(0) / es.eigenvalues()(p - 1);
+  if (es.info() != Eigen::Success || ratio >= 1e-11) return "";
+  // The direction in relative units of each parameter (absolute where the value is 0).
+  Eigen::VectorXd rel = es.eigenvectors().col(0).cwiseProduct(d);
+  for (Eigen::Index i = 0; i < p; ++i) rel(i) /= std::max(std::abs(x(i)), 1e-300);
+  Eigen::Index big = 0;
+  rel.cwiseAbs().maxCoeff(&big);
+  rel /= rel(big);  // the largest change +1
+  for (Eigen::Index i = 0; i < p; ++i)  // the first named parameter leads with +
+    if (std::abs(rel(i)) > 0.05) {
+      if (rel(i) < 0) rel = -rel;
+      break;
+    }
+  std::string which, along;
+  std::vector<std::string> involved;
+  for (Eigen::Index i = 0; i < p; ++i)
+    if (std::abs(rel(i)) > 0.05) {
+      involved.push_back(names[static_cast<size_t>(i)]);
+      along += (along.empty() ? "" : ", ") + std::string(rel(i) > 0 ? "+" : "-") +
+               detail::format("{} {}", std::round(std::abs(rel(i)) * 100) / 100, names[static_cast<size_t>(i)]);
+    }
+  for (size_t k = 0; k < involved.size(); ++k)
+    which += (k == 0 ? "" : k + 1 == involved.size() ? " and " : ", ") + involved[k];
+  return detail::format("the data cannot separate {}: changing them together by the relative amounts ({}) leaves the "
+                        "output unchanged (information ratio {}); fix one of them or reparameterise the model",
+                        which, along, std::max(ratio, 0.0));
+}
+
 
 }  // namespace ctid::internal

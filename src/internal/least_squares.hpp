@@ -8,6 +8,7 @@
 // InstrumentalVariables: theta = (sum w z x^T)^{-1} sum w z y with column scaling.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -133,5 +134,13 @@ Eigen::MatrixXd covariance(const Eigen::MatrixXd& information, double sigma2);
 /// The condition number of J with its columns scaled to unit norm, from J^T J (the square root of the eigenvalue
 /// ratio of the scaled J^T J): what scaled_condition(J) gives without J. Infinite when singular, NaN when empty.
 double gram_condition(const Eigen::MatrixXd& jtj);
+
+/// Identifiability at an estimate x of the quantities `names` from their information matrix J^T J (never a +- 0):
+/// J^T J scaled to unit diagonal; an eigenvalue below 1e-11 of the largest is a direction the output does not see.
+/// Returns "" when every direction is determined, else the message naming the parameters of the weakest direction
+/// with their relative changes along it (k/(m s^2 + c s + k): "+1 k, +1 m, +1 c" — scaling all three together
+/// leaves the output unchanged), or a parameter without any influence (zero column) by itself. Every output-error
+/// search (oe, physical, nde_oe, greybox) makes a result with such a direction Unidentifiable with this message.
+std::string unidentifiable(const Eigen::MatrixXd& jtj, const Eigen::VectorXd& x, const std::vector<std::string>& names);
 
 }  // namespace ctid::internal

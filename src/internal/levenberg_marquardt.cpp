@@ -7,7 +7,7 @@
 
 namespace ctid::internal {
 
-void set_termination(Summary& s, const LmResult& lm, const std::string& failure) {
+void set_termination(Summary& s, const LmResult& lm, const std::string& failure, const std::string& unidentifiable) {
   s.iterations = lm.iterations;
   if (!std::isfinite(lm.cost)) {
     s.termination = Termination::NumericalFailure;
@@ -18,6 +18,11 @@ void set_termination(Summary& s, const LmResult& lm, const std::string& failure)
                   : lm.converged ? Termination::Converged
                                  : Termination::MaxIterations;
   s.message = lm.converged && !lm.interrupted ? "" : lm.message;
+  // A flat direction is the real cause of a search that ended without converging too.
+  if (!unidentifiable.empty() && (s.succeeded() || s.termination == Termination::MaxIterations)) {
+    s.termination = Termination::Unidentifiable;
+    s.message = unidentifiable;
+  }
 }
 
 LmResult levenberg_marquardt(const LmEvaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& lo,

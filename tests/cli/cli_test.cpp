@@ -968,10 +968,10 @@ TEST(Cli, TrustCampaign) {
       // A fit the data cannot tell from no model.
       {"fit " + noise_csv + base + "--method tfest --nf 2", 1, "the data cannot tell this model from no model"},
       // Parameters the data do not determine separately: in k/(m s^2 + c s + k) only m/k and c/k matter. Before:
-      // "k = 1.77 +- 5.3e5, converged", exit 0; the correlation matrix's smallest eigenvalue is 6e-16.
+      // "k = 1.77 +- 5.3e5, converged", exit 0; the scaled information matrix's eigenvalue ratio is 1e-16.
       {"fit " + std::string(CTID_EXAMPLES_DATA_DIR) + "/dryer.dat --ts 0.08 --input 1 --output 2 --detrend mean "
        "--method physical --via raw --model \"k/(m*s^2+c*s+k)\" --param k=1 --param m=1 --param c=1",
-       1, "the data do not determine k, m, c separately"},
+       1, "the data cannot separate k, m and c: changing them together by the relative amounts (+1 k, +1 m, +1 c)"},
       // A user-given model with a parasitic pole.
       {"simulate " + parasitic + " " + good_csv() + " --time time --input force", 3, "zero up to rounding"},
   };
