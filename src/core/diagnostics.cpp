@@ -55,7 +55,7 @@ const std::vector<DiagnosticInfo>& diagnostic_catalogue() {
       info(diagnostic::err_sum),
       info(diagnostic::x0),
       info(diagnostic::start_scale),
-      info(diagnostic::starts_cost)};
+      info(diagnostic::starts_cost), info(diagnostic::segments), info(diagnostic::continuity_defect)};
   return all;
 }
 

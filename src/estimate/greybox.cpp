@@ -26,6 +26,11 @@ const OptionTable<GreyboxOptions>& option_table<GreyboxOptions>() {
                    "multi-start: the model's values plus starts-1 points drawn within the bounds (the lowest cost wins)")
           .integer("seed", &O::seed, "", at_least(0), "seed of the drawn starts")
           .real("rtol", &O::rtol, "", between(1e-13, 1e-4), "relative tolerance of the simulations (absolute: 1e-3 rtol)")
+          .integer("segments", &O::segments, "", at_least(0),
+                   "multiple shooting: each record split into this many segments, each from a free state tied to the "
+                   "previous segment's end; 1: single shooting; 0: automatic (multiple shooting when the free run from the "
+                   "start escapes or drifts, fit below -900 %: segments of 100 samples, halved down to 4 until each "
+                   "simulates from the start)")
           .flag("estimate_initial_state", &O::estimate_initial_state,
                 "estimate the initial states the model marks \"estimate\" (one per record); 0: hold them at their start")
           .named_reals("fixed", &O::fixed, "parameters held at a value by name (fixed.k1=0.05), on top of the model's")
@@ -47,6 +52,14 @@ struct Record {
   Intersample hold = Intersample::Zoh;
   Eigen::Index start = 0;  // first row in the stacked residual
   int n = 0;
+};
+
+// A multiple-shooting segment of a record: samples first .. first + rows (its inputs and times, one sample beyond
+// the rows whose outputs it owns: the next segment's start, where continuity is imposed; the last owns its end).
+struct Segment {
+  Eigen::MatrixXd u;
+  Eigen::VectorXd t;
+  int first = 0, rows = 0;
 };
 }  // namespace
 
@@ -178,6 +191,173 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
   lmo.max_iterations = opt.max_iterations;
   lmo.ftol = opt.tolerance;
   lmo.xtol = opt.tolerance;
+
+  // Multiple shooting (Bock & Plitt 1984, "A multiple shooting algorithm for direct solution of optimal control
+  // problems"; Bock 1983 for parameter estimation): each record is cut into segments, segment k > 0 starts from
+  // free states s_k, and continuity x_end(k-1) = s_k is imposed by penalty residuals rho_i (x_end,i - s_k,i),
+  // rho_i = mu / scale_i, with mu raised over three searches (1, 1e2, 1e4 times the RMS weighted output) so that the
+  // last leaves defects at rounding level. An unstable or integrating plant then never runs free over the whole
+  // record while the search is far from the optimum. The search vector is [v (p) | the segment states].
+  std::vector<std::vector<Segment>> seg(static_cast<size_t>(E));
+  std::vector<int> seg_offset(static_cast<size_t>(E), 0);  // each record's first segment state in the vector
+  int ns = 0;                                                // segment states in all
+  Eigen::VectorXd scale = Eigen::VectorXd::Ones(nx), rho = Eigen::VectorXd::Ones(nx);
+  double mu_base = 1.0;
+  std::vector<int> all_states(static_cast<size_t>(nx));
+  for (int i = 0; i < nx; ++i) all_states[static_cast<size_t>(i)] = i;
+  const Eigen::Index Ny = y.size();
+  // The residual (and Jacobian) of the segmented problem: weighted output errors, then the continuity residuals.
+  const internal::LmEvaluate shoot_evaluate = [&](const Eigen::VectorXd& vm, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
+    const GreyboxModel m = model_at(vm);
+    r.setZero(Ny + ns);
+    if (J) J->setZero(Ny + ns, p + ns);
+    for (int e = 0; e < E; ++e) {
+      const Record& d = rec[static_cast<size_t>(e)];
+      const auto& sg = seg[static_cast<size_t>(e)];
+      const int S = static_cast<int>(sg.size());
+      for (int k = 0; k < S; ++k) {
+        const Segment& g = sg[static_cast<size_t>(k)];
+        const Eigen::Index col_k = p + seg_offset[static_cast<size_t>(e)] + static_cast<Eigen::Index>(k - 1) * nx;
+        const Eigen::VectorXd x0 = k == 0 ? x0_of(m, vm, e) : Eigen::VectorXd(vm.segment(col_k, nx));
+        Eigen::VectorXd x_end;
+        if (!J) {
+          const GreyboxSimulation sim = m.simulate(g.u, g.t, d.hold, x0, opt.rtol);
+          if (!sim.ok()) return escape = sim.message, false;
+          for (int j = 0; j < ny; ++j)
+            r.segment(d.start + static_cast<Eigen::Index>(j) * d.n + g.first, g.rows) = w(j) * sim.y.col(j).head(g.rows);
+          x_end = sim.x.row(sim.x.rows() - 1).transpose();
+        } else {
+          const GreyboxSensitivities sn =
+              m.sensitivities(g.u, g.t, d.hold, x0, free, k == 0 ? free_x0 : all_states, opt.rtol, k == 0);
+          if (!sn.ok) return escape = sn.message, false;
+          const int nq = k == 0 ? nx0 : nx;
+          const Eigen::Index col_s = k == 0 ? pf + e * nx0 : col_k;
+          for (int j = 0; j < ny; ++j) {
+            const Eigen::Index row = d.start + static_cast<Eigen::Index>(j) * d.n + g.first;
+            const Eigen::MatrixXd& dy = sn.dy[static_cast<size_t>(j)];
+            r.segment(row, g.rows) = w(j) * sn.y.col(j).head(g.rows);
+            J->block(row, 0, g.rows, pf) = -w(j) * dy.topLeftCorner(g.rows, pf);
+            if (nq) J->block(row, col_s, g.rows, nq) = -w(j) * dy.topRightCorner(g.rows, nq);
+          }
+          x_end = sn.x_end;
+          if (k + 1 < S) {
+            const Eigen::Index c = Ny + seg_offset[static_cast<size_t>(e)] + static_cast<Eigen::Index>(k) * nx;
+            J->block(c, 0, nx, pf) = rho.asDiagonal() * sn.dx_end.leftCols(pf);
+            if (nq) J->block(c, col_s, nx, nq) = rho.asDiagonal() * sn.dx_end.rightCols(nq);
+            J->block(c, col_k + nx, nx, nx).diagonal() = -rho;
+          }
+        }
+        if (k + 1 < S) {
+          const Eigen::Index c = Ny + seg_offset[static_cast<size_t>(e)] + static_cast<Eigen::Index>(k) * nx;
+          r.segment(c, nx) = rho.cwiseProduct(x_end - vm.segment(col_k + nx, nx));
+        }
+      }
+    }
+    r.head(Ny) = wy - r.head(Ny);
+    return true;
+  };
+  // The segments' starting states, segment by segment (a greedy observer): an output that is a state alone gives
+  // that state from the data; the others either continue the previous segment's simulation or restart from the
+  // record's initial guess, whichever simulates the segment with the smaller output error. `ok`: every segment
+  // simulates from its start.
+  auto segment_guess = [&](const Eigen::VectorXd& v, bool& ok) {
+    Eigen::VectorXd vm(p + ns);
+    vm.head(p) = v;
+    ok = true;
+    const GreyboxModel m = model_at(v);
+    for (int e = 0; e < E; ++e) {
+      const Record& d = rec[static_cast<size_t>(e)];
+      const auto& sg = seg[static_cast<size_t>(e)];
+      const Eigen::VectorXd guess = x0_of(m, v, e);
+      Eigen::VectorXd x = guess;
+      for (size_t k = 0; k < sg.size(); ++k) {
+        const Segment& g = sg[k];
+        // The output error of the segment from x (infinite when it escapes), and its end state.
+        auto run = [&](Eigen::VectorXd& start, Eigen::VectorXd& end) {
+          if (k > 0)
+            for (int i = 0; i < nx; ++i)
+              if (const int o = model.output_of_state(i); o >= 0) start(i) = d.y(static_cast<Eigen::Index>(o) * d.n + g.first);
+          const GreyboxSimulation sim = m.simulate(g.u, g.t, d.hold, start, opt.rtol);
+          if (!sim.ok()) return static_cast<double>(INFINITY);
+          end = sim.x.row(sim.x.rows() - 1).transpose();
+          double cost = 0;
+          for (int j = 0; j < ny; ++j)
+            cost += (d.y.segment(static_cast<Eigen::Index>(j) * d.n + g.first, g.rows) - sim.y.col(j).head(g.rows)).squaredNorm();
+          return cost;
+        };
+        Eigen::VectorXd a = x, b = guess, end_a, end_b;
+        const double ca = run(a, end_a), cb = k > 0 ? run(b, end_b) : INFINITY;
+        if (!std::isfinite(std::min(ca, cb))) ok = false;
+        const bool take_b = cb < ca;
+        if (k > 0) vm.segment(p + seg_offset[static_cast<size_t>(e)] + static_cast<Eigen::Index>(k - 1) * nx, nx) = take_b ? b : a;
+        x = take_b ? end_b : (std::isfinite(ca) ? end_a : guess);
+      }
+    }
+    return vm;
+  };
+  // One multiple-shooting search from v (the three penalty stages).
+  auto shoot = [&](const Eigen::VectorXd& v) {
+    bool ok = true;
+    Eigen::VectorXd vm = segment_guess(v, ok);
+    for (int i = 0; i < nx; ++i) {
+      double s2 = 0;
+      for (int k = 0; k < ns / std::max(nx, 1); ++k) s2 += vm(p + static_cast<Eigen::Index>(k) * nx + i) * vm(p + static_cast<Eigen::Index>(k) * nx + i);
+      scale(i) = ns > 0 && s2 > 0 ? std::sqrt(s2 / (ns / nx)) : 1.0;
+    }
+    Eigen::VectorXd lo_m = Eigen::VectorXd::Constant(p + ns, -INFINITY), hi_m = Eigen::VectorXd::Constant(p + ns, INFINITY);
+    lo_m.head(p) = lo;
+    hi_m.head(p) = hi;
+    internal::LmResult lm;
+    int iterations = 0;
+    for (const double f : {1.0, 1e2, 1e4}) {
+      rho = (f * mu_base) * scale.cwiseInverse();
+      lm = internal::levenberg_marquardt(shoot_evaluate, vm, lo_m, hi_m, lmo);
+      iterations += lm.iterations;
+      if (!std::isfinite(lm.cost) || lm.interrupted) break;
+      vm = lm.x;
+    }
+    lm.iterations = iterations;
+    return lm;
+  };
+  bool shooting = opt.segments > 1;
+  if (opt.segments == 0) {  // automatic: the free run from the start escapes or drifts far from the data
+    Eigen::VectorXd r0;
+    shooting = !evaluate(v0, r0, nullptr) || !(fit_report_or_inf(wy, wy - r0, p).fit_percent > -900.0);
+  }
+  // Cuts every record into segments: S each when given, else segments of `length` samples.
+  auto make_segments = [&](int S_given, int length) {
+    ns = 0;
+    for (int e = 0; e < E; ++e) {
+      const Record& d = rec[static_cast<size_t>(e)];
+      const int S = std::min(S_given > 1 ? S_given : (d.n - 1 + length - 1) / length, d.n - 1);
+      seg_offset[static_cast<size_t>(e)] = ns;
+      auto& sg = seg[static_cast<size_t>(e)];
+      sg.clear();
+      for (int k = 0; k < S; ++k) {
+        const int b0 = static_cast<int>(std::llround(static_cast<double>(k) * (d.n - 1) / S));
+        const int b1 = static_cast<int>(std::llround(static_cast<double>(k + 1) * (d.n - 1) / S));
+        Segment g;
+        g.first = b0;
+        g.rows = k + 1 < S ? b1 - b0 : b1 - b0 + 1;
+        g.u = d.u.middleRows(b0, b1 - b0 + 1);
+        g.t = d.t.segment(b0, b1 - b0 + 1);
+        sg.push_back(std::move(g));
+      }
+      ns += (S - 1) * nx;
+    }
+  };
+  if (shooting) {
+    mu_base = std::sqrt(wy.squaredNorm() / static_cast<double>(std::max<Eigen::Index>(1, wy.size())));
+    if (!(mu_base > 0)) mu_base = 1.0;
+    if (opt.segments > 1) make_segments(opt.segments, 0);
+    else  // automatic: segments of 100 samples, halved (to 4) until every segment simulates from the start
+      for (int length = 100;; length /= 2) {
+        make_segments(0, length);
+        bool ok = true;
+        segment_guess(v0, ok);
+        if (ok || length <= 4) break;
+      }
+  }
   // Multi-start: start 0 is the model's values; the others draw each free parameter within its bounds.
   std::mt19937_64 rng(static_cast<std::uint64_t>(opt.seed));
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -195,7 +375,7 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
           v(j) = std::clamp(sign * mag * std::pow(10.0, 2.0 * unit(rng) - 1.0), lo(j), hi(j));
         }
       }
-    const internal::LmResult lm = internal::levenberg_marquardt(evaluate, v, lo, hi, lmo);
+    const internal::LmResult lm = shooting ? shoot(v) : internal::levenberg_marquardt(evaluate, v, lo, hi, lmo);
     start_costs(s) = lm.cost;
     if (s == 0 || lm.cost < best.cost) best = lm;
     if (lm.interrupted) {
@@ -205,7 +385,51 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
     }
   }
 
+  // After multiple shooting: the single-shooting search from its estimate where the free run is finite (a stable
+  // or integrating plant; it then ends at the output-error optimum itself); its result is taken when its cost is
+  // within 5 % of the segments' output cost. Otherwise (an unstable plant: the free run escapes or drifts) the
+  // multiple-shooting estimate stands, its covariance from the condensed Jacobian and its fit over the segments.
+  std::vector<std::string> warnings;
+  Eigen::VectorXd segment_fit;  // the segments' weighted outputs when the multiple-shooting estimate stands
+  double defect = NAN;
+  if (shooting && std::isfinite(best.cost) && !best.interrupted) {
+    const Eigen::VectorXd vm = best.x;
+    Eigen::VectorXd rm, r1;
+    shoot_evaluate(vm, rm, nullptr);
+    defect = 0;
+    for (Eigen::Index c = 0; c < ns; ++c) defect = std::max(defect, std::abs(rm(Ny + c)) / rho(c % nx) / scale(c % nx));
+    const double segment_cost = 0.5 * rm.head(Ny).squaredNorm();
+    internal::LmResult single;
+    single.cost = INFINITY;
+    escape.clear();
+    const bool runs = evaluate(vm.head(p), r1, nullptr);
+    const std::string free_run = runs ? "its free run drifts away from the data" : escape;
+    if (runs) single = internal::levenberg_marquardt(evaluate, vm.head(p), lo, hi, lmo);
+    if (std::isfinite(single.cost) && single.cost <= 1.05 * segment_cost) {
+      single.iterations += best.iterations;
+      best = single;
+    } else {
+      // The information about v with the segment states eliminated: the Schur complement of their block, the
+      // constrained problem's information as the continuity weights grow.
+      const Eigen::MatrixXd& F = best.jtj;
+      const Eigen::MatrixXd Dinv_Bt = F.bottomRightCorner(ns, ns).ldlt().solve(F.bottomLeftCorner(ns, p));
+      segment_fit = wy - rm.head(Ny);
+      best.x = vm.head(p);
+      best.jtj = F.topLeftCorner(p, p) - F.topRightCorner(p, ns) * Dinv_Bt;
+      best.cost = segment_cost;
+      warnings.push_back(detail::format(
+          "multiple shooting: the fitted model does not run free over the record{} ({}); the fit is that of {} "
+          "segments, each from its estimated state (largest continuity defect {} of the state's scale)",
+          E > 1 ? "s" : "", free_run, ns / std::max(nx, 1) + E, defect));
+    }
+  }
+  if (best.x.size() > p) {  // an interrupted or failed multiple-shooting search: its parameters only
+    best.x.conservativeResize(p);
+    if (best.jtj.rows() > p) best.jtj = best.jtj.topLeftCorner(p, p).eval();
+  }
+
   Result<GreyboxModel> r;
+  r.diagnostics.warnings = warnings;
   const GreyboxModel fitted = model_at(best.x);
   Eigen::VectorXd x0_first = x0_of(fitted, best.x, 0);
   r.model = fitted.with_estimated_initial(x0_first);
@@ -237,13 +461,18 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
   if (E > 1) r.diagnostics.set(diagnostic::experiments, E);
   r.diagnostics.set(diagnostic::noise_variance, ny == 1 ? sigma2 : NAN);
   if (opt.starts > 1) r.diagnostics.set(diagnostic::starts_cost, start_costs);
+  if (shooting) {
+    r.diagnostics.set(diagnostic::segments, ns / std::max(nx, 1) + E);
+    r.diagnostics.set(diagnostic::continuity_defect, defect);
+  }
   const std::string failure = "the model cannot be simulated on these data from its start" +
                               std::string(opt.starts > 1 ? "s" : "") + (escape.empty() ? "" : ": " + escape);
   internal::set_termination(r.summary, best, failure, unidentifiable);
   // The fit: all outputs of all records stacked, each weighted (one output: the output itself).
   Eigen::VectorXd rr;
   Eigen::VectorXd yfit = Eigen::VectorXd::Constant(y.size(), NAN);
-  if (std::isfinite(best.cost) && evaluate(best.x, rr, nullptr)) yfit = wy - rr;
+  if (segment_fit.size()) yfit = segment_fit;
+  else if (std::isfinite(best.cost) && evaluate(best.x, rr, nullptr)) yfit = wy - rr;
   else if (r.summary.succeeded()) {
     r.summary.termination = Termination::NumericalFailure;
     r.summary.message = failure;

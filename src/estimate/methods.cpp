@@ -106,7 +106,7 @@ const std::vector<MethodInfo>& methods() {
       entry<NdeOeOptions>("nde_oe", "output-error refinement of a nonlinear differential equation", {"NdeOeOptions"},
                           reports(x0, noise_variance, start_scale, experiments)),
       entry<GreyboxOptions>("greybox", "nonlinear grey-box model (state equations with named parameters) by output error",
-                            {"GreyboxOptions"}, reports(x0, noise_variance, starts_cost, experiments)),
+                            {"GreyboxOptions"}, reports(x0, noise_variance, starts_cost, experiments, segments, continuity_defect)),
   };
   return all;
 }

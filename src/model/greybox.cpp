@@ -290,7 +290,8 @@ GreyboxSimulation GreyboxModel::simulate(const Eigen::MatrixXd& u, const Eigen::
 
 GreyboxSensitivities GreyboxModel::sensitivities(const Eigen::MatrixXd& u, const Eigen::VectorXd& t, Intersample intersample,
                                                  const Eigen::VectorXd& x0, const std::vector<int>& free,
-                                                 const std::vector<int>& free_x0, double rtol) const {
+                                                 const std::vector<int>& free_x0, double rtol,
+                                                 bool x0_from_parameters) const {
   const Eigen::VectorXd start = checked_start(*this, u, t, x0);
   const Compiled& c = *c_;
   const int n = nx(), m = nu(), p = np(), ny_ = ny();
@@ -317,8 +318,10 @@ GreyboxSensitivities GreyboxModel::sensitivities(const Eigen::MatrixXd& u, const
   };
   Eigen::VectorXd a0 = Eigen::VectorXd::Zero(n + static_cast<Eigen::Index>(n) * q);
   a0.head(n) = start;
-  const Eigen::MatrixXd dx0 = initial_state_jacobian();
-  for (int j = 0; j < nf; ++j) a0.segment(n + static_cast<Eigen::Index>(n) * j, n) = dx0.col(free[static_cast<size_t>(j)]);
+  if (x0_from_parameters) {
+    const Eigen::MatrixXd dx0 = initial_state_jacobian();
+    for (int j = 0; j < nf; ++j) a0.segment(n + static_cast<Eigen::Index>(n) * j, n) = dx0.col(free[static_cast<size_t>(j)]);
+  }
   for (size_t k = 0; k < free_x0.size(); ++k) a0(n + static_cast<Eigen::Index>(n) * (nf + static_cast<int>(k)) + free_x0[k]) = 1.0;
   GreyboxSensitivities out;
   out.y = Eigen::MatrixXd::Constant(t.size(), ny_, NAN);
@@ -329,6 +332,10 @@ GreyboxSensitivities GreyboxModel::sensitivities(const Eigen::MatrixXd& u, const
         for (int o2 = 0; o2 < ny_; ++o2) {
           out.y(k, o2) = c.h[o2].gradient(v, g.data());
           for (int j = 0; j < q; ++j) out.dy[static_cast<size_t>(o2)](k, j) = chain(column(a, j), j);
+        }
+        if (k + 1 == t.size()) {
+          out.x_end = a.head(n);
+          out.dx_end = Eigen::Map<const Eigen::MatrixXd>(a.data() + n, n, q);
         }
       }, step_budget(t));
   if (!o.ok) {

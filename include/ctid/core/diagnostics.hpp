@@ -93,6 +93,9 @@ inline constexpr ScalarDiagnostic start_scale{"start_scale", "",
 // Grey-box output error.
 inline constexpr VectorDiagnostic starts_cost{"starts_cost", "",
                                               "final cost 1/2 sum of squared (weighted) errors of each start of a multi-start search"};
+inline constexpr ScalarDiagnostic segments{"segments", "", "multiple-shooting segments of all records (when used)"};
+inline constexpr ScalarDiagnostic continuity_defect{
+    "continuity_defect", "", "largest |x_end - x_start| at a segment boundary relative to the state's RMS (multiple shooting)"};
 }  // namespace diagnostic
 
 /// One declared diagnostic, untyped (for listings).

@@ -27,6 +27,11 @@ struct GreyboxOptions {
   int starts = 1;                ///< multi-start: the model's values plus starts - 1 drawn within the bounds
   int seed = 1;                  ///< seed of the drawn starts
   double rtol = 1e-8;            ///< relative tolerance of the simulations (absolute: 1e-3 rtol)
+  /// Multiple shooting: each record cut into this many segments, each starting from a free state tied to the previous
+  /// segment's end (continuity); 1: single shooting; 0: automatic — multiple shooting when the free run from the
+  /// start escapes or drifts (fit below -900 %), with segments of 100 samples halved (down to 4) until every
+  /// segment simulates from the start.
+  int segments = 0;
   bool estimate_initial_state = true;  ///< false: states marked "estimate" are held at their start values
   /// Parameters held at a value by name (fixed.k1=0.05), on top of the model's own "fixed".
   FixedValues fixed;

@@ -72,6 +72,8 @@ struct GreyboxSimulation {
 struct GreyboxSensitivities {
   Eigen::MatrixXd y;
   std::vector<Eigen::MatrixXd> dy;
+  Eigen::VectorXd x_end;   ///< the state at the last time (what multiple shooting ties to the next segment)
+  Eigen::MatrixXd dx_end;  ///< its derivatives, nx x q
   bool ok = true;
   std::string message;
 };
@@ -124,11 +126,13 @@ class GreyboxModel {
   GreyboxSimulation simulate(const Eigen::MatrixXd& u, const Eigen::VectorXd& t, Intersample intersample = Intersample::Zoh,
                              const Eigen::VectorXd& x0 = {}, double rtol = 1e-8) const;
   /// The simulation from x0 together with the output derivatives with respect to the parameters `free` (indices)
-  /// and then the initial states `free_x0` (indices of states whose x0 is varied). Initial-state expressions of
-  /// parameters contribute dx0/dtheta. Same errors as simulate().
+  /// and then the initial states `free_x0` (indices of states whose x0 is varied), and the final state with its
+  /// derivatives. Initial-state expressions of parameters contribute dx0/dtheta unless `x0_from_parameters` is
+  /// false (a multiple-shooting segment, whose start is free). Same errors as simulate().
   GreyboxSensitivities sensitivities(const Eigen::MatrixXd& u, const Eigen::VectorXd& t, Intersample intersample,
                                      const Eigen::VectorXd& x0, const std::vector<int>& free,
-                                     const std::vector<int>& free_x0, double rtol = 1e-8) const;
+                                     const std::vector<int>& free_x0, double rtol = 1e-8,
+                                     bool x0_from_parameters = true) const;
   bool operator==(const GreyboxModel& o) const { return spec_ == o.spec_; }
 
  private:
