@@ -152,7 +152,7 @@ def _report(result):
 
 
 for _cls in (_ctid.TransferFunctionResult, _ctid.MisoResult, _ctid.ModalResult, _ctid.FsfResult, _ctid.NarxResult,
-             _ctid.NdeResult):
+             _ctid.NdeResult, _ctid.GreyboxResult):
     _cls.__repr__ = _report
     _cls.report = _report
 

@@ -253,9 +253,10 @@ long step_budget(const Eigen::VectorXd& t) { return 10000L + 200L * static_cast<
 std::string escape_message(const internal::OdeOutcome& o) {
   if (o.budget || o.collapsed)
     return detail::format("the integration stalled at t = {} s ({}) with the state finite: the model is stiff at these "
-                          "parameters, or its right-hand side switches back and forth across a discontinuity (e.g. "
+                          "parameters, its right-hand side switches back and forth across a discontinuity (e.g. "
                           "sign(v) friction at rest: a sliding mode this integrator cannot follow; smooth it, e.g. "
-                          "tanh(v/0.01) for sign(v))",
+                          "tanh(v/0.01) for sign(v)), or the state runs into a singularity of it (e.g. a division by "
+                          "a state that reaches 0)",
                           o.t, o.budget ? "more than 200 steps per sample" : "the step size collapsed");
   return detail::format("the solution escapes at t = {} s (|x| = {}): the model is unstable for this input, or its "
                         "parameters are far from the data's", o.t, o.xmax);
