@@ -10,6 +10,7 @@
 #include "ctid/estimate/lssvf.hpp"
 #include "ctid/signal/prefilter.hpp"
 #include "ctid/simulate/lsim.hpp"
+#include "ctid/simulate/simulate.hpp"
 #include "ctid/validate/metrics.hpp"
 #include "estimate/svf_common.hpp"
 #include "estimate/tf_common.hpp"
@@ -30,6 +31,9 @@ const OptionTable<OeOptions>& option_table<OeOptions>() {
           .named_bounds("bounds", &O::bounds, "parameter bounds by name (bounds.a1=0,inf); the delay is always >= 0")
           .flag("estimate_delay", &O::estimate_delay, "add the input delay (s) as a parameter named delay")
           .real("delay", &O::delay, "s", at_least(0), "initial or fixed input delay, added to nk Ts")
+          .flag("estimate_initial_state", &O::estimate_initial_state,
+                "estimate each record's initial condition (its free response, nf coefficients per record; the state "
+                "of the model's realisation in diagnostics x0, what simulate and validate start from)")
           .real("transient_time", &O::transient_time, "s", at_least(0),
                 "seconds at the start of each record left out of the cost (records not at rest)")
           .include(&O::srivc, option_table<SrivcOptions>(), {"delay_min", "delay_max", "delay_grid"})
@@ -94,6 +98,7 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
   CTID_REQUIRE_OPTION(!free.empty(), "oe: every parameter is fixed; nothing to estimate");
   const int p = static_cast<int>(free.size());
   Eigen::VectorXd lo = Eigen::VectorXd::Constant(p, -INFINITY), hi = Eigen::VectorXd::Constant(p, INFINITY), x0(p);
+  // (the initial-condition coefficients are appended below, unbounded, starting at 0: the record from rest)
   // The delay stays in the range the delay search used (delay_min, delay_max; default 10 % of the record).
   const double delay_hi = opt.srivc.delay_max >= 0 ? opt.srivc.delay_max : 0.1 * shortest_duration(ds);
   for (int j = 0; j < p; ++j) {
@@ -114,21 +119,76 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
   };
   // Unstable and marginally stable models (an integrator the user fixed, an unstable plant recorded in open
   // loop) are simulated exactly like any other; a step whose simulation overflows is rejected by LM.
+  // Initial conditions (estimate_initial_state): record e adds its free response, the impulse response of
+  // E_e(s)/F(s) with E_e = c_1 s^{nf-1} + .. + c_nf (any initial state of an order-nf model gives such a response,
+  // and every such response comes from one state), so the search vector is [x (p) | c of record 1 (ni) | ..] with
+  // exact sensitivities d/dc_k = s^{nf-k}/F and d/da_i = -E s^{nf-i}/F^2 (impulse responses). The delay does not
+  // act on the free response.
+  const int E = static_cast<int>(ds.size());
+  const int ni = opt.estimate_initial_state ? o.nf : 0;
+  const int q = p + E * ni;
+  std::vector<Eigen::VectorXd> since_start;  // each record's times from its first sample
+  for (const IdData& d : ds) since_start.push_back(d.times().array() - d.times()(0));
+  auto power = [](int k) {  // s^k
+    Eigen::VectorXd c = Eigen::VectorXd::Zero(k + 1);
+    c(0) = 1.0;
+    return Polynomial(c);
+  };
   auto evaluate = [&](const Eigen::VectorXd& x, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
-    const TransferFunction g = model_of(x);
+    const TransferFunction g = model_of(x.head(p));
     Eigen::MatrixXd S;
     if (!stacked_residuals(g, ds, opt.transient_time, o.nb, opt.estimate_delay, r, J ? &S : nullptr)) return false;
     if (J) {
-      J->resize(r.size(), p);
+      J->setZero(r.size(), q);
       for (int j = 0; j < p; ++j) J->col(j) = -S.col(free[j]);
     }
-    return true;
+    if (ni == 0) return true;
+    const Polynomial& F = g.den();
+    Eigen::Index at = 0;
+    for (int e = 0; e < E; ++e) {
+      const Eigen::VectorXd& tt = since_start[static_cast<size_t>(e)];
+      const Eigen::Index m = tt.size();
+      const Polynomial Ee(Eigen::VectorXd(x.segment(p + e * ni, ni)));
+      r.segment(at, m) -= impulse_response(TransferFunction(Ee, F), tt);
+      if (J) {
+        for (int k = 0; k < ni; ++k)
+          J->block(at, p + e * ni + k, m, 1) = -impulse_response(TransferFunction(power(ni - 1 - k), F), tt);
+        for (int j = 0; j < p; ++j) {
+          const std::string& name = names[static_cast<size_t>(free[j])];
+          if (name[0] != 'a') continue;  // b and the delay do not act on the free response
+          const int i = std::stoi(name.substr(1));
+          J->block(at, j, m, 1) += impulse_response(TransferFunction(Ee * power(o.nf - i), F * F), tt);
+        }
+      }
+      at += m;
+    }
+    return r.allFinite() && (!J || J->allFinite());
   };
   internal::LmOptions lmo;
   lmo.max_iterations = opt.max_iterations;
   lmo.ftol = opt.tolerance;
   lmo.xtol = opt.tolerance;
-  const internal::LmResult lm = internal::levenberg_marquardt(evaluate, x0, lo, hi, lmo);
+  Eigen::VectorXd v0 = Eigen::VectorXd::Zero(q), v_lo = Eigen::VectorXd::Constant(q, -INFINITY),
+                  v_hi = Eigen::VectorXd::Constant(q, INFINITY);
+  v0.head(p) = x0;
+  v_lo.head(p) = lo;
+  v_hi.head(p) = hi;
+  internal::LmResult lm = internal::levenberg_marquardt(evaluate, v0, v_lo, v_hi, lmo);
+  Eigen::VectorXd free_response;  // the estimated free responses, stacked (empty: from rest)
+  if (ni > 0 && std::isfinite(lm.cost)) {
+    Eigen::VectorXd with, without;
+    evaluate(lm.x, with, nullptr);
+    Eigen::VectorXd rest = lm.x;
+    rest.tail(E * ni).setZero();
+    evaluate(rest, without, nullptr);
+    free_response = without - with;
+    // The information about the model's parameters with the initial conditions eliminated (Schur complement).
+    const Eigen::MatrixXd& F = lm.jtj;
+    lm.jtj = (F.topLeftCorner(p, p) - F.topRightCorner(p, E * ni) *
+                                          F.bottomRightCorner(E * ni, E * ni).ldlt().solve(F.bottomLeftCorner(E * ni, p)))
+                 .eval();
+  }
+  lm.x.conservativeResize(p);
 
   Result<TransferFunction> r;
   r.model = model_of(lm.x);
@@ -136,9 +196,10 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
   r.parameters.values = full;
   for (int j = 0; j < p; ++j) r.parameters.values(free[j]) = lm.x(j);
   r.parameters.fixed = c.held;
-  const auto [y_all, sim_all] = tf_detail::pooled_outputs(r.model, ds, opt.transient_time);
-  r.fit = fit_report_or_inf(y_all, sim_all, p);
-  const double sigma2 = 2.0 * lm.cost / double(std::max<Eigen::Index>(1, y_all.size() - p));
+  auto [y_all, sim_all] = tf_detail::pooled_outputs(r.model, ds, opt.transient_time);
+  if (free_response.size()) sim_all += free_response;
+  r.fit = fit_report_or_inf(y_all, sim_all, p + E * ni);
+  const double sigma2 = 2.0 * lm.cost / double(std::max<Eigen::Index>(1, y_all.size() - p - E * ni));
   std::vector<std::string> free_names;
   for (int j : free) free_names.push_back(names[static_cast<size_t>(j)]);
   const std::string unidentifiable = internal::unidentifiable(lm.jtj, lm.x, free_names);
@@ -175,6 +236,9 @@ void check_record(const IdData& data, const TfOrders& o, const OeOptions& opt, c
                o.nf + o.nb);
   CTID_REQUIRE(opt.transient_time < data.duration(), "{}: transient_time = {} s is not shorter than the record ({} s)", who,
                opt.transient_time, data.duration());
+  CTID_REQUIRE_OPTION(!(opt.estimate_initial_state && opt.transient_time > 0),
+                      "{}: estimate_initial_state and transient_time = {} s are alternatives for a record that does not "
+                      "start at rest; set one", who, opt.transient_time);
   const double delay = opt.delay + (o.nk > 0 ? o.nk * data.ts() : 0.0);
   CTID_REQUIRE(delay < data.duration(), "{}: the input delay {} s is not shorter than the record ({} s)", who, delay,
                data.duration());
@@ -277,22 +341,37 @@ Result<TransferFunction> tfest_in_units(const Records& data, const TfOrders& ord
   return r;
 }
 
+// With estimate_initial_state: each record's initial state in the fitted model's realisation, in the record's units —
+// the least-squares state of simulate(Estimated), which spans the same free responses as the fit's E_e(s)/A(s) and
+// so reproduces the fit's simulation.
+void set_initial_states(Result<TransferFunction>& r, const Records& data, const OeOptions& options) {
+  if (!options.estimate_initial_state || !r.model.den().coefficients().allFinite()) return;
+  SimulateOptions so;
+  so.initial = InitialCondition::Estimated;
+  for (std::size_t e = 0; e < data.size(); ++e)
+    r.diagnostics.set(diagnostic::x0, simulate(AnyModel(r.model), data[e], so).x0, static_cast<int>(e));
+}
+
 }  // namespace
 
 // oe and tfest estimate in normalised time and amplitude units (issue 13: the result does not depend on the
 // units of the record) and map the result back.
 Result<TransferFunction> oe(const std::vector<IdData>& data, const TfOrders& orders, const OeOptions& options) {
   check_common(data, orders, options, "oe");
-  return in_normalised_units(data, orders, options, [&](const Records& d, const OeOptions& o, auto t0) {
+  Result<TransferFunction> r = in_normalised_units(data, orders, options, [&](const Records& d, const OeOptions& o, auto t0) {
     return oe_in_units(d, orders, o, t0);
   });
+  set_initial_states(r, data, options);
+  return r;
 }
 
 Result<TransferFunction> tfest(const std::vector<IdData>& data, const TfOrders& orders, const OeOptions& options) {
   check_common(data, orders, options, "tfest");
-  return in_normalised_units(data, orders, options, [&](const Records& d, const OeOptions& o, auto t0) {
+  Result<TransferFunction> r = in_normalised_units(data, orders, options, [&](const Records& d, const OeOptions& o, auto t0) {
     return tfest_in_units(d, orders, o, t0);
   });
+  set_initial_states(r, data, options);
+  return r;
 }
 
 Result<TransferFunction> oe(const IdData& data, const TfOrders& orders, const OeOptions& options) {

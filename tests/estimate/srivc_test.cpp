@@ -14,6 +14,7 @@
 #include "ctid/estimate/srivc.hpp"
 #include "ctid/signal/prefilter.hpp"
 #include "ctid/simulate/lsim.hpp"
+#include "ctid/simulate/simulate.hpp"
 #include "ctid/validate/crlb.hpp"
 #include "test_util.hpp"
 
@@ -656,5 +657,83 @@ TEST(Ivsvf, SeveralExperimentsGiveOneEstimateBetweenTheRecords) {
     std::printf("parameter %d: rmse joint %.4g, record 1 %.4g, record 2 %.4g, combined %.4g\n", i, rmse(mc.ej),
                 rmse(mc.e1), rmse(mc.e2), combined);  // the efficient combination, for comparison
     EXPECT_LT(rmse(mc.ej), 0.85 * std::max(rmse(mc.e1), rmse(mc.e2))) << "parameter " << i;
+  }
+}
+
+// A record that does not start at rest (issue 15: initial-condition estimation for linear models). The data are
+// the exact ZOH simulation of G = (s + 3)/(s^2 + 1.2 s + 4) from the state x0 = (1.5, -0.7) of its realisation.
+// Noise-free, estimate_initial_state recovers the parameters to 1e-6 and x0 to 1e-5 (the equivalent state of the
+// free response, diagnostics x0), and simulate from that x0 is the fit's simulation; from rest the same record
+// gives parameters biased by more than 1e-2 (measured: a1 12 %, a2 4 %, b0 57 %, b1 24 %). With noise (std 0.05) every
+// parameter lies within 3.5 reported standard deviations (single seeded run; measured 0.16-0.49).
+TEST(OutputError, TheInitialConditionOfARecordNotAtRestIsEstimated) {
+  const TransferFunction truth(Polynomial{1.0, 3.0}, Polynomial{1.0, 1.2, 4.0});
+  const int n = 2000;
+  const Eigen::VectorXd u = prbs(n, {.register_length = 9, .clock_period = 12});
+  const Eigen::VectorXd t = time_grid(0.01, n);
+  LsimOptions lo;
+  lo.x0 = Eigen::Vector2d(1.5, -0.7);
+  const Eigen::VectorXd y = lsim(truth.to_state_space(), u, t, {Intersample::Zoh}, lo).col(0);
+  const IdData d(u, y, 0.01);
+  const Eigen::Vector4d want(1.2, 4.0, 1.0, 3.0);  // a1, a2, b0, b1
+  OeOptions o;
+  o.estimate_initial_state = true;
+  for (const bool with_tfest : {true, false}) {
+    const Result<TransferFunction> r = with_tfest ? tfest(d, {2, 2, 0}, o) : oe(d, {2, 2, 0}, o);
+    ASSERT_TRUE(r.usable()) << r.why_not_usable();
+    for (int i = 0; i < 4; ++i) EXPECT_NEAR(r.parameters.values(i), want(i), 1e-6 * std::abs(want(i))) << i;
+    const Eigen::VectorXd x0 = r.diagnostics.get(diagnostic::x0);
+    EXPECT_LT((x0 - lo.x0).cwiseAbs().maxCoeff(), 1e-5) << x0.transpose();
+    SimulateOptions so;
+    so.initial = InitialCondition::Estimated;
+    so.x0 = x0;
+    EXPECT_LT((simulate(AnyModel(r.model), d, so).y.col(0) - y).cwiseAbs().maxCoeff(), 1e-6);
+  }
+  const Result<TransferFunction> rest = tfest(d, {2, 2, 0});
+  EXPECT_GT((rest.parameters.values - want).cwiseQuotient(want).cwiseAbs().maxCoeff(), 1e-2);
+
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  Eigen::VectorXd yn = y;
+  for (Eigen::Index k = 0; k < n; ++k) yn(k) += noise(rng);
+  const Result<TransferFunction> r = tfest(IdData(u, yn, 0.01), {2, 2, 0}, o);
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
+  for (int i = 0; i < 4; ++i) EXPECT_LT(std::abs(r.parameters.values(i) - want(i)), 3.5 * r.parameters.std(i)) << i;
+  o.transient_time = 1.0;
+  const std::string both = ctid::test::error_of([&] { tfest(d, {2, 2, 0}, o); });
+  EXPECT_NE(both.find("estimate_initial_state and transient_time = 1 s are alternatives"), std::string::npos) << both;
+}
+
+// The same record not at rest, 50 noise realisations (std 0.05): the estimates with estimate_initial_state are
+// unbiased (|mean error| < 0.5 spread: 3.5 standard errors of the mean of 50) and the reported standard deviation,
+// with the initial conditions eliminated by the Schur complement, is the spread within 30 %. Measured here: |bias|
+// 0.05-0.08 spread, reported std / spread 0.95-1.06 (and 0.86-1.02 over 100 runs of another seed).
+TEST(OutputError, InitialConditionMonteCarloCovarianceIsTheSpread) {
+  const TransferFunction truth(Polynomial{1.0, 3.0}, Polynomial{1.0, 1.2, 4.0});
+  const int n = 2000, R = 50;
+  const Eigen::VectorXd u = prbs(n, {.register_length = 9, .clock_period = 12});
+  LsimOptions lo;
+  lo.x0 = Eigen::Vector2d(1.5, -0.7);
+  const Eigen::VectorXd y = lsim(truth.to_state_space(), u, time_grid(0.01, n), {Intersample::Zoh}, lo).col(0);
+  const Eigen::Vector4d want(1.2, 4.0, 1.0, 3.0);
+  OeOptions o;
+  o.estimate_initial_state = true;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  Eigen::MatrixXd err(R, 4), sd(R, 4);
+  for (int k = 0; k < R; ++k) {
+    Eigen::VectorXd yn = y;
+    for (Eigen::Index i = 0; i < n; ++i) yn(i) += noise(rng);
+    const Result<TransferFunction> r = tfest(IdData(u, yn, 0.01), {2, 2, 0}, o);
+    ASSERT_TRUE(r.usable()) << r.why_not_usable();
+    err.row(k) = (r.parameters.values.head(4) - want).transpose();
+    sd.row(k) = r.parameters.std.head(4).transpose();
+  }
+  for (int i = 0; i < 4; ++i) {
+    const double mean = err.col(i).mean();
+    const double spread = std::sqrt((err.col(i).array() - mean).square().sum() / (R - 1));
+    std::printf("parameter %d: bias / spread %.3f, reported std / spread %.3f\n", i, mean / spread, sd.col(i).mean() / spread);
+    EXPECT_LT(std::abs(mean), 0.5 * spread) << i;
+    EXPECT_NEAR(sd.col(i).mean() / spread, 1.0, 0.3) << i;
   }
 }

@@ -6,7 +6,10 @@
 // (dy/da_i = -s^{n-i} B/A^2 u, dy/db_j = s^{nb-1-j}/A u, dy/dT = -s B/A u; see
 // signal/prefilter.hpp), simple bounds and fixed parameters. Ljung (1999), System
 // Identification, ch. 7 and 10 (the continuous-time OE form of MATLAB's tfest refinement).
-// Covariance sigma^2 (S^T S)^{-1} with S the sensitivity matrix of the free parameters.
+// Covariance sigma^2 (S^T S)^{-1} with S the sensitivity matrix of the free parameters. With estimate_initial_state
+// each record's free response E_e(s)/A(s) is estimated with the model (the initial-condition polynomial of
+// Ljung 1999 §4.3 / the "estimate initial condition" of MATLAB's tfest), its coefficients eliminated from the
+// covariance by the Schur complement.
 #pragma once
 
 #include <map>
@@ -38,6 +41,12 @@ struct OeOptions {
   /// Seconds at the start of each record left out of the output-error cost (and of the SRIVC start): a record
   /// simulated from rest that did not start at rest.
   double transient_time = 0.0;
+  /// Estimate each record's initial condition instead of starting it from rest: its free response, the impulse
+  /// response of E(s)/A(s) with nf free coefficients per record (exact sensitivities; the model's covariance is
+  /// that with the initial conditions eliminated). diagnostics x0 (per record) holds the equivalent state of the
+  /// model's realisation (TransferFunction::to_state_space), from which simulate and validate start. Excludes
+  /// transient_time (the two are alternatives for a record that does not start at rest).
+  bool estimate_initial_state = false;
   void validate() const;
 };
 /// The settings of OeOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
