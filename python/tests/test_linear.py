@@ -380,3 +380,20 @@ def test_responses_of_any_model_are_the_librarys():
     np.testing.assert_allclose(ctid.step_response(narx, t), (1 - 0.6 ** np.arange(100)) / 0.4, atol=1e-12)
     with pytest.raises(ctid.InvalidArgument, match="GFRFs"):
         ctid.frequency_response(narx, w)
+
+
+def test_tfest_estimates_the_initial_condition_of_a_record_not_at_rest():
+    # As OutputError.TheInitialConditionOfARecordNotAtRestIsEstimated: (s + 3)/(s^2 + 1.2 s + 4) from the state
+    # (1.5, -0.7) of its realisation, noise-free: the parameters to 1e-6, the state to 1e-5.
+    g = ctid.TransferFunction([1.0, 3.0], [1.0, 1.2, 4.0])
+    n = 2000
+    u = ctid.prbs(n, register_length=9, clock_period=12)
+    rest = ctid.IdData.from_arrays(u, g.simulate(u, ctid.time_grid(0.01, n)), ts=0.01)
+    y = np.asarray(ctid.simulate(g, rest, "estimated", x0=[1.5, -0.7])).reshape(-1)
+    d = ctid.IdData.from_arrays(u, y, ts=0.01)
+    r = ctid.tfest(d, nb=2, nf=2, estimate_initial_state=True)
+    assert r.usable(), r.why_not_usable()
+    assert np.allclose(r.parameters.values[:4], [1.2, 4.0, 1.0, 3.0], rtol=1e-6)
+    assert np.allclose(r.diagnostics.vectors["x0"], [1.5, -0.7], atol=1e-5)
+    with pytest.raises(ctid.InvalidOptions, match="alternatives"):
+        ctid.tfest(d, nb=2, nf=2, estimate_initial_state=True, transient_time=1.0)
