@@ -388,7 +388,8 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
   // After multiple shooting: the single-shooting search from its estimate where the free run is finite (a stable
   // or integrating plant; it then ends at the output-error optimum itself); its result is taken when its cost is
   // within 5 % of the segments' output cost. Otherwise (an unstable plant: the free run escapes or drifts) the
-  // multiple-shooting estimate stands, its covariance from the condensed Jacobian and its fit over the segments.
+  // multiple-shooting estimate stands, its information the Schur complement of the segment states' block and its fit
+  // that of the segments.
   std::vector<std::string> warnings;
   Eigen::VectorXd segment_fit;  // the segments' weighted outputs when the multiple-shooting estimate stands
   double defect = NAN;

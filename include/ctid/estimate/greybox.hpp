@@ -10,6 +10,10 @@
 // bounds, or log-uniformly within a decade of the value where a bound is open; the lowest cost wins.
 // Covariance sigma^2 (J^T J)^{-1} with sigma^2 = V / (N ny - p); a combination of parameters the data cannot
 // separate makes the result not usable, naming the parameters (ParameterSet rules, core/types.hpp).
+// Unstable and integrating plants: multiple shooting (Bock & Plitt 1984; Bock 1983) — segments with free initial
+// states, continuity by penalty residuals raised until the defects are at rounding level — chosen automatically when
+// the free run from the start escapes or drifts, then single shooting from its estimate where the plant runs free
+// (docs/methods/greybox.md#unstable-and-integrating-plants).
 #pragma once
 
 #include <vector>
@@ -46,7 +50,9 @@ const OptionTable<GreyboxOptions>& option_table<GreyboxOptions>();
 /// order (the caller maps column names). The returned model carries the estimates and, for estimated initial
 /// states, the first record's estimate. parameters: every model parameter (held ones flagged fixed), then the
 /// estimated initial states "x1(0)", .. (with several records "r<e>.x1(0)"). diagnostics: x0 per record,
-/// noise_variance, starts_cost (the final cost of each start), experiments. Termination Converged / MaxIterations,
+/// noise_variance, starts_cost (the final cost of each start), experiments, segments and continuity_defect (multiple
+/// shooting; a warning when the fitted model cannot run free and the fit is that of the segments). Termination
+/// Converged / MaxIterations,
 /// NumericalFailure when the model cannot be simulated from any start (the message names where it escaped).
 /// Throws InvalidArgument for data whose input or output count differs from the model's, records with fewer
 /// samples than free quantities, names in fixed/bounds that are not parameters (the closest named); InvalidOptions
