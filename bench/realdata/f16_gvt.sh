@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Real-data benchmark: f16 gvt (docs/gallery.md). Usage: see bench/realdata/common.sh.
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+f16="$shared/f16_gvt"
+[ -f "$f16/F16Data_FullMSine_Level1.csv" ] && [ -n "${CTID_PYTHON:-}" ] && "$CTID_PYTHON" -c "import ctid" 2>/dev/null ||
+  skip "F-16 GVT" "data in $f16 or the Python module (CTID_PYTHON) not available"
+echo "== F-16 ground vibration test: the torsion mode at 7 excitation levels (Python: FFT + ctid.tf_from_frequency)"
+"$CTID_PYTHON" "$here/f16_modes.py" "$f16" "$out"
+col() { awk -F, -v l="$1" -v c="$2" 'NR > 1 && $1 == l { print $c }' "$out/f16_modes.csv"; }
+check "torsion frequency drop from 12 N to 98 N rms (Hz)" "$(awk -v a="$(col 1 3)" -v b="$(col 7 3)" 'BEGIN { print a - b }')" gt 0.1
+check "torsion damping ratio at 98 N over that at 12 N" "$(awk -v a="$(col 1 4)" -v b="$(col 7 4)" 'BEGIN { print b / a }')" gt 2
+check "worst FRF fit on the validation periods over the 7 levels %" \
+  "$(awk -F, 'NR > 1 && (m == "" || $6 < m) { m = $6 } END { print m }' "$out/f16_modes.csv")" gt 75
+exit $fail
