@@ -293,3 +293,60 @@ TEST(Greybox, MultipleShootingFitsAnUnstablePlantFromItsClosedLoopRecord) {
   EXPECT_GT(ms.parameters.std(ms.parameters.index("k")), 0.0);
   EXPECT_TRUE(std::isfinite(ms.parameters.std(ms.parameters.index("c"))));
 }
+
+// The Monte Carlo: a mass with viscous and Coulomb friction (tanh-smoothed over 1 cm/s) under a known P/P
+// cascade (position loop kp, velocity loop kv) whose drive force saturates at +-4 N; the reference is the input, the
+// position the output, the controller part of the model's equations (no special case for the loop). 3000 samples at
+// 10 ms, output noise at 10 dB SNR, 50 seeds, a start 30 % off. Asserted per parameter: |bias| < 0.5 std of the
+// estimates, and that std within 20 % of the Cramer-Rao bound sigma^2 (J^T J)^-1 from the exact sensitivities at
+// the truth. Measured (label montecarlo, Release, 5 s): |bias| 0.04-0.08 std; std / CRLB 0.84 (m), 1.05 (c), 0.98 (fc).
+TEST(Greybox, FrictionCascadeMonteCarloReachesTheCramerRaoBound) {
+  GreyboxSpec s;
+  s.inputs = {"r"};
+  s.states = {"q", "v"};
+  s.outputs = {{"y", "q"}};
+  s.parameters = {{"m", 1.0, 0.05, 20.0}, {"c", 0.5, 0.0}, {"fc", 0.4, 0.0},
+                  {"kp", 3.0, -INFINITY, INFINITY, true}, {"kv", 10.0, -INFINITY, INFINITY, true},
+                  {"fmax", 4.0, -INFINITY, INFINITY, true}};
+  s.equations = {"v", "(sat(kv*(kp*(r - q) - v), -fmax, fmax) - c*v - fc*tanh(v/0.01))/m"};
+  s.initial = {{"0", false}, {"0", false}};
+  const GreyboxModel truth(s);
+  const int n = 3000, R = 50;
+  const double ts = 0.01;
+  const Eigen::MatrixXd r = levels(n, 200, -1.0, 1.0, 77);
+  const Eigen::VectorXd t = time_grid(ts, n);
+  const GreyboxSimulation clean = truth.simulate(r, t, Intersample::Zoh, Eigen::Vector2d::Zero(), 1e-11);
+  ASSERT_TRUE(clean.ok()) << clean.message;
+  const double rms = std::sqrt((clean.y.array() - clean.y.mean()).square().mean());
+  const double sigma = rms / std::sqrt(10.0);  // 10 dB
+  // The bound: sigma^2 (J^T J)^-1 at the truth, J the exact output sensitivities to m, c, fc.
+  const GreyboxSensitivities sens = truth.sensitivities(r, t, Intersample::Zoh, Eigen::Vector2d::Zero(), {0, 1, 2}, {}, 1e-11);
+  ASSERT_TRUE(sens.ok) << sens.message;
+  const Eigen::MatrixXd& J = sens.dy[0];
+  const Eigen::VectorXd crlb = (sigma * sigma * (J.transpose() * J).inverse()).diagonal().cwiseSqrt();
+
+  GreyboxSpec start_spec = s;
+  start_spec.parameters[0].value = 1.3;
+  start_spec.parameters[1].value = 0.35;
+  start_spec.parameters[2].value = 0.52;
+  const GreyboxModel start(start_spec);
+  std::mt19937 rng(2024);
+  std::normal_distribution<double> noise(0.0, sigma);
+  Eigen::MatrixXd est(R, 3);
+  for (int k = 0; k < R; ++k) {
+    Eigen::MatrixXd y = clean.y;
+    for (Eigen::Index i = 0; i < n; ++i) y(i, 0) += noise(rng);
+    const Result<GreyboxModel> fit = greybox(IdData(r, y, ts), start);
+    ASSERT_TRUE(fit.usable()) << fit.why_not_usable();
+    for (int j = 0; j < 3; ++j) est(k, j) = fit.parameters.values(j);
+  }
+  const Eigen::Vector3d want(1.0, 0.5, 0.4);
+  for (int j = 0; j < 3; ++j) {
+    const double mean = est.col(j).mean();
+    const double sd = std::sqrt((est.col(j).array() - mean).square().sum() / (R - 1));
+    std::printf("%s: bias %.4g (%.3f std), std %.4g, CRLB %.4g, std / CRLB %.3f\n", s.parameters[j].name.c_str(),
+                mean - want(j), (mean - want(j)) / sd, sd, crlb(j), sd / crlb(j));
+    EXPECT_LT(std::abs(mean - want(j)), 0.5 * sd) << s.parameters[j].name;
+    EXPECT_NEAR(sd / crlb(j), 1.0, 0.2) << s.parameters[j].name;
+  }
+}
