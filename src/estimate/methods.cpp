@@ -74,7 +74,8 @@ const std::vector<MethodInfo>& methods() {
                         reports(fsf_N, fsf_a, fsf_b, regression_fit_percent, residual_rms)),
       entry<FsfOptions, PhysicalFitOptions>(
           "physical", "physical parameters of a transfer-function expression (via FSF or raw data)",
-          {"FsfOptions", "PhysicalFitOptions"}, reports(shift_a, cost, cost_history, max_pole_real_part, compressed_fit_percent, experiments)),
+          {"FsfOptions", "PhysicalFitOptions"},
+          reports(shift_a, cost, cost_history, max_pole_real_part, compressed_fit_percent, experiments, x0)),
       entry<ModalOptions>(
           "modal", "El-Shafey (1987) modal functions: transfer function from a generated or piecewise-constant input",
           {"ModalOptions"}, reports(windows, condition_by_order, experiments)),

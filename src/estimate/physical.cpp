@@ -10,6 +10,7 @@
 #include "ctid/core/check.hpp"
 #include "ctid/model/state_space.hpp"
 #include "ctid/simulate/lsim.hpp"
+#include "ctid/simulate/simulate.hpp"
 #include "ctid/validate/metrics.hpp"
 #include "internal/least_squares.hpp"
 #include "internal/levenberg_marquardt.hpp"
@@ -25,6 +26,9 @@ const OptionTable<PhysicalFitOptions>& option_table<PhysicalFitOptions>() {
           .real("tolerance", &O::tolerance, "", above(0), "relative cost decrease that stops the search")
           .integer("step_points", &O::step_points, "", at_least(2),
                    "samples of the compressed step response on [0, T] (route via fsf)")
+          .flag("estimate_initial_state", &O::estimate_initial_state,
+                "raw route: estimate each record's initial state (its free response) instead of starting from rest; "
+                "diagnostics x0 per record")
           .named_reals("fixed", &O::fixed, "parameters held at a value, by name (fixed.k=2)")
           .named_bounds("bounds", &O::bounds, "parameter bounds by name (bounds.k=0,inf)");
   return t;
@@ -34,14 +38,16 @@ void PhysicalFitOptions::validate() const { option_table<PhysicalFitOptions>().c
 
 namespace {
 
-// Residuals r(Theta) and their Jacobian from the shifted model and its sensitivities.
-using ResidualFn = std::function<void(const TransferFunction& g, const std::vector<TransferFunction>* sens,
-                                      Eigen::VectorXd& r, Eigen::MatrixXd* J)>;
+// Residuals r(Theta) and their Jacobian from the shifted model and its sensitivities (to the free parameters
+// `free`, the indices into Theta).
+using ResidualFn = std::function<void(const Eigen::VectorXd& theta, const std::vector<int>& free, const TransferFunction& g,
+                                      const std::vector<TransferFunction>* sens, Eigen::VectorXd& r, Eigen::MatrixXd* J)>;
 
-// target: the data the residuals are measured against (for the fit report).
+// target: the data the residuals are measured against (for the fit report); nuisance: further quantities the
+// residual function estimates itself (the raw route's initial states), counted in the degrees of freedom.
 Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<PhysicalParameter>& params, double a,
                              const PhysicalFitOptions& opt, const ResidualFn& residual, const Eigen::VectorXd& target,
-                             const char* route) {
+                             const char* route, int nuisance = 0) {
   const int n_data = static_cast<int>(target.size());
   const auto start = std::chrono::steady_clock::now();
   opt.validate();
@@ -112,9 +118,9 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
       const std::vector<TransferFunction> all = model.sensitivities(th, a);
       std::vector<TransferFunction> sens;
       for (int j = 0; j < p; ++j) sens.push_back(all[free[j]]);
-      residual(g, &sens, r, J);
+      residual(th, free, g, &sens, r, J);
     } else {
-      residual(g, nullptr, r, nullptr);
+      residual(th, free, g, nullptr, r, nullptr);
     }
     if (!r.allFinite() || (J && !J->allFinite())) return false;
     if (J) history.push_back(0.5 * r.squaredNorm());
@@ -131,7 +137,7 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
   res.parameters.names = model.parameter_names();
   res.parameters.values = th;
   res.parameters.fixed = fixed;
-  const double sigma2 = 2.0 * lm.cost / std::max(1, n_data - p);
+  const double sigma2 = 2.0 * lm.cost / std::max(1, n_data - p - nuisance);
   std::vector<std::string> free_names;
   for (int j : free) free_names.push_back(res.parameters.names[static_cast<size_t>(j)]);
   const std::string unidentifiable = internal::unidentifiable(lm.jtj, lm.x, free_names);
@@ -139,8 +145,8 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
   res.diagnostics.condition_number = internal::gram_condition(lm.jtj);
   {
     Eigen::VectorXd r;
-    if (std::isfinite(lm.cost) && evaluate(lm.x, r, nullptr)) res.fit = fit_report_or_inf(target, target + r, p);
-    else res.fit = fit_report_or_inf(target, Eigen::VectorXd::Constant(n_data, NAN), p);
+    if (std::isfinite(lm.cost) && evaluate(lm.x, r, nullptr)) res.fit = fit_report_or_inf(target, target + r, p + nuisance);
+    else res.fit = fit_report_or_inf(target, Eigen::VectorXd::Constant(n_data, NAN), p + nuisance);
   }
   res.diagnostics.set(diagnostic::shift_a, a);
   res.diagnostics.set(diagnostic::cost, lm.cost);
@@ -244,8 +250,10 @@ Result<TransferFunction> fit_physical_step(const PhysicalModel& model, const std
   opt.validate();
   const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(opt.step_points, 0.0, fsf.T());
   const Eigen::VectorXd target = fsf.step_response(t);
-  ResidualFn res = [&](const TransferFunction& g, const std::vector<TransferFunction>* sens, Eigen::VectorXd& r,
-                       Eigen::MatrixXd* J) {
+  CTID_REQUIRE_OPTION(!opt.estimate_initial_state, "physical: estimate_initial_state applies to the raw route (--via "
+                      "raw); the FSF routes compress the record from rest");
+  ResidualFn res = [&](const Eigen::VectorXd&, const std::vector<int>&, const TransferFunction& g,
+                       const std::vector<TransferFunction>* sens, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
     r = step_response(g, t) - target;  // e = y_model - y_s (GW 22)
     if (J) {
       J->resize(t.size(), static_cast<Eigen::Index>(sens->size()));
@@ -264,8 +272,10 @@ Result<TransferFunction> fit_physical_frequency(const PhysicalModel& model, cons
     w(k) = k * fsf.omega();
     target(k) = fsf.theta_k(k);
   }
-  ResidualFn res = [&](const TransferFunction& g, const std::vector<TransferFunction>* sens, Eigen::VectorXd& r,
-                       Eigen::MatrixXd* J) {
+  CTID_REQUIRE_OPTION(!opt.estimate_initial_state, "physical: estimate_initial_state applies to the raw route (--via "
+                      "raw); the FSF routes compress the record from rest");
+  ResidualFn res = [&](const Eigen::VectorXd&, const std::vector<int>&, const TransferFunction& g,
+                       const std::vector<TransferFunction>* sens, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
     const Eigen::VectorXcd e = g.frequency_response(w) - target;  // E(jw) of GW 30, real and imaginary parts
     r.resize(2 * (m + 1));
     r << e.real(), e.imag();
@@ -296,16 +306,66 @@ Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std:
   // windowed from its own start.
   const WindowedRecords w(records, a);
   const Eigen::Index n = w.y.size();
-  ResidualFn res = [&](const TransferFunction& g, const std::vector<TransferFunction>* sens, Eigen::VectorXd& r,
-                       Eigen::MatrixXd* J) {
+  const int nx = opt.estimate_initial_state ? model.realisation(Eigen::VectorXd::Ones(model.n_parameters())).model.nx() : 0;
+  // Initial states (estimate_initial_state): record e adds the free response C e^{(A - aI)(t - t_0)} x0_e of the
+  // model's realisation (PhysicalModel::realisation; windowed like the record). x0_e enters linearly and is eliminated
+  // by variable projection (Golub & Pereyra 1973; Kaufman 1975): at given parameters it is the least-squares fit of
+  // the record's output error, the residual is that error's projection P r_e, and the Jacobian P (S_e + d(Phi_e
+  // x0_e)/dTheta) (the free response's derivative through the sensitivity equations) — whose Gram is the parameters'
+  // information with the initial states eliminated, so the covariance accounts for them.
+  ResidualFn res = [&](const Eigen::VectorXd& theta, const std::vector<int>& free, const TransferFunction& g,
+                       const std::vector<TransferFunction>* sens, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
     r = w.simulate(g) - w.y;
     if (J) {
       J->resize(n, static_cast<Eigen::Index>(sens->size()));
       for (std::size_t j = 0; j < sens->size(); ++j) J->col(static_cast<Eigen::Index>(j)) = w.simulate((*sens)[j]);
     }
+    if (nx == 0) return;
+    const StateSpaceWithGradient m = model.realisation(theta, a);
+    const Eigen::MatrixXd zero_b = Eigen::MatrixXd::Zero(nx, 1), zero_d = Eigen::MatrixXd::Zero(1, 1);
+    const StateSpace free_system(m.model.A(), zero_b, m.model.C(), zero_d);
+    for (Eigen::Index e = 0, at = 0; e < static_cast<Eigen::Index>(records.size()); at += records[e].size(), ++e) {
+      const Eigen::VectorXd tt = records[e].times().array() - records[e].times()(0);
+      const Eigen::MatrixXd u0 = Eigen::MatrixXd::Zero(tt.size(), 1);
+      auto free_response = [&](const StateSpace& sys, const Eigen::VectorXd& x0) {
+        LsimOptions lo;
+        lo.x0 = x0;
+        return Eigen::VectorXd(lsim(sys, u0, tt, {Intersample::Zoh}, lo).col(0));
+      };
+      Eigen::MatrixXd Phi(tt.size(), nx);
+      for (int i = 0; i < nx; ++i) Phi.col(i) = free_response(free_system, Eigen::VectorXd::Unit(nx, i));
+      const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> qr(Phi);
+      const Eigen::VectorXd x0 = qr.solve(Eigen::VectorXd(-r.segment(at, tt.size())));
+      r.segment(at, tt.size()) += Phi * x0;
+      if (!J) continue;
+      Eigen::MatrixXd Je = J->middleRows(at, tt.size());
+      for (std::size_t j = 0; j < free.size(); ++j) {
+        // d/dTheta_j of C e^{At} x0: the sensitivity system [x; dx]' = [A 0; dA A][x; dx], y = [dC C][x; dx].
+        const StateSpace& d = m.derivatives[static_cast<size_t>(free[j])];
+        Eigen::MatrixXd A2 = Eigen::MatrixXd::Zero(2 * nx, 2 * nx), C2(1, 2 * nx);
+        A2.topLeftCorner(nx, nx) = m.model.A();
+        A2.bottomLeftCorner(nx, nx) = d.A();
+        A2.bottomRightCorner(nx, nx) = m.model.A();
+        C2 << d.C(), m.model.C();
+        Eigen::VectorXd z0 = Eigen::VectorXd::Zero(2 * nx);
+        z0.head(nx) = x0;
+        Je.col(static_cast<Eigen::Index>(j)) +=
+            free_response(StateSpace(A2, Eigen::MatrixXd::Zero(2 * nx, 1), C2, zero_d), z0);
+      }
+      J->middleRows(at, tt.size()) = Je - Phi * qr.solve(Je);  // the projection onto the complement of Phi
+    }
   };
-  Result<TransferFunction> r = fit(model, params, a, opt, res, w.y, "raw");
+  Result<TransferFunction> r =
+      fit(model, params, a, opt, res, w.y, "raw", nx * static_cast<int>(records.size()));
   if (records.size() > 1) r.diagnostics.set(diagnostic::experiments, static_cast<double>(records.size()));
+  if (nx > 0 && r.model.den().coefficients().allFinite()) {
+    // Each record's initial state in the fitted transfer function's realisation (what simulate and validate start
+    // from): the least-squares state of simulate(Estimated) on the record.
+    SimulateOptions so;
+    so.initial = InitialCondition::Estimated;
+    for (std::size_t e = 0; e < records.size(); ++e)
+      r.diagnostics.set(diagnostic::x0, simulate(AnyModel(r.model), records[e], so).x0, static_cast<int>(e));
+  }
   return r;
 }
 

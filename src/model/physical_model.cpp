@@ -398,6 +398,43 @@ TransferFunction PhysicalModel::shifted(const Eigen::VectorXd& theta, double a) 
 
 TransferFunction PhysicalModel::transfer_function(const Eigen::VectorXd& theta) const { return shifted(theta, 0.0); }
 
+StateSpaceWithGradient PhysicalModel::realisation(const Eigen::VectorXd& theta, double a) const {
+  CTID_REQUIRE(theta.size() == n_parameters(), "PhysicalModel: {} parameter values for {} parameters", theta.size(),
+               n_parameters());
+  CTID_REQUIRE(theta.allFinite(), "PhysicalModel: parameter values must be finite");
+  if (c_->ss) {
+    StateSpaceWithGradient g = checked_state_space(c_->ss, theta);
+    g.model = shift_ss(g.model, a);  // d(A - aI)/dTheta = dA/dTheta
+    return g;
+  }
+  Eigen::VectorXd num, den;
+  Eigen::MatrixXd dn, dd;
+  expand(*c_->root, expr_, theta, a, num, den, dn, dd);
+  const int n = static_cast<int>(den.size()) - 1, P = n_parameters();
+  // The numerator padded to the denominator's degree: b_0 s^n + .. + b_n over s^n + a_1 s^{n-1} + .. + a_n.
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(n + 1);
+  Eigen::MatrixXd db = Eigen::MatrixXd::Zero(n + 1, P);
+  b.tail(num.size()) = num;
+  db.bottomRows(num.size()) = dn;
+  auto canonical = [&](const Eigen::VectorXd& av, const Eigen::VectorXd& bv, const Eigen::VectorXd& dav,
+                       const Eigen::VectorXd& dbv, bool derivative) {
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n), B = Eigen::MatrixXd::Zero(n, 1), C(1, n), D(1, 1);
+    for (int j = 0; j < n; ++j) {
+      A(0, j) = -(derivative ? dav(j + 1) : av(j + 1));
+      if (j > 0) A(j, j - 1) = derivative ? 0.0 : 1.0;
+      C(0, j) = derivative ? dbv(j + 1) - dbv(0) * av(j + 1) - bv(0) * dav(j + 1) : bv(j + 1) - bv(0) * av(j + 1);
+    }
+    if (n > 0 && !derivative) B(0, 0) = 1.0;
+    D(0, 0) = derivative ? dbv(0) : bv(0);
+    return StateSpace(A, B, C, D);
+  };
+  StateSpaceWithGradient g;
+  g.model = canonical(den, b, den, b, false);
+  for (int k = 0; k < P; ++k)
+    g.derivatives.push_back(canonical(den, b, Eigen::VectorXd(dd.col(k)), Eigen::VectorXd(db.col(k)), true));
+  return g;
+}
+
 std::vector<TransferFunction> PhysicalModel::sensitivities(const Eigen::VectorXd& theta, double a) const {
   CTID_REQUIRE(theta.size() == n_parameters(), "PhysicalModel: {} parameter values for {} parameters", theta.size(),
                n_parameters());

@@ -30,6 +30,11 @@ struct PhysicalFitOptions {
   int max_iterations = 100;
   double tolerance = 1e-12;
   int step_points = 1000;   ///< samples of the compressed step response on [0, T] (step route)
+  /// Raw route: estimate each record's initial state instead of starting it from rest — the free response of the
+  /// model's realisation, eliminated by variable projection so that the parameters' covariance accounts for it;
+  /// diagnostics x0 per record (in the fitted transfer function's realisation, what simulate/validate start from).
+  /// The FSF routes refuse it (they compress the record from rest).
+  bool estimate_initial_state = false;
   /// Parameters held at a value, by name — the constraint vocabulary of every estimator (oe, lssvf, rls_svf):
   /// applied on top of the PhysicalParameter declarations (a parameter fixed here needs no declaration).
   FixedValues fixed;

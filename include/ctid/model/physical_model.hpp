@@ -64,6 +64,11 @@ class PhysicalModel {
   TransferFunction shifted(const Eigen::VectorXd& theta, double a) const;
   /// dG/dTheta_k(s + a) = (N_k D - N D_k)/D^2, one transfer function per parameter.
   std::vector<TransferFunction> sensitivities(const Eigen::VectorXd& theta, double a = 0.0) const;
+  /// A state-space realisation of G(s + a; Theta) with its exact parameter derivatives: the state-space forms as
+  /// given (A - aI), the transfer-function form in controllable canonical form (first row -a_1 .. -a_n of the
+  /// monic denominator, B = e_1, C = b_i - b_0 a_i, D = b_0). What initial-state estimation differentiates: the
+  /// free response C e^{At} x0 and its derivatives through the sensitivity equations.
+  StateSpaceWithGradient realisation(const Eigen::VectorXd& theta, double a = 0.0) const;
 
  private:
   PhysicalModel() = default;
