@@ -173,3 +173,18 @@ def test_recursive_johansson_tracks_a_first_order_plant():
     history = est.run(t, u, g.simulate(u, t))
     assert history.shape == (4000, 2)
     np.testing.assert_allclose(est.parameters(), [0.5, 2.0], rtol=1e-3)  # noise-free: a1 = 0.5, b0 = 2
+
+
+def test_physical_raw_route_estimates_the_initial_state():
+    # As PhysicalRaw.TheInitialStateOfARecordNotAtRestIsEstimated: 1/(m s^2 + d s + k) from the state (0.8, -1.2).
+    g = ctid.TransferFunction([1.0], [0.5, 0.4, 2.0])
+    n = 1500
+    u = ctid.prbs(n, register_length=8, clock_period=15)
+    rest = ctid.IdData.from_arrays(u, g.simulate(u, ctid.time_grid(0.01, n)), ts=0.01)
+    y = np.asarray(ctid.simulate(g, rest, "estimated", x0=[0.8, -1.2])).reshape(-1)
+    d = ctid.IdData.from_arrays(u, y, ts=0.01)
+    model = ctid.PhysicalModel("1/(m*s^2 + d*s + k)", ["m", "d", "k"])
+    r = ctid.fit_physical_raw(model, {"m": 0.8, "d": 0.2, "k": 1.5}, d, estimate_initial_state=True)
+    assert r.usable(), r.why_not_usable()
+    assert np.allclose(r.parameters.values, [0.5, 0.4, 2.0], rtol=1e-6)
+    assert np.allclose(r.diagnostics.vectors["x0"], [0.8, -1.2], atol=1e-5)
