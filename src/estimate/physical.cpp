@@ -306,7 +306,18 @@ Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std:
   // windowed from its own start.
   const WindowedRecords w(records, a);
   const Eigen::Index n = w.y.size();
-  const int nx = opt.estimate_initial_state ? model.realisation(Eigen::VectorXd::Ones(model.n_parameters())).model.nx() : 0;
+  // The realisation's order, at the declared starting values (fixed by the model's structure).
+  int nx = 0;
+  if (opt.estimate_initial_state) {
+    Eigen::VectorXd theta0 = Eigen::VectorXd::Ones(model.n_parameters());
+    for (const auto& q : params)
+      for (int i = 0; i < model.n_parameters(); ++i)
+        if (model.parameter_names()[static_cast<size_t>(i)] == q.name && std::isfinite(q.initial)) theta0(i) = q.initial;
+    for (const auto& [name, value] : opt.fixed)
+      for (int i = 0; i < model.n_parameters(); ++i)
+        if (model.parameter_names()[static_cast<size_t>(i)] == name) theta0(i) = value;
+    nx = model.realisation(theta0).model.nx();
+  }
   // Initial states (estimate_initial_state): record e adds the free response C e^{(A - aI)(t - t_0)} x0_e of the
   // model's realisation (PhysicalModel::realisation; windowed like the record). x0_e enters linearly and is eliminated
   // by variable projection (Golub & Pereyra 1973; Kaufman 1975): at given parameters it is the least-squares fit of
