@@ -333,6 +333,10 @@ Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std:
     }
     if (nx == 0) return;
     const StateSpaceWithGradient m = model.realisation(theta, a);
+    if (m.model.nx() != nx) {  // the expression's degree dropped at these values (a leading coefficient vanished)
+      r.setConstant(NAN);      // rejected by the search
+      return;
+    }
     const Eigen::MatrixXd zero_b = Eigen::MatrixXd::Zero(nx, 1), zero_d = Eigen::MatrixXd::Zero(1, 1);
     const StateSpace free_system(m.model.A(), zero_b, m.model.C(), zero_d);
     for (Eigen::Index e = 0, at = 0; e < static_cast<Eigen::Index>(records.size()); at += records[e].size(), ++e) {
