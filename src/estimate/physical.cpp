@@ -43,11 +43,12 @@ namespace {
 using ResidualFn = std::function<void(const Eigen::VectorXd& theta, const std::vector<int>& free, const TransferFunction& g,
                                       const std::vector<TransferFunction>* sens, Eigen::VectorXd& r, Eigen::MatrixXd* J)>;
 
-// target: the data the residuals are measured against (for the fit report); nuisance: further quantities the
-// residual function estimates itself (the raw route's initial states), counted in the degrees of freedom.
+// target: the data the residuals are measured against (for the fit report); nuisance_at (when given): called once with
+// the starting Theta, the number of further quantities the residual function estimates itself (the raw route's
+// initial states), counted in the degrees of freedom.
 Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<PhysicalParameter>& params, double a,
                              const PhysicalFitOptions& opt, const ResidualFn& residual, const Eigen::VectorXd& target,
-                             const char* route, int nuisance = 0) {
+                             const char* route, const std::function<int(const Eigen::VectorXd&)>& nuisance_at = {}) {
   const int n_data = static_cast<int>(target.size());
   const auto start = std::chrono::steady_clock::now();
   opt.validate();
@@ -100,6 +101,7 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
     lo(j) = lo_full(free[j]);
     hi(j) = hi_full(free[j]);
   }
+  const int nuisance = nuisance_at ? nuisance_at(full) : 0;
   auto theta_of = [&](const Eigen::VectorXd& x) {
     Eigen::VectorXd t = full;
     for (int j = 0; j < p; ++j) t(free[j]) = x(j);
@@ -306,18 +308,9 @@ Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std:
   // windowed from its own start.
   const WindowedRecords w(records, a);
   const Eigen::Index n = w.y.size();
-  // The realisation's order, at the declared starting values (fixed by the model's structure).
-  int nx = 0;
-  if (opt.estimate_initial_state) {
-    Eigen::VectorXd theta0 = Eigen::VectorXd::Ones(model.n_parameters());
-    for (const auto& q : params)
-      for (int i = 0; i < model.n_parameters(); ++i)
-        if (model.parameter_names()[static_cast<size_t>(i)] == q.name && std::isfinite(q.initial)) theta0(i) = q.initial;
-    for (const auto& [name, value] : opt.fixed)
-      for (int i = 0; i < model.n_parameters(); ++i)
-        if (model.parameter_names()[static_cast<size_t>(i)] == name) theta0(i) = value;
-    nx = model.realisation(theta0).model.nx();
-  }
+  int nx = 0;  // the realisation's order (at the starting values; fixed by the model's structure), 0: from rest
+  std::vector<Eigen::VectorXd> since_start;  // each record's times from its first sample
+  for (const IdData& d : records) since_start.push_back(d.times().array() - d.times()(0));
   // Initial states (estimate_initial_state): record e adds the free response C e^{(A - aI)(t - t_0)} x0_e of the
   // model's realisation (PhysicalModel::realisation; windowed like the record). x0_e enters linearly and is eliminated
   // by variable projection (Golub & Pereyra 1973; Kaufman 1975): at given parameters it is the least-squares fit of
@@ -340,7 +333,7 @@ Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std:
     const Eigen::MatrixXd zero_b = Eigen::MatrixXd::Zero(nx, 1), zero_d = Eigen::MatrixXd::Zero(1, 1);
     const StateSpace free_system(m.model.A(), zero_b, m.model.C(), zero_d);
     for (Eigen::Index e = 0, at = 0; e < static_cast<Eigen::Index>(records.size()); at += records[e].size(), ++e) {
-      const Eigen::VectorXd tt = records[e].times().array() - records[e].times()(0);
+      const Eigen::VectorXd& tt = since_start[static_cast<size_t>(e)];
       const Eigen::MatrixXd u0 = Eigen::MatrixXd::Zero(tt.size(), 1);
       auto free_response = [&](const StateSpace& sys, const Eigen::VectorXd& x0) {
         LsimOptions lo;
@@ -370,8 +363,11 @@ Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std:
       J->middleRows(at, tt.size()) = Je - Phi * qr.solve(Je);  // the projection onto the complement of Phi
     }
   };
-  Result<TransferFunction> r =
-      fit(model, params, a, opt, res, w.y, "raw", nx * static_cast<int>(records.size()));
+  auto initial_states = [&](const Eigen::VectorXd& theta0) {
+    nx = opt.estimate_initial_state ? model.realisation(theta0, a).model.nx() : 0;
+    return nx * static_cast<int>(records.size());
+  };
+  Result<TransferFunction> r = fit(model, params, a, opt, res, w.y, "raw", initial_states);
   if (records.size() > 1) r.diagnostics.set(diagnostic::experiments, static_cast<double>(records.size()));
   if (nx > 0 && r.model.den().coefficients().allFinite()) {
     // Each record's initial state in the fitted transfer function's realisation (what simulate and validate start

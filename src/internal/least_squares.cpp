@@ -228,5 +228,4 @@ std::string unidentifiable(const Eigen::MatrixXd& jtj, const Eigen::VectorXd& x,
                         which, along, std::max(ratio, 0.0));
 }
 
-
 }  // namespace ctid::internal

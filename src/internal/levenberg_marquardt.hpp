@@ -37,9 +37,8 @@ using LmEvaluate = std::function<bool(const Eigen::VectorXd& x, Eigen::VectorXd&
 
 /// How the search ended, with its iteration count: NumericalFailure with `failure` (or the search's own
 /// message when `failure` is empty) when it could not evaluate its start, else Interrupted, Converged or
-/// MaxIterations (with the message); a search that converged or ran out of iterations
-/// becomes Unidentifiable with `unidentifiable` when that
-/// is not empty (the message of internal::unidentifiable, least_squares.hpp).
+/// MaxIterations (with the message); a search that converged or ran out of iterations becomes Unidentifiable with
+/// `unidentifiable` when that is not empty (the message of internal::unidentifiable, least_squares.hpp).
 void set_termination(Summary& summary, const LmResult& lm, const std::string& failure = "",
                      const std::string& unidentifiable = "");
 
