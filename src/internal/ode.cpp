@@ -7,7 +7,7 @@ namespace ctid::internal {
 
 OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
                    bool hold, double rtol, double atol, Eigen::Index n_control, const OdeSample& sample,
-                   long max_steps) {
+                   long max_steps, const OdeEvents* events) {
   static const double c2 = 1. / 5, c3 = 3. / 10, c4 = 4. / 5, c5 = 8. / 9;
   static const double a21 = 1. / 5, a31 = 3. / 40, a32 = 9. / 40, a41 = 44. / 45, a42 = -56. / 15, a43 = 32. / 9,
                       a51 = 19372. / 6561, a52 = -25360. / 2187, a53 = 64448. / 6561, a54 = -212. / 729,
@@ -20,6 +20,9 @@ OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::Matr
   const Eigen::Index nu = u.cols();
   Eigen::VectorXd ui(std::max<Eigen::Index>(nu, 1));
   Eigen::VectorXd x = x0, k1(n), k2(n), k3(n), k4(n), k5(n), k6(n), k7(n), xt(n), xn(n), errv(n);
+  const int ne = events ? events->count : 0;
+  std::vector<double> g0(static_cast<size_t>(ne)), g1(g0), gi(g0);  // event values at a step's start, end, inside
+  Eigen::VectorXd xi(n_control);                                       // the interpolated controlled components
   sample(0, x);
   double h = (t.size() > 1 ? t(1) - t(0) : 1.0) / 4;
   long steps = 0;
@@ -33,6 +36,27 @@ OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::Matr
       return ui.data();
     };
     double tt = ta;
+    int fired = 0;       // events in this interval
+    int pending = -1;    // the event the step being tried ends on
+    double h_free = h;   // the step size the controller wanted before a step was cut at an event
+    // Fires event i at (tt, x); false when the integration must stop (refused, or chattering).
+    auto fire = [&](int i) {
+      out.refused = !events->fire(i, tt, x, uin(tt));
+      out.chatter = ++fired > 1000;
+      if (out.refused || out.chatter) {
+        out.ok = false;
+        out.t = tt;
+        out.xmax = x.head(n_control).cwiseAbs().maxCoeff();
+        return false;
+      }
+      events->values(tt, x.data(), uin(tt), g0.data());
+      return true;
+    };
+    if (ne) {  // an input that jumps at ta can leave an event function <= 0 already
+      events->values(tt, x.data(), uin(tt), g0.data());
+      for (int i = 0; i < ne; ++i)
+        if (g0[static_cast<size_t>(i)] <= 0 && !fire(i)) return out;
+    }
     h = std::min(h, tb - ta);
     f(tt, x, uin(tt), k1);
     while (tt < tb) {
@@ -68,11 +92,65 @@ OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::Matr
         out.xmax = xmax;
         return out;
       }
-      if (err <= 1.0) {
-        tt += h;
-        x = xn;
-        k1 = k7;  // first same as last
+      if (err > 1.0) {
+        pending = -1;
+        h *= std::clamp(0.9 * std::pow(err, -0.2), 0.2, 1.0);
+        continue;
       }
+      if (ne && pending < 0) {
+        // The first event function to change sign inside the step, located on the cubic Hermite interpolant of the
+        // step (Illinois iteration on the fraction th of the step).
+        events->values(tt + h, xn.data(), uin(tt + h), g1.data());
+        double first = 2.0;
+        for (int i = 0; i < ne; ++i) {
+          double ga = g0[static_cast<size_t>(i)], gb = g1[static_cast<size_t>(i)];
+          if (!(ga > 0 && gb <= 0)) continue;
+          double a = 0, b = 1;
+          int side = 0;
+          for (int it = 0; it < 60 && b - a > 1e-13; ++it) {
+            const double th = std::clamp((a * gb - b * ga) / (gb - ga), a + 0.01 * (b - a), b - 0.01 * (b - a));
+            const double h00 = (1 + 2 * th) * (1 - th) * (1 - th), h10 = th * (1 - th) * (1 - th),
+                         h01 = th * th * (3 - 2 * th), h11 = -th * th * (1 - th);
+            xi = h00 * x.head(n_control) + h01 * xn.head(n_control) +
+                 h * (h10 * k1.head(n_control) + h11 * k7.head(n_control));
+            events->values(tt + th * h, xi.data(), uin(tt + th * h), gi.data());
+            const double gc = gi[static_cast<size_t>(i)];
+            if (gc > 0) {
+              a = th, ga = gc;
+              if (side == 1) gb /= 2;
+              side = 1;
+            } else {
+              b = th, gb = gc;
+              if (side == -1) ga /= 2;
+              side = -1;
+            }
+          }
+          if (b < first) first = b, pending = i;
+        }
+        if (pending >= 0 && first < 1.0 - 1e-12) {
+          if (first * h <= 1e-13 * std::max(1.0, std::abs(tt))) {
+            if (!fire(pending)) return out;  // at the start of the step
+          } else {
+            h_free = h;
+            h *= first;  // repeat the step to end on the event
+            continue;
+          }
+          pending = -1;
+          f(tt, x, uin(tt), k1);
+          continue;
+        }
+      }
+      tt += h;
+      x = xn;
+      k1 = k7;  // first same as last
+      if (pending >= 0) {
+        if (!fire(pending)) return out;
+        pending = -1;
+        f(tt, x, uin(tt), k1);
+        h = std::max(h, h_free);
+        continue;
+      }
+      if (ne) g0.swap(g1);
       h *= std::clamp(0.9 * std::pow(std::max(err, 1e-10), -0.2), 0.2, 5.0);
     }
     sample(k + 1, x);

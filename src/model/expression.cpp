@@ -123,6 +123,8 @@ struct ExpressionParser : model_detail::TextCursor {
       fail(detail::format("unknown function '{}'{}", name, near.empty() ? "" : "; did you mean '" + near + "'?"));
     }
     int args = 0;
+    skip();
+    const std::size_t arg_start = pos;
     if (!accept(')')) {
       do {
         expr();
@@ -137,7 +139,15 @@ struct ExpressionParser : model_detail::TextCursor {
     using C = Expression::Code;
     static const std::array<C, 13> codes = {C::Exp, C::Log, C::Sqrt, C::Abs, C::Sign, C::Tanh, C::Sin,
                                             C::Cos, C::Atan, C::Min, C::Max, C::Pow, C::Sat};
-    emit(codes[static_cast<std::size_t>(f - kFunctions.data())], f->arity);
+    const C code = codes[static_cast<std::size_t>(f - kFunctions.data())];
+    if (code == C::Sign) {  // the argument's text, up to the closing parenthesis
+      std::size_t end = pos - 1;
+      while (end > arg_start && std::isspace(static_cast<unsigned char>(text[end - 1]))) --end;
+      emit(code, 1, static_cast<int>(e.sign_arguments_.size()));
+      e.sign_arguments_.push_back(text.substr(arg_start, end - arg_start));
+      return;
+    }
+    emit(code, f->arity);
   }
 };
 
@@ -154,7 +164,10 @@ namespace {
 double sign_of(double a) { return a > 0 ? 1.0 : a < 0 ? -1.0 : 0.0; }
 }  // namespace
 
-double Expression::operator()(const double* x) const {
+double Expression::operator()(const double* x) const { return (*this)(x, nullptr); }
+double Expression::gradient(const double* x, double* grad) const { return gradient(x, grad, nullptr); }
+
+double Expression::operator()(const double* x, const double* signs) const {
   CTID_REQUIRE(!program_.empty(), "Expression: evaluating an empty expression");
   std::array<double, kMaxDepth> st;
   int top = -1;
@@ -172,7 +185,7 @@ double Expression::operator()(const double* x) const {
       case Code::Log: st[top] = std::log(st[top]); break;
       case Code::Sqrt: st[top] = std::sqrt(st[top]); break;
       case Code::Abs: st[top] = std::abs(st[top]); break;
-      case Code::Sign: st[top] = sign_of(st[top]); break;
+      case Code::Sign: st[top] = signs && !std::isnan(signs[op.index]) ? signs[op.index] : sign_of(st[top]); break;
       case Code::Tanh: st[top] = std::tanh(st[top]); break;
       case Code::Sin: st[top] = std::sin(st[top]); break;
       case Code::Cos: st[top] = std::cos(st[top]); break;
@@ -190,7 +203,7 @@ double Expression::operator()(const double* x) const {
   return st[0];
 }
 
-double Expression::gradient(const double* x, double* grad) const {
+double Expression::gradient(const double* x, double* grad, const double* signs) const {
   CTID_REQUIRE(!program_.empty(), "Expression: evaluating an empty expression");
   const int n = n_vars_;
   std::array<double, kMaxDepth> v;
@@ -262,7 +275,10 @@ double Expression::gradient(const double* x, double* grad) const {
         break;
       }
       case Code::Abs: scale(top, sign_of(v[top])), v[top] = std::abs(v[top]); break;
-      case Code::Sign: v[top] = sign_of(v[top]), scale(top, 0.0); break;
+      case Code::Sign:
+        v[top] = signs && !std::isnan(signs[op.index]) ? signs[op.index] : sign_of(v[top]);
+        scale(top, 0.0);
+        break;
       case Code::Tanh: v[top] = std::tanh(v[top]), scale(top, 1.0 - v[top] * v[top]); break;
       case Code::Sin: scale(top, std::cos(v[top])), v[top] = std::sin(v[top]); break;
       case Code::Cos: scale(top, -std::sin(v[top])), v[top] = std::cos(v[top]); break;

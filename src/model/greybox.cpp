@@ -20,6 +20,10 @@ namespace ctid {
 struct GreyboxModel::Compiled {
   std::vector<Expression> f, h, x0;  // x0[i] empty (no text) for an estimated state without a start
   int nz = 0;
+  // Switching surfaces s(x, theta) = 0: the distinct arguments of the equations' sign() calls that read no input
+  // and not t; surface_of[i][j] is the surface of the j-th sign() call of equation i, or -1 (sign of its argument).
+  std::vector<Expression> surfaces;
+  std::vector<std::vector<int>> surface_of;
 };
 
 namespace {
@@ -87,6 +91,26 @@ GreyboxModel::GreyboxModel(GreyboxSpec spec) : spec_(std::move(spec)) {
   for (int i = 0; i < nx(); ++i)
     c->f.push_back(compile(s.equations[i], vars, "greybox model: equation of d" + s.states[i] + "/dt"));
   for (const auto& [name, e] : s.outputs) c->h.push_back(compile(e, vars, "greybox model: output " + name));
+  std::vector<std::string> surface_text;
+  for (const Expression& f : c->f) {
+    c->surface_of.emplace_back();
+    for (const std::string& arg : f.sign_arguments()) {
+      Expression a(arg, vars);
+      bool state_only = !a.uses()[static_cast<size_t>(c->nz - 1)];
+      for (int k = nx(); k < nx() + nu(); ++k) state_only = state_only && !a.uses()[static_cast<size_t>(k)];
+      std::string key = arg;
+      key.erase(std::remove_if(key.begin(), key.end(), [](unsigned char ch) { return std::isspace(ch); }), key.end());
+      int index = -1;
+      if (state_only) {
+        index = static_cast<int>(std::find(surface_text.begin(), surface_text.end(), key) - surface_text.begin());
+        if (index == static_cast<int>(surface_text.size())) {
+          surface_text.push_back(key);
+          c->surfaces.push_back(std::move(a));
+        }
+      }
+      c->surface_of.back().push_back(index);
+    }
+  }
   std::vector<std::string> pnames = parameter_names();
   for (int i = 0; i < nx(); ++i) {
     const GreyboxInitial& in = s.initial[i];
@@ -246,17 +270,216 @@ class Point {
   int n_, m_;
 };
 
+// The right-hand side with its switching surfaces s_k(x, theta) = 0 (the sign() arguments that read only states and
+// parameters; Filippov 1988, Differential Equations with Discontinuous Righthand Sides, §2.4 and §4.2). Off a
+// surface, sign(s_k) is held at the mode +-1 of the side the trajectory is on, so that f is smooth between events;
+// the integrator locates where s_k changes sign (internal::OdeEvents). There, with f+ and f- the fields with
+// sign(s_k) = +1 and -1 and a+- = ds/dx . f+-:
+//   a+ < 0 < a-  (both fields point at the surface): a sliding mode (e.g. friction sticking), the Filippov field
+//                f = alpha f+ + (1 - alpha) f-, alpha = a- / (a- - a+), which keeps ds/dt = 0; it ends where a+ or a-
+//                reaches 0 (the field on that side turns away from the surface; f is continuous there);
+//   otherwise    the trajectory crosses to the side the fields point to.
+// At a crossing or the start of a sliding mode (a state event at time tau) the sensitivities jump (Rozenvasser 1967;
+// Hiskens & Pai 2000, IEEE TCAS-I 47(2) eq. 13):
+//   S+ = S- + (f_before - f_after) dtau/dq,   dtau/dq = -(ds/dx S- + ds/dq) / (ds/dx f_before),
+// and inside a sliding mode they follow the Jacobian of the Filippov field, with the derivatives of alpha (the
+// second derivatives of s along f by a central difference of its exact gradient: zero for a surface linear in the
+// states, as sign(v)). At most one surface slides at a time (two at once is refused with a message).
+class Switching {
+ public:
+  Switching(const std::vector<Expression>& f, const std::vector<Expression>& surfaces,
+            const std::vector<std::vector<int>>& surface_of, int nx, int nz)
+      : f_(f), s_(surfaces), of_(surface_of), n_(nx), nz_(nz), mode_(surfaces.size(), 1.0) {
+    for (const auto& calls : of_) signs_.emplace_back(calls.size(), NAN);
+    for (size_t k = 0; k < s_.size(); ++k) hold(static_cast<int>(k), 1.0);
+    gs_.resize(static_cast<size_t>(nz));
+    gp_.resize(static_cast<size_t>(nz));
+    gm_.resize(static_cast<size_t>(nz));
+    fp_.resize(nx), fm_.resize(nx);
+    Gp_.resize(nx, nz), Gm_.resize(nx, nz);
+  }
+  int surfaces() const { return static_cast<int>(s_.size()); }
+  int sliding() const {
+    for (size_t k = 0; k < mode_.size(); ++k)
+      if (mode_[k] == 0.0) return static_cast<int>(k);
+    return -1;
+  }
+  std::string message;  // why the integration was stopped by a switching problem
+
+  // dx = f(z); with G (nx x nz) also its Jacobian.
+  void rhs(const double* z, double* dx, Eigen::MatrixXd* G) {
+    const int k = sliding();
+    if (k < 0) return fields(z, dx, G);
+    hold(k, 1.0);
+    fields(z, fp_.data(), G ? &Gp_ : nullptr);
+    hold(k, -1.0);
+    fields(z, fm_.data(), G ? &Gm_ : nullptr);
+    const Expression& s = s_[static_cast<size_t>(k)];
+    s.gradient(z, gs_.data());
+    const double ap = slope(fp_), am = slope(fm_), d = am - ap;
+    const double alpha = d > 0 ? std::clamp(am / d, 0.0, 1.0) : 0.5;
+    for (int i = 0; i < n_; ++i) dx[i] = alpha * fp_(i) + (1 - alpha) * fm_(i);
+    if (!G) return;
+    // d alpha = (a- d a+ - a+ d a-) / d^2, d a+- = ds/dx . G+- + (d^2 s/dx dz) f+- (the latter by central differences).
+    Eigen::RowVectorXd dap = gradient_slope(z, fp_, Gp_), dam = gradient_slope(z, fm_, Gm_);
+    const Eigen::RowVectorXd dalpha = d > 0 ? Eigen::RowVectorXd((am * dap - ap * dam) / (d * d))
+                                            : Eigen::RowVectorXd::Zero(nz_);
+    *G = alpha * Gp_ + (1 - alpha) * Gm_ + (fp_ - fm_) * dalpha;
+  }
+
+  // The event functions at z: per surface, mode * s off it; -a+ and a- on it (an event where one reaches 0).
+  void values(const double* z, double* g) {
+    for (int k = 0; k < surfaces(); ++k) {
+      const double m = mode_[static_cast<size_t>(k)];
+      if (m != 0.0) {
+        g[2 * k] = m * s_[static_cast<size_t>(k)](z);
+        g[2 * k + 1] = INFINITY;
+      } else {
+        const auto [ap, am] = slopes(k, z);
+        g[2 * k] = -ap;
+        g[2 * k + 1] = am;
+      }
+    }
+  }
+
+  // The mode of surface k at z (on it, or having just reached it), given the mode it had.
+  double decide(int k, const double* z, double old) {
+    const auto [ap, am] = slopes(k, z);
+    if (ap < 0 && am > 0) return 0.0;
+    if (am > 0) return 1.0;   // both fields point to the + side
+    if (ap < 0) return -1.0;  // both to the - side
+    return old != 0.0 ? old : (ap >= -am ? 1.0 : -1.0);  // both away from the surface: stay
+  }
+  // The start: the side of each surface the state is on (on a surface, the mode decide() gives); false (message
+  // set) when two surfaces would slide at once.
+  bool start(const double* z) {
+    for (int k = 0; k < surfaces(); ++k) {
+      const double sv = s_[static_cast<size_t>(k)](z);
+      const double m = sv > 0 ? 1.0 : sv < 0 ? -1.0 : decide(k, z, 0.0);
+      if (m == 0.0 && sliding() >= 0) return refuse(k);
+      set(k, m);
+    }
+    return true;
+  }
+  // An event of surface k at z: the new mode, or NaN when two surfaces would slide at once (message set). With S
+  // (nx x q, the sensitivities, and dsdq the direct derivatives of s with respect to the q quantities) the jump.
+  bool event(int k, const double* z, Eigen::Map<Eigen::MatrixXd>* S, const std::vector<int>& q_to_z) {
+    const double old = mode_[static_cast<size_t>(k)];
+    const double now = decide(k, z, old);
+    if (now == old) return true;
+    if (now == 0.0 && sliding() >= 0) return refuse(k);
+    if (S && old != 0.0) {  // a crossing, or the start of a sliding mode: the sensitivities jump
+      Eigen::VectorXd before(n_), after(n_);
+      fields(z, before.data(), nullptr);
+      set(k, now);
+      rhs(z, after.data(), nullptr);
+      s_[static_cast<size_t>(k)].gradient(z, gs_.data());
+      const double den = slope(before);
+      if (std::abs(den) > 1e-12 * Eigen::Map<const Eigen::VectorXd>(gs_.data(), n_).norm() * before.norm()) {
+        const Eigen::VectorXd jump = before - after;
+        for (Eigen::Index j = 0; j < S->cols(); ++j) {
+          const int zj = q_to_z[static_cast<size_t>(j)];
+          double num = zj >= 0 ? gs_[static_cast<size_t>(zj)] : 0.0;
+          for (int i = 0; i < n_; ++i) num += gs_[static_cast<size_t>(i)] * (*S)(i, j);
+          S->col(j) += jump * (-num / den);
+        }
+      }  // else a grazing contact: dtau/dq is unbounded, the jump is left out
+      return true;
+    }
+    set(k, now);
+    return true;
+  }
+
+ private:
+  bool refuse(int k) {
+    message = "two switching surfaces slide at once (" + s_[static_cast<size_t>(sliding())].text() + " = 0 and " +
+              s_[static_cast<size_t>(k)].text() + " = 0): not supported; smooth one of the sign() laws, e.g. tanh(" +
+              s_[static_cast<size_t>(k)].text() + "/0.01)";
+    return false;
+  }
+  void set(int k, double m) {
+    mode_[static_cast<size_t>(k)] = m;
+    if (m != 0.0) hold(k, m);
+  }
+  // Every sign() call on surface k evaluates to v.
+  void hold(int k, double v) {
+    for (size_t i = 0; i < of_.size(); ++i)
+      for (size_t j = 0; j < of_[i].size(); ++j)
+        if (of_[i][j] == k) signs_[i][j] = v;
+  }
+  void fields(const double* z, double* dx, Eigen::MatrixXd* G) {
+    for (int i = 0; i < n_; ++i) {
+      const double* sg = signs_[static_cast<size_t>(i)].empty() ? nullptr : signs_[static_cast<size_t>(i)].data();
+      if (!G) {
+        dx[i] = f_[static_cast<size_t>(i)](z, sg);
+        continue;
+      }
+      dx[i] = f_[static_cast<size_t>(i)].gradient(z, gp_.data(), sg);
+      for (int c = 0; c < nz_; ++c) (*G)(i, c) = gp_[static_cast<size_t>(c)];
+    }
+  }
+  double slope(const Eigen::VectorXd& fv) const {
+    double a = 0;
+    for (int i = 0; i < n_; ++i) a += gs_[static_cast<size_t>(i)] * fv(i);
+    return a;
+  }
+  // a+ and a- of surface k at z (the mode of k unchanged).
+  std::pair<double, double> slopes(int k, const double* z) {
+    const double m = mode_[static_cast<size_t>(k)];
+    s_[static_cast<size_t>(k)].gradient(z, gs_.data());
+    hold(k, 1.0);
+    fields(z, fp_.data(), nullptr);
+    hold(k, -1.0);
+    fields(z, fm_.data(), nullptr);
+    if (m != 0.0) hold(k, m);
+    return {slope(fp_), slope(fm_)};
+  }
+  // d(ds/dx . f)/dz = ds/dx . G + (d/dz ds/dx) . f, the second term as the central difference of the gradient of s
+  // along f: (grad s(x + e f) - grad s(x - e f)) / (2 e).
+  Eigen::RowVectorXd gradient_slope(const double* z, const Eigen::VectorXd& fv, const Eigen::MatrixXd& G) {
+    Eigen::RowVectorXd d = Eigen::RowVectorXd::Zero(nz_);
+    for (int i = 0; i < n_; ++i) d += gs_[static_cast<size_t>(i)] * G.row(i);
+    const int k = sliding();
+    const double fn = fv.norm();
+    if (fn == 0.0) return d;
+    double xn = 0;
+    for (int i = 0; i < n_; ++i) xn = std::max(xn, std::abs(z[i]));
+    const double e = 1e-6 * (1.0 + xn) / fn;
+    std::vector<double> zz(z, z + nz_);
+    for (int i = 0; i < n_; ++i) zz[static_cast<size_t>(i)] = z[i] + e * fv(i);
+    s_[static_cast<size_t>(k)].gradient(zz.data(), gp_.data());
+    for (int i = 0; i < n_; ++i) zz[static_cast<size_t>(i)] = z[i] - e * fv(i);
+    s_[static_cast<size_t>(k)].gradient(zz.data(), gm_.data());
+    for (int c = 0; c < nz_; ++c) d(c) += (gp_[static_cast<size_t>(c)] - gm_[static_cast<size_t>(c)]) / (2 * e);
+    return d;
+  }
+
+  const std::vector<Expression>& f_;
+  const std::vector<Expression>& s_;
+  const std::vector<std::vector<int>>& of_;
+  int n_, nz_;
+  std::vector<double> mode_;                // +1, -1, or 0 (sliding) per surface
+  std::vector<std::vector<double>> signs_;  // per equation, the value of each sign() call (NaN: its argument's sign)
+  std::vector<double> gs_, gp_, gm_;        // gradients (nz)
+  Eigen::VectorXd fp_, fm_;
+  Eigen::MatrixXd Gp_, Gm_;
+};
+
 // Greybox integrations give up after 200 steps per sample on average (a stiff system or parameters that make it
 // so, e.g. a drawn start of a multi-start search): far beyond what a model at the data's time scale needs.
 long step_budget(const Eigen::VectorXd& t) { return 10000L + 200L * static_cast<long>(t.size()); }
 
-std::string escape_message(const internal::OdeOutcome& o) {
+std::string escape_message(const internal::OdeOutcome& o, const Switching& sw) {
+  if (o.refused) return detail::format("the integration stopped at t = {} s: {}", o.t, sw.message);
+  if (o.chatter)
+    return detail::format("the integration stopped at t = {} s: more than 1000 switchings of sign() within one sample "
+                          "interval (a Zeno-type chattering the model cannot leave); smooth the law, e.g. tanh(v/0.01) for "
+                          "sign(v)", o.t);
   if (o.budget || o.collapsed)
     return detail::format("the integration stalled at t = {} s ({}) with the state finite: the model is stiff at these "
-                          "parameters, its right-hand side switches back and forth across a discontinuity (e.g. "
-                          "sign(v) friction at rest: a sliding mode this integrator cannot follow; smooth it, e.g. "
-                          "tanh(v/0.01) for sign(v)), or the state runs into a singularity of it (e.g. a division by "
-                          "a state that reaches 0)",
+                          "parameters, its right-hand side switches back and forth across a discontinuity that is not "
+                          "a sign() of the states (e.g. sign(u - v) of an input; smooth it, e.g. tanh((u - v)/0.01)), "
+                          "or the state runs into a singularity of it (e.g. a division by a state that reaches 0)",
                           o.t, o.budget ? "more than 200 steps per sample" : "the step size collapsed");
   return detail::format("the solution escapes at t = {} s (|x| = {}): the model is unstable for this input, or its "
                         "parameters are far from the data's", o.t, o.xmax);
@@ -269,22 +492,35 @@ GreyboxSimulation GreyboxModel::simulate(const Eigen::MatrixXd& u, const Eigen::
   const Compiled& c = *c_;
   const int n = nx();
   Point z(*this, c.nz);
+  Switching sw(c.f, c.surfaces, c.surface_of, n, c.nz);
   const internal::OdeRhs f = [&](double tt, const Eigen::VectorXd& x, const double* ui, Eigen::VectorXd& dx) {
-    const double* v = z.at(tt, x.data(), ui);
-    for (int i = 0; i < n; ++i) dx(i) = c.f[i](v);
+    sw.rhs(z.at(tt, x.data(), ui), dx.data(), nullptr);
   };
+  internal::OdeEvents events;
   GreyboxSimulation out;
   out.y = Eigen::MatrixXd::Constant(t.size(), ny(), NAN);
   out.x = Eigen::MatrixXd::Constant(t.size(), n, NAN);
+  if (sw.surfaces()) {
+    if (!sw.start(z.at(t(0), start.data(), u, 0))) {
+      out.termination = Termination::NumericalFailure;
+      out.message = "the integration cannot start at t = " + detail::round_trip(t(0)) + " s: " + sw.message;
+      return out;
+    }
+    events.count = 2 * sw.surfaces();
+    events.values = [&](double tt, const double* x, const double* ui, double* g) { sw.values(z.at(tt, x, ui), g); };
+    events.fire = [&](int i, double tt, Eigen::VectorXd& x, const double* ui) {
+      return sw.event(i / 2, z.at(tt, x.data(), ui), nullptr, {});
+    };
+  }
   const internal::OdeOutcome o = internal::dopri45(
       f, start, u, t, intersample == Intersample::Zoh, rtol, 1e-3 * rtol, n, [&](Eigen::Index k, const Eigen::VectorXd& x) {
         const double* v = z.at(t(k), x.data(), u, k);
         out.x.row(k) = x.transpose();
         for (int j = 0; j < ny(); ++j) out.y(k, j) = c.h[j](v);
-      }, step_budget(t));
+      }, step_budget(t), sw.surfaces() ? &events : nullptr);
   if (!o.ok) {
     out.termination = Termination::NumericalFailure;
-    out.message = escape_message(o);
+    out.message = escape_message(o, sw);
   }
   return out;
 }
@@ -299,22 +535,33 @@ GreyboxSensitivities GreyboxModel::sensitivities(const Eigen::MatrixXd& u, const
   for (int j : free) CTID_REQUIRE(j >= 0 && j < p, "greybox sensitivities: parameter index {} of {}", j, p);
   for (int j : free_x0) CTID_REQUIRE(j >= 0 && j < n, "greybox sensitivities: state index {} of {}", j, n);
   const int nf = static_cast<int>(free.size()), q = nf + static_cast<int>(free_x0.size());
+  // Column j of S is the derivative with respect to z[q_to_z[j]] (a parameter) or an initial state (-1).
+  std::vector<int> q_to_z(static_cast<size_t>(q), -1);
+  for (int j = 0; j < nf; ++j) q_to_z[static_cast<size_t>(j)] = n + m + free[static_cast<size_t>(j)];
   Point z(*this, c.nz);
+  Switching sw(c.f, c.surfaces, c.surface_of, n, c.nz);
   std::vector<double> g(static_cast<size_t>(c.nz));
   // The derivative along column j of S of the expression whose gradient g holds: dh/dx . S_j + dh/dtheta_{free[j]}
   // (no direct term for an initial state).
   auto chain = [&](const double* S, int j) {
-    double d = j < nf ? g[static_cast<size_t>(n + m + free[static_cast<size_t>(j)])] : 0.0;
+    const int zj = q_to_z[static_cast<size_t>(j)];
+    double d = zj >= 0 ? g[static_cast<size_t>(zj)] : 0.0;
     for (int k = 0; k < n; ++k) d += g[static_cast<size_t>(k)] * S[k];
     return d;
   };
   auto column = [&](const Eigen::VectorXd& a, int j) { return a.data() + n + static_cast<Eigen::Index>(n) * j; };
   // Augmented state [x; S(:,0); ..; S(:,q-1)]: dS_j/dt = (df/dx) S_j + df/dtheta_{free[j]}.
+  Eigen::MatrixXd G(n, c.nz);
   const internal::OdeRhs f = [&](double tt, const Eigen::VectorXd& a, const double* ui, Eigen::VectorXd& da) {
-    const double* v = z.at(tt, a.data(), ui);
-    for (int i = 0; i < n; ++i) {
-      da(i) = c.f[i].gradient(v, g.data());
-      for (int j = 0; j < q; ++j) da(n + static_cast<Eigen::Index>(n) * j + i) = chain(column(a, j), j);
+    sw.rhs(z.at(tt, a.data(), ui), da.data(), &G);
+    for (int j = 0; j < q; ++j) {
+      const double* S = column(a, j);
+      const int zj = q_to_z[static_cast<size_t>(j)];
+      for (int i = 0; i < n; ++i) {
+        double d = zj >= 0 ? G(i, zj) : 0.0;
+        for (int k = 0; k < n; ++k) d += G(i, k) * S[k];
+        da(n + static_cast<Eigen::Index>(n) * j + i) = d;
+      }
     }
   };
   Eigen::VectorXd a0 = Eigen::VectorXd::Zero(n + static_cast<Eigen::Index>(n) * q);
@@ -324,9 +571,23 @@ GreyboxSensitivities GreyboxModel::sensitivities(const Eigen::MatrixXd& u, const
     for (int j = 0; j < nf; ++j) a0.segment(n + static_cast<Eigen::Index>(n) * j, n) = dx0.col(free[static_cast<size_t>(j)]);
   }
   for (size_t k = 0; k < free_x0.size(); ++k) a0(n + static_cast<Eigen::Index>(n) * (nf + static_cast<int>(k)) + free_x0[k]) = 1.0;
+  internal::OdeEvents events;
   GreyboxSensitivities out;
   out.y = Eigen::MatrixXd::Constant(t.size(), ny_, NAN);
   out.dy.assign(static_cast<size_t>(ny_), Eigen::MatrixXd::Constant(t.size(), q, NAN));
+  if (sw.surfaces()) {
+    if (!sw.start(z.at(t(0), start.data(), u, 0))) {
+      out.ok = false;
+      out.message = "the integration cannot start at t = " + detail::round_trip(t(0)) + " s: " + sw.message;
+      return out;
+    }
+    events.count = 2 * sw.surfaces();
+    events.values = [&](double tt, const double* x, const double* ui, double* gv) { sw.values(z.at(tt, x, ui), gv); };
+    events.fire = [&](int i, double tt, Eigen::VectorXd& a, const double* ui) {
+      Eigen::Map<Eigen::MatrixXd> S(a.data() + n, n, q);
+      return sw.event(i / 2, z.at(tt, a.data(), ui), &S, q_to_z);
+    };
+  }
   const internal::OdeOutcome o = internal::dopri45(
       f, a0, u, t, intersample == Intersample::Zoh, rtol, 1e-3 * rtol, n, [&](Eigen::Index k, const Eigen::VectorXd& a) {
         const double* v = z.at(t(k), a.data(), u, k);
@@ -338,10 +599,10 @@ GreyboxSensitivities GreyboxModel::sensitivities(const Eigen::MatrixXd& u, const
           out.x_end = a.head(n);
           out.dx_end = Eigen::Map<const Eigen::MatrixXd>(a.data() + n, n, q);
         }
-      }, step_budget(t));
+      }, step_budget(t), sw.surfaces() ? &events : nullptr);
   if (!o.ok) {
     out.ok = false;
-    out.message = escape_message(o);
+    out.message = escape_message(o, sw);
   }
   return out;
 }

@@ -225,21 +225,116 @@ TEST(Greybox, InitialStateFromTheFirstSamplesOnlyAndBadDataNamed) {
   EXPECT_NE(name.find("did you mean 'm'"), std::string::npos) << name;
 }
 
-TEST(Greybox, ASlidingModeIsNamedNotIntegratedForever) {
-  // Coulomb friction sign(v) with the force below the friction level: the mass sticks, the right-hand side switches
-  // at every step (a Filippov sliding mode). The explicit integrator stops and says how to smooth the law.
+namespace {
+// A mass (m = 1) driven by the force 1.5 sin(t) against Coulomb friction fc sign(v), fc = 1, from rest: it sticks
+// until the force reaches fc (t1 = asin(1/1.5)), slides, sticks again where v returns to 0 (t2 = 3.3231, the force
+// -0.27 is below fc), slides back from t1 + pi to t2 + pi and sticks at q = 0. The closed form of each phase:
+//   v(t) = 1.5 (cos t1 - cos t) - (t - t1),   q(t) = 1.5 cos(t1) (t - t1) - 1.5 (sin t - sin t1) - (t - t1)^2 / 2,
+// mirrored (v -> -v(t - pi), q -> q(t2) - q(t - pi)) for the slide back.
+GreyboxModel stick_slip_model() {
   GreyboxSpec s;
-  s.inputs = {"u"};
   s.states = {"q", "v"};
   s.outputs = {{"y", "q"}};
-  s.parameters = {{"fc", 1.0}};
-  s.equations = {"v", "u - fc*sign(v)"};
+  s.parameters = {{"a", 1.5}, {"fc", 1.0}, {"m", 1.0}};
+  s.equations = {"v", "(a*sin(t) - fc*sign(v))/m"};
   s.initial = {{"0", false}, {"0", false}};
-  const GreyboxModel m(s);
-  const GreyboxSimulation r = m.simulate(Eigen::MatrixXd::Constant(100, 1, 0.5), time_grid(0.01, 100));
+  return GreyboxModel(s);
+}
+}  // namespace
+
+TEST(Greybox, CoulombFrictionSticksAndSlipsAsTheClosedFormSays) {
+  const GreyboxModel m = stick_slip_model();
+  const double t1 = std::asin(1 / 1.5);
+  auto v2 = [&](double t) { return 1.5 * (std::cos(t1) - std::cos(t)) - (t - t1); };
+  auto q2 = [&](double t) { return 1.5 * std::cos(t1) * (t - t1) - 1.5 * (std::sin(t) - std::sin(t1)) - (t - t1) * (t - t1) / 2; };
+  double a = t1 + 1, b = 4;  // t2: where v2 returns to 0 (bisection)
+  for (int i = 0; i < 200; ++i) (v2((a + b) / 2) > 0 ? a : b) = (a + b) / 2;
+  const double t2 = (a + b) / 2, pi = std::acos(-1.0);
+  ASSERT_NEAR(t2, 3.3231163, 1e-6);
+  ASSERT_LT(std::abs(1.5 * std::sin(t2)), 1.0);  // it sticks there
+  const int n = 700;  // to 6.99 s, before the third slide at t1 + 2 pi
+  const Eigen::VectorXd t = time_grid(0.01, n);
+  const GreyboxSimulation r = m.simulate(Eigen::MatrixXd(n, 0), t, Intersample::Zoh, {}, 1e-10);
+  ASSERT_TRUE(r.ok()) << r.message;
+  double eq = 0, ev = 0, stuck = 0;
+  for (int k = 0; k < n; ++k) {
+    const double tk = t(k);
+    double q = 0, v = 0;
+    if (tk > t1 && tk <= t2) q = q2(tk), v = v2(tk);
+    else if (tk > t2 && tk <= t1 + pi) q = q2(t2);
+    else if (tk > t1 + pi && tk <= t2 + pi) q = q2(t2) - q2(tk - pi), v = -v2(tk - pi);
+    eq = std::max(eq, std::abs(r.x(k, 0) - q));
+    ev = std::max(ev, std::abs(r.x(k, 1) - v));
+    if (v == 0.0) stuck = std::max(stuck, std::abs(r.x(k, 1)));
+  }
+  EXPECT_LT(eq, 1e-8);     // integration at rtol 1e-10 with the switching times located
+  EXPECT_LT(ev, 1e-8);
+  EXPECT_LT(stuck, 1e-9);  // at rest while the force is below fc: the Filippov sliding field holds v
+  EXPECT_GT(q2(t2), 0.5);  // the closed form moves (a test of something)
+}
+
+TEST(Greybox, SensitivitiesThroughStickSlipMatchCentralDifferences) {
+  // The same stick-slip motion: the switching times depend on a, fc and m, so S jumps where v crosses or reaches 0
+  // and follows the Filippov field while it sticks; central differences of the located simulation are the oracle.
+  const GreyboxModel m = stick_slip_model();
+  const int n = 700;
+  const Eigen::VectorXd t = time_grid(0.01, n);
+  const Eigen::MatrixXd u(n, 0);
+  const GreyboxSensitivities s = m.sensitivities(u, t, Intersample::Zoh, {}, {0, 1, 2}, {}, 1e-11);
+  ASSERT_TRUE(s.ok) << s.message;
+  for (int j = 0; j < 3; ++j) {
+    const double h = 1e-5;
+    Eigen::VectorXd hi = m.parameter_values(), lo = hi;
+    hi(j) += h, lo(j) -= h;
+    const Eigen::VectorXd fd = (m.with_parameters(hi).simulate(u, t, Intersample::Zoh, {}, 1e-12).y -
+                                m.with_parameters(lo).simulate(u, t, Intersample::Zoh, {}, 1e-12).y) / (2 * h);
+    const double scale = fd.cwiseAbs().maxCoeff();
+    EXPECT_GT(scale, 0.1) << m.parameter_names()[j];
+    EXPECT_LT((s.dy[0].col(j) - fd).cwiseAbs().maxCoeff(), 1e-5 * scale) << m.parameter_names()[j];
+  }
+  // With the jumps left out (checked by hand when this was written) two of the three columns are off by 2 to 3 times
+  // their scale, and the noise-free fit of the next test ends unusable.
+}
+
+TEST(Greybox, SignFrictionWithASpringIsRecoveredFromNoiseFreeStickSlipData) {
+  // Mass, spring, viscous and Coulomb friction fc sign(v), driven by random force levels that leave it stuck at
+  // times (|u - k q| < fc). Noise-free: the fit must give the generating parameters to the integration accuracy.
+  GreyboxSpec spec;
+  spec.inputs = {"u"};
+  spec.states = {"q", "v"};
+  spec.outputs = {{"y", "q"}};
+  spec.parameters = {{"k", 2.0, 0.0}, {"c", 0.4, 0.0}, {"fc", 0.5, 0.0}, {"m", 1.0, 0.01, 100.0}};
+  spec.equations = {"v", "(u - k*q - c*v - fc*sign(v))/m"};
+  spec.initial = {{"0", false}, {"0", false}};
+  const GreyboxModel truth(spec);
+  const Eigen::MatrixXd u = levels(3000, 150, -1.5, 1.5, 7);
+  const IdData d = record(truth, u, 0.01, {});
+  const GreyboxSimulation sim = truth.simulate(u, d.times(), Intersample::Zoh, {}, 1e-11);
+  int stuck = 0;
+  for (int k = 0; k < sim.x.rows(); ++k) stuck += sim.x(k, 1) == 0.0 || std::abs(sim.x(k, 1)) < 1e-12;
+  EXPECT_GT(stuck, 100) << "the record should stick at times";  // 162 samples at rest
+  Eigen::VectorXd start(4);
+  start << 1.5, 0.6, 0.35, 1.3;
+  const Result<GreyboxModel> r = greybox(d, truth.with_parameters(start));
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
+  for (int j = 0; j < 4; ++j)
+    EXPECT_NEAR(r.parameters.value(truth.parameter_names()[j]), truth.parameter_values()(j), 1e-6 * truth.parameter_values()(j))
+        << truth.parameter_names()[j];
+}
+
+TEST(Greybox, TwoSurfacesSlidingAtOnceAreNamed) {
+  // Two independent frictions at rest under forces below their levels: both slide at once (not supported): the
+  // message names both surfaces instead of a wrong answer.
+  GreyboxSpec s;
+  s.inputs = {"u"};
+  s.states = {"v1", "v2"};
+  s.outputs = {{"y", "v1"}};
+  s.parameters = {{"f1", 1.0}, {"f2", 1.0}};
+  s.equations = {"u - f1*sign(v1)", "u - f2*sign(v2)"};
+  s.initial = {{"0", false}, {"0", false}};
+  const GreyboxSimulation r = GreyboxModel(s).simulate(Eigen::MatrixXd::Constant(100, 1, 0.5), time_grid(0.01, 100));
   EXPECT_FALSE(r.ok());
-  EXPECT_NE(r.message.find("sliding mode"), std::string::npos) << r.message;
-  EXPECT_NE(r.message.find("tanh(v/0.01)"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("v1 = 0 and v2 = 0"), std::string::npos) << r.message;
 }
 
 TEST(Greybox, MultipleShootingFitsAnUnstablePlantFromItsClosedLoopRecord) {

@@ -43,6 +43,14 @@ class Expression {
   /// The value at x; grad[i] = its derivative with respect to variable i (n_variables() entries).
   double gradient(const double* x, double* grad) const;
 
+  /// The text of the argument of each sign() call, in the order the calls appear in the text.
+  const std::vector<std::string>& sign_arguments() const { return sign_arguments_; }
+  /// As above with the value of each sign() call given: signs[j] for the j-th call (NaN: the sign of its argument,
+  /// as without `signs`). A grey-box simulation holds sign(s) at +-1 on each side of a switching surface s = 0 and
+  /// gives the Filippov value on it (model/greybox.hpp).
+  double operator()(const double* x, const double* signs) const;
+  double gradient(const double* x, double* grad, const double* signs) const;
+
  private:
   enum class Code : unsigned char {
     Number, Variable, Add, Sub, Mul, Div, Pow, Neg, Exp, Log, Sqrt, Abs, Sign, Tanh, Sin, Cos, Atan, Min, Max, Sat
@@ -56,7 +64,8 @@ class Expression {
   std::string text_;
   int n_vars_ = 0;
   std::vector<bool> uses_;
-  std::vector<Op> program_;  // postfix
+  std::vector<Op> program_;  // postfix; a Sign op's index is the ordinal of its call
+  std::vector<std::string> sign_arguments_;
   int depth_ = 0;            // the largest stack the program needs
 };
 

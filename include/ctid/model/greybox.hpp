@@ -7,11 +7,13 @@
 // inputs held or linear between samples; sensitivities() integrates the forward sensitivity equations
 //     dS/dt = (df/dx) S + df/dtheta,   S(t_0) = dx0/dtheta,   dy/dtheta = (dh/dx) S + dh/dtheta
 // (Ljung 1999 §7; Hairer, Norsett & Wanner I.14) on the same steps, with the Jacobians of f and h exact (forward-mode
-// differentiation of the compiled expressions). At the kinks of sign/abs/min/max/sat the sensitivities follow the
-// one-sided derivative the integrator's stage sees (Expression's documented choices); the jump of S where a
-// trajectory crosses a switching surface is not added (it vanishes when the switching function does not depend on
-// theta and the right-hand side is continuous there, e.g. sat, min, max of the states; for sign(v) it is the
-// Filippov correction, neglected: the Jacobian of the search is then approximate at those instants).
+// differentiation of the compiled expressions). sign(s) of a function s of the states and parameters is a switching
+// surface s = 0: the integrator locates where s changes sign, holds sign(s) at +-1 on each side, follows the
+// Filippov sliding field on the surface where both sides' fields point at it (friction at rest), and the
+// sensitivities jump at each crossing and start of a sliding mode (Filippov 1988; Hiskens & Pai 2000; the method is
+// in model/greybox.cpp). At the kinks of abs/min/max/sat (f continuous) and of sign() of an input or t the
+// sensitivities follow the one-sided derivative the integrator's stage sees (Expression's documented choices); no
+// jump is needed where f is continuous and the switching function does not depend on theta.
 #pragma once
 
 #include <limits>
