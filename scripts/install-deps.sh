@@ -6,7 +6,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config
-  libeigen3-dev nlohmann-json3-dev libcli11-dev libmatio-dev
+  libeigen3-dev nlohmann-json3-dev libcli11-dev libmatio-dev libsundials-dev libomp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-pandas
   clang libclang-rt-14-dev

@@ -125,6 +125,9 @@ void bind_nonlinear(py::module_& m) {
       .def_readonly("y", &GreyboxSimulation::y)
       .def_readonly("x", &GreyboxSimulation::x)
       .def_readonly("message", &GreyboxSimulation::message)
+      .def_property_readonly("integrator", [](const GreyboxSimulation& s) {
+             return s.integrator == GreyboxIntegrator::Bdf ? "bdf" : "explicit";
+           }, "the integrator that ran: explicit or bdf")
       .def("ok", &GreyboxSimulation::ok);
   py::class_<GreyboxModel>(m, "GreyboxModel",
                            "Nonlinear continuous-time grey-box model dx/dt = f(x, u, theta, t), y = h(x, u, theta, t) "
@@ -141,10 +144,14 @@ void bind_nonlinear(py::module_& m) {
                              "x0 at the parameters (NaN: an estimated state without a value)")
       .def("with_parameters", &GreyboxModel::with_parameters, py::arg("values"))
       .def("simulate", [](const GreyboxModel& g, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
-                          const std::string& intersample, const Eigen::VectorXd& x0, double rtol) {
-             return g.simulate(u, t, intersample_from_string(intersample), x0, rtol);
+                          const std::string& intersample, const Eigen::VectorXd& x0, double rtol,
+                          const std::string& integrator) {
+             GreyboxOptions o;  // the integrator's names are those of the fit's option
+             option_table<GreyboxOptions>().set(o, "integrator", integrator);
+             return g.simulate(u, t, intersample_from_string(intersample), x0, rtol, o.integrator);
            }, py::arg("u"), py::arg("t"), py::arg("intersample") = "zoh", py::arg("x0") = Eigen::VectorXd(),
-           py::arg("rtol") = 1e-8, "Simulate from x0 (default: the model's initial state); u is N x nu.")
+           py::arg("rtol") = 1e-8, py::arg("integrator") = "auto",
+           "Simulate from x0 (default: the model's initial state); u is N x nu; integrator auto, explicit or bdf.")
       .def("to_json", [](const GreyboxModel& g) { return greybox_to_json(g); }, "The model file's text.")
       .def("__eq__", [](const GreyboxModel& a, const GreyboxModel& b) { return a == b; })
       .def("__repr__", &GreyboxModel::to_string);

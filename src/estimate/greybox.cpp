@@ -26,6 +26,10 @@ const OptionTable<GreyboxOptions>& option_table<GreyboxOptions>() {
                    "multi-start: the model's values plus starts-1 points drawn within the bounds (the lowest cost wins)")
           .integer("seed", &O::seed, "", at_least(0), "seed of the drawn starts")
           .real("rtol", &O::rtol, "", between(1e-13, 1e-4), "relative tolerance of the simulations (absolute: 1e-3 rtol)")
+          .choice("integrator", &O::integrator,
+                  {{"auto", GreyboxIntegrator::Auto}, {"explicit", GreyboxIntegrator::Explicit}, {"bdf", GreyboxIntegrator::Bdf}},
+                  "explicit: Dormand-Prince 5(4); bdf: CVODES's BDF with the exact Jacobian (stiff models); auto: "
+                  "Dormand-Prince, BDF where it needs more than 200 steps per sample")
           .integer("segments", &O::segments, "", at_least(0),
                    "multiple shooting: each record split into this many segments, each from a free state tied to the "
                    "previous segment's end; 1: single shooting; 0: automatic (multiple shooting when the free run from the "
@@ -129,6 +133,12 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
       w(j) = 1.0 / std::sqrt(var);
     }
   Eigen::VectorXd wy = y;
+  // Auto: once a simulation has found the model stiff (Dormand-Prince over its budget, BDF ran), the rest of the fit
+  // uses BDF directly instead of trying the explicit method first every time.
+  GreyboxIntegrator integrator = opt.integrator;
+  auto ran = [&](GreyboxIntegrator used) {
+    if (used == GreyboxIntegrator::Bdf) integrator = GreyboxIntegrator::Bdf;
+  };
   for (const Record& r : rec)
     for (int j = 0; j < ny; ++j) wy.segment(r.start + static_cast<Eigen::Index>(j) * r.n, r.n) *= w(j);
 
@@ -157,13 +167,15 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
       const Record& d = rec[static_cast<size_t>(e)];
       const Eigen::VectorXd x0 = x0_of(m, v, e);
       if (!J) {
-        const GreyboxSimulation s = m.simulate(d.u, d.t, d.hold, x0, opt.rtol);
+        const GreyboxSimulation s = m.simulate(d.u, d.t, d.hold, x0, opt.rtol, integrator);
+        ran(s.integrator);
         if (!s.ok()) return escape = s.message, false;
         for (int j = 0; j < ny; ++j)
           r.segment(d.start + static_cast<Eigen::Index>(j) * d.n, d.n) = w(j) * s.y.col(j);
         continue;
       }
-      const GreyboxSensitivities s = m.sensitivities(d.u, d.t, d.hold, x0, free, free_x0, opt.rtol);
+      const GreyboxSensitivities s = m.sensitivities(d.u, d.t, d.hold, x0, free, free_x0, opt.rtol, true, integrator);
+      ran(s.integrator);
       if (!s.ok) return escape = s.message, false;
       for (int j = 0; j < ny; ++j) {
         const Eigen::Index row = d.start + static_cast<Eigen::Index>(j) * d.n;
@@ -221,14 +233,16 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
         const Eigen::VectorXd x0 = k == 0 ? x0_of(m, vm, e) : Eigen::VectorXd(vm.segment(col_k, nx));
         Eigen::VectorXd x_end;
         if (!J) {
-          const GreyboxSimulation sim = m.simulate(g.u, g.t, d.hold, x0, opt.rtol);
+          const GreyboxSimulation sim = m.simulate(g.u, g.t, d.hold, x0, opt.rtol, integrator);
+          ran(sim.integrator);
           if (!sim.ok()) return escape = sim.message, false;
           for (int j = 0; j < ny; ++j)
             r.segment(d.start + static_cast<Eigen::Index>(j) * d.n + g.first, g.rows) = w(j) * sim.y.col(j).head(g.rows);
           x_end = sim.x.row(sim.x.rows() - 1).transpose();
         } else {
           const GreyboxSensitivities sn =
-              m.sensitivities(g.u, g.t, d.hold, x0, free, k == 0 ? free_x0 : all_states, opt.rtol, k == 0);
+              m.sensitivities(g.u, g.t, d.hold, x0, free, k == 0 ? free_x0 : all_states, opt.rtol, k == 0, integrator);
+          ran(sn.integrator);
           if (!sn.ok) return escape = sn.message, false;
           const int nq = k == 0 ? nx0 : nx;
           const Eigen::Index col_s = k == 0 ? pf + e * nx0 : col_k;
@@ -277,7 +291,8 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
           if (k > 0)
             for (int i = 0; i < nx; ++i)
               if (const int o = model.output_of_state(i); o >= 0) start(i) = d.y(static_cast<Eigen::Index>(o) * d.n + g.first);
-          const GreyboxSimulation sim = m.simulate(g.u, g.t, d.hold, start, opt.rtol);
+          const GreyboxSimulation sim = m.simulate(g.u, g.t, d.hold, start, opt.rtol, integrator);
+          ran(sim.integrator);
           if (!sim.ok()) return static_cast<double>(INFINITY);
           end = sim.x.row(sim.x.rows() - 1).transpose();
           double cost = 0;

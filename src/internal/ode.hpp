@@ -53,4 +53,20 @@ OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::Matr
                    bool hold, double rtol, double atol, Eigen::Index n_control, const OdeSample& sample,
                    long max_steps = 0, const OdeEvents* events = nullptr);
 
+/// A system with its derivatives for the stiff integrator: dx = f(t, x, u) (n states); when J is given also the
+/// Jacobian df/dx (n x n), when B is given the direct derivatives df/dq (n x q) of the q quantities whose
+/// sensitivities S (n x q, dS/dt = J S + B) ride along.
+using OdeJacobianRhs =
+    std::function<void(double t, const double* x, const double* u, double* dx, Eigen::MatrixXd* J, Eigen::MatrixXd* B)>;
+
+/// Stiff integration (internal/bdf.cpp): the variable-order (1-5) BDF of CVODES (SUNDIALS; Hindmarsh et al. 2005,
+/// ACM TOMS 31(3) 363-396) with Newton iterations on the exact Jacobian, and the forward sensitivities by CVODES's
+/// staggered corrector (Feehery, Tolsma & Barton 1997) kept out of the error test (as in dopri45). a0 = [x0; S0
+/// column by column] (n (1 + q) entries); sample, events, inputs, tolerances and the outcome as for dopri45, the
+/// vector passed to sample and fire being the same [x; S]. The method restarts (order 1) where a held input jumps
+/// and after each event. max_steps: 0 for 10^6 plus 1000 per sample.
+OdeOutcome bdf(const OdeJacobianRhs& f, Eigen::Index n, const Eigen::VectorXd& a0, const Eigen::MatrixXd& u,
+               const Eigen::VectorXd& t, bool hold, double rtol, double atol, const OdeSample& sample,
+               long max_steps = 0, const OdeEvents* events = nullptr);
+
 }  // namespace ctid::internal

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <functional>
 #include <set>
 
 #include "ctid/core/check.hpp"
@@ -333,7 +334,7 @@ class Switching {
       const double m = mode_[static_cast<size_t>(k)];
       if (m != 0.0) {
         g[2 * k] = m * s_[static_cast<size_t>(k)](z);
-        g[2 * k + 1] = INFINITY;
+        g[2 * k + 1] = 1.0;  // inactive (a constant that never reaches 0)
       } else {
         const auto [ap, am] = slopes(k, z);
         g[2 * k] = -ap;
@@ -477,8 +478,9 @@ std::string escape_message(const internal::OdeOutcome& o, const Switching& sw) {
                           "sign(v)", o.t);
   if (o.budget || o.collapsed)
     return detail::format("the integration stalled at t = {} s ({}) with the state finite: the model is stiff at these "
-                          "parameters, its right-hand side switches back and forth across a discontinuity that is not "
-                          "a sign() of the states (e.g. sign(u - v) of an input; smooth it, e.g. tanh((u - v)/0.01)), "
+                          "parameters (the explicit integrator gives up after 200 steps per sample; integrator=bdf "
+                          "integrates stiff models, and auto, the default, switches to it), its right-hand side "
+                          "switches back and forth across a discontinuity that is not a sign() of the states (e.g. sign(u - v) of an input; smooth it, e.g. tanh((u - v)/0.01)), "
                           "or the state runs into a singularity of it (e.g. a division by a state that reaches 0)",
                           o.t, o.budget ? "more than 200 steps per sample" : "the step size collapsed");
   return detail::format("the solution escapes at t = {} s (|x| = {}): the model is unstable for this input, or its "
@@ -486,38 +488,87 @@ std::string escape_message(const internal::OdeOutcome& o, const Switching& sw) {
 }
 }  // namespace
 
+namespace {
+// Integrates [x; S] (S: the sensitivities to the quantities q_to_z, n x q column by column after x; q = 0: the states
+// alone) from a0 with the switching surfaces' events: Dormand-Prince 5(4), or CVODES's BDF, or (Auto) Dormand-Prince
+// and, where it needs more than its step budget (a stiff model), BDF. reset() is called before each attempt.
+internal::OdeOutcome integrate(Switching& sw, Point& z, int n, int nz, const std::vector<int>& q_to_z,
+                               const Eigen::VectorXd& a0, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
+                               Intersample intersample, double rtol, GreyboxIntegrator integrator,
+                               const internal::OdeSample& sample, const std::function<void()>& reset,
+                               GreyboxIntegrator& used) {
+  const int q = static_cast<int>(q_to_z.size());
+  Eigen::MatrixXd G(n, nz);
+  // dS_j/dt = (df/dx) S_j + df/dz[q_to_z[j]] (no direct term for an initial state).
+  const internal::OdeRhs explicit_rhs = [&](double tt, const Eigen::VectorXd& a, const double* ui, Eigen::VectorXd& da) {
+    sw.rhs(z.at(tt, a.data(), ui), da.data(), q ? &G : nullptr);
+    for (int j = 0; j < q; ++j) {
+      const double* S = a.data() + n + static_cast<Eigen::Index>(n) * j;
+      const int zj = q_to_z[static_cast<size_t>(j)];
+      for (int i = 0; i < n; ++i) {
+        double d = zj >= 0 ? G(i, zj) : 0.0;
+        for (int k = 0; k < n; ++k) d += G(i, k) * S[k];
+        da(n + static_cast<Eigen::Index>(n) * j + i) = d;
+      }
+    }
+  };
+  const internal::OdeJacobianRhs stiff_rhs = [&](double tt, const double* x, const double* ui, double* dx,
+                                                 Eigen::MatrixXd* J, Eigen::MatrixXd* B) {
+    sw.rhs(z.at(tt, x, ui), dx, J || B ? &G : nullptr);
+    if (J) *J = G.leftCols(n);
+    if (B)
+      for (int j = 0; j < q; ++j)
+        B->col(j) = q_to_z[static_cast<size_t>(j)] >= 0 ? Eigen::VectorXd(G.col(q_to_z[static_cast<size_t>(j)]))
+                                                         : Eigen::VectorXd::Zero(n);
+  };
+  internal::OdeEvents events;
+  events.count = 2 * sw.surfaces();
+  events.values = [&](double tt, const double* x, const double* ui, double* g) { sw.values(z.at(tt, x, ui), g); };
+  events.fire = [&](int i, double tt, Eigen::VectorXd& a, const double* ui) {
+    Eigen::Map<Eigen::MatrixXd> S(a.data() + n, n, q);
+    return sw.event(i / 2, z.at(tt, a.data(), ui), q ? &S : nullptr, q_to_z);
+  };
+  const bool hold = intersample == Intersample::Zoh;
+  auto run = [&](bool stiff) {
+    reset();
+    if (sw.surfaces() && !sw.start(z.at(t(0), a0.data(), u, 0))) {
+      internal::OdeOutcome o;
+      o.ok = false;
+      o.refused = true;
+      o.t = t(0);
+      return o;
+    }
+    const internal::OdeEvents* ev = sw.surfaces() ? &events : nullptr;
+    return stiff ? internal::bdf(stiff_rhs, n, a0, u, t, hold, rtol, 1e-3 * rtol, sample, step_budget(t), ev)
+                 : internal::dopri45(explicit_rhs, a0, u, t, hold, rtol, 1e-3 * rtol, n, sample, step_budget(t), ev);
+  };
+  used = integrator == GreyboxIntegrator::Bdf ? GreyboxIntegrator::Bdf : GreyboxIntegrator::Explicit;
+  internal::OdeOutcome o = run(used == GreyboxIntegrator::Bdf);
+  if (integrator == GreyboxIntegrator::Auto && !o.ok && o.budget) o = run(true), used = GreyboxIntegrator::Bdf;
+  return o;
+}
+}  // namespace
+
 GreyboxSimulation GreyboxModel::simulate(const Eigen::MatrixXd& u, const Eigen::VectorXd& t, Intersample intersample,
-                                         const Eigen::VectorXd& x0, double rtol) const {
+                                         const Eigen::VectorXd& x0, double rtol, GreyboxIntegrator integrator) const {
   const Eigen::VectorXd start = checked_start(*this, u, t, x0);
   const Compiled& c = *c_;
   const int n = nx();
   Point z(*this, c.nz);
   Switching sw(c.f, c.surfaces, c.surface_of, n, c.nz);
-  const internal::OdeRhs f = [&](double tt, const Eigen::VectorXd& x, const double* ui, Eigen::VectorXd& dx) {
-    sw.rhs(z.at(tt, x.data(), ui), dx.data(), nullptr);
-  };
-  internal::OdeEvents events;
   GreyboxSimulation out;
-  out.y = Eigen::MatrixXd::Constant(t.size(), ny(), NAN);
-  out.x = Eigen::MatrixXd::Constant(t.size(), n, NAN);
-  if (sw.surfaces()) {
-    if (!sw.start(z.at(t(0), start.data(), u, 0))) {
-      out.termination = Termination::NumericalFailure;
-      out.message = "the integration cannot start at t = " + detail::round_trip(t(0)) + " s: " + sw.message;
-      return out;
-    }
-    events.count = 2 * sw.surfaces();
-    events.values = [&](double tt, const double* x, const double* ui, double* g) { sw.values(z.at(tt, x, ui), g); };
-    events.fire = [&](int i, double tt, Eigen::VectorXd& x, const double* ui) {
-      return sw.event(i / 2, z.at(tt, x.data(), ui), nullptr, {});
-    };
-  }
-  const internal::OdeOutcome o = internal::dopri45(
-      f, start, u, t, intersample == Intersample::Zoh, rtol, 1e-3 * rtol, n, [&](Eigen::Index k, const Eigen::VectorXd& x) {
+  const internal::OdeOutcome o = integrate(
+      sw, z, n, c.nz, {}, start, u, t, intersample, rtol, integrator,
+      [&](Eigen::Index k, const Eigen::VectorXd& x) {
         const double* v = z.at(t(k), x.data(), u, k);
         out.x.row(k) = x.transpose();
         for (int j = 0; j < ny(); ++j) out.y(k, j) = c.h[j](v);
-      }, step_budget(t), sw.surfaces() ? &events : nullptr);
+      },
+      [&] {
+        out.y = Eigen::MatrixXd::Constant(t.size(), ny(), NAN);
+        out.x = Eigen::MatrixXd::Constant(t.size(), n, NAN);
+      },
+      out.integrator);
   if (!o.ok) {
     out.termination = Termination::NumericalFailure;
     out.message = escape_message(o, sw);
@@ -528,7 +579,7 @@ GreyboxSimulation GreyboxModel::simulate(const Eigen::MatrixXd& u, const Eigen::
 GreyboxSensitivities GreyboxModel::sensitivities(const Eigen::MatrixXd& u, const Eigen::VectorXd& t, Intersample intersample,
                                                  const Eigen::VectorXd& x0, const std::vector<int>& free,
                                                  const std::vector<int>& free_x0, double rtol,
-                                                 bool x0_from_parameters) const {
+                                                 bool x0_from_parameters, GreyboxIntegrator integrator) const {
   const Eigen::VectorXd start = checked_start(*this, u, t, x0);
   const Compiled& c = *c_;
   const int n = nx(), m = nu(), p = np(), ny_ = ny();
@@ -541,28 +592,12 @@ GreyboxSensitivities GreyboxModel::sensitivities(const Eigen::MatrixXd& u, const
   Point z(*this, c.nz);
   Switching sw(c.f, c.surfaces, c.surface_of, n, c.nz);
   std::vector<double> g(static_cast<size_t>(c.nz));
-  // The derivative along column j of S of the expression whose gradient g holds: dh/dx . S_j + dh/dtheta_{free[j]}
-  // (no direct term for an initial state).
+  // The derivative along column j of S of the output whose gradient g holds: dh/dx . S_j + dh/dz[q_to_z[j]].
   auto chain = [&](const double* S, int j) {
     const int zj = q_to_z[static_cast<size_t>(j)];
     double d = zj >= 0 ? g[static_cast<size_t>(zj)] : 0.0;
     for (int k = 0; k < n; ++k) d += g[static_cast<size_t>(k)] * S[k];
     return d;
-  };
-  auto column = [&](const Eigen::VectorXd& a, int j) { return a.data() + n + static_cast<Eigen::Index>(n) * j; };
-  // Augmented state [x; S(:,0); ..; S(:,q-1)]: dS_j/dt = (df/dx) S_j + df/dtheta_{free[j]}.
-  Eigen::MatrixXd G(n, c.nz);
-  const internal::OdeRhs f = [&](double tt, const Eigen::VectorXd& a, const double* ui, Eigen::VectorXd& da) {
-    sw.rhs(z.at(tt, a.data(), ui), da.data(), &G);
-    for (int j = 0; j < q; ++j) {
-      const double* S = column(a, j);
-      const int zj = q_to_z[static_cast<size_t>(j)];
-      for (int i = 0; i < n; ++i) {
-        double d = zj >= 0 ? G(i, zj) : 0.0;
-        for (int k = 0; k < n; ++k) d += G(i, k) * S[k];
-        da(n + static_cast<Eigen::Index>(n) * j + i) = d;
-      }
-    }
   };
   Eigen::VectorXd a0 = Eigen::VectorXd::Zero(n + static_cast<Eigen::Index>(n) * q);
   a0.head(n) = start;
@@ -571,35 +606,26 @@ GreyboxSensitivities GreyboxModel::sensitivities(const Eigen::MatrixXd& u, const
     for (int j = 0; j < nf; ++j) a0.segment(n + static_cast<Eigen::Index>(n) * j, n) = dx0.col(free[static_cast<size_t>(j)]);
   }
   for (size_t k = 0; k < free_x0.size(); ++k) a0(n + static_cast<Eigen::Index>(n) * (nf + static_cast<int>(k)) + free_x0[k]) = 1.0;
-  internal::OdeEvents events;
   GreyboxSensitivities out;
-  out.y = Eigen::MatrixXd::Constant(t.size(), ny_, NAN);
-  out.dy.assign(static_cast<size_t>(ny_), Eigen::MatrixXd::Constant(t.size(), q, NAN));
-  if (sw.surfaces()) {
-    if (!sw.start(z.at(t(0), start.data(), u, 0))) {
-      out.ok = false;
-      out.message = "the integration cannot start at t = " + detail::round_trip(t(0)) + " s: " + sw.message;
-      return out;
-    }
-    events.count = 2 * sw.surfaces();
-    events.values = [&](double tt, const double* x, const double* ui, double* gv) { sw.values(z.at(tt, x, ui), gv); };
-    events.fire = [&](int i, double tt, Eigen::VectorXd& a, const double* ui) {
-      Eigen::Map<Eigen::MatrixXd> S(a.data() + n, n, q);
-      return sw.event(i / 2, z.at(tt, a.data(), ui), &S, q_to_z);
-    };
-  }
-  const internal::OdeOutcome o = internal::dopri45(
-      f, a0, u, t, intersample == Intersample::Zoh, rtol, 1e-3 * rtol, n, [&](Eigen::Index k, const Eigen::VectorXd& a) {
+  const internal::OdeOutcome o = integrate(
+      sw, z, n, c.nz, q_to_z, a0, u, t, intersample, rtol, integrator,
+      [&](Eigen::Index k, const Eigen::VectorXd& a) {
         const double* v = z.at(t(k), a.data(), u, k);
         for (int o2 = 0; o2 < ny_; ++o2) {
           out.y(k, o2) = c.h[o2].gradient(v, g.data());
-          for (int j = 0; j < q; ++j) out.dy[static_cast<size_t>(o2)](k, j) = chain(column(a, j), j);
+          for (int j = 0; j < q; ++j)
+            out.dy[static_cast<size_t>(o2)](k, j) = chain(a.data() + n + static_cast<Eigen::Index>(n) * j, j);
         }
         if (k + 1 == t.size()) {
           out.x_end = a.head(n);
           out.dx_end = Eigen::Map<const Eigen::MatrixXd>(a.data() + n, n, q);
         }
-      }, step_budget(t), sw.surfaces() ? &events : nullptr);
+      },
+      [&] {
+        out.y = Eigen::MatrixXd::Constant(t.size(), ny_, NAN);
+        out.dy.assign(static_cast<size_t>(ny_), Eigen::MatrixXd::Constant(t.size(), q, NAN));
+      },
+      out.integrator);
   if (!o.ok) {
     out.ok = false;
     out.message = escape_message(o, sw);

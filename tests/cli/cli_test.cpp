@@ -1345,6 +1345,12 @@ TEST(Cli, GreyboxModelFileFitSimulateAndValidate) {
     EXPECT_NEAR(file.result.parameters.values(i), lib.parameters.values(i), 1e-9 * std::abs(lib.parameters.values(i)))
         << lib.parameters.names[i];
   EXPECT_NEAR(file.result.parameters.value("q(0)"), 0.4, 0.01);  // the noise 0.005 over the first samples
+  // The integrator is a setting of the fit: BDF reaches the same optimum (to the integration tolerances).
+  const CliRun stiff = ctid_run("fit " + csv + " --time t --method greybox --model " + model + " --set integrator=bdf");
+  ASSERT_EQ(stiff.code, 0) << stiff.out << stiff.err;
+  const CliRun bad = ctid_run("fit " + csv + " --time t --method greybox --model " + model + " --set integrator=rk4");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("auto, explicit, bdf"), std::string::npos) << bad.err;
   // simulate: from the fitted initial state by default (the fit's own simulation, to the integration tolerance).
   const std::string sim = test::temp_path("spring_sim.csv");
   const CliRun s = ctid_run("simulate " + json + " " + csv + " --time t --out " + sim + " --force");

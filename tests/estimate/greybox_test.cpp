@@ -322,6 +322,87 @@ TEST(Greybox, SignFrictionWithASpringIsRecoveredFromNoiseFreeStickSlipData) {
         << truth.parameter_names()[j];
 }
 
+namespace {
+// A stiff plant: an actuator 10^5 times faster than the sampling (k1 = 1e5 1/s, ts = 0.01 s) ahead of a slow lag:
+// y = b k1 / ((s + k1)(tau s + 1)) u, exactly simulated by lsim for the oracle.
+GreyboxModel stiff_model(double b, double tau) {
+  GreyboxSpec s;
+  s.inputs = {"u"};
+  s.states = {"x1", "x2"};
+  s.outputs = {{"y", "x2"}};
+  s.parameters = {{"b", b}, {"tau", tau, 1e-3, 100.0}, {"k1", 1e5, 0.0, INFINITY, true}};
+  s.equations = {"k1*(b*u - x1)", "(x1 - x2)/tau"};
+  s.initial = {{"0", false}, {"0", false}};
+  return GreyboxModel(s);
+}
+}  // namespace
+
+TEST(Greybox, AStiffModelIsIntegratedByBdf) {
+  const GreyboxModel m = stiff_model(2.0, 0.5);
+  const Eigen::MatrixXd u = levels(500, 50, -1, 1, 3);
+  const IdData d(u, Eigen::MatrixXd::Zero(500, 1), 0.01);
+  const Eigen::VectorXd t = d.times();
+  const Eigen::VectorXd exact = lsim(TransferFunction(Eigen::Vector2d(0.0, 2e5), Eigen::Vector3d(0.5, 0.5e5 + 1, 1e5)), d);
+  // The explicit method would need ~300 steps per sample (stability, not accuracy): it stops and names the remedy.
+  const GreyboxSimulation ex = m.simulate(u, t, Intersample::Zoh, {}, 1e-10, GreyboxIntegrator::Explicit);
+  EXPECT_FALSE(ex.ok());
+  EXPECT_NE(ex.message.find("integrator=bdf"), std::string::npos) << ex.message;
+  const GreyboxSimulation bdf = m.simulate(u, t, Intersample::Zoh, {}, 1e-10, GreyboxIntegrator::Bdf);
+  ASSERT_TRUE(bdf.ok()) << bdf.message;
+  EXPECT_LT((bdf.y.col(0) - exact).cwiseAbs().maxCoeff(), 1e-7 * exact.cwiseAbs().maxCoeff());  // rtol 1e-10 + restarts
+  const GreyboxSimulation automatic = m.simulate(u, t, Intersample::Zoh, {}, 1e-10);
+  ASSERT_TRUE(automatic.ok()) << automatic.message;
+  EXPECT_EQ((automatic.y - bdf.y).cwiseAbs().maxCoeff(), 0.0);  // auto fell back to the same BDF run
+  // BDF sensitivities (CVODES's staggered corrector) against central differences of BDF simulations.
+  const GreyboxSensitivities sens = m.sensitivities(u, t, Intersample::Zoh, {}, {0, 1}, {}, 1e-10, true, GreyboxIntegrator::Bdf);
+  ASSERT_TRUE(sens.ok) << sens.message;
+  for (int j = 0; j < 2; ++j) {
+    const double h = 1e-5;
+    Eigen::VectorXd hi = m.parameter_values(), lo = hi;
+    hi(j) += h, lo(j) -= h;
+    const Eigen::VectorXd fd = (m.with_parameters(hi).simulate(u, t, Intersample::Zoh, {}, 1e-12, GreyboxIntegrator::Bdf).y -
+                                m.with_parameters(lo).simulate(u, t, Intersample::Zoh, {}, 1e-12, GreyboxIntegrator::Bdf).y) /
+                               (2 * h);
+    EXPECT_LT((sens.dy[0].col(j) - fd).cwiseAbs().maxCoeff(), 1e-5 * fd.cwiseAbs().maxCoeff()) << m.parameter_names()[j];
+  }
+  // The fit (integrator auto: it finds the model stiff and uses BDF) gives b and tau back from the exact record.
+  const Result<GreyboxModel> r = greybox(IdData(u, exact, 0.01), stiff_model(1.5, 0.7));
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
+  EXPECT_NEAR(r.parameters.value("b"), 2.0, 1e-6 * 2.0);
+  EXPECT_NEAR(r.parameters.value("tau"), 0.5, 1e-6 * 0.5);
+}
+
+TEST(Greybox, BdfLocatesTheStickSlipSwitchingsToo) {
+  // The closed-form stick-slip motion again, integrated by BDF: CVODES's root finding locates the switchings, the
+  // same Filippov field and sensitivity jumps apply.
+  const GreyboxModel m = stick_slip_model();
+  const double t1 = std::asin(1 / 1.5);
+  auto q2 = [&](double t) { return 1.5 * std::cos(t1) * (t - t1) - 1.5 * (std::sin(t) - std::sin(t1)) - (t - t1) * (t - t1) / 2; };
+  const double t2 = 3.3231163, pi = std::acos(-1.0);  // from the explicit test's bisection (to 1e-6)
+  const int n = 700;
+  const Eigen::VectorXd t = time_grid(0.01, n);
+  const Eigen::MatrixXd u(n, 0);
+  const GreyboxSimulation r = m.simulate(u, t, Intersample::Zoh, {}, 1e-10, GreyboxIntegrator::Bdf);
+  ASSERT_TRUE(r.ok()) << r.message;
+  double eq = 0;
+  for (int k = 0; k < n; ++k) {
+    const double tk = t(k);
+    const double q = tk <= t1 ? 0 : tk <= t2 ? q2(tk) : tk <= t1 + pi ? q2(t2) : tk <= t2 + pi ? q2(t2) - q2(tk - pi) : 0;
+    if (std::abs(tk - t2) > 0.02 && std::abs(tk - t2 - pi) > 0.02) eq = std::max(eq, std::abs(r.x(k, 0) - q));
+  }
+  EXPECT_LT(eq, 1e-6);
+  const GreyboxSensitivities s = m.sensitivities(u, t, Intersample::Zoh, {}, {0, 1, 2}, {}, 1e-11, true, GreyboxIntegrator::Bdf);
+  ASSERT_TRUE(s.ok) << s.message;
+  for (int j = 0; j < 3; ++j) {
+    const double h = 1e-5;
+    Eigen::VectorXd hi = m.parameter_values(), lo = hi;
+    hi(j) += h, lo(j) -= h;
+    const Eigen::VectorXd fd = (m.with_parameters(hi).simulate(u, t, Intersample::Zoh, {}, 1e-12).y -
+                                m.with_parameters(lo).simulate(u, t, Intersample::Zoh, {}, 1e-12).y) / (2 * h);
+    EXPECT_LT((s.dy[0].col(j) - fd).cwiseAbs().maxCoeff(), 1e-4 * fd.cwiseAbs().maxCoeff()) << m.parameter_names()[j];
+  }
+}
+
 TEST(Greybox, TwoSurfacesSlidingAtOnceAreNamed) {
   // Two independent frictions at rest under forces below their levels: both slide at once (not supported): the
   // message names both surfaces instead of a wrong answer.

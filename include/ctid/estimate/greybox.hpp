@@ -31,6 +31,9 @@ struct GreyboxOptions {
   int starts = 1;                ///< multi-start: the model's values plus starts - 1 drawn within the bounds
   int seed = 1;                  ///< seed of the drawn starts
   double rtol = 1e-8;            ///< relative tolerance of the simulations (absolute: 1e-3 rtol)
+  /// The integrator of every simulation of the fit (model/greybox.hpp): auto (Dormand-Prince, BDF where it needs
+  /// more than 200 steps per sample), explicit, bdf (stiff models).
+  GreyboxIntegrator integrator = GreyboxIntegrator::Auto;
   /// Multiple shooting: each record cut into this many segments, each starting from a free state tied to the previous
   /// segment's end (continuity); 1: single shooting; 0: automatic — multiple shooting when the free run from the
   /// start escapes or drifts (fit below -900 %), with segments of 100 samples halved (down to 4) until every

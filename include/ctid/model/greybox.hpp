@@ -60,12 +60,18 @@ struct GreyboxSpec {
   bool operator==(const GreyboxSpec&) const = default;
 };
 
+/// How a grey-box model is integrated: Explicit — adaptive Dormand-Prince 5(4) (non-stiff, cheapest per step); Bdf —
+/// CVODES's variable-order BDF with Newton on the exact Jacobian (stiff models: time constants far apart); Auto —
+/// Dormand-Prince, and BDF where it needs more than 200 steps per sample on average (the sign of stiffness).
+enum class GreyboxIntegrator { Auto, Explicit, Bdf };
+
 /// States and outputs of a simulation.
 struct GreyboxSimulation {
   Eigen::MatrixXd y;  ///< N x ny outputs at the sample times (NaN from an escape on)
   Eigen::MatrixXd x;  ///< N x nx states
   Termination termination = Termination::Completed;  ///< NumericalFailure when the solution escapes
   std::string message;
+  GreyboxIntegrator integrator = GreyboxIntegrator::Explicit;  ///< the one that ran (Auto: Explicit or Bdf)
   bool ok() const { return termination == Termination::Completed; }
 };
 
@@ -78,6 +84,7 @@ struct GreyboxSensitivities {
   Eigen::MatrixXd dx_end;  ///< its derivatives, nx x q
   bool ok = true;
   std::string message;
+  GreyboxIntegrator integrator = GreyboxIntegrator::Explicit;  ///< the one that ran (Auto: Explicit or Bdf)
 };
 
 class GreyboxModel {
@@ -122,11 +129,12 @@ class GreyboxModel {
 
   /// Simulates from x0 (nx entries; empty: initial_state(), where estimated states without a value start at 0)
   /// driven by the inputs u (N x nu) at the increasing times t (seconds; the expressions' t), the inputs held or
-  /// linear between samples, with relative tolerance rtol (absolute tolerance rtol times 1e-3). An escaping
+  /// linear between samples, with relative tolerance rtol (absolute tolerance rtol times 1e-3) by `integrator`. An escaping
   /// solution (|x| > 1e12, non-finite, step-size collapse) ends with NumericalFailure, a message naming the time,
   /// and NaN from there. Throws InvalidArgument for size mismatches or non-increasing times.
   GreyboxSimulation simulate(const Eigen::MatrixXd& u, const Eigen::VectorXd& t, Intersample intersample = Intersample::Zoh,
-                             const Eigen::VectorXd& x0 = {}, double rtol = 1e-8) const;
+                             const Eigen::VectorXd& x0 = {}, double rtol = 1e-8,
+                             GreyboxIntegrator integrator = GreyboxIntegrator::Auto) const;
   /// The simulation from x0 together with the output derivatives with respect to the parameters `free` (indices)
   /// and then the initial states `free_x0` (indices of states whose x0 is varied), and the final state with its
   /// derivatives. Initial-state expressions of parameters contribute dx0/dtheta unless `x0_from_parameters` is
@@ -134,7 +142,8 @@ class GreyboxModel {
   GreyboxSensitivities sensitivities(const Eigen::MatrixXd& u, const Eigen::VectorXd& t, Intersample intersample,
                                      const Eigen::VectorXd& x0, const std::vector<int>& free,
                                      const std::vector<int>& free_x0, double rtol = 1e-8,
-                                     bool x0_from_parameters = true) const;
+                                     bool x0_from_parameters = true,
+                                     GreyboxIntegrator integrator = GreyboxIntegrator::Auto) const;
   bool operator==(const GreyboxModel& o) const { return spec_ == o.spec_; }
 
  private:
