@@ -108,9 +108,7 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
     r.t = d.times();
     r.y = Eigen::Map<const Eigen::VectorXd>(d.y().data(), d.y().size());
     r.n = d.size();
-    bool zoh = true;
-    for (int i = 0; i < d.nu(); ++i) zoh = zoh && d.intersample(i) == Intersample::Zoh;
-    r.hold = zoh ? Intersample::Zoh : Intersample::Foh;
+    r.hold = greybox_intersample(d);
     r.start = static_cast<Eigen::Index>(N) * ny;
     N += d.size();
   }

@@ -190,7 +190,8 @@ Result<NdeModel> nde_oe(const std::vector<IdData>& records, const NdeModel& init
     const Eigen::Index n = ys[e].size();
     yhat.resize(n);
     S.resize(n, q);
-    return internal::dopri45(rhs, z0, us[e], ts[e], holds[e] == Intersample::Zoh, opt.rtol, 1e-12, L,
+    return internal::dopri45(rhs, z0, us[e], ts[e],
+                             holds[e] == Intersample::Zoh ? internal::Between::Hold : internal::Between::Linear, opt.rtol, 1e-12, L,
                              [&](Eigen::Index k, const Eigen::VectorXd& z) {
                                yhat(k) = z(0);
                                for (int j = 0; j < q; ++j) S(k, j) = z(L + static_cast<Eigen::Index>(L) * j);

@@ -21,19 +21,12 @@ namespace {
 struct Problem {
   const OdeJacobianRhs* f = nullptr;
   const OdeEvents* events = nullptr;
-  const Eigen::MatrixXd* u = nullptr;
-  bool hold = true;
+  InputReader* reader = nullptr;
   Eigen::Index k = 0;  // the current sample interval [t(k), t(k + 1)]
   double ta = 0, tb = 1;
-  Eigen::VectorXd ui;
   Eigen::MatrixXd J, B;
   Eigen::VectorXd dx;
-  const double* inputs(double t) {
-    const double w = hold ? 0.0 : (t - ta) / (tb - ta);
-    const Eigen::Index k1 = std::min<Eigen::Index>(k + 1, u->rows() - 1);
-    for (Eigen::Index i = 0; i < u->cols(); ++i) ui(i) = (1 - w) * (*u)(k, i) + w * (hold ? 0.0 : (*u)(k1, i));
-    return ui.data();
-  }
+  const double* inputs(double t) { return reader->at(k, t); }
 };
 
 Problem& of(void* data) { return *static_cast<Problem*>(data); }
@@ -97,16 +90,15 @@ struct Cvodes {
 }  // namespace
 
 OdeOutcome bdf(const OdeJacobianRhs& f, Eigen::Index n, const Eigen::VectorXd& a0, const Eigen::MatrixXd& u,
-               const Eigen::VectorXd& t, bool hold, double rtol, double atol, const OdeSample& sample, long max_steps,
+               const Eigen::VectorXd& t, Between intersample, double rtol, double atol, const OdeSample& sample, long max_steps,
                const OdeEvents* events) {
   OdeOutcome out;
   const int q = static_cast<int>((a0.size() - n) / n);
   Problem p;
   p.f = &f;
   p.events = events;
-  p.u = &u;
-  p.hold = hold;
-  p.ui.resize(std::max<Eigen::Index>(u.cols(), 1));
+  InputReader reader(u, t, intersample);
+  p.reader = &reader;
   p.J.resize(n, n);
   p.B.resize(n, q);
   p.dx.resize(n);
@@ -178,7 +170,7 @@ OdeOutcome bdf(const OdeJacobianRhs& f, Eigen::Index n, const Eigen::VectorXd& a
   };
   for (Eigen::Index k = 0; k + 1 < t.size(); ++k) {
     p.k = k, p.ta = t(k), p.tb = t(k + 1);
-    bool jump = hold && k > 0 && u.row(k) != u.row(k - 1);
+    bool jump = intersample == Between::Hold && k > 0 && u.row(k) != u.row(k - 1);
     int fired = 0;
     if (ne) {  // an input that jumps at t(k) can leave an event function <= 0 already
       events->values(p.ta, a.data(), p.inputs(p.ta), g.data());

@@ -5,8 +5,41 @@
 
 namespace ctid::internal {
 
+InputReader::InputReader(const Eigen::MatrixXd& u, const Eigen::VectorXd& t, Between mode)
+    : u_(u), t_(t), mode_(mode), ui_(std::max<Eigen::Index>(u.cols(), 1)) {}
+
+const double* InputReader::at(Eigen::Index k, double tt) {
+  const Eigen::Index nu = u_.cols(), N = u_.rows();
+  const Eigen::Index k1 = std::min<Eigen::Index>(k + 1, N - 1);
+  const double h = t_(k1) - t_(k), s = h > 0 ? (tt - t_(k)) / h : 0.0;
+  if (mode_ == Between::Hold || s == 0.0) {
+    for (Eigen::Index i = 0; i < nu; ++i) ui_(i) = u_(k, i);
+  } else if (mode_ == Between::Linear) {
+    for (Eigen::Index i = 0; i < nu; ++i) ui_(i) = (1 - s) * u_(k, i) + s * u_(k1, i);
+  } else {
+    // Lanczos: w(x) = sinc(x) sinc(x / a) for the samples at offsets j = -a+1 .. a, x = s - j; sin(pi (s - j)) =
+    // (-1)^j sin(pi s).
+    const double pi = 3.14159265358979323846, a = kTaps, sps = std::sin(pi * s);
+    double total = 0;
+    for (int j = -kTaps + 1; j <= kTaps; ++j) {
+      const double x = s - j;
+      const double w = std::abs(x) < 1e-12 ? 1.0
+                                            : ((j % 2 == 0) ? sps : -sps) / (pi * x) * std::sin(pi * x / a) / (pi * x / a);
+      w_[j + kTaps - 1] = w;
+      total += w;
+    }
+    for (Eigen::Index i = 0; i < nu; ++i) {
+      double v = 0;
+      for (int j = -kTaps + 1; j <= kTaps; ++j)
+        v += w_[j + kTaps - 1] * u_(std::clamp<Eigen::Index>(k + j, 0, N - 1), i);
+      ui_(i) = v / total;
+    }
+  }
+  return ui_.data();
+}
+
 OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
-                   bool hold, double rtol, double atol, Eigen::Index n_control, const OdeSample& sample,
+                   Between intersample, double rtol, double atol, Eigen::Index n_control, const OdeSample& sample,
                    long max_steps, const OdeEvents* events) {
   static const double c2 = 1. / 5, c3 = 3. / 10, c4 = 4. / 5, c5 = 8. / 9;
   static const double a21 = 1. / 5, a31 = 3. / 40, a32 = 9. / 40, a41 = 44. / 45, a42 = -56. / 15, a43 = 32. / 9,
@@ -17,8 +50,7 @@ OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::Matr
                       e7 = -1. / 40;
   const Eigen::Index n = x0.size();
   OdeOutcome out;
-  const Eigen::Index nu = u.cols();
-  Eigen::VectorXd ui(std::max<Eigen::Index>(nu, 1));
+  InputReader reader(u, t, intersample);
   Eigen::VectorXd x = x0, k1(n), k2(n), k3(n), k4(n), k5(n), k6(n), k7(n), xt(n), xn(n), errv(n);
   const int ne = events ? events->count : 0;
   std::vector<double> g0(static_cast<size_t>(ne)), g1(g0), gi(g0);  // event values at a step's start, end, inside
@@ -29,12 +61,7 @@ OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::Matr
   const long budget = max_steps > 0 ? max_steps : 1000000L + 1000L * static_cast<long>(t.size());
   for (Eigen::Index k = 0; k + 1 < t.size(); ++k) {
     const double ta = t(k), tb = t(k + 1);
-    // The inputs at a time inside [ta, tb] (into ui; the same values for every stage when held).
-    auto uin = [&](double tt) {
-      const double w = hold ? 0.0 : (tt - ta) / (tb - ta);
-      for (Eigen::Index i = 0; i < nu; ++i) ui(i) = (1 - w) * u(k, i) + w * (hold ? 0.0 : u(k + 1, i));
-      return ui.data();
-    };
+    auto uin = [&](double tt) { return reader.at(k, tt); };  // the inputs at a time inside [ta, tb]
     double tt = ta;
     int fired = 0;       // events in this interval
     int pending = -1;    // the event the step being tried ends on

@@ -18,6 +18,30 @@
 
 namespace ctid::internal {
 
+/// How the inputs are read between samples (ctid::Intersample without the data layer).
+enum class Between { Hold, Linear, BandLimited };
+
+/// The inputs u (N x nu, one row per time t) between samples: held, linear, or band-limited — the
+/// windowed-sinc interpolation of the samples (Lanczos kernel, 16 samples each side, weights normalised to sum 1;
+/// Shannon reconstruction of a signal without content above the Nyquist frequency: a generator with a
+/// reconstruction filter, e.g. the Silverbox's), which needs uniformly spaced times; the record is extended by
+/// its end values. No allocation per call.
+class InputReader {
+ public:
+  InputReader(const Eigen::MatrixXd& u, const Eigen::VectorXd& t, Between mode);
+  /// The inputs at time tt of the interval [t(k), t(k + 1)] (nu values; at t(k) exactly u(k, .)).
+  const double* at(Eigen::Index k, double tt);
+  Between mode() const { return mode_; }
+
+ private:
+  static constexpr int kTaps = 16;
+  const Eigen::MatrixXd& u_;
+  const Eigen::VectorXd& t_;
+  Between mode_;
+  Eigen::VectorXd ui_;
+  double w_[2 * kTaps];
+};
+
 /// dx = f(t, x, u) for the input values u[0 .. nu-1] at the time t (the scale of the times given).
 using OdeRhs = std::function<void(double t, const Eigen::VectorXd& x, const double* u, Eigen::VectorXd& dx)>;
 /// Called with the sample index k and the state at t(k), for k = 0 .. N-1.
@@ -43,14 +67,14 @@ struct OdeOutcome {
   bool refused = false;  ///< with ok false: an event handler stopped the integration
 };
 
-/// Integrates from x0 at t(0) through the increasing times t, the inputs u (N x nu, one row per time) held
-/// (hold) or linear between samples, calling sample at each time. The error is
+/// Integrates from x0 at t(0) through the increasing times t, the inputs u (N x nu, one row per time) read between
+/// samples as `intersample` says (InputReader), calling sample at each time. The error is
 /// controlled on the first n_control components (the rest — e.g. sensitivities — ride along on the same
 /// steps); rtol relative, atol absolute tolerance. At most max_steps accepted and rejected steps in all (0: 10^6 plus
 /// 1000 per sample) — an explicit method on a stiff system stops there instead of creeping on. `events`: state
 /// events (above), or none.
 OdeOutcome dopri45(const OdeRhs& f, const Eigen::VectorXd& x0, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
-                   bool hold, double rtol, double atol, Eigen::Index n_control, const OdeSample& sample,
+                   Between intersample, double rtol, double atol, Eigen::Index n_control, const OdeSample& sample,
                    long max_steps = 0, const OdeEvents* events = nullptr);
 
 /// A system with its derivatives for the stiff integrator: dx = f(t, x, u) (n states); when J is given also the
@@ -66,7 +90,7 @@ using OdeJacobianRhs =
 /// vector passed to sample and fire being the same [x; S]. The method restarts (order 1) where a held input jumps
 /// and after each event. max_steps: 0 for 10^6 plus 1000 per sample.
 OdeOutcome bdf(const OdeJacobianRhs& f, Eigen::Index n, const Eigen::VectorXd& a0, const Eigen::MatrixXd& u,
-               const Eigen::VectorXd& t, bool hold, double rtol, double atol, const OdeSample& sample,
+               const Eigen::VectorXd& t, Between intersample, double rtol, double atol, const OdeSample& sample,
                long max_steps = 0, const OdeEvents* events = nullptr);
 
 }  // namespace ctid::internal

@@ -231,12 +231,19 @@ std::string GreyboxModel::to_string() const {
 namespace {
 // Checks shared by simulate and sensitivities; returns the start state (estimated states without a value at 0).
 Eigen::VectorXd checked_start(const GreyboxModel& m, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
-                              const Eigen::VectorXd& x0) {
+                              const Eigen::VectorXd& x0, Intersample intersample) {
   CTID_REQUIRE(u.rows() == t.size(), "greybox simulate: {} input rows for {} times", u.rows(), t.size());
   CTID_REQUIRE(u.cols() == m.nu(), "greybox simulate: {} input columns for the model's {} inputs", u.cols(), m.nu());
   CTID_REQUIRE(t.size() >= 1, "greybox simulate: no samples");
   for (Eigen::Index k = 1; k < t.size(); ++k)
     CTID_REQUIRE(t(k) > t(k - 1), "greybox simulate: times must increase (t[{}] = {}, t[{}] = {})", k - 1, t(k - 1), k, t(k));
+  if (intersample == Intersample::BandLimited && t.size() > 2) {
+    const double h = (t(t.size() - 1) - t(0)) / static_cast<double>(t.size() - 1);
+    for (Eigen::Index k = 1; k < t.size(); ++k)
+      CTID_REQUIRE(std::abs(t(k) - t(k - 1) - h) <= 1e-6 * h,
+                   "greybox simulate: band-limited inputs need uniformly sampled times (t[{}] - t[{}] = {} s, the mean "
+                   "spacing is {} s); use foh for an irregularly sampled record", k, k - 1, t(k) - t(k - 1), h);
+  }
   CTID_REQUIRE(x0.size() == 0 || x0.size() == m.nx(), "greybox simulate: x0 has {} entries, the model has {} states",
                x0.size(), m.nx());
   Eigen::VectorXd start = x0.size() ? x0 : m.initial_state();
@@ -393,9 +400,10 @@ class Switching {
 
  private:
   bool refuse(int k) {
-    message = "two switching surfaces slide at once (" + s_[static_cast<size_t>(sliding())].text() + " = 0 and " +
-              s_[static_cast<size_t>(k)].text() + " = 0): not supported; smooth one of the sign() laws, e.g. tanh(" +
-              s_[static_cast<size_t>(k)].text() + "/0.01)";
+    const std::string& a = s_[static_cast<size_t>(sliding())].text();
+    const std::string& b = s_[static_cast<size_t>(k)].text();
+    message = detail::format("two switching surfaces slide at once ({} = 0 and {} = 0): not supported; smooth one of the "
+                             "sign() laws, e.g. tanh({}/0.01)", a, b, b);
     return false;
   }
   void set(int k, double m) {
@@ -521,6 +529,9 @@ internal::OdeOutcome integrate(Switching& sw, Point& z, int n, int nz, const std
         B->col(j) = q_to_z[static_cast<size_t>(j)] >= 0 ? Eigen::VectorXd(G.col(q_to_z[static_cast<size_t>(j)]))
                                                          : Eigen::VectorXd::Zero(n);
   };
+  const internal::Between between = intersample == Intersample::Zoh           ? internal::Between::Hold
+                                    : intersample == Intersample::BandLimited ? internal::Between::BandLimited
+                                                                              : internal::Between::Linear;
   internal::OdeEvents events;
   events.count = 2 * sw.surfaces();
   events.values = [&](double tt, const double* x, const double* ui, double* g) { sw.values(z.at(tt, x, ui), g); };
@@ -528,7 +539,6 @@ internal::OdeOutcome integrate(Switching& sw, Point& z, int n, int nz, const std
     Eigen::Map<Eigen::MatrixXd> S(a.data() + n, n, q);
     return sw.event(i / 2, z.at(tt, a.data(), ui), q ? &S : nullptr, q_to_z);
   };
-  const bool hold = intersample == Intersample::Zoh;
   auto run = [&](bool stiff) {
     reset();
     if (sw.surfaces() && !sw.start(z.at(t(0), a0.data(), u, 0))) {
@@ -539,8 +549,8 @@ internal::OdeOutcome integrate(Switching& sw, Point& z, int n, int nz, const std
       return o;
     }
     const internal::OdeEvents* ev = sw.surfaces() ? &events : nullptr;
-    return stiff ? internal::bdf(stiff_rhs, n, a0, u, t, hold, rtol, 1e-3 * rtol, sample, step_budget(t), ev)
-                 : internal::dopri45(explicit_rhs, a0, u, t, hold, rtol, 1e-3 * rtol, n, sample, step_budget(t), ev);
+    return stiff ? internal::bdf(stiff_rhs, n, a0, u, t, between, rtol, 1e-3 * rtol, sample, step_budget(t), ev)
+                 : internal::dopri45(explicit_rhs, a0, u, t, between, rtol, 1e-3 * rtol, n, sample, step_budget(t), ev);
   };
   used = integrator == GreyboxIntegrator::Bdf ? GreyboxIntegrator::Bdf : GreyboxIntegrator::Explicit;
   internal::OdeOutcome o = run(used == GreyboxIntegrator::Bdf);
@@ -551,7 +561,7 @@ internal::OdeOutcome integrate(Switching& sw, Point& z, int n, int nz, const std
 
 GreyboxSimulation GreyboxModel::simulate(const Eigen::MatrixXd& u, const Eigen::VectorXd& t, Intersample intersample,
                                          const Eigen::VectorXd& x0, double rtol, GreyboxIntegrator integrator) const {
-  const Eigen::VectorXd start = checked_start(*this, u, t, x0);
+  const Eigen::VectorXd start = checked_start(*this, u, t, x0, intersample);
   const Compiled& c = *c_;
   const int n = nx();
   Point z(*this, c.nz);
@@ -580,7 +590,7 @@ GreyboxSensitivities GreyboxModel::sensitivities(const Eigen::MatrixXd& u, const
                                                  const Eigen::VectorXd& x0, const std::vector<int>& free,
                                                  const std::vector<int>& free_x0, double rtol,
                                                  bool x0_from_parameters, GreyboxIntegrator integrator) const {
-  const Eigen::VectorXd start = checked_start(*this, u, t, x0);
+  const Eigen::VectorXd start = checked_start(*this, u, t, x0, intersample);
   const Compiled& c = *c_;
   const int n = nx(), m = nu(), p = np(), ny_ = ny();
   for (int j : free) CTID_REQUIRE(j >= 0 && j < p, "greybox sensitivities: parameter index {} of {}", j, p);
@@ -633,6 +643,15 @@ GreyboxSensitivities GreyboxModel::sensitivities(const Eigen::MatrixXd& u, const
   return out;
 }
 
+Intersample greybox_intersample(const IdData& data) {
+  bool zoh = true, bl = true;
+  for (int i = 0; i < data.nu(); ++i) {
+    zoh = zoh && data.intersample(i) == Intersample::Zoh;
+    bl = bl && data.intersample(i) == Intersample::BandLimited;
+  }
+  return zoh ? Intersample::Zoh : bl ? Intersample::BandLimited : Intersample::Foh;
+}
+
 Eigen::VectorXd greybox_initial_state(const GreyboxModel& model, const IdData& data, int samples, double rtol) {
   CTID_REQUIRE(data.nu() == model.nu() && data.ny() == model.ny(),
                "greybox initial state: the data have {} inputs and {} outputs, the model {} and {}", data.nu(), data.ny(),
@@ -648,7 +667,7 @@ Eigen::VectorXd greybox_initial_state(const GreyboxModel& model, const IdData& d
                "greybox initial state: {} samples cannot determine {} initial states", n, which.size());
   const IdData d = data.slice(0, n);
   const Eigen::VectorXd t = d.times();
-  const Intersample hold = d.intersample(0) == Intersample::Zoh ? Intersample::Zoh : Intersample::Foh;
+  const Intersample hold = greybox_intersample(d);
   const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(d.y().data(), d.y().size());
   Eigen::VectorXd x0 = model.initial_state_guess(data);
   auto state = [&](const Eigen::VectorXd& v) {

@@ -215,7 +215,8 @@ NdeSimulation NdeModel::simulate(const Eigen::VectorXd& u, const Eigen::VectorXd
   NdeSimulation out;
   out.y = Eigen::VectorXd::Constant(t.size(), std::numeric_limits<double>::quiet_NaN());
   const internal::OdeOutcome o =
-      internal::dopri45(f, x0.size() ? x0 : Eigen::VectorXd::Zero(L), u, t, intersample == Intersample::Zoh, rtol,
+      internal::dopri45(f, x0.size() ? x0 : Eigen::VectorXd::Zero(L), u, t,
+                        intersample == Intersample::Zoh ? internal::Between::Hold : internal::Between::Linear, rtol,
                         1e-12, L, [&](Eigen::Index k, const Eigen::VectorXd& x) { out.y(k) = x(0); });
   if (!o.ok) {
     out.termination = Termination::NumericalFailure;

@@ -194,9 +194,7 @@ Simulation simulate_greybox(const GreyboxModel& m, const IdData& d, const Simula
       s.x0 = o.x0.size() ? o.x0 : greybox_initial_state(m, d, o.initial_samples);
     }
   }
-  bool zoh = true;
-  for (int i = 0; i < d.nu(); ++i) zoh = zoh && d.intersample(i) == Intersample::Zoh;
-  const GreyboxSimulation r = m.simulate(d.u(), d.times(), zoh ? Intersample::Zoh : Intersample::Foh, s.x0);
+  const GreyboxSimulation r = m.simulate(d.u(), d.times(), greybox_intersample(d), s.x0);
   s.y = r.y;
   if (!r.ok()) s.problem = r.message;
   return s;

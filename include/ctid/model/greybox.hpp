@@ -128,8 +128,8 @@ class GreyboxModel {
   std::string to_string() const;
 
   /// Simulates from x0 (nx entries; empty: initial_state(), where estimated states without a value start at 0)
-  /// driven by the inputs u (N x nu) at the increasing times t (seconds; the expressions' t), the inputs held or
-  /// linear between samples, with relative tolerance rtol (absolute tolerance rtol times 1e-3) by `integrator`. An escaping
+  /// driven by the inputs u (N x nu) at the increasing times t (seconds; the expressions' t), the inputs held,
+  /// linear or band-limited (windowed-sinc interpolation, uniform times only) between samples, with relative tolerance rtol (absolute tolerance rtol times 1e-3) by `integrator`. An escaping
   /// solution (|x| > 1e12, non-finite, step-size collapse) ends with NumericalFailure, a message naming the time,
   /// and NaN from there. Throws InvalidArgument for size mismatches or non-increasing times.
   GreyboxSimulation simulate(const Eigen::MatrixXd& u, const Eigen::VectorXd& t, Intersample intersample = Intersample::Zoh,
@@ -151,6 +151,11 @@ class GreyboxModel {
   GreyboxSpec spec_;
   std::shared_ptr<const Compiled> c_;
 };
+
+/// How a grey-box simulation reads the inputs of `data` between samples (one way for all inputs): held when every
+/// input is Zoh, band-limited (windowed-sinc interpolation; uniformly sampled records only) when every input is
+/// BandLimited, linear otherwise.
+Intersample greybox_intersample(const IdData& data);
 
 /// The initial state that best explains the first `samples` samples of `data` (0: all) from the model's
 /// initial-state guess, estimating the states marked "estimate" (every state when none is marked), by Levenberg-Marquardt on
