@@ -217,10 +217,19 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
   for (int i = 0; i < nx; ++i) all_states[static_cast<size_t>(i)] = i;
   const Eigen::Index Ny = y.size();
   // The residual (and Jacobian) of the segmented problem: weighted output errors, then the continuity residuals.
-  const internal::LmEvaluate shoot_evaluate = [&](const Eigen::VectorXd& vm, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
+  // The Jacobian is block sparse (a segment's rows depend on the parameters and its own start only): it is built from
+  // triplets and the normal equations are solved sparse (internal/levenberg_marquardt.hpp).
+  std::vector<Eigen::Triplet<double>> nz;
+  auto put = [&](Eigen::Index row, Eigen::Index col, const Eigen::MatrixXd& block) {
+    for (Eigen::Index c = 0; c < block.cols(); ++c)
+      for (Eigen::Index i = 0; i < block.rows(); ++i)
+        if (block(i, c) != 0.0) nz.emplace_back(static_cast<int>(row + i), static_cast<int>(col + c), block(i, c));
+  };
+  const internal::LmSparseEvaluate shoot_evaluate = [&](const Eigen::VectorXd& vm, Eigen::VectorXd& r,
+                                                        Eigen::SparseMatrix<double>* J) {
     const GreyboxModel m = model_at(vm);
     r.setZero(Ny + ns);
-    if (J) J->setZero(Ny + ns, p + ns);
+    nz.clear();
     for (int e = 0; e < E; ++e) {
       const Record& d = rec[static_cast<size_t>(e)];
       const auto& sg = seg[static_cast<size_t>(e)];
@@ -248,15 +257,15 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
             const Eigen::Index row = d.start + static_cast<Eigen::Index>(j) * d.n + g.first;
             const Eigen::MatrixXd& dy = sn.dy[static_cast<size_t>(j)];
             r.segment(row, g.rows) = w(j) * sn.y.col(j).head(g.rows);
-            J->block(row, 0, g.rows, pf) = -w(j) * dy.topLeftCorner(g.rows, pf);
-            if (nq) J->block(row, col_s, g.rows, nq) = -w(j) * dy.topRightCorner(g.rows, nq);
+            put(row, 0, -w(j) * dy.topLeftCorner(g.rows, pf));
+            if (nq) put(row, col_s, -w(j) * dy.topRightCorner(g.rows, nq));
           }
           x_end = sn.x_end;
           if (k + 1 < S) {
             const Eigen::Index c = Ny + seg_offset[static_cast<size_t>(e)] + static_cast<Eigen::Index>(k) * nx;
-            J->block(c, 0, nx, pf) = rho.asDiagonal() * sn.dx_end.leftCols(pf);
-            if (nq) J->block(c, col_s, nx, nq) = rho.asDiagonal() * sn.dx_end.rightCols(nq);
-            J->block(c, col_k + nx, nx, nx).diagonal() = -rho;
+            put(c, 0, rho.asDiagonal() * sn.dx_end.leftCols(pf));
+            if (nq) put(c, col_s, rho.asDiagonal() * sn.dx_end.rightCols(nq));
+            put(c, col_k + nx, Eigen::MatrixXd((-rho).asDiagonal()));
           }
         }
         if (k + 1 < S) {
@@ -266,6 +275,10 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
       }
     }
     r.head(Ny) = wy - r.head(Ny);
+    if (J) {
+      J->resize(Ny + ns, p + ns);
+      J->setFromTriplets(nz.begin(), nz.end());
+    }
     return true;
   };
   // The segments' starting states, segment by segment (a greedy observer): an output that is a state alone gives

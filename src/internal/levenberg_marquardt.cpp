@@ -1,6 +1,9 @@
 #include "internal/levenberg_marquardt.hpp"
 
 #include <cmath>
+#include <type_traits>
+
+#include <Eigen/SparseCholesky>
 
 #include "ctid/core/check.hpp"
 #include "ctid/core/progress.hpp"
@@ -25,14 +28,39 @@ void set_termination(Summary& s, const LmResult& lm, const std::string& failure,
   }
 }
 
-LmResult levenberg_marquardt(const LmEvaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& lo,
-                             const Eigen::VectorXd& hi, const LmOptions& o) {
+namespace {
+using Sparse = Eigen::SparseMatrix<double>;
+
+bool finite(const Eigen::MatrixXd& J) { return J.allFinite(); }
+bool finite(const Sparse& J) { return Eigen::Map<const Eigen::VectorXd>(J.valuePtr(), J.nonZeros()).allFinite(); }
+
+// (A + lambda diag(d)) step = -g, dense or sparse.
+Eigen::VectorXd solve(const Eigen::MatrixXd& A, const Eigen::VectorXd& d, double lambda, const Eigen::VectorXd& g) {
+  Eigen::MatrixXd M = A;
+  M.diagonal() += lambda * d;
+  return -M.ldlt().solve(g);
+}
+Eigen::VectorXd solve(const Sparse& A, const Eigen::VectorXd& d, double lambda, const Eigen::VectorXd& g) {
+  Sparse D(A.rows(), A.cols());
+  D.setIdentity();
+  const Sparse M = A + Sparse(Eigen::VectorXd(lambda * d).asDiagonal() * D);
+  Eigen::SimplicialLDLT<Sparse> ldlt(M);
+  if (ldlt.info() != Eigen::Success) return Eigen::VectorXd::Constant(g.size(), NAN);
+  return -ldlt.solve(g);
+}
+Eigen::VectorXd diagonal(const Eigen::MatrixXd& A) { return A.diagonal(); }
+Eigen::VectorXd diagonal(const Sparse& A) { return A.diagonal(); }
+
+template <class Jacobian, class Evaluate>
+LmResult lm(const Evaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& lo, const Eigen::VectorXd& hi,
+            const LmOptions& o) {
+  using Normal = std::conditional_t<std::is_same_v<Jacobian, Sparse>, Sparse, Eigen::MatrixXd>;
   const Eigen::Index p = x.size();
   LmResult res;
   x = x.cwiseMax(lo).cwiseMin(hi);
   Eigen::VectorXd r;
-  Eigen::MatrixXd J;
-  if (!evaluate(x, r, &J) || !r.allFinite() || !J.allFinite()) {
+  Jacobian J;
+  if (!evaluate(x, r, &J) || !r.allFinite() || !finite(J)) {
     res.x = x;
     res.cost = INFINITY;
     res.message = "the model cannot be evaluated at the initial parameters";
@@ -48,21 +76,19 @@ LmResult levenberg_marquardt(const LmEvaluate& evaluate, Eigen::VectorXd x, cons
       break;
     }
     res.iterations = it;
-    const Eigen::MatrixXd A = J.transpose() * J;
+    const Normal A = Normal(J.transpose()) * J;
     const Eigen::VectorXd g = J.transpose() * r;  // gradient of the cost
-    Eigen::VectorXd d = A.diagonal().cwiseMax(1e-300);
+    Eigen::VectorXd d = diagonal(A).cwiseMax(1e-300);
     // Active bounds: a parameter at a bound whose gradient pushes it outward stays there this iteration (its row and
     // column are decoupled), so the others move as if it were fixed instead of being projected back every time.
     Eigen::VectorXd keep = Eigen::VectorXd::Ones(p);
     for (Eigen::Index i = 0; i < p; ++i)
       if ((x(i) <= lo(i) && g(i) > 0) || (x(i) >= hi(i) && g(i) < 0)) keep(i) = 0.0;
-    const Eigen::MatrixXd Ak = keep.asDiagonal() * A * keep.asDiagonal();
+    const Normal Ak = keep.asDiagonal() * A * keep.asDiagonal();
     const Eigen::VectorXd gk = keep.cwiseProduct(g);
     bool accepted = false;
     for (int tries = 0; tries < 30 && !accepted; ++tries) {
-      Eigen::MatrixXd M = Ak;
-      M.diagonal() += lambda * d;
-      const Eigen::VectorXd step = -M.ldlt().solve(gk);
+      const Eigen::VectorXd step = solve(Ak, d, lambda, gk);
       const Eigen::VectorXd xt = (x + step).cwiseMax(lo).cwiseMin(hi);
       if (!step.allFinite()) { lambda *= 10; continue; }
       if (evaluate(xt, rt, nullptr) && rt.allFinite()) {
@@ -95,8 +121,18 @@ LmResult levenberg_marquardt(const LmEvaluate& evaluate, Eigen::VectorXd x, cons
   if (!res.converged && res.message.empty()) res.message = "iteration limit reached";
   res.x = x;
   res.cost = cost;
-  res.jtj = J.transpose() * J;
+  res.jtj = Eigen::MatrixXd(Normal(J.transpose()) * J);
   return res;
+}
+}  // namespace
+
+LmResult levenberg_marquardt(const LmEvaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& lo,
+                             const Eigen::VectorXd& hi, const LmOptions& o) {
+  return lm<Eigen::MatrixXd>(evaluate, std::move(x), lo, hi, o);
+}
+LmResult levenberg_marquardt(const LmSparseEvaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& lo,
+                             const Eigen::VectorXd& hi, const LmOptions& o) {
+  return lm<Sparse>(evaluate, std::move(x), lo, hi, o);
 }
 
 }  // namespace ctid::internal

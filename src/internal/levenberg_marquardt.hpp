@@ -1,4 +1,5 @@
-// ctid internal — Levenberg-Marquardt for small dense nonlinear least squares
+// ctid internal — Levenberg-Marquardt for nonlinear least squares (dense, or with a sparse Jacobian: then the normal
+// equations are sparse and solved by Eigen's simplicial LDL^T — multiple shooting, whose Jacobian is block sparse)
 // min 1/2 ||r(x)||^2 with simple bounds, driven by exact Jacobians supplied by the caller
 // (Marquardt scaling by diag(J^T J); bounds by projection of each trial step, with the parameters at a bound whose
 // gradient points outward held there for the iteration — an active set, as in projected Gauss-Newton methods,
@@ -9,6 +10,7 @@
 #include <string>
 
 #include <Eigen/Dense>
+#include <Eigen/SparseCore>
 
 #include "ctid/core/status.hpp"
 
@@ -35,6 +37,10 @@ struct LmResult {
 /// cannot be evaluated at x (e.g. an unstable simulation), which rejects the step.
 using LmEvaluate = std::function<bool(const Eigen::VectorXd& x, Eigen::VectorXd& r, Eigen::MatrixXd* J)>;
 
+/// The same with a sparse Jacobian (J^T J of the result dense).
+using LmSparseEvaluate =
+    std::function<bool(const Eigen::VectorXd& x, Eigen::VectorXd& r, Eigen::SparseMatrix<double>* J)>;
+
 /// How the search ended, with its iteration count: NumericalFailure with `failure` (or the search's own
 /// message when `failure` is empty) when it could not evaluate its start, else Interrupted, Converged or
 /// MaxIterations (with the message); a search that converged or ran out of iterations becomes Unidentifiable with
@@ -44,6 +50,8 @@ void set_termination(Summary& summary, const LmResult& lm, const std::string& fa
 
 
 LmResult levenberg_marquardt(const LmEvaluate& evaluate, Eigen::VectorXd x0, const Eigen::VectorXd& lower,
+                             const Eigen::VectorXd& upper, const LmOptions& options);
+LmResult levenberg_marquardt(const LmSparseEvaluate& evaluate, Eigen::VectorXd x0, const Eigen::VectorXd& lower,
                              const Eigen::VectorXd& upper, const LmOptions& options);
 
 }  // namespace ctid::internal

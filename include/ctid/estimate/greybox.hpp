@@ -11,7 +11,8 @@
 // Covariance sigma^2 (J^T J)^{-1} with sigma^2 = V / (N ny - p); a combination of parameters the data cannot
 // separate makes the result not usable, naming the parameters (ParameterSet rules, core/types.hpp).
 // Unstable and integrating plants: multiple shooting (Bock & Plitt 1984; Bock 1983) — segments with free initial
-// states, continuity by penalty residuals raised until the defects are at rounding level — chosen automatically when
+// states, continuity by penalty residuals raised until the defects are at rounding level, the block-sparse Jacobian
+// solved sparse — chosen automatically when
 // the free run from the start escapes or drifts, then single shooting from its estimate where the plant runs free
 // (docs/methods/greybox.md#unstable-and-integrating-plants).
 #pragma once
