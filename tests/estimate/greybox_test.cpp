@@ -52,6 +52,19 @@ Eigen::MatrixXd levels(int n, int hold, double lo, double hi, unsigned seed) {
   return u;
 }
 
+// Column j of the sensitivities s against the central difference (step 1e-5) of simulations at rtol 1e-12 by
+// `integrator`: {the largest difference, the largest |central difference|}.
+std::pair<double, double> sensitivity_error(const GreyboxModel& m, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
+                                            const GreyboxSensitivities& s, int j,
+                                            GreyboxIntegrator integrator = GreyboxIntegrator::Auto) {
+  const double h = 1e-5;
+  Eigen::VectorXd hi = m.parameter_values(), lo = hi;
+  hi(j) += h, lo(j) -= h;
+  const Eigen::VectorXd fd = (m.with_parameters(hi).simulate(u, t, Intersample::Zoh, {}, 1e-12, integrator).y -
+                              m.with_parameters(lo).simulate(u, t, Intersample::Zoh, {}, 1e-12, integrator).y) / (2 * h);
+  return {(s.dy[0].col(j) - fd).cwiseAbs().maxCoeff(), fd.cwiseAbs().maxCoeff()};
+}
+
 IdData record(const GreyboxModel& m, const Eigen::MatrixXd& u, double ts, const Eigen::VectorXd& x0) {
   const Eigen::VectorXd t = time_grid(ts, static_cast<int>(u.rows()));
   const GreyboxSimulation s = m.simulate(u, t, Intersample::Zoh, x0, 1e-11);
@@ -284,14 +297,9 @@ TEST(Greybox, SensitivitiesThroughStickSlipMatchCentralDifferences) {
   const GreyboxSensitivities s = m.sensitivities(u, t, Intersample::Zoh, {}, {0, 1, 2}, {}, 1e-11);
   ASSERT_TRUE(s.ok) << s.message;
   for (int j = 0; j < 3; ++j) {
-    const double h = 1e-5;
-    Eigen::VectorXd hi = m.parameter_values(), lo = hi;
-    hi(j) += h, lo(j) -= h;
-    const Eigen::VectorXd fd = (m.with_parameters(hi).simulate(u, t, Intersample::Zoh, {}, 1e-12).y -
-                                m.with_parameters(lo).simulate(u, t, Intersample::Zoh, {}, 1e-12).y) / (2 * h);
-    const double scale = fd.cwiseAbs().maxCoeff();
+    const auto [error, scale] = sensitivity_error(m, u, t, s, j);
     EXPECT_GT(scale, 0.1) << m.parameter_names()[j];
-    EXPECT_LT((s.dy[0].col(j) - fd).cwiseAbs().maxCoeff(), 1e-5 * scale) << m.parameter_names()[j];
+    EXPECT_LT(error, 1e-5 * scale) << m.parameter_names()[j];
   }
   // With the jumps left out (checked by hand when this was written) two of the three columns are off by 2 to 3 times
   // their scale, and the noise-free fit of the next test ends unusable.
@@ -358,13 +366,8 @@ TEST(Greybox, AStiffModelIsIntegratedByBdf) {
   const GreyboxSensitivities sens = m.sensitivities(u, t, Intersample::Zoh, {}, {0, 1}, {}, 1e-10, true, GreyboxIntegrator::Bdf);
   ASSERT_TRUE(sens.ok) << sens.message;
   for (int j = 0; j < 2; ++j) {
-    const double h = 1e-5;
-    Eigen::VectorXd hi = m.parameter_values(), lo = hi;
-    hi(j) += h, lo(j) -= h;
-    const Eigen::VectorXd fd = (m.with_parameters(hi).simulate(u, t, Intersample::Zoh, {}, 1e-12, GreyboxIntegrator::Bdf).y -
-                                m.with_parameters(lo).simulate(u, t, Intersample::Zoh, {}, 1e-12, GreyboxIntegrator::Bdf).y) /
-                               (2 * h);
-    EXPECT_LT((sens.dy[0].col(j) - fd).cwiseAbs().maxCoeff(), 1e-5 * fd.cwiseAbs().maxCoeff()) << m.parameter_names()[j];
+    const auto [error, scale] = sensitivity_error(m, u, t, sens, j, GreyboxIntegrator::Bdf);
+    EXPECT_LT(error, 1e-5 * scale) << m.parameter_names()[j];
   }
   // The fit (integrator auto: it finds the model stiff and uses BDF) gives b and tau back from the exact record.
   const Result<GreyboxModel> r = greybox(IdData(u, exact, 0.01), stiff_model(1.5, 0.7));
@@ -395,12 +398,8 @@ TEST(Greybox, BdfLocatesTheStickSlipSwitchingsToo) {
   const GreyboxSensitivities s = m.sensitivities(u, t, Intersample::Zoh, {}, {0, 1, 2}, {}, 1e-11, true, GreyboxIntegrator::Bdf);
   ASSERT_TRUE(s.ok) << s.message;
   for (int j = 0; j < 3; ++j) {
-    const double h = 1e-5;
-    Eigen::VectorXd hi = m.parameter_values(), lo = hi;
-    hi(j) += h, lo(j) -= h;
-    const Eigen::VectorXd fd = (m.with_parameters(hi).simulate(u, t, Intersample::Zoh, {}, 1e-12).y -
-                                m.with_parameters(lo).simulate(u, t, Intersample::Zoh, {}, 1e-12).y) / (2 * h);
-    EXPECT_LT((s.dy[0].col(j) - fd).cwiseAbs().maxCoeff(), 1e-4 * fd.cwiseAbs().maxCoeff()) << m.parameter_names()[j];
+    const auto [error, scale] = sensitivity_error(m, u, t, s, j);
+    EXPECT_LT(error, 1e-4 * scale) << m.parameter_names()[j];
   }
 }
 
