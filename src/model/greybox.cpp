@@ -303,6 +303,8 @@ class Switching {
     gs_.resize(static_cast<size_t>(nz));
     gp_.resize(static_cast<size_t>(nz));
     gm_.resize(static_cast<size_t>(nz));
+    zz_.resize(static_cast<size_t>(nz));
+    dap_.resize(nz), dam_.resize(nz), dalpha_.resize(nz);
     fp_.resize(nx), fm_.resize(nx);
     Gp_.resize(nx, nz), Gm_.resize(nx, nz);
   }
@@ -329,10 +331,12 @@ class Switching {
     for (int i = 0; i < n_; ++i) dx[i] = alpha * fp_(i) + (1 - alpha) * fm_(i);
     if (!G) return;
     // d alpha = (a- d a+ - a+ d a-) / d^2, d a+- = ds/dx . G+- + (d^2 s/dx dz) f+- (the latter by central differences).
-    Eigen::RowVectorXd dap = gradient_slope(z, fp_, Gp_), dam = gradient_slope(z, fm_, Gm_);
-    const Eigen::RowVectorXd dalpha = d > 0 ? Eigen::RowVectorXd((am * dap - ap * dam) / (d * d))
-                                            : Eigen::RowVectorXd::Zero(nz_);
-    *G = alpha * Gp_ + (1 - alpha) * Gm_ + (fp_ - fm_) * dalpha;
+    gradient_slope(z, fp_, Gp_, dap_);
+    gradient_slope(z, fm_, Gm_, dam_);
+    if (d > 0) dalpha_ = (am * dap_ - ap * dam_) / (d * d);
+    else dalpha_.setZero();
+    G->noalias() = alpha * Gp_ + (1 - alpha) * Gm_;
+    G->noalias() += (fp_ - fm_) * dalpha_;
   }
 
   // The event functions at z: per surface, mode * s off it; -a+ and a- on it (an event where one reaches 0).
@@ -445,22 +449,21 @@ class Switching {
   }
   // d(ds/dx . f)/dz = ds/dx . G + (d/dz ds/dx) . f, the second term as the central difference of the gradient of s
   // along f: (grad s(x + e f) - grad s(x - e f)) / (2 e).
-  Eigen::RowVectorXd gradient_slope(const double* z, const Eigen::VectorXd& fv, const Eigen::MatrixXd& G) {
-    Eigen::RowVectorXd d = Eigen::RowVectorXd::Zero(nz_);
+  void gradient_slope(const double* z, const Eigen::VectorXd& fv, const Eigen::MatrixXd& G, Eigen::RowVectorXd& d) {
+    d.setZero();
     for (int i = 0; i < n_; ++i) d += gs_[static_cast<size_t>(i)] * G.row(i);
     const int k = sliding();
     const double fn = fv.norm();
-    if (fn == 0.0) return d;
+    if (fn == 0.0) return;
     double xn = 0;
     for (int i = 0; i < n_; ++i) xn = std::max(xn, std::abs(z[i]));
     const double e = 1e-6 * (1.0 + xn) / fn;
-    std::vector<double> zz(z, z + nz_);
-    for (int i = 0; i < n_; ++i) zz[static_cast<size_t>(i)] = z[i] + e * fv(i);
-    s_[static_cast<size_t>(k)].gradient(zz.data(), gp_.data());
-    for (int i = 0; i < n_; ++i) zz[static_cast<size_t>(i)] = z[i] - e * fv(i);
-    s_[static_cast<size_t>(k)].gradient(zz.data(), gm_.data());
+    std::copy(z, z + nz_, zz_.begin());
+    for (int i = 0; i < n_; ++i) zz_[static_cast<size_t>(i)] = z[i] + e * fv(i);
+    s_[static_cast<size_t>(k)].gradient(zz_.data(), gp_.data());
+    for (int i = 0; i < n_; ++i) zz_[static_cast<size_t>(i)] = z[i] - e * fv(i);
+    s_[static_cast<size_t>(k)].gradient(zz_.data(), gm_.data());
     for (int c = 0; c < nz_; ++c) d(c) += (gp_[static_cast<size_t>(c)] - gm_[static_cast<size_t>(c)]) / (2 * e);
-    return d;
   }
 
   const std::vector<Expression>& f_;
@@ -469,9 +472,10 @@ class Switching {
   int n_, nz_;
   std::vector<double> mode_;                // +1, -1, or 0 (sliding) per surface
   std::vector<std::vector<double>> signs_;  // per equation, the value of each sign() call (NaN: its argument's sign)
-  std::vector<double> gs_, gp_, gm_;        // gradients (nz)
+  std::vector<double> gs_, gp_, gm_, zz_;   // gradients (nz), a shifted point
   Eigen::VectorXd fp_, fm_;
   Eigen::MatrixXd Gp_, Gm_;
+  Eigen::RowVectorXd dap_, dam_, dalpha_;  // d a+, d a-, d alpha (nz)
 };
 
 // Greybox integrations give up after 200 steps per sample on average (a stiff system or parameters that make it
@@ -525,9 +529,10 @@ internal::OdeOutcome integrate(Switching& sw, Point& z, int n, int nz, const std
     sw.rhs(z.at(tt, x, ui), dx, J || B ? &G : nullptr);
     if (J) *J = G.leftCols(n);
     if (B)
-      for (int j = 0; j < q; ++j)
-        B->col(j) = q_to_z[static_cast<size_t>(j)] >= 0 ? Eigen::VectorXd(G.col(q_to_z[static_cast<size_t>(j)]))
-                                                         : Eigen::VectorXd::Zero(n);
+      for (int j = 0; j < q; ++j) {
+        if (q_to_z[static_cast<size_t>(j)] >= 0) B->col(j) = G.col(q_to_z[static_cast<size_t>(j)]);
+        else B->col(j).setZero();
+      }
   };
   const internal::Between between = intersample == Intersample::Zoh           ? internal::Between::Hold
                                     : intersample == Intersample::BandLimited ? internal::Between::BandLimited
