@@ -690,14 +690,35 @@ Eigen::VectorXd greybox_initial_state(const GreyboxModel& model, const IdData& d
     }
     return true;
   };
-  Eigen::VectorXd v(static_cast<Eigen::Index>(which.size()));
-  for (size_t k = 0; k < which.size(); ++k) v(static_cast<Eigen::Index>(k)) = x0(which[k]);
-  const Eigen::VectorXd inf = Eigen::VectorXd::Constant(v.size(), INFINITY);
+  // Starts: the model's guess (after a fit, the fitted initial state of its first record); then the guess with the
+  // estimated states that no output measures at 0, all together and one at a time. A fast state that the fit could not
+  // pin down (e.g. a velocity that relaxes within a sample) may carry a value there that no other record can start from.
+  std::vector<Eigen::VectorXd> starts(1, Eigen::VectorXd(static_cast<Eigen::Index>(which.size())));
+  for (size_t k = 0; k < which.size(); ++k) starts[0](static_cast<Eigen::Index>(k)) = x0(which[k]);
+  std::vector<Eigen::Index> hidden;
+  for (size_t k = 0; k < which.size(); ++k)
+    if (model.output_of_state(which[k]) < 0 && starts[0](static_cast<Eigen::Index>(k)) != 0.0)
+      hidden.push_back(static_cast<Eigen::Index>(k));
+  if (!hidden.empty()) {
+    starts.push_back(starts[0]);
+    for (Eigen::Index k : hidden) starts.back()(k) = 0.0;
+    if (hidden.size() > 1)
+      for (Eigen::Index k : hidden) {
+        starts.push_back(starts[0]);
+        starts.back()(k) = 0.0;
+      }
+  }
+  const Eigen::VectorXd inf = Eigen::VectorXd::Constant(starts[0].size(), INFINITY);
   internal::LmOptions o;
   o.max_iterations = 100;
-  const internal::LmResult lm = internal::levenberg_marquardt(evaluate, v, -inf, inf, o);
+  internal::LmResult lm;
+  lm.cost = INFINITY;
+  for (const Eigen::VectorXd& v : starts) {
+    internal::LmResult r = internal::levenberg_marquardt(evaluate, v, -inf, inf, o);
+    if (std::isfinite(r.cost) && !(r.cost >= lm.cost)) lm = std::move(r);
+  }
   CTID_REQUIRE(std::isfinite(lm.cost), "greybox initial state: the model cannot be simulated on the first {} samples "
-               "from its initial-state guess", n);
+               "from its initial-state guess (nor with its unmeasured states at 0)", n);
   return state(lm.x);
 }
 
