@@ -55,7 +55,7 @@ void reject_flags_that_do_not_apply(const FitArgs& a) {
   if (has("param") && m != "physical") refuse("param", "describes the model of --method physical (got " + m + ")");
   if (has("delay") && !tf_data) refuse("delay", "(delay estimation) needs --method srivc, oe or tfest (got " + m + ")");
   for (const char* f : {"nb", "nf", "nk"})
-    if (has(f) && (m == "narx" || m == "kia" || m == "fsf" || m == "physical" || m == "greybox"))
+    if (has(f) && (m == "narx" || m == "kia" || m == "fsf" || m == "physical" || m == "greybox" || m == "subspace"))
       refuse(f, "sets transfer-function orders; " + m + " has its own structure settings (--set)");
   if (!a.frequency)
     for (const char* f : {"w", "re", "im", "u-re", "u-im", "y-re", "y-im"})
@@ -430,6 +430,14 @@ int run_experiments(const FitArgs& a) {
   return fit_experiments<OeOptions>(a, ds, a.method == "oe" ? static_cast<Joint>(&oe) : static_cast<Joint>(&tfest));
 }
 
+// Subspace: any number of inputs and outputs, one record.
+int run_subspace(const FitArgs& a, const IdData& d) {
+  SubspaceOptions o;
+  apply_sets("subspace", a.sets, o);
+  const Result<StateSpace> r = call_library([&] { return subspace(d, o); });
+  return finish(r, a.method, d, a, settings_of(o));
+}
+
 int run(const FitArgs& a) {
   reject_flags_that_do_not_apply(a);
   std::vector<std::string> inputs = a.paths;
@@ -448,7 +456,10 @@ int run(const FitArgs& a) {
     require_io_data(d, a.method.c_str(), -1, -1);
     return 0;
   });
-  if (d.ny() != 1) throw UsageError(detail::format("{} estimates single-output models (selected {} outputs)", a.method, d.ny()));
+  if (a.method == "subspace") return run_subspace(a, d);
+  if (d.ny() != 1)
+    throw UsageError(detail::format("{} estimates single-output models (selected {} outputs; --method subspace takes "
+                                    "several)", a.method, d.ny()));
   if (d.nu() > 1) return run_miso(a, {d});
   return fit_methods().at(a.method).run(a, d);
 }
@@ -466,6 +477,7 @@ const std::map<std::string, FitMethod>& fit_methods() {
       {"physical", {{"physical"}, run_physical}},
       {"greybox", {{"greybox"}, [](const FitArgs& a, const IdData&) { return run_greybox(a); }}},
       {"modal", {{"modal"}, run_modal}},
+      {"subspace", {{"subspace"}, run_subspace}},
       {"narx",
        {{"narx"},
         [](const FitArgs& a, const IdData& d) { return run_narx_or_kia(a.method, {d}, a.sets, a.narx, a.json, a.report, {}); }}},
@@ -513,8 +525,8 @@ void setup_fit(CLI::App& app) {
   std::vector<std::string> names;
   for (const auto& [name, m] : fit_methods()) names.push_back(name);
   app.add_option("--method", a->method,
-                 "Estimator: srivc, tfest, oe, lssvf, ivsvf, rls-svf, fsf, physical, greybox, modal, narx or kia (with --help: "
-                 "its settings)")
+                 "Estimator: srivc, tfest, oe, lssvf, ivsvf, rls-svf, fsf, physical, greybox, modal, narx, kia or subspace (with "
+                 "--help: its settings)")
       ->check(CLI::IsMember(names))
       ->capture_default_str();
   g_fit_args = a;

@@ -1,6 +1,7 @@
 #include "common.hpp"
 
 #include <cmath>
+#include <numbers>
 #include <cstdio>
 #include <filesystem>
 #include <unistd.h>
@@ -259,6 +260,53 @@ void print_result(const Result<GreyboxModel>& r, const std::string& method, cons
   for (std::size_t i = text.find('\n'); i != std::string::npos && i + 1 < text.size(); i = text.find('\n', i + 1))
     text.insert(i + 1, "        ");
   print_any(r, method, d, text.substr(0, text.size() - 1));
+}
+
+void print_result(const Result<StateSpace>& r, const std::string& method, const IdData& d) {
+  const StateSpace& m = r.model;
+  std::printf("method: %s   samples: %d   %s   %d inputs, %d outputs, %d states\n", method.c_str(), d.size(),
+              d.is_uniform() ? ("Ts = " + detail::format("{}", d.ts()) + " s").c_str() : "irregular sampling", m.nu(),
+              m.ny(), m.nx());
+  if (r.diagnostics.has(diagnostic::singular_values)) {
+    const Eigen::VectorXd& sv = r.diagnostics.get(diagnostic::singular_values);
+    std::printf("singular values (the order is where they drop):");
+    for (Eigen::Index i = 0; i < std::min<Eigen::Index>(sv.size(), 12); ++i) std::printf(" %.3g", sv(i) / sv(0));
+    std::printf("\n");
+  }
+  if (m.nx() == 0) {
+    std::printf("termination: %s\nnote: %s\n", to_string(r.summary.termination), r.summary.message.c_str());
+    return;
+  }
+  auto matrix = [](const char* name, const Eigen::MatrixXd& M) {
+    for (Eigen::Index i = 0; i < M.rows(); ++i) {
+      std::printf("  %s%s", i == 0 ? name : " ", i == 0 ? " = [" : "     ");
+      for (Eigen::Index j = 0; j < M.cols(); ++j) std::printf(" %11.5g", M(i, j));
+      std::printf("%s\n", i + 1 == M.rows() ? " ]" : "");
+    }
+  };
+  std::printf("model:  dx/dt = A x + B u,  y = C x + D u\n");
+  matrix("A", m.A());
+  matrix("B", m.B());
+  matrix("C", m.C());
+  matrix("D", m.D());
+  std::printf("poles (natural frequency, damping ratio):\n");
+  const Eigen::VectorXcd p = m.poles();
+  for (Eigen::Index i = 0; i < p.size(); ++i) {
+    if (p(i).imag() < 0) continue;
+    const double wn = std::abs(p(i));
+    std::printf("  %12.6g %+12.6gj   wn = %.6g rad/s (%.6g Hz)   zeta = %.4g\n", p(i).real(), p(i).imag(), wn,
+                wn / (2 * std::numbers::pi), wn > 0 ? -p(i).real() / wn : NAN);
+  }
+  if (r.diagnostics.has(diagnostic::tau)) std::printf("filter time constant tau = %.6g s\n", r.diagnostics.get(diagnostic::tau));
+  std::printf("fit: %.2f %% (every output scaled alike)", r.fit.fit_percent);
+  if (r.diagnostics.has(diagnostic::output_fit_percent)) {
+    const Eigen::VectorXd& f = r.diagnostics.get(diagnostic::output_fit_percent);
+    for (Eigen::Index j = 0; j < f.size(); ++j)
+      std::printf("   %s %.2f %%", j < static_cast<Eigen::Index>(d.output_names().size()) ? d.output_names()[static_cast<size_t>(j)].c_str() : "y", f(j));
+  }
+  std::printf("\ntermination: %s   %.3g s\n", to_string(r.summary.termination), r.summary.seconds);
+  if (!r.summary.message.empty()) std::printf("note: %s\n", r.summary.message.c_str());
+  for (const auto& w : r.diagnostics.warnings) std::printf("warning: %s\n", w.c_str());
 }
 
 void print_result(const Result<FsfModel>& r, const std::string& method, const IdData& d) {

@@ -86,6 +86,7 @@ void print_result(const Result<TransferFunction>& r, const std::string& method, 
 void print_result(const Result<MisoModel>& r, const std::string& method, const IdData& data);
 void print_result(const Result<FsfModel>& r, const std::string& method, const IdData& data);
 void print_result(const Result<GreyboxModel>& r, const std::string& method, const IdData& data);
+void print_result(const Result<StateSpace>& r, const std::string& method, const IdData& data);
 
 /// Method settings as NAME/VALUE text pairs (the report's "settings" section).
 using Settings = std::vector<std::pair<std::string, std::string>>;

@@ -361,6 +361,14 @@ def greybox(data, model, **options):
     return _ctid.greybox(data, greybox_model(model), _options(_ctid.GreyboxOptions, "greybox", options))
 
 
+def subspace(data, nx=0, **options):
+    """MIMO continuous-time state space by subspace identification (as `ctid fit --method subspace`): Johansson's
+    lambda operator (route='lambda', any sampling) or discrete MOESP + logm (route='discrete'); nx = 0 chooses the
+    order from the singular values (r.diagnostics['singular_values']). Options: SubspaceOptions
+    (ctid.settings('subspace'))."""
+    return _ctid.subspace(data, _options(_ctid.SubspaceOptions, "subspace", {"nx": nx, **options}))
+
+
 def modal_fit(data, nb, input=None, **options):
     """El-Shafey (1987) modal-function identification (options: ModalOptions; shifts= is required; input: an
     InputGenerator for a generated input, None for a piecewise-constant one). data: an IdData, or a list of IdData

@@ -36,6 +36,10 @@ void def_experiments_estimator(py::module_& m, const char* name, ExperimentsEsti
 void bind_linear(py::module_& m) {
 
   bind_options<LssvfOptions>(m, "LssvfOptions");
+  bind_options<SubspaceOptions>(m, "SubspaceOptions");
+  m.def("subspace", [](const IdData& d, const SubspaceOptions& o) { return interruptible([&] { return subspace(d, o); }); },
+        py::arg("data"), py::arg("options") = SubspaceOptions{},
+        "MIMO continuous-time state space by subspace identification.");
   bind_options<IvsvfOptions>(m, "IvsvfOptions");
   bind_options<SrivcOptions>(m, "SrivcOptions");
   bind_options<OeOptions>(m, "OeOptions");

@@ -55,7 +55,8 @@ const std::vector<DiagnosticInfo>& diagnostic_catalogue() {
       info(diagnostic::err_sum),
       info(diagnostic::x0),
       info(diagnostic::start_scale),
-      info(diagnostic::starts_cost), info(diagnostic::segments), info(diagnostic::continuity_defect)};
+      info(diagnostic::starts_cost), info(diagnostic::segments), info(diagnostic::continuity_defect),
+      info(diagnostic::singular_values), info(diagnostic::output_fit_percent)};
   return all;
 }
 

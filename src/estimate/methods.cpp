@@ -17,6 +17,7 @@
 #include "ctid/estimate/physical.hpp"
 #include "ctid/estimate/rls_svf.hpp"
 #include "ctid/estimate/srivc.hpp"
+#include "ctid/estimate/subspace.hpp"
 
 namespace ctid {
 
@@ -108,6 +109,11 @@ const std::vector<MethodInfo>& methods() {
                           reports(x0, noise_variance, start_scale, experiments)),
       entry<GreyboxOptions>("greybox", "nonlinear grey-box model (state equations with named parameters) by output error",
                             {"GreyboxOptions"}, reports(x0, noise_variance, starts_cost, experiments, segments, continuity_defect)),
+      entry<SubspaceOptions>("subspace",
+                             "MIMO continuous-time state space by subspace identification (lambda operator or "
+                             "discrete MOESP + logm)",
+                             {"SubspaceOptions"},
+                             reports(singular_values, output_fit_percent, x0, tau, tau_grid, tau_grid_fit_percent)),
   };
   return all;
 }

@@ -1076,7 +1076,7 @@ TEST(Cli, MethodHelpListsEveryRegisteredSettingAndSetAcceptsIt) {
       {"lssvf", {"lssvf"}}, {"ivsvf", {"ivsvf"}}, {"rls-svf", {"rls_svf"}},
       {"srivc", {"srivc", "srivc_miso", "srivc_closed_loop"}}, {"oe", {"oe", "tf_from_frequency"}},
       {"tfest", {"tfest", "tf_from_frequency"}}, {"fsf", {"fsf"}}, {"physical", {"physical"}},
-      {"modal", {"modal"}}, {"narx", {"narx"}}, {"kia", {"kia", "narx"}}, {"greybox", {"greybox"}}};
+      {"modal", {"modal"}}, {"narx", {"narx"}}, {"kia", {"kia", "narx"}}, {"greybox", {"greybox"}}, {"subspace", {"subspace"}}};
   std::set<std::string> covered;
   for (const auto& [cli, entries] : cli_methods) {
     const CliRun h = ctid_run("fit --method " + cli + " --help");
@@ -1375,4 +1375,42 @@ TEST(Cli, GreyboxModelFileFitSimulateAndValidate) {
   const CliRun d = ctid_run("fit " + csv + " --time t --method greybox --model " + model + " --json " + model + " --force");
   EXPECT_EQ(d.code, 2);  // the model file is an input: never overwritten
   EXPECT_EQ(read_greybox_json(model).parameter_values()(0), 2.0);
+}
+
+TEST(Cli, SubspaceFitsSeveralOutputsAndWritesAStateSpaceResult) {
+  // Two inputs, two outputs, modes at 2 rad/s (zeta 0.05) and 5 rad/s (zeta 0.2), noise-free ZOH record.
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(4, 4), B(4, 2), C(2, 4);
+  A.block(0, 0, 2, 2) << 0, 1, -4, -0.2;
+  A.block(2, 2, 2, 2) << 0, 1, -25, -2;
+  B << 0, 0, 1, 0.5, 0, 0, -0.4, 1;
+  C << 4, 0.5, 10, 0, 1, -1, 20, 2;
+  const StateSpace truth(A, B, C, Eigen::MatrixXd::Zero(2, 2));
+  const int N = 3000;
+  Eigen::MatrixXd u(N, 2);
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> level(-1, 1);
+  for (int k = 0; k < N; ++k)
+    for (int i = 0; i < 2; ++i) u(k, i) = k % 7 == 0 ? level(rng) : u(k - 1, i);
+  const IdData d(u, Eigen::MatrixXd::Zero(N, 2), 0.05);
+  const Eigen::MatrixXd y = lsim(truth, d);
+  Eigen::MatrixXd m(N, 4);
+  m << u, y;
+  const std::string csv = test::temp_path("two_modes.csv");
+  write_csv(csv, {"u1", "u2", "y1", "y2"}, m);
+  const std::string json = test::temp_path("two_modes_ss.json");
+  const CliRun r = ctid_run("fit " + csv + " --ts 0.05 --input u1 --input u2 --output y1 --output y2 --method subspace "
+                            "--set route=discrete --json " + json + " --force");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("2 inputs, 2 outputs, 4 states"), std::string::npos) << r.out;  // the order chosen by BIC
+  EXPECT_NE(r.out.find("zeta = 0.05"), std::string::npos) << r.out;
+  const ResultFile file = read_result_file(json);
+  const StateSpace& back = std::get<StateSpace>(file.result.model);
+  EXPECT_EQ(back.ny(), 2);
+  // The file holds the library's model: the same frequency response as the system (noise-free, exact route).
+  EXPECT_LT(std::abs(back.frequency_response(Eigen::VectorXd::Constant(1, 2.0), 1, 0)(0) -
+                     truth.frequency_response(Eigen::VectorXd::Constant(1, 2.0), 1, 0)(0)),
+            1e-6);
+  const CliRun nb = ctid_run("fit " + csv + " --ts 0.05 --input u1 --output y1 --method subspace --nf 2");
+  EXPECT_EQ(nb.code, 2);
+  EXPECT_NE(nb.err.find("--nf sets transfer-function orders"), std::string::npos) << nb.err;
 }

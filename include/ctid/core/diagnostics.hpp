@@ -87,6 +87,10 @@ inline constexpr ScalarDiagnostic gls_iterations{"gls_iterations", "", "generali
 inline constexpr ScalarDiagnostic gls_order{"gls_order", "", "order of the GLS noise model of a KIA stage"};
 inline constexpr ScalarDiagnostic err_sum{"err_sum", "%", "sum of the ERR of a KIA stage's terms"};
 // NDE output error.
+// Subspace identification (issue 16).
+inline constexpr VectorDiagnostic singular_values{"singular_values", "",
+                                                  "singular values of the weighted projected output block (order choice)"};
+inline constexpr VectorDiagnostic output_fit_percent{"output_fit_percent", "%", "simulation fit of each output"};
 inline constexpr VectorDiagnostic x0{"x0", "", "fitted initial state of each record", true};
 inline constexpr ScalarDiagnostic start_scale{"start_scale", "",
                                               "factor the NDE start was shrunk by until its simulation was finite"};
