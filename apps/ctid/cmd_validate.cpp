@@ -1,5 +1,5 @@
 // ctid validate MODEL.json DATA [--initial rest|measured|estimated] [--json OUT.json]: fit and residual tests of any
-// single-output result or model file on a record (simulated by simulate(), simulate/simulate.hpp).
+// result or model file on a record, per output (simulated by simulate(), simulate/simulate.hpp).
 #include <cstdio>
 #include <functional>
 
@@ -30,16 +30,12 @@ nlohmann::ordered_json corr_json(const CorrelationTest& c) {
           {"passed", c.passed()}};
 }
 
-// One record's fit and residual tests, printed and as JSON.
-nlohmann::ordered_json validate_record(const ValArgs& a, const ResultFile& file, const IdData& d, const std::string& path) {
-  if (d.ny() != 1) throw UsageError(detail::format("validate compares one output; {} were selected", d.ny()));
-  if (a.lags < 1 || a.lags >= d.size())
-    throw UsageError(detail::format("--lags must be in [1, {}] for {}", d.size() - 1, path));
-  const Eigen::VectorXd yhat = simulate_result(file.result, d, initial_or_default(a.initial, file), a.initial_samples).col(0);
-  const Eigen::VectorXd y = d.y().col(0);
+// One output's fit and residual tests, printed and as JSON.
+nlohmann::ordered_json validate_output(const ValArgs& a, const IdData& d, const Eigen::VectorXd& y,
+                                       const Eigen::VectorXd& yhat, int n_coefficients, const std::string& path) {
   FitReport f;
   try {
-    f = fit_report(y, yhat, model_coefficient_count(file.result.model));
+    f = fit_report(y, yhat, n_coefficients);
   } catch (const InvalidArgument& e) {
     throw InputError(path + ": " + e.what());
   }
@@ -54,11 +50,37 @@ nlohmann::ordered_json validate_record(const ValArgs& a, const ResultFile& file,
     std::printf("input %s - residual independence (lags -%d..%d): %d outside -> %s\n", d.input_names()[i].c_str(), a.lags,
                 a.lags, xcs[i].n_outside, xcs[i].passed() ? "passed" : "correlated (unmodelled dynamics)");
   nlohmann::ordered_json j;
-  j["data"] = path;
   j["fit"] = {{"fit_percent", f.fit_percent}, {"nrmse", f.nrmse}, {"mse", f.mse}, {"n_samples", f.n_samples}};
   j["residual_autocorrelation"] = corr_json(ac);
   j["input_residual_crosscorrelation"] = nlohmann::ordered_json::array();
   for (const auto& xc : xcs) j["input_residual_crosscorrelation"].push_back(corr_json(xc));
+  return j;
+}
+
+// One record: each output's fit and residual tests (one output: at the top level of the JSON; several: under
+// "outputs", each with its name).
+nlohmann::ordered_json validate_record(const ValArgs& a, const ResultFile& file, const IdData& d, const std::string& path) {
+  const int ny = model_outputs(file.result.model);
+  if (d.ny() != ny)
+    throw UsageError(detail::format("the model has {} output(s) and {} were selected (--output, once per output)", ny,
+                                    d.ny()));
+  if (a.lags < 1 || a.lags >= d.size())
+    throw UsageError(detail::format("--lags must be in [1, {}] for {}", d.size() - 1, path));
+  const Eigen::MatrixXd yhat = simulate_result(file.result, d, initial_or_default(a.initial, file), a.initial_samples);
+  const int n = model_coefficient_count(file.result.model);
+  nlohmann::ordered_json j;
+  j["data"] = path;
+  if (ny == 1) {
+    j.update(validate_output(a, d, d.y().col(0), yhat.col(0), n, path));
+    return j;
+  }
+  j["outputs"] = nlohmann::ordered_json::array();
+  for (int o = 0; o < ny; ++o) {
+    std::printf("output %s:\n", d.output_names()[static_cast<size_t>(o)].c_str());
+    nlohmann::ordered_json jo = {{"output", d.output_names()[static_cast<size_t>(o)]}};
+    jo.update(validate_output(a, d, d.y().col(o), yhat.col(o), n, path));
+    j["outputs"].push_back(jo);
+  }
   return j;
 }
 
@@ -68,7 +90,6 @@ int run(const ValArgs& a) {
   check_outputs({a.json}, inputs, a.force);
   const ResultFile file = read_result(a.model);
   const AnyModel& model = file.result.model;
-  if (model_outputs(model) != 1) throw UsageError("validate compares one output; the model has " + std::to_string(model_outputs(model)));
   const std::vector<IdData> ds = columns_of(a.data, model).load_each(a.paths, true);
   std::printf("model:  %s\n", describe(model).c_str());
   // Finite on these records, but growing: the numbers below say little beyond them.

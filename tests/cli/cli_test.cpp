@@ -1410,6 +1410,18 @@ TEST(Cli, SubspaceFitsSeveralOutputsAndWritesAStateSpaceResult) {
   EXPECT_LT(std::abs(back.frequency_response(Eigen::VectorXd::Constant(1, 2.0), 1, 0)(0) -
                      truth.frequency_response(Eigen::VectorXd::Constant(1, 2.0), 1, 0)(0)),
             1e-6);
+  // validate: each output's fit and residual tests; the noise-free record is reproduced (fit above 99.999 %).
+  const std::string vjson = test::temp_path("two_modes_val.json");
+  const CliRun v = ctid_run("validate " + json + " " + csv + " --ts 0.05 --input u1 --input u2 --output y1 --output y2 "
+                            "--initial estimated --json " + vjson + " --force");
+  ASSERT_EQ(v.code, 0) << v.out << v.err;
+  EXPECT_NE(v.out.find("output y2:"), std::string::npos) << v.out;
+  const nlohmann::json vj = nlohmann::json::parse(std::ifstream(vjson));
+  ASSERT_EQ(vj["outputs"].size(), 2u);
+  for (const auto& o : vj["outputs"]) EXPECT_GT(o["fit"]["fit_percent"].get<double>(), 99.999) << o["output"];
+  const CliRun one = ctid_run("validate " + json + " " + csv + " --ts 0.05 --input u1 --input u2 --output y1");
+  EXPECT_EQ(one.code, 2);
+  EXPECT_NE(one.err.find("the model has 2 output(s) and 1 were selected"), std::string::npos) << one.err;
   const CliRun nb = ctid_run("fit " + csv + " --ts 0.05 --input u1 --output y1 --method subspace --nf 2");
   EXPECT_EQ(nb.code, 2);
   EXPECT_NE(nb.err.find("--nf sets transfer-function orders"), std::string::npos) << nb.err;
