@@ -118,7 +118,7 @@ Eigen::MatrixXd lambda_gram(const IdData& d, const Scaled& s, int r, double tau)
     if (k == 0)
       bank.set_current(next.data());
     else
-      bank.step(d.time(k) - d.time(k - 1), prev.data(), next.data());
+      bank.step(d.is_uniform() ? d.ts() : d.time(k) - d.time(k - 1), prev.data(), next.data());
     for (int b = 0; b < r; ++b) {
       for (int i = 0; i < nu; ++i) {
         g.set(b * nu + i, power(i, r - 1 - b));
@@ -291,7 +291,7 @@ StateSpace subspace_bd(const Eigen::MatrixXd& A, const Eigen::MatrixXd& C, const
   Eigen::MatrixXd Xn(nx, pb);
   for (int k = 0; k < N; ++k) {
     if (k > 0) {
-      const double h = data.time(k) - data.time(k - 1);
+      const double h = data.is_uniform() ? data.ts() : data.time(k) - data.time(k - 1);  // one exponential if uniform
       if (!(std::abs(disc.h - h) <= 1e-13 * h)) disc = discretize(A, I, h);
       Xn.noalias() = disc.Phi * X;
       for (int i = 0; i < nu; ++i) {
