@@ -289,13 +289,17 @@ void print_result(const Result<StateSpace>& r, const std::string& method, const 
   matrix("B", m.B());
   matrix("C", m.C());
   matrix("D", m.D());
-  std::printf("poles (natural frequency, damping ratio):\n");
-  const Eigen::VectorXcd p = m.poles();
-  for (Eigen::Index i = 0; i < p.size(); ++i) {
-    if (p(i).imag() < 0) continue;
-    const double wn = std::abs(p(i));
-    std::printf("  %12.6g %+12.6gj   wn = %.6g rad/s (%.6g Hz)   zeta = %.4g\n", p(i).real(), p(i).imag(), wn,
-                wn / (2 * std::numbers::pi), wn > 0 ? -p(i).real() / wn : NAN);
+  std::printf("modes: pole, natural frequency, damping ratio; shape = |C v| per output (phase, degrees)\n");
+  for (const Mode& mode : m.modes()) {
+    std::printf("  %12.6g %+12.6gj   wn = %.6g rad/s (%.6g Hz)   zeta = %.4g   shape", mode.pole.real(), mode.pole.imag(),
+                mode.wn, mode.wn / (2 * std::numbers::pi), mode.zeta);
+    for (Eigen::Index j = 0; j < mode.shape.size(); ++j) {
+      // Whole degrees in (-180, 180], without a "-0".
+      double deg = std::round(std::arg(mode.shape(j)) * 180 / std::numbers::pi);
+      if (deg == 0.0 || deg == -180.0) deg = std::abs(deg);
+      std::printf(" %.3f (%.0f)", std::abs(mode.shape(j)), deg);
+    }
+    std::printf("\n");
   }
   if (r.diagnostics.has(diagnostic::tau)) std::printf("filter time constant tau = %.6g s\n", r.diagnostics.get(diagnostic::tau));
   std::printf("fit: %.2f %% (every output scaled alike)", r.fit.fit_percent);

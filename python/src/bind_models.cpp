@@ -39,6 +39,15 @@ void bind_models(py::module_& m) {
       .def_property_readonly("nu", &StateSpace::nu)
       .def_property_readonly("ny", &StateSpace::ny)
       .def("poles", &StateSpace::poles)
+      .def("modes", [](const StateSpace& ss) {
+             py::list out;
+             for (const Mode& m : ss.modes())
+               out.append(py::dict(py::arg("pole") = m.pole, py::arg("wn") = m.wn, py::arg("zeta") = m.zeta,
+                                   py::arg("shape") = m.shape));
+             return out;
+           },
+           "Modes by increasing natural frequency: dicts with pole, wn (rad/s), zeta and shape (C v, unit norm, its "
+           "largest entry real and positive).")
       .def("to_transfer_function", &StateSpace::to_transfer_function, py::arg("out") = 0, py::arg("input") = 0);
   bind_result<StateSpace>(m, "StateSpaceResult");
 

@@ -1,5 +1,6 @@
 #include "ctid/model/state_space.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Eigenvalues>
@@ -44,6 +45,28 @@ StateSpace StateSpace::observable_canonical(const TransferFunction& tf) {
 Eigen::VectorXcd StateSpace::poles() const {
   if (nx() == 0) return Eigen::VectorXcd(0);
   return Eigen::EigenSolver<Eigen::MatrixXd>(A_, false).eigenvalues();
+}
+
+std::vector<Mode> StateSpace::modes() const {
+  std::vector<Mode> out;
+  if (nx() == 0) return out;
+  const Eigen::EigenSolver<Eigen::MatrixXd> es(A_, true);
+  for (Eigen::Index i = 0; i < nx(); ++i) {
+    const std::complex<double> p = es.eigenvalues()(i);
+    if (p.imag() < 0) continue;
+    Mode m;
+    m.pole = p;
+    m.wn = std::abs(p);
+    m.zeta = m.wn > 0 ? -p.real() / m.wn : 1.0;
+    m.shape = C_.cast<std::complex<double>>() * es.eigenvectors().col(i);
+    Eigen::Index big = 0;
+    if (m.shape.size() > 0) m.shape.cwiseAbs().maxCoeff(&big);
+    const double norm = m.shape.norm();
+    if (norm > 0) m.shape *= std::conj(m.shape(big)) / (std::abs(m.shape(big)) * norm);
+    out.push_back(std::move(m));
+  }
+  std::sort(out.begin(), out.end(), [](const Mode& a, const Mode& b) { return a.wn < b.wn; });
+  return out;
 }
 
 bool StateSpace::is_stable() const {

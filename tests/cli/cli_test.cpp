@@ -1403,6 +1403,18 @@ TEST(Cli, SubspaceFitsSeveralOutputsAndWritesAStateSpaceResult) {
   ASSERT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("2 inputs, 2 outputs, 4 states"), std::string::npos) << r.out;  // the order chosen by BIC
   EXPECT_NE(r.out.find("zeta = 0.05"), std::string::npos) << r.out;
+  // The mode shapes printed are the system's (exact route): |C v| and phase of each output.
+  for (const Mode& mode : truth.modes()) {
+    std::string shape = "shape";
+    for (Eigen::Index j = 0; j < mode.shape.size(); ++j) {
+      char buf[64];
+      double deg = std::round(std::arg(mode.shape(j)) * 180 / M_PI);
+      if (deg == 0.0 || deg == -180.0) deg = std::abs(deg);
+      std::snprintf(buf, sizeof buf, " %.3f (%.0f)", std::abs(mode.shape(j)), deg);
+      shape += buf;
+    }
+    EXPECT_NE(r.out.find(shape), std::string::npos) << shape << "\n" << r.out;
+  }
   const ResultFile file = read_result_file(json);
   const StateSpace& back = std::get<StateSpace>(file.result.model);
   EXPECT_EQ(back.ny(), 2);

@@ -87,6 +87,22 @@ TEST(Subspace, DiscreteRouteRecoversAMimoSystemExactlyFromNoiseFreeData) {
   EXPECT_GT(r.fit.fit_percent, 99.9999);
   const Eigen::VectorXd sv = r.diagnostics.get(diagnostic::singular_values);
   EXPECT_LT(sv(4), 1e-8 * sv(3));  // the order is visible: four singular values, then rounding
+  // Modes and their shapes (the output direction C v, independent of the state coordinates) are the system's.
+  const std::vector<Mode> est = r.model.modes(), tru = m.modes();
+  ASSERT_EQ(est.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_NEAR(est[i].wn, tru[i].wn, 1e-8 * tru[i].wn);
+    EXPECT_NEAR(est[i].zeta, tru[i].zeta, 1e-8);
+    EXPECT_LT((est[i].shape - tru[i].shape).norm(), 1e-8);
+  }
+  EXPECT_NEAR(tru[0].wn, 2.0, 1e-12);  // the system's own numbers: 2 rad/s, zeta 0.05
+  EXPECT_NEAR(tru[0].zeta, 0.05, 1e-12);
+  // By hand: the first block's eigenvector is (1, p), so C v = (4 + 0.5 p, 1 - p), scaled as Mode::shape says.
+  const std::complex<double> p = tru[0].pole;
+  Eigen::Vector2cd cv(4.0 + 0.5 * p, 1.0 - p);
+  const Eigen::Index big = std::abs(cv(0)) >= std::abs(cv(1)) ? 0 : 1;
+  cv *= std::conj(cv(big)) / (std::abs(cv(big)) * cv.norm());
+  EXPECT_LT((tru[0].shape - cv).norm(), 1e-12);
   // Transfer functions equal (a realisation-free check): G(j1) of every channel.
   for (int i = 0; i < 2; ++i)
     for (int j = 0; j < 2; ++j)

@@ -1,11 +1,24 @@
 // ctid — continuous-time state space  dx/dt = A x + B u,  y = C x + D u.
 #pragma once
 
+#include <complex>
+#include <vector>
+
 #include <Eigen/Dense>
 
 #include "ctid/model/transfer_function.hpp"
 
 namespace ctid {
+
+/// One mode of a state-space model: a real pole or a complex pair (listed once, the pole with imag > 0).
+struct Mode {
+  std::complex<double> pole;  ///< 1/s
+  double wn = 0.0;            ///< natural frequency |pole| (rad/s)
+  double zeta = 0.0;          ///< damping ratio -Re(pole)/|pole| (1 for a real stable pole, negative when unstable)
+  /// Mode shape: the output direction C v of the pole's eigenvector v (ny entries), scaled to unit 2-norm with its
+  /// largest entry real and positive — independent of the state coordinates.
+  Eigen::VectorXcd shape;
+};
 
 class StateSpace {
  public:
@@ -28,6 +41,8 @@ class StateSpace {
   int ny() const { return static_cast<int>(C_.rows()); }
 
   Eigen::VectorXcd poles() const;
+  /// The modes in order of increasing natural frequency (see Mode).
+  std::vector<Mode> modes() const;
   bool is_stable() const;
   /// Transfer function from input `in` to output `out` (0-based), by
   /// C (sI-A)^{-1} B = [det(sI - A + B C) - det(sI - A)] / det(sI - A).
