@@ -353,8 +353,8 @@ Result<StateSpace> subspace(const IdData& data, const SubspaceOptions& options) 
   // with one order that is the best fit), stable models first.
   Estimate best;
   Fits best_fit;
-  best_fit.all.fit_percent = best_fit.all.bic = std::numeric_limits<double>::infinity();
-  best_fit.all.fit_percent = -best_fit.all.fit_percent;
+  best_fit.all.fit_percent = -INFINITY;
+  best_fit.all.bic = INFINITY;
   double best_tau = 0.0;
   bool best_stable = false;
   std::vector<double> grid;
