@@ -16,6 +16,7 @@
 #include "ctid/signal/svf.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/validate/metrics.hpp"
+#include "internal/least_squares.hpp"
 
 namespace ctid {
 
@@ -203,9 +204,8 @@ struct Estimate {
   std::string refusal;  // non-empty: no continuous-time model (discrete route: no real logarithm)
 };
 
-Estimate estimate_at(const IdData& d, const SubspaceOptions& o, int r, double tau) {
+Estimate estimate_at(const IdData& d, const Scaled& s, const SubspaceOptions& o, int r, double tau) {
   const int nu = d.nu(), ny = d.ny();
-  const Scaled s = scales(d);
   const bool lambda = o.route == SubspaceRoute::Lambda;
   const Range range = lambda ? moesp(lambda_gram(d, s, r, tau), r * nu, r * nu, r * ny)
                              : moesp(discrete_gram(d, s, r), r * nu, r * (nu + ny), r * ny);
@@ -244,11 +244,10 @@ struct Fits {
   Eigen::VectorXd per_output;
 };
 
-Fits fits_of(const StateSpace& m, const IdData& d, const Eigen::VectorXd& x0, int n_parameters) {
+Fits fits_of(const StateSpace& m, const IdData& d, const Scaled& s, const Eigen::VectorXd& x0, int n_parameters) {
   LsimOptions lo;
   lo.x0 = x0;
-  Eigen::MatrixXd yhat = lsim(m, d, lo);
-  const Scaled s = scales(d);
+  const Eigen::MatrixXd yhat = lsim(m, d, lo);
   const int N = d.size(), ny = d.ny();
   Eigen::VectorXd y(static_cast<Eigen::Index>(N) * ny), h(static_cast<Eigen::Index>(N) * ny);
   Fits f;
@@ -274,21 +273,14 @@ StateSpace subspace_bd(const Eigen::MatrixXd& A, const Eigen::MatrixXd& C, const
   const int pb = nx * nu, pd = estimate_d ? ny * nu : 0, px = estimate_initial_state ? nx : 0, p = pb + pd + px;
   CTID_REQUIRE(static_cast<long>(N) * ny > p, "subspace: {} samples of {} outputs cannot determine {} values of B, D "
                "and x0", N, ny, p);
-  // X = [X_1 .. X_nu] (X_i' = A X_i + I u_i) and Phi(t) = e^{A (t - t0)}, stepped exactly between samples.
+  // X = [X_1 .. X_nu] (X_i' = A X_i + I u_i) and P(t) = e^{A (t - t0)}, stepped exactly between samples; each
+  // sample's ny regression rows go to the shared streaming least-squares kernel (blocked QR; minimum-norm when the
+  // record does not determine every value, e.g. an x0 direction that decays before the second sample).
   const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(nx, nx);
-  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(nx, pb), P = I, rows(static_cast<Eigen::Index>(kBatch) * ny, p);
-  Eigen::MatrixXd ys(static_cast<Eigen::Index>(kBatch) * ny, 1);
-  Eigen::MatrixXd NtN = Eigen::MatrixXd::Zero(p, p), Nty = Eigen::VectorXd::Zero(p);
-  int fill = 0;
-  auto flush = [&] {
-    if (fill == 0) return;
-    const Eigen::Index m = static_cast<Eigen::Index>(fill) * ny;
-    NtN.selfadjointView<Eigen::Lower>().rankUpdate(rows.topRows(m).transpose());
-    Nty.noalias() += rows.topRows(m).transpose() * ys.topRows(m);
-    fill = 0;
-  };
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(nx, pb), Xn(nx, pb), P = I, Pn(nx, nx);
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> R = Eigen::MatrixXd::Zero(ny, p);
+  internal::StreamingLeastSquares ls(p);
   Discretization disc;
-  Eigen::MatrixXd Xn(nx, pb);
   for (int k = 0; k < N; ++k) {
     if (k > 0) {
       const double h = data.is_uniform() ? data.ts() : data.time(k) - data.time(k - 1);  // one exponential if uniform
@@ -300,27 +292,17 @@ StateSpace subspace_bd(const Eigen::MatrixXd& A, const Eigen::MatrixXd& C, const
         if (data.intersample(i) != Intersample::Zoh) Xn.middleCols(static_cast<Eigen::Index>(i) * nx, nx) += disc.Gamma1 * (u1 - u0);
       }
       X.swap(Xn);
-      P = disc.Phi * P;
+      Pn.noalias() = disc.Phi * P;
+      P.swap(Pn);
     }
-    auto R = rows.middleRows(static_cast<Eigen::Index>(fill) * ny, ny);
     R.leftCols(pb).noalias() = C * X;
-    if (pd > 0) {
-      R.middleCols(pb, pd).setZero();
+    if (pd > 0)  // D(j, i) multiplies u_i in row j only (R's other entries there stay 0)
       for (int i = 0; i < nu; ++i)
         for (int j = 0; j < ny; ++j) R(j, pb + i * ny + j) = data.u()(k, i);
-    }
     if (px > 0) R.rightCols(px).noalias() = C * P;
-    ys.middleRows(static_cast<Eigen::Index>(fill) * ny, ny) = data.y().row(k).transpose();
-    if (++fill == kBatch) flush();
+    for (int j = 0; j < ny; ++j) ls.add(R.row(j).data(), data.y()(k, j));
   }
-  flush();
-  // Column scaling, then the pseudo-inverse of the scaled normal equations.
-  const Eigen::MatrixXd Nf = NtN.selfadjointView<Eigen::Lower>();
-  Eigen::VectorXd sc = Nf.diagonal().cwiseSqrt();
-  for (Eigen::Index j = 0; j < sc.size(); ++j)
-    if (!(sc(j) > 0)) sc(j) = 1.0;
-  const Eigen::MatrixXd Ns = sc.cwiseInverse().asDiagonal() * Nf * sc.cwiseInverse().asDiagonal();
-  const Eigen::VectorXd theta = sc.cwiseInverse().asDiagonal() * (spd_pinv(Ns, -1.0, 1e-14) * (sc.cwiseInverse().asDiagonal() * Nty));
+  const Eigen::VectorXd theta = ls.solve().theta;
   Eigen::MatrixXd B(nx, nu), D = Eigen::MatrixXd::Zero(ny, nu);
   for (int i = 0; i < nu; ++i) B.col(i) = theta.segment(static_cast<Eigen::Index>(i) * nx, nx);
   if (pd > 0)
@@ -345,6 +327,7 @@ Result<StateSpace> subspace(const IdData& data, const SubspaceOptions& options) 
                "subspace: nx = {} needs (horizon - 1) * outputs >= nx (horizon {}, {} outputs)", options.nx, r, ny);
 
   Result<StateSpace> res;
+  const Scaled scale = scales(data);  // every output and input to unit standard deviation
   // The free parameters of a minimal realisation (A, B, C, D up to a change of basis) and the initial state.
   auto n_free = [&](int nx) {
     return nx * (nu + ny) + (options.estimate_d ? ny * nu : 0) + (options.estimate_initial_state ? nx : 0);
@@ -374,7 +357,7 @@ Result<StateSpace> subspace(const IdData& data, const SubspaceOptions& options) 
   for (size_t g = 0; g < grid.size(); ++g) {
     Estimate e;
     try {
-      e = estimate_at(data, options, r, grid[g]);
+      e = estimate_at(data, scale, options, r, grid[g]);
     } catch (const InvalidArgument& ex) {
       last_problem = ex.what();
       if (grid.size() == 1) throw;
@@ -383,7 +366,7 @@ Result<StateSpace> subspace(const IdData& data, const SubspaceOptions& options) 
     Fits f;
     f.all.fit_percent = -INFINITY;
     f.all.bic = INFINITY;
-    if (e.refusal.empty()) f = fits_of(e.model, data, e.x0, n_free(e.model.nx()));
+    if (e.refusal.empty()) f = fits_of(e.model, data, scale, e.x0, n_free(e.model.nx()));
     grid_fit(static_cast<Eigen::Index>(g)) = f.all.fit_percent;
     // A stable model before an unstable one, then the BIC.
     const bool stable = e.refusal.empty() && e.model.is_stable();

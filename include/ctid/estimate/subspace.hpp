@@ -16,10 +16,10 @@
 // axis or at 0: no real continuous-time A maps onto it).
 // Both routes then estimate B, D and the initial state x0 by linear least squares in continuous time: with A, C
 // fixed, y(t) = C e^{A t} x0 + sum_i C X_i(t) b_i + D u(t), X_i' = A X_i + I u_i (exact ZOH/FOH between samples),
-// accumulated in normal equations as the record streams by.
+// solved by the shared streaming least-squares kernel (blocked QR) as the record streams by.
 //
 // Memory is O(1) in the number of samples: the data enter only through Gram matrices of size
-// (2 r nu + r ny)^2 (continuous) or 2 r (nu + ny) squared (discrete) and the normal equations of (B, D, x0).
+// (2 r nu + r ny)^2 (continuous) or 2 r (nu + ny) squared (discrete) and the QR factor of the (B, D, x0) regression.
 #pragma once
 
 #include <vector>
