@@ -26,6 +26,7 @@ struct FitArgs {
   std::vector<std::string> params;
   std::string w = "w", re = "re", im = "im", u_re, u_im, y_re, y_im;
   std::string json, narx, report;
+  std::string nx, initial;  ///< subspace/ssest: state dimension N or range A:B; ssest: a starting model (JSON)
   bool force = false;
   std::set<std::string> given;  ///< long names of the options given on the command line
 };
@@ -54,8 +55,11 @@ void reject_flags_that_do_not_apply(const FitArgs& a) {
     refuse("model", "describes the model of --method physical or greybox (got " + m + ")");
   if (has("param") && m != "physical") refuse("param", "describes the model of --method physical (got " + m + ")");
   if (has("delay") && !tf_data) refuse("delay", "(delay estimation) needs --method srivc, oe or tfest (got " + m + ")");
+  if (has("nx") && m != "subspace" && m != "ssest") refuse("nx", "sets a state dimension: it needs --method subspace or ssest (got " + m + ")");
+  if (has("initial") && m != "ssest") refuse("initial", "gives ssest its starting model: it needs --method ssest (got " + m + ")");
   for (const char* f : {"nb", "nf", "nk"})
-    if (has(f) && (m == "narx" || m == "kia" || m == "fsf" || m == "physical" || m == "greybox" || m == "subspace"))
+    if (has(f) && (m == "narx" || m == "kia" || m == "fsf" || m == "physical" || m == "greybox" || m == "subspace" ||
+                   m == "ssest"))
       refuse(f, "sets transfer-function orders; " + m + " has its own structure settings (--set)");
   if (!a.frequency)
     for (const char* f : {"w", "re", "im", "u-re", "u-im", "y-re", "y-im"})
@@ -406,11 +410,17 @@ int run_miso(const FitArgs& a, const std::vector<IdData>& ds) {
   return finish(r, "srivc", ds.front(), a, settings_of(o), more_records_of(a, ds));
 }
 
+int run_ssest(const FitArgs& a, const std::vector<IdData>& ds);
+
 int run_experiments(const FitArgs& a) {
+  if (a.method == "ssest") {
+    if (a.frequency) throw UsageError("several DATA files: time-domain data only (not --frequency)");
+    return run_ssest(a, a.data.load_each(a.paths, true));
+  }
   if (a.method != "srivc" && a.method != "oe" && a.method != "tfest" && a.method != "lssvf" && a.method != "ivsvf" &&
       a.method != "rls-svf" && a.method != "narx" && a.method != "kia" && a.method != "physical" && a.method != "modal")
     throw UsageError(detail::format("{} DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, "
-                                    "lssvf, ivsvf, rls-svf, narx, kia, modal, physical --via raw or srivc with "
+                                    "lssvf, ivsvf, rls-svf, narx, kia, modal, ssest, physical --via raw or srivc with "
                                     "--closed-loop-controller (got {}; the other estimators take one record so far)",
                                     a.paths.size(), a.method));
   if (a.frequency) throw UsageError("several DATA files: time-domain data only (not --frequency)");
@@ -430,18 +440,63 @@ int run_experiments(const FitArgs& a) {
   return fit_experiments<OeOptions>(a, ds, a.method == "oe" ? static_cast<Joint>(&oe) : static_cast<Joint>(&tfest));
 }
 
+// --nx N or A:B: the state dimension (and the upper end of an order range), 0 when not given.
+std::pair<int, int> nx_of(const FitArgs& a) {
+  if (a.nx.empty()) return {0, 0};
+  const auto colon = a.nx.find(':');
+  auto number = [&](const std::string& t) {
+    if (t.empty() || t.find_first_not_of("0123456789") != std::string::npos || t.size() > 4 || std::stoi(t) < 1)
+      throw UsageError("--nx must be a state dimension N >= 1 or a range A:B (got '" + a.nx + "')");
+    return std::stoi(t);
+  };
+  if (colon == std::string::npos) return {number(a.nx), 0};
+  const int lo = number(a.nx.substr(0, colon)), hi = number(a.nx.substr(colon + 1));
+  if (hi < lo) throw UsageError("--nx A:B needs A <= B (got '" + a.nx + "')");
+  return {lo, hi};
+}
+
 // Subspace: any number of inputs and outputs, one record.
 int run_subspace(const FitArgs& a, const IdData& d) {
   SubspaceOptions o;
   apply_sets("subspace", a.sets, o);
+  const auto [nx, nx_max] = nx_of(a);
+  if (nx_max > 0) throw UsageError("--nx A:B (an order range) is for --method ssest; subspace takes one N (or none: "
+                                   "its singular values choose)");
+  if (nx > 0) o.nx = nx;
   const Result<StateSpace> r = call_library([&] { return subspace(d, o); });
   return finish(r, a.method, d, a, settings_of(o));
+}
+
+// ssest: any number of inputs and outputs, one or several records; the subspace start or --initial MODEL.json.
+int run_ssest(const FitArgs& a, const std::vector<IdData>& ds) {
+  SsestOptions o;
+  apply_sets("ssest", a.sets, o);
+  const auto [nx, nx_max] = nx_of(a);
+  if (nx > 0) o.nx = nx;
+  if (nx_max > 0) o.nx_max = nx_max;
+  Result<StateSpace> r;
+  if (!a.initial.empty()) {
+    const LinearModel m = [&] {
+      try {
+        return read_model_json(a.initial);
+      } catch (const std::exception& e) {
+        throw InputError(std::string("--initial: ") + e.what());
+      }
+    }();
+    if (!std::holds_alternative<StateSpace>(m))
+      throw UsageError("--initial " + a.initial + " holds a transfer function; ssest starts from a state-space model "
+                       "(\"type\": \"state_space\")");
+    r = call_library([&] { return ssest(ds, std::get<StateSpace>(m), o); });
+  } else {
+    r = call_library([&] { return ssest(ds, o); });
+  }
+  return finish(r, a.method, ds.front(), a, settings_of(o));
 }
 
 int run(const FitArgs& a) {
   reject_flags_that_do_not_apply(a);
   std::vector<std::string> inputs = a.paths;
-  inputs.insert(inputs.end(), {a.narx, a.controller, a.method == "greybox" ? a.model_expr : ""});
+  inputs.insert(inputs.end(), {a.narx, a.controller, a.initial, a.method == "greybox" ? a.model_expr : ""});
   check_outputs({a.json, a.report, a.responses.empty() ? "" : a.responses + "_time.csv",
                  a.responses.empty() ? "" : a.responses + "_freq.csv"},
                 inputs, a.force);
@@ -457,9 +512,10 @@ int run(const FitArgs& a) {
     return 0;
   });
   if (a.method == "subspace") return run_subspace(a, d);
+  if (a.method == "ssest") return run_ssest(a, {d});
   if (d.ny() != 1)
-    throw UsageError(detail::format("{} estimates single-output models (selected {} outputs; --method subspace takes "
-                                    "several)", a.method, d.ny()));
+    throw UsageError(detail::format("{} estimates single-output models (selected {} outputs; --method ssest and "
+                                    "subspace take several)", a.method, d.ny()));
   if (d.nu() > 1) return run_miso(a, {d});
   return fit_methods().at(a.method).run(a, d);
 }
@@ -478,6 +534,7 @@ const std::map<std::string, FitMethod>& fit_methods() {
       {"greybox", {{"greybox"}, [](const FitArgs& a, const IdData&) { return run_greybox(a); }}},
       {"modal", {{"modal"}, run_modal}},
       {"subspace", {{"subspace"}, run_subspace}},
+      {"ssest", {{"ssest"}, [](const FitArgs& a, const IdData& d) { return run_ssest(a, {d}); }}},
       {"narx",
        {{"narx"},
         [](const FitArgs& a, const IdData& d) { return run_narx_or_kia(a.method, {d}, a.sets, a.narx, a.json, a.report, {}); }}},
@@ -525,8 +582,8 @@ void setup_fit(CLI::App& app) {
   std::vector<std::string> names;
   for (const auto& [name, m] : fit_methods()) names.push_back(name);
   app.add_option("--method", a->method,
-                 "Estimator: srivc, tfest, oe, lssvf, ivsvf, rls-svf, fsf, physical, greybox, modal, narx, kia or subspace (with "
-                 "--help: its settings)")
+                 "Estimator: srivc, tfest, oe, lssvf, ivsvf, rls-svf, fsf, physical, greybox, modal, narx, kia, subspace or "
+                 "ssest (with --help: its settings)")
       ->check(CLI::IsMember(names))
       ->capture_default_str();
   g_fit_args = a;
@@ -569,6 +626,9 @@ void setup_fit(CLI::App& app) {
                  "fsf: write PREFIX_time.csv (step and impulse with standard deviations) and PREFIX_freq.csv (G(jw) with "
                  "standard deviations of its real and imaginary parts)");
   app.add_option("--narx", a->narx, "kia: the NARX model JSON to reconstruct from (otherwise a NARX model is fitted first)");
+  app.add_option("--nx", a->nx, "subspace, ssest: state dimension N, or ssest: a range A:B (the least BIC is kept)");
+  app.add_option("--initial", a->initial, "ssest: starting model, a state-space JSON file (a result of ctid fit --json); "
+                 "fixed.A1_2=.. entries refer to its coordinates");
   app.add_option("--json", a->json, "Write the result (model, parameters, fit) to this JSON file");
   app.add_option("--report", a->report, "Write a self-contained HTML report (plots, tests, parameters) to this file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");

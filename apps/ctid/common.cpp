@@ -290,9 +290,20 @@ void print_result(const Result<StateSpace>& r, const std::string& method, const 
   matrix("C", m.C());
   matrix("D", m.D());
   std::printf("modes: pole, natural frequency, damping ratio; shape = |C v| per output (phase, degrees)\n");
-  for (const Mode& mode : m.modes()) {
-    std::printf("  %12.6g %+12.6gj   wn = %.6g rad/s (%.6g Hz)   zeta = %.4g   shape", mode.pole.real(), mode.pole.imag(),
-                mode.wn, mode.wn / (2 * std::numbers::pi), mode.zeta);
+  const std::vector<Mode> modes = m.modes();
+  const bool with_std = r.diagnostics.has(diagnostic::mode_wn_std) &&
+                        r.diagnostics.get(diagnostic::mode_wn_std).size() == static_cast<Eigen::Index>(modes.size()) &&
+                        r.diagnostics.get(diagnostic::mode_wn_std).allFinite();
+  for (size_t k = 0; k < modes.size(); ++k) {
+    const Mode& mode = modes[k];
+    if (with_std)
+      std::printf("  %12.6g %+12.6gj   wn = %.6g +- %.2g rad/s (%.6g Hz)   zeta = %.4g +- %.2g   shape", mode.pole.real(),
+                  mode.pole.imag(), mode.wn, r.diagnostics.get(diagnostic::mode_wn_std)(static_cast<Eigen::Index>(k)),
+                  mode.wn / (2 * std::numbers::pi), mode.zeta,
+                  r.diagnostics.get(diagnostic::mode_zeta_std)(static_cast<Eigen::Index>(k)));
+    else
+      std::printf("  %12.6g %+12.6gj   wn = %.6g rad/s (%.6g Hz)   zeta = %.4g   shape", mode.pole.real(), mode.pole.imag(),
+                  mode.wn, mode.wn / (2 * std::numbers::pi), mode.zeta);
     for (Eigen::Index j = 0; j < mode.shape.size(); ++j) {
       // Whole degrees in (-180, 180], without a "-0".
       double deg = std::round(std::arg(mode.shape(j)) * 180 / std::numbers::pi);
@@ -302,6 +313,16 @@ void print_result(const Result<StateSpace>& r, const std::string& method, const 
     std::printf("\n");
   }
   if (r.diagnostics.has(diagnostic::tau)) std::printf("filter time constant tau = %.6g s\n", r.diagnostics.get(diagnostic::tau));
+  if (r.diagnostics.has(diagnostic::start_fit_percent))
+    std::printf("subspace start: fit %.2f %%; ", r.diagnostics.get(diagnostic::start_fit_percent));
+  if (r.diagnostics.has(diagnostic::cost)) std::printf("output-error refinement: %d iterations\n", r.summary.iterations);
+  if (r.diagnostics.has(diagnostic::nx_grid)) {
+    const Eigen::VectorXd& g = r.diagnostics.get(diagnostic::nx_grid);
+    const Eigen::VectorXd& b = r.diagnostics.get(diagnostic::nx_grid_bic);
+    std::printf("order search (BIC):");
+    for (Eigen::Index i = 0; i < g.size(); ++i) std::printf("  nx = %.0f: %.6g", g(i), b(i));
+    std::printf("\n");
+  }
   std::printf("fit: %.2f %% (every output scaled alike)", r.fit.fit_percent);
   if (r.diagnostics.has(diagnostic::output_fit_percent)) {
     const Eigen::VectorXd& f = r.diagnostics.get(diagnostic::output_fit_percent);

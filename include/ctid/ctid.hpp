@@ -15,6 +15,7 @@
 #include "ctid/estimate/frols.hpp"
 #include "ctid/estimate/gfrf.hpp"
 #include "ctid/estimate/greybox.hpp"
+#include "ctid/estimate/ssest.hpp"
 #include "ctid/estimate/subspace.hpp"
 #include "ctid/estimate/kia.hpp"
 #include "ctid/estimate/nde_oe.hpp"

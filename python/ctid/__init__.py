@@ -19,7 +19,7 @@ from ._ctid import (  # noqa: F401  (re-exported)
     InvalidOptions, MisoModel, ModalModel, ModalWindow, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm,
     NonlinearCorrelationTests, PhysicalModel, ResultFile, Simulation, StateSpace, TransferFunction, add_noise_snr, fit_percent, frequency_grid,
     generator_fitted_to_input, html_report,
-    input_residual_crosscorrelation, load, magnitude_band, methods, settings, diagnostics, narx_candidates, narx_noise_candidates,
+    input_residual_crosscorrelation, load, magnitude_band, mode_uncertainty, frequency_response_std, methods, settings, diagnostics, narx_candidates, narx_noise_candidates,
     nonlinear_correlation_tests, one_sided_dft, piecewise_constant_windows, prbs, read_narx_json, read_nde_json,
     greybox_initial_state, read_result, residual_autocorrelation, response_horizon, time_grid, write_result,
 )
@@ -367,6 +367,25 @@ def subspace(data, nx=0, **options):
     order from the singular values (r.diagnostics['singular_values']). Options: SubspaceOptions
     (ctid.settings('subspace'))."""
     return _ctid.subspace(data, _options(_ctid.SubspaceOptions, "subspace", {"nx": nx, **options}))
+
+
+def ssest(data, nx=0, initial=None, **options):
+    """MIMO continuous-time state space by output error (as `ctid fit --method ssest`): the subspace start (or
+    `initial`, a StateSpace) refined by weighted output error with exact sensitivities; returned in real modal form
+    with the parameter covariance, each mode's wn/zeta standard deviation (r.diagnostics['mode_wn_std'],
+    ['mode_zeta_std']) and each record's initial state. data: an IdData or a list of them (several records of one
+    system). nx = 0: the start's choice; nx_max=B fits nx..B and keeps the least BIC. Options: SsestOptions
+    (ctid.settings('ssest')), e.g. estimate_d=False, integrators=1, fixed={'D1_1': 0}."""
+    records = list(data) if isinstance(data, (list, tuple)) else [data]
+    return _ctid.ssest(records, initial, _options(_ctid.SsestOptions, "ssest", {"nx": nx, **options}))
+
+
+def ssest_crlb(truth, data, noise_variance, **options):
+    """The Cramer-Rao bound of ssest's parameters and modes at the true model `truth` for records with these inputs
+    and times (at rest) under white output noise of the given variances (one per output); the bound a Monte Carlo
+    study compares ssest's spread with (diagnostics mode_wn_std, mode_zeta_std). Options: as ssest."""
+    records = list(data) if isinstance(data, (list, tuple)) else [data]
+    return _ctid.ssest_crlb(truth, records, noise_variance, _options(_ctid.SsestOptions, "ssest", options))
 
 
 def modal_fit(data, nb, input=None, **options):

@@ -40,6 +40,33 @@ void bind_linear(py::module_& m) {
   m.def("subspace", [](const IdData& d, const SubspaceOptions& o) { return interruptible([&] { return subspace(d, o); }); },
         py::arg("data"), py::arg("options") = SubspaceOptions{},
         "MIMO continuous-time state space by subspace identification.");
+  bind_options<SsestOptions>(m, "SsestOptions");
+  m.def("ssest",
+        [](const std::vector<IdData>& d, const std::optional<StateSpace>& initial, const SsestOptions& o) {
+          return interruptible([&] { return initial ? ssest(d, *initial, o) : ssest(d, o); });
+        },
+        py::arg("data"), py::arg("initial") = std::nullopt, py::arg("options") = SsestOptions{},
+        "MIMO continuous-time state space by output error (records: a list of IdData; initial: a starting model).");
+  m.def("ssest_crlb", &ssest_crlb, py::arg("truth"), py::arg("data"), py::arg("noise_variance"),
+        py::arg("options") = SsestOptions{},
+        "Cramer-Rao bound of ssest's parameters and modes at a true model (records at rest, white output noise).");
+  m.def(
+      "mode_uncertainty",
+      [](const Result<StateSpace>& r) {
+        const std::vector<ModeUncertainty> u = mode_uncertainty(r);
+        Eigen::MatrixXd out(static_cast<Eigen::Index>(u.size()), 2);
+        for (size_t k = 0; k < u.size(); ++k) out.row(static_cast<Eigen::Index>(k)) << u[k].wn_std, u[k].zeta_std;
+        return out;
+      },
+      py::arg("result"), "Standard deviations [wn (rad/s), zeta] of each mode of a state-space result, one row per mode.");
+  m.def(
+      "frequency_response_std",
+      [](const Result<StateSpace>& r, const Eigen::VectorXd& w, int out, int in) {
+        const ResponseStd s = frequency_response_std(r, w, out, in);
+        return std::make_pair(s.magnitude, s.phase);
+      },
+      py::arg("result"), py::arg("w"), py::arg("out") = 0, py::arg("in") = 0,
+      "Standard deviations of |G(jw)| and arg G(jw) (rad) from input `in` to output `out` of a state-space result.");
   bind_options<IvsvfOptions>(m, "IvsvfOptions");
   bind_options<SrivcOptions>(m, "SrivcOptions");
   bind_options<OeOptions>(m, "OeOptions");

@@ -17,6 +17,7 @@
 #include "ctid/estimate/physical.hpp"
 #include "ctid/estimate/rls_svf.hpp"
 #include "ctid/estimate/srivc.hpp"
+#include "ctid/estimate/ssest.hpp"
 #include "ctid/estimate/subspace.hpp"
 
 namespace ctid {
@@ -114,6 +115,12 @@ const std::vector<MethodInfo>& methods() {
                              "discrete MOESP + logm)",
                              {"SubspaceOptions"},
                              reports(singular_values, output_fit_percent, x0, tau, tau_grid, tau_grid_fit_percent)),
+      entry<SsestOptions>("ssest",
+                          "MIMO continuous-time state space by output error from the subspace start (modal form, "
+                          "covariance, several records)",
+                          {"SsestOptions"},
+                          reports(singular_values, output_fit_percent, output_noise_variance, x0, start_fit_percent,
+                                  mode_wn_std, mode_zeta_std, cost, experiments, nx_grid, nx_grid_bic)),
   };
   return all;
 }

@@ -37,7 +37,10 @@ const OptionTable<SubspaceOptions>& option_table<SubspaceOptions>() {
                 "duration/50")
           .flag("estimate_d", &O::estimate_d, "estimate the direct term D (false: D = 0)")
           .flag("estimate_initial_state", &O::estimate_initial_state,
-                "estimate the record's initial state (false: it starts at rest)");
+                "estimate the record's initial state (false: it starts at rest)")
+          .flag("stabilize", &O::stabilize,
+                "move right-half-plane poles of A to the left half plane (re -> -re) before B, D and x0 are "
+                "estimated (false: keep them, e.g. for an unstable plant)");
   return t;
 }
 
@@ -197,6 +200,20 @@ Eigen::MatrixXd shift_invariance(const Eigen::MatrixXd& O, int ny) {
   return O.topRows(rows).completeOrthogonalDecomposition().solve(O.bottomRows(rows));
 }
 
+// A with each eigenvalue re + j im of re > 0 moved to -re + j im (same eigenvectors): the stable model nearest in
+// its modes. A spurious noise mode (typical of a subspace estimate from noisy, finely sampled data) then becomes a fast
+// stable mode instead of a response that overflows over the record.
+Eigen::MatrixXd reflected_into_left_half_plane(const Eigen::MatrixXd& A) {
+  Eigen::EigenSolver<Eigen::MatrixXd> es(A);
+  Eigen::VectorXcd l = es.eigenvalues();
+  if (es.info() != Eigen::Success || (l.real().array() <= 0.0).all()) return A;
+  for (Eigen::Index i = 0; i < l.size(); ++i)
+    if (l(i).real() > 0.0) l(i) = std::complex<double>(-l(i).real(), l(i).imag());
+  const Eigen::MatrixXcd V = es.eigenvectors();
+  const Eigen::MatrixXd R = (V * l.asDiagonal() * V.inverse()).real();
+  return R.allFinite() ? R : A;
+}
+
 // Subspace estimates at a given tau (or the discrete route), one per candidate order.
 struct Estimate {
   StateSpace model;
@@ -228,6 +245,7 @@ Estimate estimate_at(const IdData& d, const Scaled& s, const SubspaceOptions& o,
       }
     A = step.log() / d.ts();
   }
+  if (o.stabilize) A = reflected_into_left_half_plane(A);
   const Eigen::MatrixXd C = s.sy.asDiagonal() * O.topRows(ny);
   try {
     e.model = subspace_bd(A, C, d, o.estimate_d, o.estimate_initial_state, &e.x0);

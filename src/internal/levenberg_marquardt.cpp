@@ -51,24 +51,24 @@ Eigen::VectorXd solve(const Sparse& A, const Eigen::VectorXd& d, double lambda, 
 Eigen::VectorXd diagonal(const Eigen::MatrixXd& A) { return A.diagonal(); }
 Eigen::VectorXd diagonal(const Sparse& A) { return A.diagonal(); }
 
-template <class Jacobian, class Evaluate>
-LmResult lm(const Evaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& lo, const Eigen::VectorXd& hi,
+// The search on the normal equations: normal(x, cost, A, g) sets cost = 1/2 ||r||^2 and, when A and g are not null,
+// A = J^T J and g = J^T r (Normal: dense or sparse).
+template <class Normal, class Evaluate>
+LmResult lm(const Evaluate& normal, Eigen::VectorXd x, const Eigen::VectorXd& lo, const Eigen::VectorXd& hi,
             const LmOptions& o) {
-  using Normal = std::conditional_t<std::is_same_v<Jacobian, Sparse>, Sparse, Eigen::MatrixXd>;
   const Eigen::Index p = x.size();
   LmResult res;
   x = x.cwiseMax(lo).cwiseMin(hi);
-  Eigen::VectorXd r;
-  Jacobian J;
-  if (!evaluate(x, r, &J) || !r.allFinite() || !finite(J)) {
+  double cost = INFINITY;
+  Normal A;
+  Eigen::VectorXd g;
+  if (!normal(x, cost, &A, &g) || !std::isfinite(cost) || !finite(A) || !g.allFinite()) {
     res.x = x;
     res.cost = INFINITY;
     res.message = "the model cannot be evaluated at the initial parameters";
     return res;
   }
-  double cost = 0.5 * r.squaredNorm();
   double lambda = o.lambda0;
-  Eigen::VectorXd rt;
   for (int it = 1; it <= o.max_iterations; ++it) {
     if (!report_progress("levenberg_marquardt", it, cost)) {
       res.interrupted = true;
@@ -76,8 +76,6 @@ LmResult lm(const Evaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& 
       break;
     }
     res.iterations = it;
-    const Normal A = Normal(J.transpose()) * J;
-    const Eigen::VectorXd g = J.transpose() * r;  // gradient of the cost
     Eigen::VectorXd d = diagonal(A).cwiseMax(1e-300);
     // Active bounds: a parameter at a bound whose gradient pushes it outward stays there this iteration (its row and
     // column are decoupled), so the others move as if it were fixed instead of being projected back every time.
@@ -91,22 +89,17 @@ LmResult lm(const Evaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& 
       const Eigen::VectorXd step = solve(Ak, d, lambda, gk);
       const Eigen::VectorXd xt = (x + step).cwiseMax(lo).cwiseMin(hi);
       if (!step.allFinite()) { lambda *= 10; continue; }
-      if (evaluate(xt, rt, nullptr) && rt.allFinite()) {
-        const double ct = 0.5 * rt.squaredNorm();
-        if (ct < cost) {
-          double dx = 0;
-          for (Eigen::Index i = 0; i < p; ++i) dx = std::max(dx, std::abs(xt(i) - x(i)) / std::max(std::abs(xt(i)), 1e-8));
-          const double rel = (cost - ct) / std::max(cost, 1e-300);
-          x = xt;
-          cost = ct;
-          if (!evaluate(x, r, &J)) { res.message = "evaluation failed at an accepted point"; break; }
-          lambda = std::max(lambda / 10, 1e-12);
-          accepted = true;
-          if (rel < o.ftol || dx < o.xtol) {
-            res.converged = true;
-          }
-          continue;
-        }
+      double ct = INFINITY;
+      if (normal(xt, ct, nullptr, nullptr) && std::isfinite(ct) && ct < cost) {
+        double dx = 0;
+        for (Eigen::Index i = 0; i < p; ++i) dx = std::max(dx, std::abs(xt(i) - x(i)) / std::max(std::abs(xt(i)), 1e-8));
+        const double rel = (cost - ct) / std::max(cost, 1e-300);
+        x = xt;
+        if (!normal(x, cost, &A, &g)) { res.message = "evaluation failed at an accepted point"; break; }
+        lambda = std::max(lambda / 10, 1e-12);
+        accepted = true;
+        if (rel < o.ftol || dx < o.xtol) res.converged = true;
+        continue;
       }
       lambda *= 10;
     }
@@ -121,18 +114,41 @@ LmResult lm(const Evaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& 
   if (!res.converged && res.message.empty()) res.message = "iteration limit reached";
   res.x = x;
   res.cost = cost;
-  res.jtj = Eigen::MatrixXd(Normal(J.transpose()) * J);
+  res.jtj = Eigen::MatrixXd(A);
   return res;
+}
+
+// The residual form: the normal equations formed from r and J.
+template <class Jacobian, class Evaluate>
+LmResult lm_residuals(const Evaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& lo, const Eigen::VectorXd& hi,
+                      const LmOptions& o) {
+  using Normal = std::conditional_t<std::is_same_v<Jacobian, Sparse>, Sparse, Eigen::MatrixXd>;
+  Eigen::VectorXd r;
+  Jacobian J;
+  auto normal = [&](const Eigen::VectorXd& xv, double& cost, Normal* A, Eigen::VectorXd* g) {
+    if (!evaluate(xv, r, A ? &J : nullptr) || !r.allFinite() || (A && !finite(J))) return false;
+    cost = 0.5 * r.squaredNorm();
+    if (A) {
+      *A = Normal(J.transpose()) * J;
+      *g = J.transpose() * r;
+    }
+    return true;
+  };
+  return lm<Normal>(normal, std::move(x), lo, hi, o);
 }
 }  // namespace
 
 LmResult levenberg_marquardt(const LmEvaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& lo,
                              const Eigen::VectorXd& hi, const LmOptions& o) {
-  return lm<Eigen::MatrixXd>(evaluate, std::move(x), lo, hi, o);
+  return lm_residuals<Eigen::MatrixXd>(evaluate, std::move(x), lo, hi, o);
 }
 LmResult levenberg_marquardt(const LmSparseEvaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& lo,
                              const Eigen::VectorXd& hi, const LmOptions& o) {
-  return lm<Sparse>(evaluate, std::move(x), lo, hi, o);
+  return lm_residuals<Sparse>(evaluate, std::move(x), lo, hi, o);
+}
+LmResult levenberg_marquardt(const LmNormalEvaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& lo,
+                             const Eigen::VectorXd& hi, const LmOptions& o) {
+  return lm<Eigen::MatrixXd>(evaluate, std::move(x), lo, hi, o);
 }
 
 }  // namespace ctid::internal

@@ -49,9 +49,16 @@ void set_termination(Summary& summary, const LmResult& lm, const std::string& fa
                      const std::string& unidentifiable = "");
 
 
+/// The same from the normal equations: evaluate(x, cost, JtJ, Jtr) sets cost = 1/2 ||r||^2 and, when the pointers are
+/// not null, J^T J and J^T r — for callers that stream the residuals and never hold J (memory O(parameters^2)).
+using LmNormalEvaluate =
+    std::function<bool(const Eigen::VectorXd& x, double& cost, Eigen::MatrixXd* JtJ, Eigen::VectorXd* Jtr)>;
+
 LmResult levenberg_marquardt(const LmEvaluate& evaluate, Eigen::VectorXd x0, const Eigen::VectorXd& lower,
                              const Eigen::VectorXd& upper, const LmOptions& options);
 LmResult levenberg_marquardt(const LmSparseEvaluate& evaluate, Eigen::VectorXd x0, const Eigen::VectorXd& lower,
+                             const Eigen::VectorXd& upper, const LmOptions& options);
+LmResult levenberg_marquardt(const LmNormalEvaluate& evaluate, Eigen::VectorXd x0, const Eigen::VectorXd& lower,
                              const Eigen::VectorXd& upper, const LmOptions& options);
 
 }  // namespace ctid::internal

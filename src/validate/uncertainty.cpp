@@ -99,4 +99,123 @@ MagnitudeBand magnitude_band(const Result<TransferFunction>& r, const Eigen::Vec
   return band;
 }
 
+namespace {
+// "X<i>_<j>" -> (i-1, j-1); "pole<a>" etc. -> (a-1, -1); false when the name is not of that form.
+bool parse_indexed(const std::string& name, const std::string& prefix, int& i, int& j) {
+  if (name.rfind(prefix, 0) != 0) return false;
+  const std::string rest = name.substr(prefix.size());
+  const auto us = rest.find('_');
+  auto number = [](const std::string& t, int& v) {
+    if (t.empty() || t.find_first_not_of("0123456789") != std::string::npos || t.size() > 6) return false;
+    v = std::stoi(t) - 1;
+    return v >= 0;
+  };
+  if (us == std::string::npos) {
+    j = -1;
+    return number(rest, i);
+  }
+  return number(rest.substr(0, us), i) && number(rest.substr(us + 1), j);
+}
+}  // namespace
+
+std::vector<StateSpaceDirection> state_space_directions(const StateSpace& m, const ParameterSet& p) {
+  const int nx = m.nx(), nu = m.nu(), ny = m.ny();
+  std::vector<StateSpaceDirection> out;
+  for (const std::string& name : p.names) {
+    StateSpaceDirection d{Eigen::MatrixXd::Zero(nx, nx), Eigen::MatrixXd::Zero(nx, nu), Eigen::MatrixXd::Zero(ny, nx),
+                          Eigen::MatrixXd::Zero(ny, nu)};
+    int i = -1, j = -1;
+    auto entry = [&](Eigen::MatrixXd& M) {
+      CTID_REQUIRE(j >= 0 && i < M.rows() && j < M.cols(), "state_space_directions: parameter '{}' is outside the {}x{} "
+                   "matrix", name, M.rows(), M.cols());
+      M(i, j) = 1.0;
+    };
+    auto mode = [&](bool pair) {
+      CTID_REQUIRE(j < 0 && i + (pair ? 1 : 0) < nx, "state_space_directions: parameter '{}' is outside the {} states",
+                   name, nx);
+    };
+    if (parse_indexed(name, "A", i, j)) entry(d.dA);
+    else if (parse_indexed(name, "B", i, j)) entry(d.dB);
+    else if (parse_indexed(name, "C", i, j)) entry(d.dC);
+    else if (parse_indexed(name, "D", i, j)) entry(d.dD);
+    else if (parse_indexed(name, "pole", i, j)) { mode(false); d.dA(i, i) = 1.0; }
+    else if (parse_indexed(name, "sigma", i, j)) { mode(true); d.dA(i, i) = d.dA(i + 1, i + 1) = 1.0; }
+    else if (parse_indexed(name, "omega", i, j)) { mode(true); d.dA(i, i + 1) = 1.0; d.dA(i + 1, i) = -1.0; }
+    else CTID_REQUIRE(false, "state_space_directions: '{}' is not a parameter of a state-space model", name);
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
+namespace {
+// The covariance over the parameters, or an empty matrix when it is missing or not finite.
+Eigen::MatrixXd finite_covariance(const ParameterSet& p) {
+  const Eigen::MatrixXd& c = p.covariance;
+  if (c.rows() != p.size() || c.cols() != p.size() || !c.allFinite()) return {};
+  return c;
+}
+}  // namespace
+
+std::vector<ModeUncertainty> mode_uncertainty(const Result<StateSpace>& r) {
+  const std::vector<Mode> modes = r.model.modes();
+  const Eigen::MatrixXd cov = finite_covariance(r.parameters);
+  std::vector<ModeUncertainty> out(modes.size(), {NAN, NAN});
+  if (cov.size() == 0 || modes.empty()) return out;
+  const std::vector<StateSpaceDirection> dirs = state_space_directions(r.model, r.parameters);
+  Eigen::EigenSolver<Eigen::MatrixXd> es(r.model.A());
+  const Eigen::MatrixXcd V = es.eigenvectors(), Vi = V.inverse();
+  const Eigen::VectorXcd lam = es.eigenvalues();
+  for (size_t m = 0; m < modes.size(); ++m) {
+    Eigen::Index i = 0;
+    (lam.array() - modes[m].pole).abs().minCoeff(&i);
+    // Gradients of wn = |lambda| and zeta = -Re(lambda)/|lambda| along each parameter.
+    const std::complex<double> l = lam(i);
+    const double wn = std::abs(l);
+    Eigen::VectorXd gw(r.parameters.size()), gz(r.parameters.size());
+    for (size_t k = 0; k < dirs.size(); ++k) {
+      const std::complex<double> dl = (Vi.row(i) * dirs[k].dA.cast<std::complex<double>>() * V.col(i))(0, 0);
+      const double dwn = wn > 0 ? (std::conj(l) * dl).real() / wn : std::abs(dl);
+      gw(static_cast<Eigen::Index>(k)) = dwn;
+      gz(static_cast<Eigen::Index>(k)) = wn > 0 ? -(dl.real() * wn - l.real() * dwn) / (wn * wn) : 0.0;
+    }
+    out[m] = {std::sqrt(std::max(0.0, gw.dot(cov * gw))), std::sqrt(std::max(0.0, gz.dot(cov * gz)))};
+  }
+  return out;
+}
+
+ResponseStd frequency_response_std(const Result<StateSpace>& r, const Eigen::VectorXd& w, int out, int in) {
+  const StateSpace& m = r.model;
+  CTID_REQUIRE(out >= 0 && out < m.ny() && in >= 0 && in < m.nu(),
+               "frequency_response_std: output {} / input {} outside the model's {} outputs and {} inputs", out, in,
+               m.ny(), m.nu());
+  ResponseStd s{Eigen::VectorXd::Constant(w.size(), NAN), Eigen::VectorXd::Constant(w.size(), NAN)};
+  const Eigen::MatrixXd cov = finite_covariance(r.parameters);
+  if (cov.size() == 0) return s;
+  const std::vector<StateSpaceDirection> dirs = state_space_directions(m, r.parameters);
+  using C = std::complex<double>;
+  const int nx = m.nx();
+  const Eigen::MatrixXcd A = m.A().cast<C>();
+  const Eigen::VectorXcd b = m.B().col(in).cast<C>();
+  const Eigen::RowVectorXcd c = m.C().row(out).cast<C>();
+  for (Eigen::Index k = 0; k < w.size(); ++k) {
+    const Eigen::MatrixXcd R = (C(0, w(k)) * Eigen::MatrixXcd::Identity(nx, nx) - A).partialPivLu().inverse();
+    const Eigen::VectorXcd Rb = R * b;          // R B e_in
+    const Eigen::RowVectorXcd cR = c * R;       // e_out^T C R
+    const C G = (c * Rb)(0, 0) + m.D()(out, in);
+    if (!(std::abs(G) > 0)) continue;
+    // d|G| = Re(conj(G) dG)/|G|, d arg G = Im(dG / G).
+    Eigen::VectorXd gm(r.parameters.size()), gp(r.parameters.size());
+    for (size_t j = 0; j < dirs.size(); ++j) {
+      const StateSpaceDirection& d = dirs[j];
+      const C dG = (d.dC.row(out).cast<C>() * Rb)(0, 0) + (cR * d.dA.cast<C>() * Rb)(0, 0) +
+                   (cR * d.dB.col(in).cast<C>())(0, 0) + d.dD(out, in);
+      gm(static_cast<Eigen::Index>(j)) = (std::conj(G) * dG).real() / std::abs(G);
+      gp(static_cast<Eigen::Index>(j)) = (dG / G).imag();
+    }
+    s.magnitude(k) = std::sqrt(std::max(0.0, gm.dot(cov * gm)));
+    s.phase(k) = std::sqrt(std::max(0.0, gp.dot(cov * gp)));
+  }
+  return s;
+}
+
 }  // namespace ctid

@@ -1076,7 +1076,8 @@ TEST(Cli, MethodHelpListsEveryRegisteredSettingAndSetAcceptsIt) {
       {"lssvf", {"lssvf"}}, {"ivsvf", {"ivsvf"}}, {"rls-svf", {"rls_svf"}},
       {"srivc", {"srivc", "srivc_miso", "srivc_closed_loop"}}, {"oe", {"oe", "tf_from_frequency"}},
       {"tfest", {"tfest", "tf_from_frequency"}}, {"fsf", {"fsf"}}, {"physical", {"physical"}},
-      {"modal", {"modal"}}, {"narx", {"narx"}}, {"kia", {"kia", "narx"}}, {"greybox", {"greybox"}}, {"subspace", {"subspace"}}};
+      {"modal", {"modal"}}, {"narx", {"narx"}}, {"kia", {"kia", "narx"}}, {"greybox", {"greybox"}}, {"subspace", {"subspace"}},
+      {"ssest", {"ssest"}}};
   std::set<std::string> covered;
   for (const auto& [cli, entries] : cli_methods) {
     const CliRun h = ctid_run("fit --method " + cli + " --help");
@@ -1188,7 +1189,7 @@ TEST(Cli, SeveralDataFilesAreFittedJointly) {
   const CliRun o = ctid_run("fit " + files[0] + " " + files[1] + " --time time --input force --output position --method fsf");
   EXPECT_EQ(o.code, 2);
   EXPECT_NE(o.err.find("2 DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, lssvf, "
-                       "ivsvf, rls-svf, narx, kia, modal, physical --via raw or srivc with --closed-loop-controller (got fsf"),
+                       "ivsvf, rls-svf, narx, kia, modal, ssest, physical --via raw or srivc with --closed-loop-controller (got fsf"),
             std::string::npos)
       << o.err;
   // NARX on both records (resampled NARX at Ts = 0.02 s): the CLI's file equals the library's joint fit.
@@ -1437,4 +1438,69 @@ TEST(Cli, SubspaceFitsSeveralOutputsAndWritesAStateSpaceResult) {
   const CliRun nb = ctid_run("fit " + csv + " --ts 0.05 --input u1 --output y1 --method subspace --nf 2");
   EXPECT_EQ(nb.code, 2);
   EXPECT_NE(nb.err.find("--nf sets transfer-function orders"), std::string::npos) << nb.err;
+}
+
+TEST(Cli, SsestRefinesWithUncertaintyOrderRangeAndAStartingModel) {
+  // The two-mode system of issue 16 with 10 dB white noise on each output (seeded); reference: the true modes.
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(4, 4), B(4, 2), C(2, 4);
+  A.block(0, 0, 2, 2) << 0, 1, -4, -0.2;
+  A.block(2, 2, 2, 2) << 0, 1, -25, -2;
+  B << 0, 0, 1, 0.5, 0, 0, -0.4, 1;
+  C << 4, 0.5, 10, 0, 1, -1, 20, 2;
+  const StateSpace truth(A, B, C, Eigen::MatrixXd::Zero(2, 2));
+  const int N = 2000;
+  Eigen::MatrixXd u(N, 2);
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> level(-1, 1);
+  for (int k = 0; k < N; ++k)
+    for (int i = 0; i < 2; ++i) u(k, i) = k % 7 == 0 ? level(rng) : u(k - 1, i);
+  Eigen::MatrixXd y = lsim(truth, IdData(u, Eigen::MatrixXd::Zero(N, 2), 0.05));
+  std::normal_distribution<double> e(0, 1);
+  for (int j = 0; j < 2; ++j) {
+    const double s = std::sqrt((y.col(j).array() - y.col(j).mean()).square().mean() / 10.0);
+    for (int k = 0; k < N; ++k) y(k, j) += s * e(rng);
+  }
+  Eigen::MatrixXd m(N, 4);
+  m << u, y;
+  const std::string csv = test::temp_path("two_modes_noisy.csv");
+  write_csv(csv, {"u1", "u2", "y1", "y2"}, m);
+  const std::string io = csv + " --ts 0.05 --input u1 --input u2 --output y1 --output y2 --method ssest";
+  const std::string json = test::temp_path("two_modes_ssest.json");
+  const CliRun r = ctid_run("fit " + io + " --nx 4 --set estimate_d=0 --json " + json + " --force");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("subspace start: fit"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("termination: converged"), std::string::npos) << r.out;
+  // Each mode with its standard deviation; the slow mode's wn within 4 of them of 2 rad/s.
+  const ResultFile file = read_result_file(json);
+  const StateSpace& fitted = std::get<StateSpace>(file.result.model);
+  const double wn = fitted.modes()[0].wn;
+  const auto pos = r.out.find("wn = ");
+  ASSERT_NE(pos, std::string::npos);
+  const double sd = std::stod(r.out.substr(r.out.find("+- ", pos) + 3));
+  EXPECT_GT(sd, 0.0);
+  EXPECT_LT(std::abs(wn - 2.0), 4 * sd) << r.out;
+  EXPECT_EQ(file.result.parameters.names[0], "sigma1");
+  // An order range: the least BIC is 4 states, the search is printed.
+  const CliRun range = ctid_run("fit " + io + " --nx 3:5 --set estimate_d=0");
+  ASSERT_EQ(range.code, 0) << range.out << range.err;
+  EXPECT_NE(range.out.find("order search (BIC):  nx = 3:"), std::string::npos) << range.out;
+  EXPECT_NE(range.out.find("2 inputs, 2 outputs, 4 states"), std::string::npos) << range.out;
+  // From the fitted model: the search starts at its optimum (one or two iterations).
+  const CliRun again = ctid_run("fit " + io + " --initial " + json + " --set estimate_d=0");
+  ASSERT_EQ(again.code, 0) << again.out << again.err;
+  const auto it = again.out.find("output-error refinement: ");
+  ASSERT_NE(it, std::string::npos) << again.out;
+  EXPECT_LE(std::stoi(again.out.substr(it + 25)), 2) << again.out;
+  // Holding one entry of C in the starting model's coordinates leaves 15 of the 16 changes of basis free: the
+  // entries are not determined, and the answer says so (exit 1).
+  const CliRun loose = ctid_run("fit " + io + " --initial " + json + " --set estimate_d=0 fixed.C1_1=1");
+  EXPECT_EQ(loose.code, 1) << loose.out << loose.err;
+  EXPECT_NE(loose.err.find("leave 15 direction(s) of a change of state coordinates free"), std::string::npos) << loose.err;
+  // Bad input named.
+  const CliRun bad = ctid_run("fit " + io + " --nx 5:3");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("--nx A:B needs A <= B (got '5:3')"), std::string::npos) << bad.err;
+  const CliRun other = ctid_run("fit " + csv + " --ts 0.05 --input u1 --output y1 --method srivc --nx 2");
+  EXPECT_EQ(other.code, 2);
+  EXPECT_NE(other.err.find("--nx sets a state dimension"), std::string::npos) << other.err;
 }

@@ -92,6 +92,15 @@ inline constexpr VectorDiagnostic singular_values{"singular_values", "",
                                                   "singular values of the weighted projected output block (order choice)"};
 inline constexpr VectorDiagnostic output_fit_percent{"output_fit_percent", "%", "simulation fit of each output"};
 inline constexpr VectorDiagnostic x0{"x0", "", "fitted initial state of each record", true};
+// State-space output error (ssest, issue 16).
+inline constexpr VectorDiagnostic output_noise_variance{"output_noise_variance", "y^2",
+                                                        "variance of each output's error (the weights 1/variance of the cost)"};
+inline constexpr ScalarDiagnostic start_fit_percent{"start_fit_percent", "%", "simulation fit of the subspace start"};
+inline constexpr VectorDiagnostic mode_wn_std{"mode_wn_std", "rad/s",
+                                              "standard deviation of each mode's natural frequency (modes in model order)"};
+inline constexpr VectorDiagnostic mode_zeta_std{"mode_zeta_std", "", "standard deviation of each mode's damping ratio"};
+inline constexpr VectorDiagnostic nx_grid{"nx_grid", "", "state dimensions tried by the order search"};
+inline constexpr VectorDiagnostic nx_grid_bic{"nx_grid_bic", "", "BIC of the fit at each state dimension tried"};
 inline constexpr ScalarDiagnostic start_scale{"start_scale", "",
                                               "factor the NDE start was shrunk by until its simulation was finite"};
 // Grey-box output error.

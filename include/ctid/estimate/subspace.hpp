@@ -49,6 +49,10 @@ struct SubspaceOptions {
   double tau = 0.0;
   bool estimate_d = true;               ///< false: D = 0 (a strictly proper model)
   bool estimate_initial_state = true;   ///< false: the record starts at rest (x0 = 0)
+  /// Move each pole re + j im of A with re > 0 to -re + j im (same eigenvectors) before B, D and x0 are estimated:
+  /// a spurious noise mode of noisy, finely sampled data becomes a fast stable mode instead of a response that
+  /// overflows over the record. false: keep A as estimated (an unstable plant).
+  bool stabilize = true;
   void validate() const;
 };
 /// The settings of SubspaceOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "ctid/core/types.hpp"
+#include "ctid/model/state_space.hpp"
 #include "ctid/model/transfer_function.hpp"
 
 namespace ctid {
@@ -48,5 +49,32 @@ struct MagnitudeBand {
 /// coefficient of its model (e.g. physical parameters). Throws InvalidArgument for level outside (0, 1) or draws < 10.
 MagnitudeBand magnitude_band(const Result<TransferFunction>& r, const Eigen::VectorXd& w, double level = 0.95,
                              int draws = 200, unsigned seed = 1);
+
+// State-space results (ssest): what a parameter is, and the uncertainty of poles and frequency responses.
+
+/// The change of (A, B, C, D) per unit change of one parameter of a state-space result.
+struct StateSpaceDirection {
+  Eigen::MatrixXd dA, dB, dC, dD;
+};
+/// One direction per parameter of p, read from its name: A<i>_<j>, B<i>_<j>, C<i>_<j>, D<i>_<j> (that entry, 1-based),
+/// pole<a> (A(a,a)), sigma<a> (A(a,a) and A(a+1,a+1)), omega<a> (A(a,a+1) and, negated, A(a+1,a)) — the names of
+/// ssest's and subspace's parameters. Throws InvalidArgument for another name or an index outside m.
+std::vector<StateSpaceDirection> state_space_directions(const StateSpace& m, const ParameterSet& p);
+
+/// Standard deviations of each mode's natural frequency (rad/s) and damping ratio, in the order of
+/// r.model.modes(), from the parameter covariance by first-order propagation (the derivative of a simple eigenvalue:
+/// d lambda_i = (V^-1 dA V)_ii). NaN where there is no finite covariance.
+struct ModeUncertainty {
+  double wn_std = 0.0, zeta_std = 0.0;
+};
+std::vector<ModeUncertainty> mode_uncertainty(const Result<StateSpace>& r);
+
+/// Standard deviations of |G(jw)| and arg G(jw) (rad) from input `in` to output `out` at each w (rad/s), by
+/// first-order propagation of the parameter covariance (dG = dC R B + C R dA R B + C R dB + dD, R = (jwI - A)^-1).
+/// NaN where there is no finite covariance. Throws InvalidArgument for out/in outside the model.
+struct ResponseStd {
+  Eigen::VectorXd magnitude, phase;
+};
+ResponseStd frequency_response_std(const Result<StateSpace>& r, const Eigen::VectorXd& w, int out = 0, int in = 0);
 
 }  // namespace ctid

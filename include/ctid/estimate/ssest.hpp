@@ -1,0 +1,92 @@
+// ctid — multi-input multi-output continuous-time state space by output error (issue 16, item 2): `ssest` =
+// the subspace start (estimate/subspace.hpp) refined by prediction-error minimisation for white output noise.
+//
+// Cost: V = 1/2 sum_records sum_k sum_j w_j (y_j(t_k) - yhat_j(t_k))^2, yhat the exact simulation of
+// dx/dt = A x + B u, y = C x + D u from each record's initial state x0_e (ZOH/FOH inputs, any sample times), with
+// w_j = 1/sigma_j^2 the inverse noise variance of output j, re-estimated from the residuals of the converged model
+// and the search repeated once — the Gaussian maximum-likelihood estimate for independent white output noise of
+// unknown variances (Ljung 1999, "System Identification", §7.4 and §9.4: asymptotic covariance (J^T W J)^-1).
+//
+// Parametrisation: every entry of (A, B, C, D, x0_e) (the "full parametrisation" of McKelvey, Helmersson &
+// Ribarits 2004, "Data driven local coordinates for multivariable linear systems and their application to system
+// identification", Automatica 40(9), 1629-1635), searched in data-driven local coordinates: only in the directions
+// orthogonal to the tangent space of the change-of-basis manifold {(T^-1 A T, T^-1 B, C T, D, T^-1 x0)} at the
+// current model (their eq. 9-12), re-centred between rounds of Levenberg-Marquardt; states, inputs and outputs
+// scaled to unit variance at the start, so the search is well conditioned. Exact sensitivities: the derivative of
+// the output in a direction (dA, dB, dC, dD, dx0) is the output of the linear system
+//   [x; dx]' = [[A, 0], [dA, A]] [x; dx] + [B; dB] u,   dy = [dC, C] [x; dx] + dD u,   dx(0) = dx0,
+// discretised exactly like the model itself (Van Loan's block exponential), so it is exact for ZOH/FOH inputs on
+// any sample grid. The residuals stream through; only J^T W J and J^T W r are kept (memory O(N) for the data
+// themselves, O(parameters^2) for the search).
+//
+// Structure: D = 0 (estimate_d false); k known integrators (poles held at 0: A's first k columns zero); entries of
+// A, B, C, D held at values given by name in `fixed` (A, B, C entries only with a starting model, whose coordinates
+// they refer to). Result: without held A/B/C entries the model is returned in real modal form — A block diagonal,
+// a real pole p at state a ("pole<a>") or a pair sigma +- j omega as the block [[sigma, omega], [-omega, sigma]] at
+// states a, a+1 ("sigma<a>", "omega<a>"), modes in order of increasing natural frequency, each mode's scale fixed
+// by one entry of C (the largest of its column(s): 1, and 0 beside it for a pair) — a parametrisation in which
+// every parameter is determined by the data, with its covariance. With held A/B/C entries the model is returned in
+// the starting model's coordinates.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "ctid/core/types.hpp"
+#include "ctid/data/iddata.hpp"
+#include "ctid/estimate/options.hpp"
+#include "ctid/estimate/subspace.hpp"
+#include "ctid/model/state_space.hpp"
+
+namespace ctid {
+
+struct SsestOptions {
+  /// State dimension; 0 = the subspace start's choice (where its singular values drop most).
+  int nx = 0;
+  /// With nx_max > nx: every order nx..nx_max is fitted and the least BIC kept (diagnostics nx_grid, nx_grid_bic).
+  int nx_max = 0;
+  /// Levenberg-Marquardt iterations, summed over the rounds. Real records with unmodelled dynamics can need a few
+  /// hundred (the industrial dryer at nx = 5: 328); reaching the limit makes the result not usable.
+  int max_iterations = 500;
+  /// A round of the search ends when a step lowers the cost 1/2 sum_j sum_k e_j^2/sigma_j^2 (the squared errors in noise
+  /// standard deviations) by less than this: a move worth a small fraction of one standard deviation.
+  double tolerance = 1e-3;
+  bool estimate_d = true;       ///< false: D = 0 (a strictly proper model)
+  bool estimate_initial_state = true;  ///< false: each record starts at rest
+  /// Known pure integrators: k poles held at 0 (the first k states integrate; A's first k columns are zero).
+  int integrators = 0;
+  /// Entries held at a value by name: "D1_2" (row 1, column 2), and with a starting model "A1_1", "B2_1", "C1_3".
+  FixedValues fixed;
+  /// The subspace start's settings (horizon, route, tau, stabilize: CLI/Python start_horizon ..); its nx, estimate_d and estimate_initial_state are ssest's.
+  SubspaceOptions start;
+  void validate() const;
+};
+/// The settings of SsestOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
+template <>
+const OptionTable<SsestOptions>& option_table<SsestOptions>();
+
+/// Output-error estimate of a continuous-time state-space model from one record (see the file comment).
+/// Result: the model (modal form, or the starting model's coordinates when A/B/C entries are held); parameters
+/// with covariance; fit over all outputs (each scaled by its standard deviation); diagnostics output_fit_percent,
+/// output_noise_variance, x0, start_fit_percent, mode_wn_std and mode_zeta_std (aligned with model.modes()), cost,
+/// singular_values (of the start). Throws InvalidArgument for data without inputs, non-finite values or too few
+/// samples; InvalidOptions for bad options or a held entry that is not one of the model's. A search that cannot
+/// leave its start, ends at the iteration limit or leaves a parameter undetermined is returned with usable() false
+/// and the reason.
+Result<StateSpace> ssest(const IdData& data, const SsestOptions& options = {});
+/// Several records of one system: one (A, B, C, D), an initial state per record (diagnostics x0, x0_2, ..).
+/// The start is the subspace estimate on the longest record.
+Result<StateSpace> ssest(const std::vector<IdData>& data, const SsestOptions& options = {});
+/// The same from a given starting model (its nx; options.nx must be 0 or equal): held A/B/C entries refer to it.
+Result<StateSpace> ssest(const std::vector<IdData>& data, const StateSpace& initial, const SsestOptions& options = {});
+
+/// The Cramér-Rao bound of ssest's parameters at `truth` for records with these inputs and sample times, each starting
+/// at rest, under independent white output noise of the given variances (one per output): a Result in ssest's
+/// parametrisation (the modal form of `truth`) whose covariance is (J^T W J)^-1 at the truth (W = the inverse
+/// variances; the initial states, when estimate_initial_state, as nuisance parameters), with diagnostics mode_wn_std
+/// and mode_zeta_std — the bound a Monte Carlo study compares ssest's spread with. The outputs of `data` are used for
+/// the fits only. Throws InvalidArgument for mismatched sizes or non-positive variances.
+Result<StateSpace> ssest_crlb(const StateSpace& truth, const std::vector<IdData>& data, const Eigen::VectorXd& noise_variance,
+                              const SsestOptions& options = {});
+
+}  // namespace ctid

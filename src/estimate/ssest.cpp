@@ -1,0 +1,1048 @@
+// ctid — ssest: output-error refinement of a MIMO continuous-time state-space model (estimate/ssest.hpp).
+// McKelvey, Helmersson & Ribarits (2004) eqs 9-12 (data-driven local coordinates of the full parametrisation);
+// Ljung (1999) §7.4, §9.4 (the weighted output-error / ML criterion and its covariance); Van Loan (1978) block
+// exponentials for the exact sensitivities; the subspace start of estimate/subspace.hpp (JVC 1999).
+#include "ctid/estimate/ssest.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <tuple>
+
+#include "ctid/core/check.hpp"
+#include "ctid/core/error.hpp"
+#include "ctid/simulate/lsim.hpp"
+#include "ctid/validate/metrics.hpp"
+#include "ctid/validate/uncertainty.hpp"
+#include "internal/levenberg_marquardt.hpp"
+
+namespace ctid {
+
+template <>
+const OptionTable<SsestOptions>& option_table<SsestOptions>() {
+  using O = SsestOptions;
+  static const OptionTable<O> t =
+      OptionTable<O>("ssest")
+          .integer("nx", &O::nx, "", or_special(at_least(1), 0, "the subspace start's choice"), "state dimension")
+          .integer("nx_max", &O::nx_max, "", or_special(at_least(1), 0, "nx only"),
+                   "with nx_max > nx: fit every order nx..nx_max and keep the least BIC")
+          .integer("max_iterations", &O::max_iterations, "", at_least(1), "Levenberg-Marquardt iterations (all rounds)")
+          .real("tolerance", &O::tolerance, "", above(0),
+                "decrease of the cost (1/2 sum of squared errors in noise standard deviations) below which a round "
+                "ends")
+          .flag("estimate_d", &O::estimate_d, "estimate the direct term D (false: D = 0)")
+          .flag("estimate_initial_state", &O::estimate_initial_state,
+                "estimate each record's initial state (false: it starts at rest)")
+          .integer("integrators", &O::integrators, "", at_least(0),
+                   "known pure integrators: poles held at 0 (the first states integrate)")
+          .named_reals("fixed", &O::fixed,
+                       "entries held at a value by name (fixed.D1_1=0; A, B, C entries with a starting model)")
+          .include(&O::start, option_table<SubspaceOptions>(), {"horizon", "route", "tau", "stabilize"},
+                   {{"horizon", "start_horizon"}, {"route", "start_route"}, {"tau", "start_tau"},
+                    {"stabilize", "start_stabilize"}});
+  return t;
+}
+
+void SsestOptions::validate() const {
+  option_table<SsestOptions>().check(*this);
+  start.validate();
+  CTID_REQUIRE_OPTION(nx_max == 0 || nx_max >= std::max(nx, 1),
+                      "ssest: nx_max = {} must be at least nx = {} (or 0: nx only)", nx_max, nx);
+  CTID_REQUIRE_OPTION(nx_max == 0 || nx_max - std::max(nx, 1) <= 20, "ssest: nx_max - nx = {} orders are too many (at most 20)",
+                      nx_max - std::max(nx, 1));
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr int kBatch = 128;  // samples gathered before one rank-k update of J^T W J
+
+// A model with one initial state per record.
+struct Point {
+  Eigen::MatrixXd A, B, C, D;
+  std::vector<Eigen::VectorXd> x0;
+};
+
+// The parameter vector theta = [A | B | C | D (row-major) | x0 of each record].
+struct Layout {
+  int nx, nu, ny, E;
+  Eigen::Index a(int i, int j) const { return i * nx + j; }
+  Eigen::Index b(int i, int j) const { return nx * nx + i * nu + j; }
+  Eigen::Index c(int i, int j) const { return nx * nx + nx * nu + i * nx + j; }
+  Eigen::Index d(int i, int j) const { return nx * nx + nx * nu + ny * nx + i * nu + j; }
+  Eigen::Index x0(int e, int i) const { return nx * nx + nx * nu + ny * nx + ny * nu + e * nx + i; }
+  Eigen::Index size() const { return x0(E, 0); }
+};
+
+Eigen::VectorXd pack(const Layout& L, const Point& m) {
+  Eigen::VectorXd v(L.size());
+  for (int i = 0; i < L.nx; ++i)
+    for (int j = 0; j < L.nx; ++j) v(L.a(i, j)) = m.A(i, j);
+  for (int i = 0; i < L.nx; ++i)
+    for (int j = 0; j < L.nu; ++j) v(L.b(i, j)) = m.B(i, j);
+  for (int i = 0; i < L.ny; ++i)
+    for (int j = 0; j < L.nx; ++j) v(L.c(i, j)) = m.C(i, j);
+  for (int i = 0; i < L.ny; ++i)
+    for (int j = 0; j < L.nu; ++j) v(L.d(i, j)) = m.D(i, j);
+  for (int e = 0; e < L.E; ++e)
+    for (int i = 0; i < L.nx; ++i) v(L.x0(e, i)) = m.x0[static_cast<size_t>(e)](i);
+  return v;
+}
+
+Point unpack(const Layout& L, const Eigen::VectorXd& v) {
+  Point m{Eigen::MatrixXd(L.nx, L.nx), Eigen::MatrixXd(L.nx, L.nu), Eigen::MatrixXd(L.ny, L.nx),
+          Eigen::MatrixXd(L.ny, L.nu), std::vector<Eigen::VectorXd>(static_cast<size_t>(L.E), Eigen::VectorXd(L.nx))};
+  for (int i = 0; i < L.nx; ++i)
+    for (int j = 0; j < L.nx; ++j) m.A(i, j) = v(L.a(i, j));
+  for (int i = 0; i < L.nx; ++i)
+    for (int j = 0; j < L.nu; ++j) m.B(i, j) = v(L.b(i, j));
+  for (int i = 0; i < L.ny; ++i)
+    for (int j = 0; j < L.nx; ++j) m.C(i, j) = v(L.c(i, j));
+  for (int i = 0; i < L.ny; ++i)
+    for (int j = 0; j < L.nu; ++j) m.D(i, j) = v(L.d(i, j));
+  for (int e = 0; e < L.E; ++e)
+    for (int i = 0; i < L.nx; ++i) m.x0[static_cast<size_t>(e)](i) = v(L.x0(e, i));
+  return m;
+}
+
+// One record as the search sees it: inputs and outputs divided by the channel scales.
+struct Record {
+  Eigen::MatrixXd u, y;
+  Eigen::VectorXd t;
+  bool uniform = true;
+  double h = 0.0;
+  std::vector<bool> foh;
+};
+
+std::vector<Record> records_of(const std::vector<IdData>& ds, const Eigen::VectorXd& su, const Eigen::VectorXd& sy) {
+  std::vector<Record> out;
+  for (const IdData& d : ds) {
+    Record r;
+    r.u = d.u() * su.cwiseInverse().asDiagonal();
+    r.y = d.y() * sy.cwiseInverse().asDiagonal();
+    r.t = d.times();
+    r.uniform = d.is_uniform();
+    r.h = r.uniform && d.size() > 1 ? d.ts() : 0.0;
+    for (int i = 0; i < d.nu(); ++i) r.foh.push_back(d.intersample(i) != Intersample::Zoh);
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+// The exact one-interval maps of the model and of its sensitivities in P directions (stacked: block d of W1 is
+// nx x nx, of W2 and W3 nx x nu).
+struct Step {
+  double h = -1.0;
+  Eigen::MatrixXd Phi, G0, G1, W1, W2, W3;
+};
+
+Step step_of(const Point& m, const std::vector<Point>& dirs, double h, const std::vector<bool>& foh) {
+  const Eigen::Index nx = m.A.rows(), nu = m.B.cols();
+  const Eigen::Index P = static_cast<Eigen::Index>(dirs.size());
+  Step s;
+  s.h = h;
+  const Discretization base = discretize(m.A, m.B, h);
+  s.Phi = base.Phi;
+  s.G0 = base.Gamma0;
+  s.G1 = base.Gamma1;
+  for (Eigen::Index j = 0; j < nu; ++j)
+    if (!foh[static_cast<size_t>(j)]) s.G1.col(j).setZero();
+  s.W1.setZero(nx * P, nx);
+  s.W2.setZero(nx * P, nu);
+  s.W3.setZero(nx * P, nu);
+  Eigen::MatrixXd Ab = Eigen::MatrixXd::Zero(2 * nx, 2 * nx), Bb(2 * nx, nu);
+  Ab.topLeftCorner(nx, nx) = m.A;
+  Ab.bottomRightCorner(nx, nx) = m.A;
+  Bb.topRows(nx) = m.B;
+  for (Eigen::Index d = 0; d < P; ++d) {
+    const Point& q = dirs[static_cast<size_t>(d)];
+    if (q.A.isZero(0) && q.B.isZero(0)) continue;  // a direction of C, D or x0 only: no forcing of the state
+    Ab.bottomLeftCorner(nx, nx) = q.A;
+    Bb.bottomRows(nx) = q.B;
+    const Discretization a = discretize(Ab, Bb, h);  // Van Loan: the sensitivity blocks of the exponential
+    s.W1.middleRows(d * nx, nx) = a.Phi.bottomLeftCorner(nx, nx);
+    s.W2.middleRows(d * nx, nx) = a.Gamma0.bottomRows(nx);
+    s.W3.middleRows(d * nx, nx) = a.Gamma1.bottomRows(nx);
+    for (Eigen::Index j = 0; j < nu; ++j)
+      if (!foh[static_cast<size_t>(j)]) s.W3.block(d * nx, j, nx, 1).setZero();
+  }
+  return s;
+}
+
+// The weighted output-error cost 1/2 sum w_j e_j^2 of every record (sw = sqrt(w)); with JtJ/Jtr the normal equations
+// of the directions `dirs` (J = d e / d direction); with yhat each record's simulated outputs. False when a
+// simulation overflows. The record is processed kBatch samples at a time: the model's states of a batch first (a
+// cheap recursion), then the sensitivities' forcing and output terms of the whole batch as matrix products, the
+// sensitivity recursion dX_{k+1} = Phi dX_k + F_k, and one rank-k update of J^T W J.
+bool evaluate(const Point& m, const std::vector<Point>* dirs, const std::vector<Record>& recs, const Eigen::VectorXd& sw,
+              double& cost, Eigen::MatrixXd* JtJ, Eigen::VectorXd* Jtr, std::vector<Eigen::MatrixXd>* yhat = nullptr) {
+  const Eigen::Index nx = m.A.rows(), nu = m.B.cols(), ny = m.C.rows();
+  const bool sens = dirs && JtJ && Jtr;
+  const Eigen::Index P = sens ? static_cast<Eigen::Index>(dirs->size()) : 0;
+  const std::vector<Point> none;
+  cost = 0.0;
+  if (sens) {
+    JtJ->setZero(P, P);
+    Jtr->setZero(P);
+  }
+  if (yhat) yhat->clear();
+  Eigen::MatrixXd dCs(ny * P, nx), dDs(ny * P, nu);
+  for (Eigen::Index d = 0; d < P; ++d) {
+    dCs.middleRows(d * ny, ny) = (*dirs)[static_cast<size_t>(d)].C;
+    dDs.middleRows(d * ny, ny) = (*dirs)[static_cast<size_t>(d)].D;
+  }
+  // Per batch: states X, inputs U and their changes dU to the next sample, weighted residuals R, sensitivity states
+  // (Dall: the nx x P block of each sample side by side), forcing F, output terms G, J rows.
+  Eigen::MatrixXd X(nx, kBatch), U(nu, kBatch), dU(nu, kBatch), R(ny, kBatch), Dall(nx, P * kBatch),
+      F(nx * P, kBatch), G(ny * P, kBatch), CD(ny, P * kBatch), Jb(kBatch * ny, P), Delta(nx, P);
+  Eigen::VectorXd x(nx), xn(nx), yk(ny);
+  for (size_t e = 0; e < recs.size(); ++e) {
+    const Record& rec = recs[e];
+    const Eigen::Index N = rec.u.rows();
+    std::vector<Step> cache;
+    auto step = [&](double h) -> const Step& {
+      for (const Step& s : cache)
+        if (std::abs(s.h - h) <= 1e-13 * h) return s;
+      if (cache.size() >= 4) cache.erase(cache.begin());
+      cache.push_back(step_of(m, sens ? *dirs : none, h, rec.foh));
+      return cache.back();
+    };
+    auto h_at = [&](Eigen::Index k) { return rec.uniform ? rec.h : rec.t(k + 1) - rec.t(k); };
+    x = m.x0[e];
+    for (Eigen::Index d = 0; d < P; ++d) Delta.col(d) = (*dirs)[static_cast<size_t>(d)].x0[e];
+    if (yhat) yhat->emplace_back(N, ny);
+    for (Eigen::Index k0 = 0; k0 < N; k0 += kBatch) {
+      const Eigen::Index n = std::min<Eigen::Index>(kBatch, N - k0);
+      // The model over the batch (x at each sample; x carried to the next batch).
+      for (Eigen::Index i = 0; i < n; ++i) {
+        const Eigen::Index k = k0 + i;
+        X.col(i) = x;
+        U.col(i) = rec.u.row(k).transpose();
+        yk.noalias() = m.C * x;
+        yk.noalias() += m.D * U.col(i);
+        if (yhat) yhat->back().row(k) = yk.transpose();
+        R.col(i) = (rec.y.row(k).transpose() - yk).cwiseProduct(sw);
+        if (k + 1 == N) {
+          dU.col(i).setZero();
+          break;
+        }
+        const Step& s = step(h_at(k));
+        dU.col(i) = rec.u.row(k + 1).transpose() - U.col(i);
+        xn.noalias() = s.Phi * x;
+        xn.noalias() += s.G0 * U.col(i);
+        xn.noalias() += s.G1 * dU.col(i);
+        x.swap(xn);
+      }
+      cost += 0.5 * R.leftCols(n).squaredNorm();
+      if (!x.allFinite() || !std::isfinite(cost)) return false;
+      if (!sens) continue;
+      // Sensitivities: the output terms dC x + dD u, the forcing of the next sample's sensitivity states.
+      G.leftCols(n).noalias() = dCs * X.leftCols(n);
+      G.leftCols(n).noalias() += dDs * U.leftCols(n);
+      const bool uniform = rec.uniform;
+      if (uniform && N > 1) {
+        const Step& s = step(rec.h);
+        F.leftCols(n).noalias() = s.W1 * X.leftCols(n);
+        F.leftCols(n).noalias() += s.W2 * U.leftCols(n);
+        F.leftCols(n).noalias() += s.W3 * dU.leftCols(n);
+      }
+      for (Eigen::Index i = 0; i < n; ++i) {
+        const Eigen::Index k = k0 + i;
+        Dall.middleCols(i * P, P) = Delta;
+        if (k + 1 == N) break;
+        const Step& s = step(h_at(k));
+        if (!uniform) {
+          F.col(i).noalias() = s.W1 * X.col(i);
+          F.col(i).noalias() += s.W2 * U.col(i);
+          F.col(i).noalias() += s.W3 * dU.col(i);
+        }
+        Delta.noalias() = s.Phi * Dall.middleCols(i * P, P);
+        Delta += Eigen::Map<const Eigen::MatrixXd>(F.col(i).data(), nx, P);
+      }
+      CD.leftCols(n * P).noalias() = m.C * Dall.leftCols(n * P);
+      for (Eigen::Index i = 0; i < n; ++i)
+        Jb.middleRows(i * ny, ny).noalias() =
+            -(sw.asDiagonal() * (CD.middleCols(i * P, P) + Eigen::Map<const Eigen::MatrixXd>(G.col(i).data(), ny, P)));
+      const Eigen::Index rows = n * ny;
+      JtJ->selfadjointView<Eigen::Lower>().rankUpdate(Jb.topRows(rows).transpose());
+      Jtr->noalias() += Jb.topRows(rows).transpose() * Eigen::Map<const Eigen::VectorXd>(R.data(), rows);
+    }
+  }
+  if (sens) *JtJ = JtJ->selfadjointView<Eigen::Lower>();
+  return std::isfinite(cost) && (!sens || (JtJ->allFinite() && Jtr->allFinite()));
+}
+
+// Data-driven local coordinates: an orthonormal basis of the free entries of (A, B, C, D) orthogonal to the tangent of
+// the change-of-basis manifold that keeps the held entries (McKelvey et al. 2004 eq. 10: the tangent at T = I + X
+// is (XA - AX, XB, -CX, 0)), plus each free initial-state entry on its own (no change of basis moves (A, B, C, D)
+// and x0 alone, so this removes the same redundancy; a direction of x0 alone needs no sensitivity exponential).
+// `similar` receives the dimension of the tangent removed.
+Eigen::MatrixXd local_directions(const Layout& L, const Point& m, const std::vector<bool>& held, int* similar = nullptr) {
+  const Eigen::Index n = L.size(), nx = L.nx, nm = L.x0(0, 0);  // nm: the entries of (A, B, C, D)
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(nm, nx * nx);
+  for (int i = 0; i < L.nx; ++i)
+    for (int j = 0; j < L.nx; ++j) {
+      const Eigen::Index col = i * nx + j;  // X = e_i e_j^T
+      for (int c = 0; c < L.nx; ++c) M(L.a(i, c), col) += m.A(j, c);    // X A: row i gets A's row j
+      for (int r = 0; r < L.nx; ++r) M(L.a(r, j), col) -= m.A(r, i);    // A X: column j gets A's column i
+      for (int c = 0; c < L.nu; ++c) M(L.b(i, c), col) += m.B(j, c);    // X B
+      for (int r = 0; r < L.ny; ++r) M(L.c(r, j), col) -= m.C(r, i);    // -C X
+    }
+  std::vector<Eigen::Index> free_rows, held_rows, free_x0;
+  for (Eigen::Index k = 0; k < nm; ++k) (held[static_cast<size_t>(k)] ? held_rows : free_rows).push_back(k);
+  for (Eigen::Index k = nm; k < n; ++k)
+    if (!held[static_cast<size_t>(k)]) free_x0.push_back(k);
+  // Changes of basis that keep every held entry: the null space of the held rows of M.
+  Eigen::MatrixXd keep = Eigen::MatrixXd::Identity(nx * nx, nx * nx);
+  if (!held_rows.empty()) {
+    Eigen::MatrixXd Mh(static_cast<Eigen::Index>(held_rows.size()), nx * nx);
+    for (size_t k = 0; k < held_rows.size(); ++k) Mh.row(static_cast<Eigen::Index>(k)) = M.row(held_rows[k]);
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(Mh, Eigen::ComputeFullV);
+    const Eigen::VectorXd& s = svd.singularValues();
+    const double tol = 1e-10 * std::max(s.size() ? s(0) : 0.0, 1.0);
+    Eigen::Index rank = 0;
+    while (rank < s.size() && s(rank) > tol) ++rank;
+    keep = svd.matrixV().rightCols(nx * nx - rank);
+  }
+  const Eigen::Index nf = static_cast<Eigen::Index>(free_rows.size());
+  Eigen::MatrixXd T(nf, keep.cols());
+  const Eigen::MatrixXd MK = M * keep;
+  for (Eigen::Index k = 0; k < nf; ++k) T.row(k) = MK.row(free_rows[static_cast<size_t>(k)]);
+  Eigen::Index rank = 0;
+  Eigen::MatrixXd U = Eigen::MatrixXd::Identity(nf, nf);
+  if (T.cols() > 0 && nf > 0) {
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(T, Eigen::ComputeFullU);
+    const Eigen::VectorXd& s = svd.singularValues();
+    const double tol = 1e-10 * std::max(s.size() ? s(0) : 0.0, 1.0);
+    while (rank < s.size() && s(rank) > tol) ++rank;
+    U = svd.matrixU();
+  }
+  if (similar) *similar = static_cast<int>(rank);
+  const Eigen::Index nq = nf - rank, nx0 = static_cast<Eigen::Index>(free_x0.size());
+  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(n, nq + nx0);
+  for (Eigen::Index k = 0; k < nf; ++k) Q.row(free_rows[static_cast<size_t>(k)]).head(nq) = U.row(k).tail(nq);
+  for (Eigen::Index k = 0; k < nx0; ++k) Q(free_x0[static_cast<size_t>(k)], nq + k) = 1.0;
+  return Q;
+}
+
+std::vector<Point> directions_of(const Layout& L, const Eigen::MatrixXd& Q) {
+  std::vector<Point> dirs;
+  for (Eigen::Index d = 0; d < Q.cols(); ++d) dirs.push_back(unpack(L, Q.col(d)));
+  return dirs;
+}
+
+// Per-output residual variances of a model (scaled units), pooled over the records.
+Eigen::VectorXd residual_variances(const Point& m, const std::vector<Record>& recs) {
+  std::vector<Eigen::MatrixXd> yh;
+  double cost = 0.0;
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(m.C.rows());
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(m.C.rows());
+  if (!evaluate(m, nullptr, recs, ones, cost, nullptr, nullptr, &yh)) return Eigen::VectorXd::Constant(m.C.rows(), NAN);
+  Eigen::Index n = 0;
+  for (size_t e = 0; e < recs.size(); ++e) {
+    v += (recs[e].y - yh[e]).colwise().squaredNorm().transpose();
+    n += recs[e].y.rows();
+  }
+  return v / static_cast<double>(std::max<Eigen::Index>(n, 1));
+}
+
+struct Search {
+  Eigen::VectorXd theta;
+  Eigen::VectorXd weights;  // 1/sigma_j^2 (scaled units)
+  int iterations = 0;
+  internal::LmResult last;
+  bool failed_start = false;
+};
+
+// Rounds of Levenberg-Marquardt in local coordinates re-centred after each round, then the weights re-estimated and
+// the search repeated once (weighted output error = ML for independent Gaussian output noise).
+Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& held, const std::vector<Record>& recs,
+              const SsestOptions& o) {
+  Search s;
+  s.weights = residual_variances(unpack(L, theta), recs).cwiseMax(1e-12).cwiseInverse();
+  if (!s.weights.allFinite()) {
+    s.failed_start = true;
+    s.theta = theta;
+    return s;
+  }
+  internal::LmOptions lmo;
+  lmo.xtol = 1e-10;
+  int left = o.max_iterations;
+  for (int pass = 0; pass < 2; ++pass) {
+    const Eigen::VectorXd sw = s.weights.cwiseSqrt();
+    bool converged = false;
+    while (left > 0 && !converged) {
+      const Eigen::MatrixXd Q = local_directions(L, unpack(L, theta), held);
+      const std::vector<Point> dirs = directions_of(L, Q);
+      auto normal = [&](const Eigen::VectorXd& xi, double& cost, Eigen::MatrixXd* A, Eigen::VectorXd* g) {
+        const Point m = unpack(L, theta + Q * xi);
+        return evaluate(m, A ? &dirs : nullptr, recs, sw, cost, A, g);
+      };
+      lmo.max_iterations = std::min(left, 25);
+      // The cost is in noise units (1/2 sum of e^2/sigma^2): a round ends when a step gains less than `tolerance`.
+      double c0 = 0.0;
+      if (evaluate(unpack(L, theta), nullptr, recs, sw, c0, nullptr, nullptr) && c0 > 0) lmo.ftol = o.tolerance / c0;
+      internal::LmResult lm = internal::levenberg_marquardt(internal::LmNormalEvaluate(normal),
+                                                            Eigen::VectorXd::Zero(Q.cols()),
+                                                            Eigen::VectorXd::Constant(Q.cols(), -INFINITY),
+                                                            Eigen::VectorXd::Constant(Q.cols(), INFINITY), lmo);
+      if (!std::isfinite(lm.cost)) {
+        s.failed_start = s.iterations == 0;
+        s.last = lm;
+        s.theta = theta;
+        return s;
+      }
+      theta += Q * lm.x;
+      left -= std::max(lm.iterations, 1);
+      s.iterations += lm.iterations;
+      converged = lm.converged || lm.interrupted;
+      s.last = lm;
+      if (lm.interrupted) break;
+    }
+    if (s.last.interrupted || !converged) break;
+    if (pass == 0) {
+      const Eigen::VectorXd w = residual_variances(unpack(L, theta), recs).cwiseMax(1e-12).cwiseInverse();
+      if (!w.allFinite()) break;
+      const double change = ((w - s.weights).array().abs() / s.weights.array()).maxCoeff();
+      s.weights = w;
+      // Weights within 10 % of those the search ran with: the optimum moves by a negligible fraction of its standard
+      // deviation (the loss of efficiency is second order in the weights' error), so no second search.
+      if (change < 0.1) break;
+    }
+  }
+  s.theta = theta;
+  return s;
+}
+
+// A change of state coordinates x = T z applied to a model.
+Point transformed(const Point& m, const Eigen::MatrixXd& T) {
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(T);
+  Point r{lu.solve(m.A * T), lu.solve(m.B), m.C * T, m.D, {}};
+  for (const auto& x : m.x0) r.x0.push_back(lu.solve(x));
+  return r;
+}
+
+// Input and output scaling of a model: u = su .* u_s, y = sy .* y_s.
+Point scaled(const Point& m, const Eigen::VectorXd& su, const Eigen::VectorXd& sy) {
+  return {m.A, m.B * su.asDiagonal(), sy.cwiseInverse().asDiagonal() * m.C,
+          sy.cwiseInverse().asDiagonal() * m.D * su.asDiagonal(), m.x0};
+}
+Point unscaled(const Point& m, const Eigen::VectorXd& su, const Eigen::VectorXd& sy) {
+  return scaled(m, su.cwiseInverse(), sy.cwiseInverse());
+}
+
+// Real modal form (see the header) of a model with distinct poles; the first `integrators` states keep their block
+// (poles at 0) with k x k rows of C set to the identity. Returns false when the eigenvectors are too ill-conditioned
+// (nearly repeated poles), leaving the model as it was.
+struct ModalForm {
+  Point model;
+  std::vector<std::string> names;    // the parameters of A: pole<a>, sigma<a>, omega<a> (in state order)
+  std::vector<std::tuple<int, int, double>> c_held;  // entries of C fixed by the normalisation (row, column, value)
+};
+bool modal_form(const Point& m, int integrators, ModalForm& out) {
+  const int nx = static_cast<int>(m.A.rows());
+  Eigen::EigenSolver<Eigen::MatrixXd> es(m.A);
+  if (es.info() != Eigen::Success) return false;
+  const Eigen::VectorXcd lam = es.eigenvalues();
+  const Eigen::MatrixXcd V = es.eigenvectors();
+  // The integrators' states come first and stay as they are (their columns of A are zero).
+  struct Entry {
+    double wn;
+    int index;
+  };
+  std::vector<Entry> order;
+  std::vector<bool> used(static_cast<size_t>(nx), false);
+  for (int i = 0; i < nx; ++i) {
+    if (lam(i).imag() < 0) continue;  // a pair is listed once, by its member with imag > 0
+    order.push_back({std::abs(lam(i)), i});
+  }
+  // The integrator poles: the `integrators` real eigenvalues nearest 0 (exactly 0 by construction).
+  std::sort(order.begin(), order.end(), [](const Entry& a, const Entry& b) { return a.wn < b.wn; });
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(nx, nx);
+  int col = 0;
+  out.names.clear();
+  out.c_held.clear();
+  if (integrators > 0) {
+    T.leftCols(integrators) = Eigen::MatrixXd::Identity(nx, integrators);
+    col = integrators;
+  }
+  int skipped = 0;
+  for (const Entry& en : order) {
+    const std::complex<double> l = lam(en.index);
+    if (skipped < integrators && l.imag() == 0.0) {
+      ++skipped;
+      continue;
+    }
+    if (l.imag() == 0.0) {
+      T.col(col) = V.col(en.index).real();
+      out.names.push_back("pole" + std::to_string(col + 1));
+      ++col;
+    } else {
+      if (col + 2 > nx) return false;
+      T.col(col) = V.col(en.index).real();
+      T.col(col + 1) = V.col(en.index).imag();
+      out.names.push_back("sigma" + std::to_string(col + 1));
+      out.names.push_back("omega" + std::to_string(col + 1));
+      col += 2;
+    }
+  }
+  if (col != nx) return false;
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(T);
+  const Eigen::VectorXd& sv = svd.singularValues();
+  if (!(sv(nx - 1) > 1e-10 * sv(0))) return false;
+  Point p = transformed(m, T);
+  // Exact block structure, and each mode's scale fixed by the largest entry of its C column(s).
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(nx, nx);
+  Eigen::MatrixXd S = Eigen::MatrixXd::Identity(nx, nx);  // the per-mode rescaling
+  if (integrators > 0) {
+    // Rows of C that make the integrators' block of C the identity.
+    const Eigen::MatrixXd Ci = p.C.leftCols(integrators);
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Ci.transpose());
+    if (qr.rank() < integrators) return false;
+    Eigen::MatrixXd sub(integrators, integrators);
+    for (int k = 0; k < integrators; ++k) {
+      const int row = static_cast<int>(qr.colsPermutation().indices()(k));
+      sub.row(k) = Ci.row(row);
+      for (int c = 0; c < integrators; ++c) out.c_held.emplace_back(row, c, c == k ? 1.0 : 0.0);
+    }
+    S.topLeftCorner(integrators, integrators) = sub.inverse();
+  }
+  for (int a = integrators; a < nx;) {
+    const bool pair = a + 1 < nx && std::abs(p.A(a, a + 1)) > 1e-12 * (1.0 + p.A.cwiseAbs().maxCoeff()) &&
+                      out.names[static_cast<size_t>(a - integrators)].rfind("sigma", 0) == 0;
+    Eigen::Index row = 0;
+    if (!pair) {
+      A(a, a) = p.A(a, a);
+      p.C.col(a).cwiseAbs().maxCoeff(&row);
+      if (!(std::abs(p.C(row, a)) > 0)) return false;
+      S(a, a) = 1.0 / p.C(row, a);
+      out.c_held.emplace_back(static_cast<int>(row), a, 1.0);
+      a += 1;
+    } else {
+      const double sigma = 0.5 * (p.A(a, a) + p.A(a + 1, a + 1)), omega = 0.5 * (p.A(a, a + 1) - p.A(a + 1, a));
+      A(a, a) = A(a + 1, a + 1) = sigma;
+      A(a, a + 1) = omega;
+      A(a + 1, a) = -omega;
+      (p.C.col(a).array().square() + p.C.col(a + 1).array().square()).maxCoeff(&row);
+      const double c1 = p.C(row, a), c2 = p.C(row, a + 1), n2 = c1 * c1 + c2 * c2;
+      if (!(n2 > 0)) return false;
+      // z -> (alpha I + beta J) z commutes with the block; it maps [c1, c2] to [1, 0].
+      const double al = c1 / n2, be = -c2 / n2;
+      S(a, a) = al;
+      S(a, a + 1) = be;
+      S(a + 1, a) = -be;
+      S(a + 1, a + 1) = al;
+      out.c_held.emplace_back(static_cast<int>(row), a, 1.0);
+      out.c_held.emplace_back(static_cast<int>(row), a + 1, 0.0);
+      a += 2;
+    }
+  }
+  p.A = A;
+  p = transformed(p, S);
+  p.A = A;  // exact (the scaling commutes with each block)
+  for (const auto& [r, c, v] : out.c_held) p.C(r, c) = v;  // exact normalisation
+  out.model = p;
+  return true;
+}
+
+struct Fits {
+  FitReport all;
+  Eigen::VectorXd per_output;
+};
+
+Fits fits_of(const std::vector<IdData>& ds, const std::vector<Eigen::MatrixXd>& yhat, const Eigen::VectorXd& sy,
+             int n_parameters) {
+  const int ny = ds.front().ny();
+  Eigen::Index n = 0;
+  for (const IdData& d : ds) n += d.size();
+  Eigen::VectorXd y(n * ny), h(n * ny);
+  Fits f;
+  f.per_output.resize(ny);
+  for (int j = 0; j < ny; ++j) {
+    Eigen::VectorXd yj(n), hj(n);
+    Eigen::Index at = 0;
+    for (size_t e = 0; e < ds.size(); ++e) {
+      const Eigen::Index m = ds[e].size();
+      yj.segment(at, m) = ds[e].y().col(j);
+      hj.segment(at, m) = yhat[e].col(j);
+      at += m;
+    }
+    f.per_output(j) = fit_report_or_inf(yj, hj, n_parameters).fit_percent;
+    const double mean = yj.mean();
+    y.segment(j * n, n) = (yj.array() - mean) / sy(j);
+    h.segment(j * n, n) = (hj.array() - mean) / sy(j);
+  }
+  f.all = fit_report_or_inf(y, h, n_parameters);
+  return f;
+}
+
+void check_records(const std::vector<IdData>& ds) {
+  CTID_REQUIRE(!ds.empty(), "ssest: no records were given");
+  const int nu = ds.front().nu(), ny = ds.front().ny();
+  CTID_REQUIRE(nu >= 1 && ny >= 1, "ssest: the data need at least one input and one output (got {} and {})", nu, ny);
+  for (size_t e = 0; e < ds.size(); ++e) {
+    const IdData& d = ds[e];
+    CTID_REQUIRE(d.nu() == nu && d.ny() == ny, "ssest: record {} has {} inputs and {} outputs, record 1 has {} and {}",
+                 e + 1, d.nu(), d.ny(), nu, ny);
+    CTID_REQUIRE(d.u().allFinite() && d.y().allFinite(), "ssest: record {} contains non-finite values", e + 1);
+  }
+}
+
+// Channel scales: standard deviation over all records (1 where constant).
+Eigen::VectorXd channel_scales(const std::vector<IdData>& ds, bool outputs) {
+  const int n = outputs ? ds.front().ny() : ds.front().nu();
+  Eigen::VectorXd s(n);
+  for (int j = 0; j < n; ++j) {
+    double sum = 0, sum2 = 0;
+    Eigen::Index cnt = 0;
+    for (const IdData& d : ds) {
+      const auto c = outputs ? d.y().col(j) : d.u().col(j);
+      sum += c.sum();
+      sum2 += c.squaredNorm();
+      cnt += c.size();
+    }
+    const double mean = sum / static_cast<double>(cnt);
+    const double v = std::sqrt(std::max(0.0, sum2 / static_cast<double>(cnt) - mean * mean));
+    s(j) = v > 1e-300 && std::isfinite(v) ? v : 1.0;
+  }
+  return s;
+}
+
+std::string entry_name(char M, int i, int j) { return std::string(1, M) + std::to_string(i + 1) + "_" + std::to_string(j + 1); }
+
+// The entries the options hold (set to their held values in p): D (estimate_d false), x0 (records at rest), the
+// integrators' columns of A.
+void hold_structure(const Layout& L, const SsestOptions& o, Point& p, std::vector<bool>& held) {
+  if (!o.estimate_d) {
+    p.D.setZero();
+    for (int i = 0; i < L.ny; ++i)
+      for (int j = 0; j < L.nu; ++j) held[static_cast<size_t>(L.d(i, j))] = true;
+  }
+  if (!o.estimate_initial_state)
+    for (int e = 0; e < L.E; ++e) {
+      p.x0[static_cast<size_t>(e)].setZero();
+      for (int i = 0; i < L.nx; ++i) held[static_cast<size_t>(L.x0(e, i))] = true;
+    }
+  for (int j = 0; j < o.integrators; ++j)
+    for (int i = 0; i < L.nx; ++i) {
+      p.A(i, j) = 0.0;
+      held[static_cast<size_t>(L.a(i, j))] = true;
+    }
+}
+
+// The result at the final model `fin` (user units): the modal form (or the user's coordinates), the parameters and
+// their covariance (J^T W J)^-1 with W the inverse noise variances (the residuals' or, for a bound, the given ones),
+// fits, initial states, modes and their uncertainty.
+void deliver(Result<StateSpace>& res, const std::vector<IdData>& ds, Point fin, bool user_coordinates,
+             const std::vector<bool>& held, int similar, const SsestOptions& o, const Eigen::VectorXd* noise_variance) {
+  const int nx = static_cast<int>(fin.A.rows()), nu = ds.front().nu(), ny = ds.front().ny();
+  const int E = static_cast<int>(ds.size());
+  const Layout L{nx, nu, ny, E};
+  const Eigen::VectorXd sy = channel_scales(ds, true);
+  Eigen::Index total = 0;
+  for (const IdData& d : ds) total += d.size();
+  const int n_free_params = static_cast<int>(std::count(held.begin(), held.end(), false)) - similar;
+  // Back to the user's units (and, for a free structure, to the modal form).
+  std::vector<std::string> pnames;
+  std::vector<Point> pdirs;  // each reported parameter's direction (x0 of every record after them)
+  std::vector<bool> pfixed;
+  Eigen::VectorXd pvalues;
+  std::vector<double> vals;
+  auto zero_point = [&] {
+    return Point{Eigen::MatrixXd::Zero(nx, nx), Eigen::MatrixXd::Zero(nx, nu), Eigen::MatrixXd::Zero(ny, nx),
+                 Eigen::MatrixXd::Zero(ny, nu), std::vector<Eigen::VectorXd>(static_cast<size_t>(E), Eigen::VectorXd::Zero(nx))};
+  };
+  auto add_entry = [&](char M, int i, int j, double value, bool fixed) {
+    Point d = zero_point();
+    (M == 'A' ? d.A : M == 'B' ? d.B : M == 'C' ? d.C : d.D)(i, j) = 1.0;
+    pnames.push_back(entry_name(M, i, j));
+    vals.push_back(value);
+    pfixed.push_back(fixed);
+    pdirs.push_back(std::move(d));
+  };
+  ModalForm mf;
+  const bool modal = !user_coordinates && modal_form(fin, o.integrators, mf);
+  if (!user_coordinates && !modal)
+    res.diagnostics.warnings.push_back("the model has nearly repeated poles: it is returned in the search's coordinates, "
+                                       "where its entries are not determined (poles and responses are)");
+  if (modal) {
+    fin = mf.model;
+    for (int k = 0; k < o.integrators; ++k) {
+      // An integrator's pole, held at 0.
+      pnames.push_back("pole" + std::to_string(k + 1));
+      vals.push_back(0.0);
+      pfixed.push_back(true);
+      Point d = zero_point();
+      d.A(k, k) = 1.0;
+      pdirs.push_back(std::move(d));
+    }
+    for (const std::string& n : mf.names) {
+      Point d = zero_point();
+      const int a = std::stoi(n.substr(n[0] == 'p' ? 4 : 5)) - 1;
+      double v = 0;
+      if (n[0] == 'p') { d.A(a, a) = 1.0; v = fin.A(a, a); }
+      else if (n[0] == 's') { d.A(a, a) = d.A(a + 1, a + 1) = 1.0; v = fin.A(a, a); }
+      else { d.A(a, a + 1) = 1.0; d.A(a + 1, a) = -1.0; v = fin.A(a, a + 1); }
+      pnames.push_back(n);
+      vals.push_back(v);
+      pfixed.push_back(false);
+      pdirs.push_back(std::move(d));
+    }
+    for (int i = 0; i < nx; ++i)
+      for (int j = 0; j < nu; ++j) add_entry('B', i, j, fin.B(i, j), false);
+    for (int i = 0; i < ny; ++i)
+      for (int j = 0; j < nx; ++j) {
+        bool norm = false;
+        for (const auto& [r, c, v] : mf.c_held) norm = norm || (r == i && c == j);
+        add_entry('C', i, j, fin.C(i, j), norm);
+      }
+  } else {
+    for (int i = 0; i < nx; ++i)
+      for (int j = 0; j < nx; ++j) add_entry('A', i, j, fin.A(i, j), held[static_cast<size_t>(L.a(i, j))]);
+    for (int i = 0; i < nx; ++i)
+      for (int j = 0; j < nu; ++j) add_entry('B', i, j, fin.B(i, j), held[static_cast<size_t>(L.b(i, j))]);
+    for (int i = 0; i < ny; ++i)
+      for (int j = 0; j < nx; ++j) add_entry('C', i, j, fin.C(i, j), held[static_cast<size_t>(L.c(i, j))]);
+  }
+  if (o.estimate_d)
+    for (int i = 0; i < ny; ++i)
+      for (int j = 0; j < nu; ++j) add_entry('D', i, j, fin.D(i, j), held[static_cast<size_t>(L.d(i, j))]);
+  res.model = StateSpace(fin.A, fin.B, fin.C, fin.D);
+  res.parameters.names = pnames;
+  res.parameters.values = Eigen::Map<const Eigen::VectorXd>(vals.data(), static_cast<Eigen::Index>(vals.size()));
+  res.parameters.fixed = pfixed;
+
+  // Covariance: (J^T W J)^-1 over the free parameters and the initial states at the final model, in the user's units
+  // (columns scaled before the inversion); the parameters' block of it.
+  std::vector<int> slots;
+  std::vector<Point> cdirs;
+  for (size_t k = 0; k < pdirs.size(); ++k)
+    if (!pfixed[k]) {
+      slots.push_back(static_cast<int>(k));
+      cdirs.push_back(pdirs[k]);
+    }
+  const int np = static_cast<int>(cdirs.size());
+  if (o.estimate_initial_state)
+    for (int e = 0; e < E; ++e)
+      for (int i = 0; i < nx; ++i) {
+        Point d = zero_point();
+        d.x0[static_cast<size_t>(e)](i) = 1.0;
+        cdirs.push_back(std::move(d));
+      }
+  const std::vector<Record> raw = records_of(ds, Eigen::VectorXd::Ones(nu), Eigen::VectorXd::Ones(ny));
+  const Eigen::VectorXd var = noise_variance ? *noise_variance : residual_variances(fin, raw);
+  Eigen::MatrixXd JtJ;
+  Eigen::VectorXd Jtr;
+  double cost = 0;
+  std::vector<Eigen::MatrixXd> yhat;
+  const bool ok = var.allFinite() &&
+                  evaluate(fin, &cdirs, raw, var.cwiseMax(1e-300).cwiseInverse().cwiseSqrt(), cost, &JtJ, &Jtr, &yhat);
+  Eigen::MatrixXd cov;
+  if (ok) {
+    const Eigen::VectorXd dg = JtJ.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+    const Eigen::MatrixXd Sc = dg.asDiagonal() * JtJ * dg.asDiagonal();
+    Eigen::LDLT<Eigen::MatrixXd> ldlt(Sc);
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Sc, Eigen::EigenvaluesOnly);
+    if (ldlt.info() == Eigen::Success && eig.eigenvalues()(0) > 1e-13 * eig.eigenvalues().maxCoeff()) {
+      const Eigen::MatrixXd full = dg.asDiagonal() * ldlt.solve(Eigen::MatrixXd::Identity(Sc.rows(), Sc.cols())) *
+                                   dg.asDiagonal();
+      cov = full.topLeftCorner(np, np);
+    }
+  }
+  res.parameters.values = res.parameters.values;
+  res.parameters.set_covariance(cov, slots);
+  if (user_coordinates && similar > 0 && res.summary.succeeded()) {
+    res.summary.termination = Termination::Unidentifiable;
+    res.summary.message = detail::format(
+        "the held entries leave {} direction(s) of a change of state coordinates free: those combinations of the "
+        "entries of A, B and C are not determined by the data (the poles and responses are); hold more entries, or "
+        "hold none of A, B, C (the modal form)", similar);
+  }
+
+  // Fits, noise, initial states, modes.
+  if (ok) {
+    const Fits f = fits_of(ds, yhat, sy, n_free_params + (o.estimate_initial_state ? E * nx : 0));
+    res.fit = f.all;
+    res.diagnostics.set(diagnostic::output_fit_percent, f.per_output);
+    res.diagnostics.set(diagnostic::output_noise_variance, var);
+    res.diagnostics.set(diagnostic::cost, cost);
+  } else {
+    res.fit.fit_percent = -INFINITY;
+    res.fit.n_samples = static_cast<int>(total * ny);
+  }
+  for (int e = 0; e < E; ++e) res.diagnostics.set(diagnostic::x0, fin.x0[static_cast<size_t>(e)], e);
+  const std::vector<ModeUncertainty> mu = mode_uncertainty(res);
+  Eigen::VectorXd wn_std(static_cast<Eigen::Index>(mu.size())), zeta_std(static_cast<Eigen::Index>(mu.size()));
+  for (size_t k = 0; k < mu.size(); ++k) {
+    wn_std(static_cast<Eigen::Index>(k)) = mu[k].wn_std;
+    zeta_std(static_cast<Eigen::Index>(k)) = mu[k].zeta_std;
+  }
+  res.diagnostics.set(diagnostic::mode_wn_std, wn_std);
+  res.diagnostics.set(diagnostic::mode_zeta_std, zeta_std);
+  int unstable = 0;
+  for (const auto& p : res.model.poles()) unstable += p.real() > 1e-12 * (1.0 + std::abs(p));
+  if (unstable > 0)
+    res.diagnostics.warnings.push_back(
+        detail::format("the model has {} pole(s) in the right half plane", unstable));
+  }
+
+Result<StateSpace> fit_from(const std::vector<IdData>& ds, Point start, bool user_coordinates,
+                            const Eigen::VectorXd& singular_values, const SsestOptions& o, Clock::time_point t0) {
+  const int nx = static_cast<int>(start.A.rows()), nu = ds.front().nu(), ny = ds.front().ny();
+  const int E = static_cast<int>(ds.size());
+  const Layout L{nx, nu, ny, E};
+  const Eigen::VectorXd su = channel_scales(ds, false), sy = channel_scales(ds, true);
+  const std::vector<Record> recs = records_of(ds, su, sy);
+  Eigen::Index total = 0;
+  for (const IdData& d : ds) total += d.size();
+
+  // Held entries: D (estimate_d false or fixed.D..), A/B/C (fixed.., with a starting model), x0 (from rest),
+  // the integrators' columns of A.
+  std::vector<std::string> names;
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < nx; ++j) names.push_back(entry_name('A', i, j));
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < nu; ++j) names.push_back(entry_name('B', i, j));
+  for (int i = 0; i < ny; ++i)
+    for (int j = 0; j < nx; ++j) names.push_back(entry_name('C', i, j));
+  for (int i = 0; i < ny; ++i)
+    for (int j = 0; j < nu; ++j) names.push_back(entry_name('D', i, j));
+  std::vector<bool> held(static_cast<size_t>(L.size()), false);
+  for (const auto& [name, value] : o.fixed) {
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end()) {
+      const std::vector<std::string> cands(names.begin(), names.end());
+      (void)resolve_constraints({{name, value}}, {}, cands, "ssest",
+                                "an entry of A, B, C or D of this model (" + std::to_string(nx) + " states)");
+    }
+    const auto k = static_cast<size_t>(it - names.begin());
+    CTID_REQUIRE_OPTION(user_coordinates || name[0] == 'D',
+                        "ssest: fixed.{}: entries of A, B and C refer to the coordinates of a starting model; give "
+                        "one (ssest(data, initial, options); Python initial=...)", name);
+    held[k] = true;
+    Eigen::VectorXd v = pack(L, start);
+    v(static_cast<Eigen::Index>(k)) = value;
+    start = unpack(L, v);
+  }
+  hold_structure(L, o, start, held);
+
+  // Scaled units; without held A/B/C entries also whitened states (unit covariance along the start's trajectory).
+  Point s = scaled(start, su, sy);
+  Eigen::MatrixXd W = Eigen::MatrixXd::Identity(nx, nx);
+  if (!user_coordinates && o.integrators == 0) {
+    Eigen::MatrixXd Sx = Eigen::MatrixXd::Zero(nx, nx);
+    Eigen::Index n = 0;
+    // The state trajectory of the start (C = I).
+    const StateSpace states(s.A, s.B, Eigen::MatrixXd::Identity(nx, nx), Eigen::MatrixXd::Zero(nx, nu));
+    for (size_t e = 0; e < recs.size(); ++e) {
+      LsimOptions lo;
+      lo.x0 = s.x0[e];
+      std::vector<Intersample> is;
+      for (bool f : recs[e].foh) is.push_back(f ? Intersample::Foh : Intersample::Zoh);
+      const Eigen::MatrixXd X = lsim(states, recs[e].u, recs[e].t, is, lo);
+      if (!X.allFinite()) continue;
+      Sx += X.transpose() * X;
+      n += X.rows();
+    }
+    Sx /= static_cast<double>(std::max<Eigen::Index>(n, 1));
+    Eigen::LLT<Eigen::MatrixXd> llt(Sx + 1e-9 * std::max(Sx.trace(), 1e-300) * Eigen::MatrixXd::Identity(nx, nx));
+    if (llt.info() == Eigen::Success && Sx.allFinite()) W = llt.matrixL();
+    s = transformed(s, W);
+  }
+  int similar = 0;
+  (void)local_directions(L, s, held, &similar);
+
+  Result<StateSpace> res;
+  Search sr = search(L, pack(L, s), held, recs, o);
+  auto finish = [&] { res.summary.seconds = std::chrono::duration<double>(Clock::now() - t0).count(); };
+  if (singular_values.size() > 0) res.diagnostics.set(diagnostic::singular_values, singular_values);
+  if (E > 1) res.diagnostics.set(diagnostic::experiments, static_cast<double>(E));
+  if (sr.failed_start) {
+    res.model = StateSpace(start.A, start.B, start.C, start.D);
+    res.summary.termination = Termination::NumericalFailure;
+    res.summary.message = "ssest: the starting model cannot be simulated on the data (its output overflows)";
+    finish();
+    return res;
+  }
+  internal::set_termination(res.summary, sr.last);
+  res.summary.iterations = sr.iterations;
+
+  deliver(res, ds, unscaled(transformed(unpack(L, sr.theta), W.inverse()), su, sy), user_coordinates, held, similar, o,
+          nullptr);
+  finish();
+  return res;
+}
+
+// The subspace start (on the longest record) and each record's initial state for it.
+struct Start {
+  Point point;
+  Eigen::VectorXd sigma;
+  double fit = NAN;
+  Result<StateSpace> failure;
+  bool failed = false;
+};
+
+Start subspace_start(const std::vector<IdData>& ds, int nx, const SsestOptions& o) {
+  size_t longest = 0;
+  for (size_t e = 1; e < ds.size(); ++e)
+    if (ds[e].size() > ds[longest].size()) longest = e;
+  SubspaceOptions so = o.start;
+  so.nx = nx;
+  so.estimate_d = o.estimate_d;
+  so.estimate_initial_state = o.estimate_initial_state;
+  Start s;
+  Result<StateSpace> r = subspace(ds[longest], so);
+  if (r.model.nx() == 0) {
+    s.failed = true;
+    s.failure = std::move(r);
+    return s;
+  }
+  s.sigma = r.diagnostics.get(diagnostic::singular_values);
+  s.fit = r.fit.fit_percent;
+  const StateSpace& m = r.model;
+  s.point = Point{m.A(), m.B(), m.C(), m.D(), {}};
+  for (size_t e = 0; e < ds.size(); ++e) {
+    if (e == longest) {
+      s.point.x0.push_back(r.diagnostics.get(diagnostic::x0));
+      continue;
+    }
+    Eigen::VectorXd x0 = Eigen::VectorXd::Zero(m.nx());
+    if (o.estimate_initial_state) (void)subspace_bd(m.A(), m.C(), ds[e], o.estimate_d, true, &x0);
+    s.point.x0.push_back(x0);
+  }
+  return s;
+}
+
+// Known integrators: the start moved to coordinates whose first k states are the eigenvectors of its k real poles
+// nearest 0, those poles set to 0 (A's first k columns zero).
+void with_integrators(Point& p, int k) {
+  const int nx = static_cast<int>(p.A.rows());
+  CTID_REQUIRE_OPTION(k < nx, "ssest: integrators = {} needs a larger state dimension (nx = {})", k, nx);
+  Eigen::EigenSolver<Eigen::MatrixXd> es(p.A);
+  std::vector<std::pair<double, int>> real;
+  for (int i = 0; i < nx; ++i)
+    if (es.eigenvalues()(i).imag() == 0.0) real.emplace_back(std::abs(es.eigenvalues()(i)), i);
+  CTID_REQUIRE_OPTION(static_cast<int>(real.size()) >= k,
+                      "ssest: integrators = {}: the start has only {} real pole(s) to hold at 0", k, real.size());
+  std::sort(real.begin(), real.end());
+  Eigen::MatrixXd V(nx, k);
+  for (int j = 0; j < k; ++j) V.col(j) = es.eigenvectors().col(real[static_cast<size_t>(j)].second).real();
+  // T = [V, an orthonormal complement of span(V)].
+  Eigen::HouseholderQR<Eigen::MatrixXd> qr(V);
+  const Eigen::MatrixXd Qf = qr.householderQ() * Eigen::MatrixXd::Identity(nx, nx);
+  Eigen::MatrixXd T(nx, nx);
+  T << V, Qf.rightCols(nx - k);
+  p = transformed(p, T);
+  p.A.leftCols(k).setZero();
+}
+
+Result<StateSpace> ssest_order(const std::vector<IdData>& ds, int nx, const SsestOptions& o, Clock::time_point t0) {
+  Start s = subspace_start(ds, nx, o);
+  if (s.failed) {
+    Result<StateSpace> r = std::move(s.failure);
+    r.summary.message = "ssest: the subspace start failed: " + r.summary.message;
+    return r;
+  }
+  if (o.integrators > 0) with_integrators(s.point, o.integrators);
+  Result<StateSpace> r = fit_from(ds, s.point, false, s.sigma, o, t0);
+  r.diagnostics.set(diagnostic::start_fit_percent, s.fit);
+  return r;
+}
+
+}  // namespace
+
+Result<StateSpace> ssest(const std::vector<IdData>& data, const SsestOptions& options) {
+  const auto t0 = Clock::now();
+  options.validate();
+  check_records(data);
+  if (options.nx_max <= options.nx || options.nx_max == 0) return ssest_order(data, options.nx, options, t0);
+  // Order search: the least BIC among the usable fits (all fits when none is usable).
+  const int lo = std::max(options.nx, 1), hi = options.nx_max;
+  Eigen::VectorXd grid(hi - lo + 1), bic(hi - lo + 1);
+  Result<StateSpace> best;
+  bool best_usable = false;
+  double best_bic = INFINITY;
+  for (int n = lo; n <= hi; ++n) {
+    Result<StateSpace> r;
+    try {
+      r = ssest_order(data, n, options, t0);
+    } catch (const InvalidArgument&) {
+      if (n == lo) throw;
+      grid.conservativeResize(n - lo);
+      bic.conservativeResize(n - lo);
+      break;
+    }
+    grid(n - lo) = n;
+    bic(n - lo) = r.fit.n_samples > 0 ? r.fit.bic : INFINITY;
+    const bool usable = r.usable();
+    if ((usable && !best_usable) || (usable == best_usable && bic(n - lo) < best_bic) || best.model.nx() == 0) {
+      best_usable = usable;
+      best_bic = bic(n - lo);
+      best = std::move(r);
+    }
+  }
+  best.diagnostics.set(diagnostic::nx_grid, grid);
+  best.diagnostics.set(diagnostic::nx_grid_bic, bic);
+  best.summary.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return best;
+}
+
+Result<StateSpace> ssest(const IdData& data, const SsestOptions& options) {
+  return ssest(std::vector<IdData>{data}, options);
+}
+
+Result<StateSpace> ssest(const std::vector<IdData>& data, const StateSpace& initial, const SsestOptions& options) {
+  const auto t0 = Clock::now();
+  options.validate();
+  check_records(data);
+  CTID_REQUIRE_OPTION(options.nx == 0 || options.nx == initial.nx(),
+                      "ssest: nx = {} differs from the starting model's {} states", options.nx, initial.nx());
+  CTID_REQUIRE_OPTION(options.nx_max == 0, "ssest: nx_max needs the subspace start (a starting model has one order)");
+  CTID_REQUIRE(initial.nu() == data.front().nu() && initial.ny() == data.front().ny(),
+               "ssest: the starting model has {} inputs and {} outputs, the data {} and {}", initial.nu(), initial.ny(),
+               data.front().nu(), data.front().ny());
+  CTID_REQUIRE(initial.nx() >= 1, "ssest: the starting model has no states");
+  bool user = false;
+  for (const auto& [name, v] : options.fixed) user = user || name[0] != 'D';
+  Point p{initial.A(), initial.B(), initial.C(), initial.D(), {}};
+  for (const IdData& d : data) {
+    Eigen::VectorXd x0 = Eigen::VectorXd::Zero(initial.nx());
+    if (options.estimate_initial_state) (void)subspace_bd(initial.A(), initial.C(), d, options.estimate_d, true, &x0);
+    p.x0.push_back(x0);
+  }
+  if (options.integrators > 0) {
+    CTID_REQUIRE_OPTION(!user, "ssest: integrators with held A/B/C entries: hold the integrators' columns of A at 0 "
+                               "instead (fixed.A1_1=0 ..)");
+    with_integrators(p, options.integrators);
+  }
+  return fit_from(data, p, user, Eigen::VectorXd(), options, t0);
+}
+
+Result<StateSpace> ssest_crlb(const StateSpace& truth, const std::vector<IdData>& data,
+                              const Eigen::VectorXd& noise_variance, const SsestOptions& options) {
+  const auto t0 = Clock::now();
+  options.validate();
+  check_records(data);
+  const int nx = truth.nx(), nu = data.front().nu(), ny = data.front().ny();
+  CTID_REQUIRE(truth.nu() == nu && truth.ny() == ny, "ssest_crlb: the model has {} inputs and {} outputs, the data {} "
+               "and {}", truth.nu(), truth.ny(), nu, ny);
+  CTID_REQUIRE(noise_variance.size() == ny && (noise_variance.array() > 0).all() && noise_variance.allFinite(),
+               "ssest_crlb: give one positive noise variance per output ({} outputs, {} values)", ny,
+               noise_variance.size());
+  const Layout L{nx, nu, ny, static_cast<int>(data.size())};
+  Point p{truth.A(), truth.B(), truth.C(), truth.D(),
+          std::vector<Eigen::VectorXd>(data.size(), Eigen::VectorXd::Zero(nx))};
+  std::vector<bool> held(static_cast<size_t>(L.size()), false);
+  hold_structure(L, options, p, held);
+  int similar = 0;
+  (void)local_directions(L, p, held, &similar);
+  Result<StateSpace> res;
+  res.summary.termination = Termination::Completed;
+  deliver(res, data, p, false, held, similar, options, &noise_variance);
+  res.summary.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return res;
+}
+
+}  // namespace ctid
