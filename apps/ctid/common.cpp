@@ -192,7 +192,11 @@ Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, cons
       if (o.initial != InitialCondition::Estimated || !std::holds_alternative<GreyboxModel>(r.model))
         throw UsageError("--initial-samples needs --initial estimated and a grey-box model");
       o.initial_samples = initial_samples;
-    } else if (o.initial == InitialCondition::Estimated && r.diagnostics.has(diagnostic::x0)) {
+    } else if (o.initial == InitialCondition::Estimated && r.diagnostics.has(diagnostic::x0) &&
+               !std::holds_alternative<TransferFunction>(r.model) && !std::holds_alternative<StateSpace>(r.model) &&
+               !std::holds_alternative<MisoModel>(r.model)) {
+      // A nonlinear model's fitted x0 (its own record's); a linear model's initial state is estimated by least squares
+      // on the record being simulated (the fitted x0 belongs to the estimation record, not to another one).
       o.x0 = r.diagnostics.get(diagnostic::x0);
     }
     s = simulate(r.model, d, o);

@@ -20,4 +20,26 @@ check "dry bulb temperature (column 5): validation fit %" "$(fit_of dryer2_5.jso
 check "wet bulb temperature (column 6): validation fit %" "$(fit_of dryer2_6.json dryer2_val.dat $i --output 6)" gt 25
 check "moisture content (column 7): validation fit % (no linear model generalises)" \
   "$(fit_of dryer2_7.json dryer2_val.dat $i --output 7)" lt 0
+
+echo "== the same, initial state of the validation part estimated (least squares on it; MATLAB compare's default):"
+echo "   MISO SRIVC per output, MIMO ssest (order by BIC over 1..6 on the estimation part), discrete N4SID (MOESP + logm)"
+fits_of() { "$ctid" validate "$@" --initial estimated | awk '/fit:/ { for (i = 1; i < NF; ++i) if ($i == "fit:") printf "%s ", $(i + 1) } END { print "" }'; }
+read -r s5 < <(fits_of dryer2_5.json dryer2_val.dat $i --output 5)
+read -r s6 < <(fits_of dryer2_6.json dryer2_val.dat $i --output 6)
+read -r s7 < <(fits_of dryer2_7.json dryer2_val.dat $i --output 7)
+echo "  MISO SRIVC: $s5 $s6 $s7"
+o="$i --output 5 --output 6 --output 7"
+"$ctid" fit dryer2_est.dat $o --method ssest --nx 1:6 --json dryer2_ss.json --force > dryer2_ss.txt
+nx=$(awk '/states$/ { print $(NF - 1); exit }' dryer2_ss.txt)
+grep "order search" dryer2_ss.txt
+read -r m5 m6 m7 < <(fits_of dryer2_ss.json dryer2_val.dat $o)
+echo "  MIMO ssest, nx = $nx: $m5 $m6 $m7"
+"$ctid" fit dryer2_est.dat $o --method subspace --set route=discrete --nx "$nx" --json dryer2_n4.json --force >/dev/null
+read -r n5 n6 n7 < <(fits_of dryer2_n4.json dryer2_val.dat $o)
+echo "  discrete N4SID (MOESP + logm), nx = $nx: $n5 $n6 $n7"
+check "ssest order chosen by BIC" "$nx" gt 1
+for k in 5 6 7; do
+  eval "m=\$m$k; s=\$s$k"
+  check "output $k: ssest validation fit minus MISO SRIVC's (at least as good)" "$(awk -v a="$m" -v b="$s" 'BEGIN { print a - b }')" gt -0.5
+done
 exit $fail

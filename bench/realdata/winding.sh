@@ -27,4 +27,22 @@ check "tension T3, separate denominators: exit code (1 = not usable, reported)" 
   --force >/dev/null
 check "tension T3, common third-order denominator: validation fit %" \
   "$(fit_of winding_7c3.json winding_val.dat $w --output 7)" gt 50
+
+echo "== one MIMO model of both tensions: ssest (order by BIC over 1..8 on the estimation part) against the MISO"
+echo "   SRIVC models and the discrete N4SID route; the validation part's initial state estimated (least squares)"
+fits_of() { "$ctid" validate "$@" --initial estimated | awk '/fit:/ { for (i = 1; i < NF; ++i) if ($i == "fit:") printf "%s ", $(i + 1) } END { print "" }'; }
+read -r s6 < <(fits_of winding_6s.json winding_val.dat $w --output 6)
+read -r s7 < <(fits_of winding_7c3.json winding_val.dat $w --output 7)
+echo "  best MISO SRIVC (T1 separate first-order denominators, T3 common third order): $s6 $s7"
+o="$w --output 6 --output 7"
+"$ctid" fit winding_est.dat $o --method ssest --nx 1:8 --json winding_ss.json --force > winding_ss.txt
+nx=$(awk '/states$/ { print $(NF - 1); exit }' winding_ss.txt)
+grep "order search" winding_ss.txt
+read -r m6 m7 < <(fits_of winding_ss.json winding_val.dat $o)
+echo "  MIMO ssest, nx = $nx: $m6 $m7"
+"$ctid" fit winding_est.dat $o --method subspace --set route=discrete --nx "$nx" --json winding_n4.json --force >/dev/null
+read -r n6 n7 < <(fits_of winding_n4.json winding_val.dat $o)
+echo "  discrete N4SID (MOESP + logm), nx = $nx: $n6 $n7"
+check "T1: ssest validation fit minus the best MISO SRIVC's" "$(awk -v a="$m6" -v b="$s6" 'BEGIN { print a - b }')" gt 10
+check "T3: ssest validation fit minus the best MISO SRIVC's" "$(awk -v a="$m7" -v b="$s7" 'BEGIN { print a - b }')" gt 8
 exit $fail

@@ -35,6 +35,9 @@ const OptionTable<SsestOptions>& option_table<SsestOptions>() {
           .flag("estimate_d", &O::estimate_d, "estimate the direct term D (false: D = 0)")
           .flag("estimate_initial_state", &O::estimate_initial_state,
                 "estimate each record's initial state (false: it starts at rest)")
+          .flag("enforce_stability", &O::enforce_stability,
+                "keep a stable start stable: steps that move a pole into the right half plane are rejected (false: "
+                "an unstable plant)")
           .integer("integrators", &O::integrators, "", at_least(0),
                    "known pure integrators: poles held at 0 (the first states integrate)")
           .named_reals("fixed", &O::fixed,
@@ -138,12 +141,25 @@ struct Step {
   Eigen::MatrixXd Phi, G0, G1, W1, W2, W3;
 };
 
+// discretize(), without the linear-input block when every input is held (an exponential of size n + m instead of
+// n + 2m: the irregular grids compute one per interval and direction).
+Discretization exact_step(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, double h, bool any_foh) {
+  if (any_foh) return discretize(A, B, h);
+  const Eigen::Index n = A.rows(), m = B.cols();
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n + m, n + m);
+  M.topLeftCorner(n, n) = A * h;
+  M.topRightCorner(n, m) = B * h;
+  const Eigen::MatrixXd E = expm(M);
+  return {E.topLeftCorner(n, n), E.topRightCorner(n, m), Eigen::MatrixXd::Zero(n, m), h};
+}
+
 Step step_of(const Point& m, const std::vector<Point>& dirs, double h, const std::vector<bool>& foh) {
   const Eigen::Index nx = m.A.rows(), nu = m.B.cols();
   const Eigen::Index P = static_cast<Eigen::Index>(dirs.size());
+  const bool any_foh = std::find(foh.begin(), foh.end(), true) != foh.end();
   Step s;
   s.h = h;
-  const Discretization base = discretize(m.A, m.B, h);
+  const Discretization base = exact_step(m.A, m.B, h, any_foh);
   s.Phi = base.Phi;
   s.G0 = base.Gamma0;
   s.G1 = base.Gamma1;
@@ -161,7 +177,7 @@ Step step_of(const Point& m, const std::vector<Point>& dirs, double h, const std
     if (q.A.isZero(0) && q.B.isZero(0)) continue;  // a direction of C, D or x0 only: no forcing of the state
     Ab.bottomLeftCorner(nx, nx) = q.A;
     Bb.bottomRows(nx) = q.B;
-    const Discretization a = discretize(Ab, Bb, h);  // Van Loan: the sensitivity blocks of the exponential
+    const Discretization a = exact_step(Ab, Bb, h, any_foh);  // Van Loan: the sensitivity blocks of the exponential
     s.W1.middleRows(d * nx, nx) = a.Phi.bottomLeftCorner(nx, nx);
     s.W2.middleRows(d * nx, nx) = a.Gamma0.bottomRows(nx);
     s.W3.middleRows(d * nx, nx) = a.Gamma1.bottomRows(nx);
@@ -258,7 +274,7 @@ bool evaluate(const Point& m, const std::vector<Point>* dirs, const std::vector<
           F.col(i).noalias() += s.W2 * U.col(i);
           F.col(i).noalias() += s.W3 * dU.col(i);
         }
-        Delta.noalias() = s.Phi * Dall.middleCols(i * P, P);
+        Delta.noalias() = s.Phi.lazyProduct(Dall.middleCols(i * P, P));  // small: no GEMM packing
         Delta += Eigen::Map<const Eigen::MatrixXd>(F.col(i).data(), nx, P);
       }
       CD.leftCols(n * P).noalias() = m.C * Dall.leftCols(n * P);
@@ -355,66 +371,6 @@ struct Search {
   internal::LmResult last;
   bool failed_start = false;
 };
-
-// Rounds of Levenberg-Marquardt in local coordinates re-centred after each round, then the weights re-estimated and
-// the search repeated once (weighted output error = ML for independent Gaussian output noise).
-Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& held, const std::vector<Record>& recs,
-              const SsestOptions& o) {
-  Search s;
-  s.weights = residual_variances(unpack(L, theta), recs).cwiseMax(1e-12).cwiseInverse();
-  if (!s.weights.allFinite()) {
-    s.failed_start = true;
-    s.theta = theta;
-    return s;
-  }
-  internal::LmOptions lmo;
-  lmo.xtol = 1e-10;
-  int left = o.max_iterations;
-  for (int pass = 0; pass < 2; ++pass) {
-    const Eigen::VectorXd sw = s.weights.cwiseSqrt();
-    bool converged = false;
-    while (left > 0 && !converged) {
-      const Eigen::MatrixXd Q = local_directions(L, unpack(L, theta), held);
-      const std::vector<Point> dirs = directions_of(L, Q);
-      auto normal = [&](const Eigen::VectorXd& xi, double& cost, Eigen::MatrixXd* A, Eigen::VectorXd* g) {
-        const Point m = unpack(L, theta + Q * xi);
-        return evaluate(m, A ? &dirs : nullptr, recs, sw, cost, A, g);
-      };
-      lmo.max_iterations = std::min(left, 25);
-      // The cost is in noise units (1/2 sum of e^2/sigma^2): a round ends when a step gains less than `tolerance`.
-      double c0 = 0.0;
-      if (evaluate(unpack(L, theta), nullptr, recs, sw, c0, nullptr, nullptr) && c0 > 0) lmo.ftol = o.tolerance / c0;
-      internal::LmResult lm = internal::levenberg_marquardt(internal::LmNormalEvaluate(normal),
-                                                            Eigen::VectorXd::Zero(Q.cols()),
-                                                            Eigen::VectorXd::Constant(Q.cols(), -INFINITY),
-                                                            Eigen::VectorXd::Constant(Q.cols(), INFINITY), lmo);
-      if (!std::isfinite(lm.cost)) {
-        s.failed_start = s.iterations == 0;
-        s.last = lm;
-        s.theta = theta;
-        return s;
-      }
-      theta += Q * lm.x;
-      left -= std::max(lm.iterations, 1);
-      s.iterations += lm.iterations;
-      converged = lm.converged || lm.interrupted;
-      s.last = lm;
-      if (lm.interrupted) break;
-    }
-    if (s.last.interrupted || !converged) break;
-    if (pass == 0) {
-      const Eigen::VectorXd w = residual_variances(unpack(L, theta), recs).cwiseMax(1e-12).cwiseInverse();
-      if (!w.allFinite()) break;
-      const double change = ((w - s.weights).array().abs() / s.weights.array()).maxCoeff();
-      s.weights = w;
-      // Weights within 10 % of those the search ran with: the optimum moves by a negligible fraction of its standard
-      // deviation (the loss of efficiency is second order in the weights' error), so no second search.
-      if (change < 0.1) break;
-    }
-  }
-  s.theta = theta;
-  return s;
-}
 
 // A change of state coordinates x = T z applied to a model.
 Point transformed(const Point& m, const Eigen::MatrixXd& T) {
@@ -545,6 +501,103 @@ bool modal_form(const Point& m, int integrators, ModalForm& out) {
   for (const auto& [r, c, v] : out.c_held) p.C(r, c) = v;  // exact normalisation
   out.model = p;
   return true;
+}
+
+// The model in state coordinates of unit covariance along its trajectory over the records (x = L z, L L^T the
+// states' second moment): every state of a comparable size, so the search's coordinates are well conditioned.
+Point whitened(const Point& m, const std::vector<Record>& recs) {
+  const Eigen::Index nx = m.A.rows(), nu = m.B.cols();
+  Eigen::MatrixXd Sx = Eigen::MatrixXd::Zero(nx, nx);
+  Eigen::Index n = 0;
+  const StateSpace states(m.A, m.B, Eigen::MatrixXd::Identity(nx, nx), Eigen::MatrixXd::Zero(nx, nu));
+  for (size_t e = 0; e < recs.size(); ++e) {
+    LsimOptions lo;
+    lo.x0 = m.x0[e];
+    std::vector<Intersample> is;
+    for (bool f : recs[e].foh) is.push_back(f ? Intersample::Foh : Intersample::Zoh);
+    const Eigen::MatrixXd X = lsim(states, recs[e].u, recs[e].t, is, lo);
+    if (!X.allFinite()) continue;
+    Sx += X.transpose() * X;
+    n += X.rows();
+  }
+  Sx /= static_cast<double>(std::max<Eigen::Index>(n, 1));
+  Eigen::LLT<Eigen::MatrixXd> llt(Sx + 1e-9 * std::max(Sx.trace(), 1e-300) * Eigen::MatrixXd::Identity(nx, nx));
+  if (llt.info() != Eigen::Success || !Sx.allFinite()) return m;
+  return transformed(m, llt.matrixL());
+}
+
+// Every pole in the open left half plane, apart from the k held integrators (A's first k columns are zero, so the
+// other poles are those of the lower-right block).
+bool stable(const Eigen::MatrixXd& A, int k) {
+  const Eigen::Index n = A.rows() - k;
+  if (n <= 0) return true;
+  const Eigen::VectorXcd p = A.bottomRightCorner(n, n).eigenvalues();
+  return p.allFinite() && (p.real().array() < 0.0).all();
+}
+
+// Rounds of Levenberg-Marquardt in local coordinates re-centred after each round, then the weights re-estimated and
+// the search repeated once (weighted output error = ML for independent Gaussian output noise).
+Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& held, const std::vector<Record>& recs,
+              const SsestOptions& o, bool free_coordinates) {
+  Search s;
+  // enforce_stability keeps a stable start stable (an unstable start is searched freely: it may be an unstable plant).
+  const bool check_stability = o.enforce_stability && stable(unpack(L, theta).A, o.integrators);
+  s.weights = residual_variances(unpack(L, theta), recs).cwiseMax(1e-12).cwiseInverse();
+  if (!s.weights.allFinite()) {
+    s.failed_start = true;
+    s.theta = theta;
+    return s;
+  }
+  internal::LmOptions lmo;
+  lmo.xtol = 1e-10;
+  int left = o.max_iterations;
+  for (int pass = 0; pass < 2; ++pass) {
+    const Eigen::VectorXd sw = s.weights.cwiseSqrt();
+    bool converged = false;
+    while (left > 0 && !converged) {
+      if (free_coordinates) theta = pack(L, whitened(unpack(L, theta), recs));
+      const Eigen::MatrixXd Q = local_directions(L, unpack(L, theta), held);
+      const std::vector<Point> dirs = directions_of(L, Q);
+      auto normal = [&](const Eigen::VectorXd& xi, double& cost, Eigen::MatrixXd* A, Eigen::VectorXd* g) {
+        const Point m = unpack(L, theta + Q * xi);
+        if (check_stability && !stable(m.A, o.integrators)) return false;  // a rejected step
+        return evaluate(m, A ? &dirs : nullptr, recs, sw, cost, A, g);
+      };
+      lmo.max_iterations = std::min(left, 5);
+      // The cost is in noise units (1/2 sum of e^2/sigma^2): a round ends when a step gains less than `tolerance`.
+      double c0 = 0.0;
+      if (evaluate(unpack(L, theta), nullptr, recs, sw, c0, nullptr, nullptr) && c0 > 0) lmo.ftol = o.tolerance / c0;
+      internal::LmResult lm = internal::levenberg_marquardt(internal::LmNormalEvaluate(normal),
+                                                            Eigen::VectorXd::Zero(Q.cols()),
+                                                            Eigen::VectorXd::Constant(Q.cols(), -INFINITY),
+                                                            Eigen::VectorXd::Constant(Q.cols(), INFINITY), lmo);
+      if (!std::isfinite(lm.cost)) {
+        s.failed_start = s.iterations == 0;
+        s.last = lm;
+        s.theta = theta;
+        return s;
+      }
+      theta += Q * lm.x;
+      lmo.lambda0 = std::clamp(lm.lambda, 1e-12, 1e-3);  // the next round goes on with the damping reached
+      left -= std::max(lm.iterations, 1);
+      s.iterations += lm.iterations;
+      converged = lm.converged || lm.interrupted;
+      s.last = lm;
+      if (lm.interrupted) break;
+    }
+    if (s.last.interrupted || !converged) break;
+    if (pass == 0) {
+      const Eigen::VectorXd w = residual_variances(unpack(L, theta), recs).cwiseMax(1e-12).cwiseInverse();
+      if (!w.allFinite()) break;
+      const double change = ((w - s.weights).array().abs() / s.weights.array()).maxCoeff();
+      s.weights = w;
+      // Weights within 10 % of those the search ran with: the optimum moves by a negligible fraction of its standard
+      // deviation (the loss of efficiency is second order in the weights' error), so no second search.
+      if (change < 0.1) break;
+    }
+  }
+  s.theta = theta;
+  return s;
 }
 
 struct Fits {
@@ -828,34 +881,15 @@ Result<StateSpace> fit_from(const std::vector<IdData>& ds, Point start, bool use
   }
   hold_structure(L, o, start, held);
 
-  // Scaled units; without held A/B/C entries also whitened states (unit covariance along the start's trajectory).
+  // Scaled units; without held A/B/C entries (and integrators) also whitened states, again at each round.
+  const bool free_coordinates = !user_coordinates && o.integrators == 0;
   Point s = scaled(start, su, sy);
-  Eigen::MatrixXd W = Eigen::MatrixXd::Identity(nx, nx);
-  if (!user_coordinates && o.integrators == 0) {
-    Eigen::MatrixXd Sx = Eigen::MatrixXd::Zero(nx, nx);
-    Eigen::Index n = 0;
-    // The state trajectory of the start (C = I).
-    const StateSpace states(s.A, s.B, Eigen::MatrixXd::Identity(nx, nx), Eigen::MatrixXd::Zero(nx, nu));
-    for (size_t e = 0; e < recs.size(); ++e) {
-      LsimOptions lo;
-      lo.x0 = s.x0[e];
-      std::vector<Intersample> is;
-      for (bool f : recs[e].foh) is.push_back(f ? Intersample::Foh : Intersample::Zoh);
-      const Eigen::MatrixXd X = lsim(states, recs[e].u, recs[e].t, is, lo);
-      if (!X.allFinite()) continue;
-      Sx += X.transpose() * X;
-      n += X.rows();
-    }
-    Sx /= static_cast<double>(std::max<Eigen::Index>(n, 1));
-    Eigen::LLT<Eigen::MatrixXd> llt(Sx + 1e-9 * std::max(Sx.trace(), 1e-300) * Eigen::MatrixXd::Identity(nx, nx));
-    if (llt.info() == Eigen::Success && Sx.allFinite()) W = llt.matrixL();
-    s = transformed(s, W);
-  }
+  if (free_coordinates) s = whitened(s, recs);
   int similar = 0;
   (void)local_directions(L, s, held, &similar);
 
   Result<StateSpace> res;
-  Search sr = search(L, pack(L, s), held, recs, o);
+  Search sr = search(L, pack(L, s), held, recs, o, free_coordinates);
   auto finish = [&] { res.summary.seconds = std::chrono::duration<double>(Clock::now() - t0).count(); };
   if (singular_values.size() > 0) res.diagnostics.set(diagnostic::singular_values, singular_values);
   if (E > 1) res.diagnostics.set(diagnostic::experiments, static_cast<double>(E));
@@ -869,8 +903,7 @@ Result<StateSpace> fit_from(const std::vector<IdData>& ds, Point start, bool use
   internal::set_termination(res.summary, sr.last);
   res.summary.iterations = sr.iterations;
 
-  deliver(res, ds, unscaled(transformed(unpack(L, sr.theta), W.inverse()), su, sy), user_coordinates, held, similar, o,
-          nullptr);
+  deliver(res, ds, unscaled(unpack(L, sr.theta), su, sy), user_coordinates, held, similar, o, nullptr);
   finish();
   return res;
 }

@@ -114,6 +114,7 @@ LmResult lm(const Evaluate& normal, Eigen::VectorXd x, const Eigen::VectorXd& lo
   if (!res.converged && res.message.empty()) res.message = "iteration limit reached";
   res.x = x;
   res.cost = cost;
+  res.lambda = lambda;
   res.jtj = Eigen::MatrixXd(A);
   return res;
 }

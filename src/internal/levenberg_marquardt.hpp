@@ -28,6 +28,7 @@ struct LmResult {
   double cost = 0.0;                // 1/2 ||r||^2 at x
   Eigen::MatrixXd jtj;              // J^T J at x
   int iterations = 0;
+  double lambda = 0.0;              // the damping at the end (a search continued in new coordinates starts there)
   bool converged = false;
   bool interrupted = false;         // the progress callback (core/progress.hpp) asked to stop
   std::string message;

@@ -53,6 +53,9 @@ struct SsestOptions {
   double tolerance = 1e-3;
   bool estimate_d = true;       ///< false: D = 0 (a strictly proper model)
   bool estimate_initial_state = true;  ///< false: each record starts at rest
+  /// Keep a stable start stable: a step that moves a pole (other than a held integrator) to Re >= 0 is rejected. An
+  /// unstable start is searched without it. false: an unstable plant (with start.stabilize false).
+  bool enforce_stability = true;
   /// Known pure integrators: k poles held at 0 (the first k states integrate; A's first k columns are zero).
   int integrators = 0;
   /// Entries held at a value by name: "D1_2" (row 1, column 2), and with a starting model "A1_1", "B2_1", "C1_3".
