@@ -48,7 +48,13 @@ void bind_models(py::module_& m) {
            },
            "Modes by increasing natural frequency: dicts with pole, wn (rad/s), zeta and shape (C v, unit norm, its "
            "largest entry real and positive).")
-      .def("to_transfer_function", &StateSpace::to_transfer_function, py::arg("out") = 0, py::arg("input") = 0);
+      .def("to_transfer_function", &StateSpace::to_transfer_function, py::arg("out") = 0, py::arg("input") = 0)
+      .def("step", [](const StateSpace& ss, const Eigen::VectorXd& t) { return step_response(ss, t); }, py::arg("t"),
+           "Step responses: a list over the inputs of (len(t) x ny) arrays (unit step at t = 0, from rest).")
+      .def("impulse", [](const StateSpace& ss, const Eigen::VectorXd& t) { return impulse_response(ss, t); },
+           py::arg("t"), "Impulse responses C e^{At} B: a list over the inputs of (len(t) x ny) arrays.")
+      .def("frequency_response", [](const StateSpace& ss, const Eigen::VectorXd& w) { return frequency_response(ss, w); },
+           py::arg("w"), "G(jw) (ny x nu complex) at each w (rad/s), as a list.");
   bind_result<StateSpace>(m, "StateSpaceResult");
 
   py::class_<Simulation>(m, "Simulation", "A simulation: outputs y (N x ny), the initial state used, and the problem "

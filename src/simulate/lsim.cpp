@@ -339,6 +339,53 @@ Eigen::VectorXd step_response(const TransferFunction& tf, const Eigen::VectorXd&
   return has_zero ? y : Eigen::VectorXd(y.tail(t.size()));
 }
 
+namespace {
+void require_response_times(const Eigen::VectorXd& t, const char* who) {
+  for (Eigen::Index k = 0; k < t.size(); ++k) {
+    CTID_REQUIRE(std::isfinite(t(k)) && t(k) >= 0.0, "{}: times must be finite and >= 0 (t[{}] = {})", who, k, t(k));
+    CTID_REQUIRE(k == 0 || t(k) > t(k - 1), "{}: times must increase (t[{}] = {} after {})", who, k, t(k), t(k - 1));
+  }
+}
+}  // namespace
+
+std::vector<Eigen::MatrixXd> step_response(const StateSpace& sys, const Eigen::VectorXd& t) {
+  require_response_times(t, "step_response");
+  const Eigen::Index n = sys.nx(), m = sys.nu();
+  std::vector<Eigen::MatrixXd> out(static_cast<size_t>(m), Eigen::MatrixXd(t.size(), sys.ny()));
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n + m, n + m);
+  for (Eigen::Index k = 0; k < t.size(); ++k) {
+    M.topLeftCorner(n, n) = sys.A() * t(k);
+    M.topRightCorner(n, m) = sys.B() * t(k);
+    // Top-right block of the exponential: the states after a unit step of each input held over [0, t].
+    const Eigen::MatrixXd X = t(k) > 0 ? Eigen::MatrixXd(expm(M).topRightCorner(n, m)) : Eigen::MatrixXd::Zero(n, m);
+    const Eigen::MatrixXd Y = sys.C() * X + sys.D();
+    for (Eigen::Index i = 0; i < m; ++i) out[static_cast<size_t>(i)].row(k) = Y.col(i).transpose();
+  }
+  return out;
+}
+
+std::vector<Eigen::MatrixXd> impulse_response(const StateSpace& sys, const Eigen::VectorXd& t) {
+  require_response_times(t, "impulse_response");
+  std::vector<Eigen::MatrixXd> out(static_cast<size_t>(sys.nu()), Eigen::MatrixXd(t.size(), sys.ny()));
+  for (Eigen::Index k = 0; k < t.size(); ++k) {
+    const Eigen::MatrixXd Y = sys.C() * expm(sys.A() * t(k)) * sys.B();
+    for (Eigen::Index i = 0; i < sys.nu(); ++i) out[static_cast<size_t>(i)].row(k) = Y.col(i).transpose();
+  }
+  return out;
+}
+
+std::vector<Eigen::MatrixXcd> frequency_response(const StateSpace& sys, const Eigen::VectorXd& w) {
+  std::vector<Eigen::MatrixXcd> out;
+  const Eigen::MatrixXcd A = sys.A().cast<std::complex<double>>(), B = sys.B().cast<std::complex<double>>();
+  const Eigen::Index n = sys.nx();
+  for (Eigen::Index k = 0; k < w.size(); ++k) {
+    CTID_REQUIRE(std::isfinite(w(k)), "frequency_response: w[{}] is not finite", k);
+    const Eigen::MatrixXcd R = (std::complex<double>(0, w(k)) * Eigen::MatrixXcd::Identity(n, n) - A).partialPivLu().solve(B);
+    out.push_back(sys.C().cast<std::complex<double>>() * R + sys.D().cast<std::complex<double>>());
+  }
+  return out;
+}
+
 Eigen::VectorXd impulse_response(const TransferFunction& tf, const Eigen::VectorXd& t) {
   const StateSpace ss = tf.to_state_space();
   Eigen::VectorXd g = Eigen::VectorXd::Zero(t.size());

@@ -6,6 +6,7 @@
 
 #include "ctid/core/error.hpp"
 #include "ctid/simulate/lsim.hpp"
+#include "estimate/state_space_fixtures.hpp"
 #include "test_util.hpp"
 
 using namespace ctid;
@@ -109,4 +110,35 @@ TEST(Lsim, GeneratedInputIsSimulatedExactly) {
   for (Eigen::Index i = 0; i < ti.size(); ++i)
     EXPECT_NEAR(yi(i), std::exp(-2 * ti(i)) * (ss.C() * Eigen::VectorXd::Ones(1))(0), 1e-12);
   EXPECT_THROW(lsim(ss, InputGenerator::constant(1.0), Eigen::Vector2d(1.0, 0.5)), InvalidArgument);
+}
+
+// MIMO responses of the two-mode 2x2 system (issue 16): the step response equals the exact simulation of a step input
+// (lsim, ZOH), tends to the DC gain -C A^-1 B + D, the impulse response equals each channel's transfer function's,
+// and the frequency-response matrix equals StateSpace::frequency_response channel by channel.
+TEST(Lsim, MimoStepImpulseAndFrequencyResponseMatrices) {
+  const StateSpace m = ctid::test::ss::two_modes();
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(401, 0.0, 40.0);
+  const std::vector<Eigen::MatrixXd> step = step_response(m, t), imp = impulse_response(m, t);
+  ASSERT_EQ(step.size(), 2u);
+  const Eigen::MatrixXd dc = -m.C() * m.A().partialPivLu().solve(m.B()) + m.D();
+  for (int i = 0; i < 2; ++i) {
+    Eigen::MatrixXd u = Eigen::MatrixXd::Zero(t.size(), 2);
+    u.col(i).setOnes();
+    const Eigen::MatrixXd y = lsim(m, u, t, {Intersample::Zoh, Intersample::Zoh});
+    EXPECT_LT((step[static_cast<size_t>(i)] - y).cwiseAbs().maxCoeff(), 1e-10) << "input " << i;
+    // After 40 s the slow mode (decay 0.1 1/s) is down to e^-4: the step is within 5 % of the DC gain.
+    for (int j = 0; j < 2; ++j) {
+      EXPECT_NEAR(step[static_cast<size_t>(i)](400, j), dc(j, i), 0.05 * dc.cwiseAbs().maxCoeff());
+      const Eigen::VectorXd g = impulse_response(m.to_transfer_function(j, i), t);
+      EXPECT_LT((imp[static_cast<size_t>(i)].col(j) - g).cwiseAbs().maxCoeff(), 1e-9) << j << i;
+    }
+  }
+  const Eigen::VectorXd w = Eigen::VectorXd::LinSpaced(4, 0.5, 6.0);
+  const std::vector<Eigen::MatrixXcd> G = frequency_response(m, w);
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) {
+      const Eigen::VectorXcd g = m.frequency_response(w, j, i);
+      for (Eigen::Index k = 0; k < w.size(); ++k) EXPECT_LT(std::abs(G[static_cast<size_t>(k)](j, i) - g(k)), 1e-12);
+    }
+  EXPECT_THROW(step_response(m, (Eigen::VectorXd(2) << 1.0, 0.5).finished()), InvalidArgument);
 }

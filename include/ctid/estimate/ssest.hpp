@@ -4,15 +4,18 @@
 // Cost: V = 1/2 sum_records sum_k sum_j w_j (y_j(t_k) - yhat_j(t_k))^2, yhat the exact simulation of
 // dx/dt = A x + B u, y = C x + D u from each record's initial state x0_e (ZOH/FOH inputs, any sample times), with
 // w_j = 1/sigma_j^2 the inverse noise variance of output j, re-estimated from the residuals of the converged model
-// and the search repeated once — the Gaussian maximum-likelihood estimate for independent white output noise of
-// unknown variances (Ljung 1999, "System Identification", §7.4 and §9.4: asymptotic covariance (J^T W J)^-1).
+// and the search repeated once when one moved by more than 10 % — the Gaussian maximum-likelihood estimate for
+// independent white output noise of unknown variances (Ljung 1999, "System Identification", §7.4 and §9.4:
+// asymptotic covariance (J^T W J)^-1).
 //
 // Parametrisation: every entry of (A, B, C, D, x0_e) (the "full parametrisation" of McKelvey, Helmersson &
 // Ribarits 2004, "Data driven local coordinates for multivariable linear systems and their application to system
 // identification", Automatica 40(9), 1629-1635), searched in data-driven local coordinates: only in the directions
 // orthogonal to the tangent space of the change-of-basis manifold {(T^-1 A T, T^-1 B, C T, D, T^-1 x0)} at the
-// current model (their eq. 9-12), re-centred between rounds of Levenberg-Marquardt; states, inputs and outputs
-// scaled to unit variance at the start, so the search is well conditioned. Exact sensitivities: the derivative of
+// current model (their eq. 9-12), re-centred every 5 Levenberg-Marquardt iterations (the damping carried over);
+// inputs and outputs scaled to unit variance, and the states whitened along the model's trajectory at each
+// re-centring, so the search stays well conditioned. enforce_stability rejects steps that make a stable model
+// unstable. Exact sensitivities: the derivative of
 // the output in a direction (dA, dB, dC, dD, dx0) is the output of the linear system
 //   [x; dx]' = [[A, 0], [dA, A]] [x; dx] + [B; dB] u,   dy = [dC, C] [x; dx] + dD u,   dx(0) = dx0,
 // discretised exactly like the model itself (Van Loan's block exponential), so it is exact for ZOH/FOH inputs on

@@ -10,6 +10,9 @@
 // (the system at rest with x0 unless x0 is given).
 #pragma once
 
+#include <complex>
+#include <vector>
+
 #include <Eigen/Dense>
 
 #include "ctid/data/iddata.hpp"
@@ -63,6 +66,16 @@ Eigen::VectorXd step_response(const TransferFunction& tf, const Eigen::VectorXd&
 /// Impulse response g(t) = C e^{A (t - Td)} B for t >= Td, 0 before; a direct term
 /// (Dirac at Td) is not representable on samples and is left out.
 Eigen::VectorXd impulse_response(const TransferFunction& tf, const Eigen::VectorXd& t);
+/// MIMO step responses (issue 16): element i is the response of every output (N x ny) to a unit step on input i at
+/// t = 0, from rest, at the times t (t >= 0, increasing): C int_0^t e^{A s} ds B e_i + D e_i, each time by the block
+/// exponential of [[A, B], [0, 0]] t (exact). Throws InvalidArgument for bad times.
+std::vector<Eigen::MatrixXd> step_response(const StateSpace& sys, const Eigen::VectorXd& t);
+/// MIMO impulse responses: element i is C e^{A t} B e_i (N x ny) at the times t (t >= 0); the direct term D (a Dirac
+/// at 0) is not representable on samples and is left out.
+std::vector<Eigen::MatrixXd> impulse_response(const StateSpace& sys, const Eigen::VectorXd& t);
+/// The frequency-response matrix G(j w_k) = C (j w_k I - A)^-1 B + D (ny x nu) at each w (rad/s).
+std::vector<Eigen::MatrixXcd> frequency_response(const StateSpace& sys, const Eigen::VectorXd& w);
+
 /// n equally spaced times 0, h, ..., (n-1) h.
 Eigen::VectorXd time_grid(double h, int n);
 
