@@ -19,6 +19,9 @@ check() {  # check NAME VALUE OP BOUND   (OP: lt | gt)
   if [ "$ok" = 1 ]; then echo "  $1 = $2 (bound: $3 $4)"; else echo "  FAILED: $1 = $2 (bound: $3 $4)"; fail=1; fi
 }
 fit_of() { "$ctid" validate "$@" | awk '/^fit:/ { print $2; exit }'; }
+# The validation fit of every output, the initial state estimated by least squares on the record validated:
+# fits_of MODEL.json DATA [validate options]  ->  "fit1 fit2 ..." on one line
+fits_of() { "$ctid" validate "$@" --initial estimated | awk '/fit:/ { for (i = 1; i < NF; ++i) if ($i == "fit:") printf "%s ", $(i + 1) } END { print "" }'; }
 mse_of() { "$ctid" validate "$@" | awk '/^fit:/ { for (i = 1; i < NF; ++i) if ($i == "MSE") print $(i + 1); exit }'; }
 # RMS of (simulated - measured) after removing the measured mean, skipping the first 50 samples:
 # rms SIM.csv DATA.csv COLUMN_OF_Y_IN_DATA

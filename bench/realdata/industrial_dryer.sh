@@ -23,7 +23,6 @@ check "moisture content (column 7): validation fit % (no linear model generalise
 
 echo "== the same, initial state of the validation part estimated (least squares on it; MATLAB compare's default):"
 echo "   MISO SRIVC per output, MIMO ssest (order by BIC over 1..6 on the estimation part), discrete N4SID (MOESP + logm)"
-fits_of() { "$ctid" validate "$@" --initial estimated | awk '/fit:/ { for (i = 1; i < NF; ++i) if ($i == "fit:") printf "%s ", $(i + 1) } END { print "" }'; }
 read -r s5 < <(fits_of dryer2_5.json dryer2_val.dat $i --output 5)
 read -r s6 < <(fits_of dryer2_6.json dryer2_val.dat $i --output 6)
 read -r s7 < <(fits_of dryer2_7.json dryer2_val.dat $i --output 7)

@@ -30,7 +30,6 @@ check "tension T3, common third-order denominator: validation fit %" \
 
 echo "== one MIMO model of both tensions: ssest (order by BIC over 1..8 on the estimation part) against the MISO"
 echo "   SRIVC models and the discrete N4SID route; the validation part's initial state estimated (least squares)"
-fits_of() { "$ctid" validate "$@" --initial estimated | awk '/fit:/ { for (i = 1; i < NF; ++i) if ($i == "fit:") printf "%s ", $(i + 1) } END { print "" }'; }
 read -r s6 < <(fits_of winding_6s.json winding_val.dat $w --output 6)
 read -r s7 < <(fits_of winding_7c3.json winding_val.dat $w --output 7)
 echo "  best MISO SRIVC (T1 separate first-order denominators, T3 common third order): $s6 $s7"
