@@ -16,6 +16,7 @@
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/validate/metrics.hpp"
 #include "ctid/validate/uncertainty.hpp"
+#include "estimate/state_space_common.hpp"
 #include "internal/levenberg_marquardt.hpp"
 
 namespace ctid {
@@ -116,7 +117,7 @@ struct Record {
   Eigen::VectorXd t;
   bool uniform = true;
   double h = 0.0;
-  std::vector<bool> foh;
+  std::vector<Intersample> intersample;  // of each input
 };
 
 std::vector<Record> records_of(const std::vector<IdData>& ds, const Eigen::VectorXd& su, const Eigen::VectorXd& sy) {
@@ -128,7 +129,7 @@ std::vector<Record> records_of(const std::vector<IdData>& ds, const Eigen::Vecto
     r.t = d.times();
     r.uniform = d.is_uniform();
     r.h = r.uniform && d.size() > 1 ? d.ts() : 0.0;
-    for (int i = 0; i < d.nu(); ++i) r.foh.push_back(d.intersample(i) != Intersample::Zoh);
+    for (int i = 0; i < d.nu(); ++i) r.intersample.push_back(d.intersample(i));
     out.push_back(std::move(r));
   }
   return out;
@@ -153,10 +154,12 @@ Discretization exact_step(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, do
   return {E.topLeftCorner(n, n), E.topRightCorner(n, m), Eigen::MatrixXd::Zero(n, m), h};
 }
 
-Step step_of(const Point& m, const std::vector<Point>& dirs, double h, const std::vector<bool>& foh) {
+Step step_of(const Point& m, const std::vector<Point>& dirs, double h, const std::vector<Intersample>& is) {
   const Eigen::Index nx = m.A.rows(), nu = m.B.cols();
   const Eigen::Index P = static_cast<Eigen::Index>(dirs.size());
-  const bool any_foh = std::find(foh.begin(), foh.end(), true) != foh.end();
+  auto foh = [&](Eigen::Index j) { return is[static_cast<size_t>(j)] != Intersample::Zoh; };
+  bool any_foh = false;
+  for (Eigen::Index j = 0; j < nu; ++j) any_foh = any_foh || foh(j);
   Step s;
   s.h = h;
   const Discretization base = exact_step(m.A, m.B, h, any_foh);
@@ -164,7 +167,7 @@ Step step_of(const Point& m, const std::vector<Point>& dirs, double h, const std
   s.G0 = base.Gamma0;
   s.G1 = base.Gamma1;
   for (Eigen::Index j = 0; j < nu; ++j)
-    if (!foh[static_cast<size_t>(j)]) s.G1.col(j).setZero();
+    if (!foh(j)) s.G1.col(j).setZero();
   s.W1.setZero(nx * P, nx);
   s.W2.setZero(nx * P, nu);
   s.W3.setZero(nx * P, nu);
@@ -182,7 +185,7 @@ Step step_of(const Point& m, const std::vector<Point>& dirs, double h, const std
     s.W2.middleRows(d * nx, nx) = a.Gamma0.bottomRows(nx);
     s.W3.middleRows(d * nx, nx) = a.Gamma1.bottomRows(nx);
     for (Eigen::Index j = 0; j < nu; ++j)
-      if (!foh[static_cast<size_t>(j)]) s.W3.block(d * nx, j, nx, 1).setZero();
+      if (!foh(j)) s.W3.block(d * nx, j, nx, 1).setZero();
   }
   return s;
 }
@@ -222,7 +225,7 @@ bool evaluate(const Point& m, const std::vector<Point>* dirs, const std::vector<
       for (const Step& s : cache)
         if (std::abs(s.h - h) <= 1e-13 * h) return s;
       if (cache.size() >= 4) cache.erase(cache.begin());
-      cache.push_back(step_of(m, sens ? *dirs : none, h, rec.foh));
+      cache.push_back(step_of(m, sens ? *dirs : none, h, rec.intersample));
       return cache.back();
     };
     auto h_at = [&](Eigen::Index k) { return rec.uniform ? rec.h : rec.t(k + 1) - rec.t(k); };
@@ -409,7 +412,6 @@ bool modal_form(const Point& m, int integrators, ModalForm& out) {
     int index;
   };
   std::vector<Entry> order;
-  std::vector<bool> used(static_cast<size_t>(nx), false);
   for (int i = 0; i < nx; ++i) {
     if (lam(i).imag() < 0) continue;  // a pair is listed once, by its member with imag > 0
     order.push_back({std::abs(lam(i)), i});
@@ -466,8 +468,7 @@ bool modal_form(const Point& m, int integrators, ModalForm& out) {
     S.topLeftCorner(integrators, integrators) = sub.inverse();
   }
   for (int a = integrators; a < nx;) {
-    const bool pair = a + 1 < nx && std::abs(p.A(a, a + 1)) > 1e-12 * (1.0 + p.A.cwiseAbs().maxCoeff()) &&
-                      out.names[static_cast<size_t>(a - integrators)].rfind("sigma", 0) == 0;
+    const bool pair = out.names[static_cast<size_t>(a - integrators)].rfind("sigma", 0) == 0;
     Eigen::Index row = 0;
     if (!pair) {
       A(a, a) = p.A(a, a);
@@ -513,9 +514,7 @@ Point whitened(const Point& m, const std::vector<Record>& recs) {
   for (size_t e = 0; e < recs.size(); ++e) {
     LsimOptions lo;
     lo.x0 = m.x0[e];
-    std::vector<Intersample> is;
-    for (bool f : recs[e].foh) is.push_back(f ? Intersample::Foh : Intersample::Zoh);
-    const Eigen::MatrixXd X = lsim(states, recs[e].u, recs[e].t, is, lo);
+    const Eigen::MatrixXd X = lsim(states, recs[e].u, recs[e].t, recs[e].intersample, lo);
     if (!X.allFinite()) continue;
     Sx += X.transpose() * X;
     n += X.rows();
@@ -553,6 +552,7 @@ Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& h
   int left = o.max_iterations;
   for (int pass = 0; pass < 2; ++pass) {
     const Eigen::VectorXd sw = s.weights.cwiseSqrt();
+    double cost = INFINITY;  // at theta, with these weights
     bool converged = false;
     while (left > 0 && !converged) {
       if (free_coordinates) theta = pack(L, whitened(unpack(L, theta), recs));
@@ -565,8 +565,10 @@ Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& h
       };
       lmo.max_iterations = std::min(left, 5);
       // The cost is in noise units (1/2 sum of e^2/sigma^2): a round ends when a step gains less than `tolerance`.
-      double c0 = 0.0;
-      if (evaluate(unpack(L, theta), nullptr, recs, sw, c0, nullptr, nullptr) && c0 > 0) lmo.ftol = o.tolerance / c0;
+      // It is the last round's final cost (a change of state coordinates does not change it), evaluated afresh only
+      // at the start of a pass.
+      if (!std::isfinite(cost) && !evaluate(unpack(L, theta), nullptr, recs, sw, cost, nullptr, nullptr)) cost = INFINITY;
+      if (std::isfinite(cost) && cost > 0) lmo.ftol = o.tolerance / cost;
       internal::LmResult lm = internal::levenberg_marquardt(internal::LmNormalEvaluate(normal),
                                                             Eigen::VectorXd::Zero(Q.cols()),
                                                             Eigen::VectorXd::Constant(Q.cols(), -INFINITY),
@@ -578,6 +580,7 @@ Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& h
         return s;
       }
       theta += Q * lm.x;
+      cost = lm.cost;
       lmo.lambda0 = std::clamp(lm.lambda, 1e-12, 1e-3);  // the next round goes on with the damping reached
       left -= std::max(lm.iterations, 1);
       s.iterations += lm.iterations;
@@ -600,37 +603,6 @@ Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& h
   return s;
 }
 
-struct Fits {
-  FitReport all;
-  Eigen::VectorXd per_output;
-};
-
-Fits fits_of(const std::vector<IdData>& ds, const std::vector<Eigen::MatrixXd>& yhat, const Eigen::VectorXd& sy,
-             int n_parameters) {
-  const int ny = ds.front().ny();
-  Eigen::Index n = 0;
-  for (const IdData& d : ds) n += d.size();
-  Eigen::VectorXd y(n * ny), h(n * ny);
-  Fits f;
-  f.per_output.resize(ny);
-  for (int j = 0; j < ny; ++j) {
-    Eigen::VectorXd yj(n), hj(n);
-    Eigen::Index at = 0;
-    for (size_t e = 0; e < ds.size(); ++e) {
-      const Eigen::Index m = ds[e].size();
-      yj.segment(at, m) = ds[e].y().col(j);
-      hj.segment(at, m) = yhat[e].col(j);
-      at += m;
-    }
-    f.per_output(j) = fit_report_or_inf(yj, hj, n_parameters).fit_percent;
-    const double mean = yj.mean();
-    y.segment(j * n, n) = (yj.array() - mean) / sy(j);
-    h.segment(j * n, n) = (hj.array() - mean) / sy(j);
-  }
-  f.all = fit_report_or_inf(y, h, n_parameters);
-  return f;
-}
-
 void check_records(const std::vector<IdData>& ds) {
   CTID_REQUIRE(!ds.empty(), "ssest: no records were given");
   const int nu = ds.front().nu(), ny = ds.front().ny();
@@ -641,26 +613,6 @@ void check_records(const std::vector<IdData>& ds) {
                  e + 1, d.nu(), d.ny(), nu, ny);
     CTID_REQUIRE(d.u().allFinite() && d.y().allFinite(), "ssest: record {} contains non-finite values", e + 1);
   }
-}
-
-// Channel scales: standard deviation over all records (1 where constant).
-Eigen::VectorXd channel_scales(const std::vector<IdData>& ds, bool outputs) {
-  const int n = outputs ? ds.front().ny() : ds.front().nu();
-  Eigen::VectorXd s(n);
-  for (int j = 0; j < n; ++j) {
-    double sum = 0, sum2 = 0;
-    Eigen::Index cnt = 0;
-    for (const IdData& d : ds) {
-      const auto c = outputs ? d.y().col(j) : d.u().col(j);
-      sum += c.sum();
-      sum2 += c.squaredNorm();
-      cnt += c.size();
-    }
-    const double mean = sum / static_cast<double>(cnt);
-    const double v = std::sqrt(std::max(0.0, sum2 / static_cast<double>(cnt) - mean * mean));
-    s(j) = v > 1e-300 && std::isfinite(v) ? v : 1.0;
-  }
-  return s;
 }
 
 std::string entry_name(char M, int i, int j) { return std::string(1, M) + std::to_string(i + 1) + "_" + std::to_string(j + 1); }
@@ -693,27 +645,25 @@ void deliver(Result<StateSpace>& res, const std::vector<IdData>& ds, Point fin, 
   const int nx = static_cast<int>(fin.A.rows()), nu = ds.front().nu(), ny = ds.front().ny();
   const int E = static_cast<int>(ds.size());
   const Layout L{nx, nu, ny, E};
-  const Eigen::VectorXd sy = channel_scales(ds, true);
+  const Eigen::VectorXd sy = ss_detail::channel_scales(ds, true);
   Eigen::Index total = 0;
   for (const IdData& d : ds) total += d.size();
   const int n_free_params = static_cast<int>(std::count(held.begin(), held.end(), false)) - similar;
   // Back to the user's units (and, for a free structure, to the modal form).
   std::vector<std::string> pnames;
-  std::vector<Point> pdirs;  // each reported parameter's direction (x0 of every record after them)
   std::vector<bool> pfixed;
-  Eigen::VectorXd pvalues;
   std::vector<double> vals;
-  auto zero_point = [&] {
-    return Point{Eigen::MatrixXd::Zero(nx, nx), Eigen::MatrixXd::Zero(nx, nu), Eigen::MatrixXd::Zero(ny, nx),
-                 Eigen::MatrixXd::Zero(ny, nu), std::vector<Eigen::VectorXd>(static_cast<size_t>(E), Eigen::VectorXd::Zero(nx))};
-  };
-  auto add_entry = [&](char M, int i, int j, double value, bool fixed) {
-    Point d = zero_point();
-    (M == 'A' ? d.A : M == 'B' ? d.B : M == 'C' ? d.C : d.D)(i, j) = 1.0;
-    pnames.push_back(entry_name(M, i, j));
+  auto add = [&](std::string name, double value, bool fixed) {
+    pnames.push_back(std::move(name));
     vals.push_back(value);
     pfixed.push_back(fixed);
-    pdirs.push_back(std::move(d));
+  };
+  auto add_entries = [&](char M, const Eigen::MatrixXd& X, auto is_held) {
+    for (int i = 0; i < X.rows(); ++i)
+      for (int j = 0; j < X.cols(); ++j) add(entry_name(M, i, j), X(i, j), is_held(i, j));
+  };
+  auto held_at = [&](Eigen::Index (Layout::*at)(int, int) const) {
+    return [&, at](int i, int j) { return static_cast<bool>(held[static_cast<size_t>((L.*at)(i, j))]); };
   };
   ModalForm mf;
   const bool modal = !user_coordinates && modal_form(fin, o.integrators, mf);
@@ -722,65 +672,46 @@ void deliver(Result<StateSpace>& res, const std::vector<IdData>& ds, Point fin, 
                                        "where its entries are not determined (poles and responses are)");
   if (modal) {
     fin = mf.model;
-    for (int k = 0; k < o.integrators; ++k) {
-      // An integrator's pole, held at 0.
-      pnames.push_back("pole" + std::to_string(k + 1));
-      vals.push_back(0.0);
-      pfixed.push_back(true);
-      Point d = zero_point();
-      d.A(k, k) = 1.0;
-      pdirs.push_back(std::move(d));
-    }
+    for (int k = 0; k < o.integrators; ++k) add("pole" + std::to_string(k + 1), 0.0, true);  // held at 0
     for (const std::string& n : mf.names) {
-      Point d = zero_point();
       const int a = std::stoi(n.substr(n[0] == 'p' ? 4 : 5)) - 1;
-      double v = 0;
-      if (n[0] == 'p') { d.A(a, a) = 1.0; v = fin.A(a, a); }
-      else if (n[0] == 's') { d.A(a, a) = d.A(a + 1, a + 1) = 1.0; v = fin.A(a, a); }
-      else { d.A(a, a + 1) = 1.0; d.A(a + 1, a) = -1.0; v = fin.A(a, a + 1); }
-      pnames.push_back(n);
-      vals.push_back(v);
-      pfixed.push_back(false);
-      pdirs.push_back(std::move(d));
+      add(n, n[0] == 'o' ? fin.A(a, a + 1) : fin.A(a, a), false);
     }
-    for (int i = 0; i < nx; ++i)
-      for (int j = 0; j < nu; ++j) add_entry('B', i, j, fin.B(i, j), false);
-    for (int i = 0; i < ny; ++i)
-      for (int j = 0; j < nx; ++j) {
-        bool norm = false;
-        for (const auto& [r, c, v] : mf.c_held) norm = norm || (r == i && c == j);
-        add_entry('C', i, j, fin.C(i, j), norm);
-      }
+    add_entries('B', fin.B, [](int, int) { return false; });
+    add_entries('C', fin.C, [&](int i, int j) {
+      bool norm = false;
+      for (const auto& [r, c, v] : mf.c_held) norm = norm || (r == i && c == j);
+      return norm;
+    });
   } else {
-    for (int i = 0; i < nx; ++i)
-      for (int j = 0; j < nx; ++j) add_entry('A', i, j, fin.A(i, j), held[static_cast<size_t>(L.a(i, j))]);
-    for (int i = 0; i < nx; ++i)
-      for (int j = 0; j < nu; ++j) add_entry('B', i, j, fin.B(i, j), held[static_cast<size_t>(L.b(i, j))]);
-    for (int i = 0; i < ny; ++i)
-      for (int j = 0; j < nx; ++j) add_entry('C', i, j, fin.C(i, j), held[static_cast<size_t>(L.c(i, j))]);
+    add_entries('A', fin.A, held_at(&Layout::a));
+    add_entries('B', fin.B, held_at(&Layout::b));
+    add_entries('C', fin.C, held_at(&Layout::c));
   }
-  if (o.estimate_d)
-    for (int i = 0; i < ny; ++i)
-      for (int j = 0; j < nu; ++j) add_entry('D', i, j, fin.D(i, j), held[static_cast<size_t>(L.d(i, j))]);
+  if (o.estimate_d) add_entries('D', fin.D, held_at(&Layout::d));
   res.model = StateSpace(fin.A, fin.B, fin.C, fin.D);
   res.parameters.names = pnames;
   res.parameters.values = Eigen::Map<const Eigen::VectorXd>(vals.data(), static_cast<Eigen::Index>(vals.size()));
   res.parameters.fixed = pfixed;
 
-  // Covariance: (J^T W J)^-1 over the free parameters and the initial states at the final model, in the user's units
-  // (columns scaled before the inversion); the parameters' block of it.
+  // Covariance: (J^T W J)^-1 over the free parameters (their directions read from their names, the one reading of
+  // validate/uncertainty.hpp) and the initial states at the final model, in the user's units (columns scaled before
+  // the inversion); the parameters' block of it.
   std::vector<int> slots;
   std::vector<Point> cdirs;
+  const std::vector<Eigen::VectorXd> no_x0(static_cast<size_t>(E), Eigen::VectorXd::Zero(nx));
+  const std::vector<StateSpaceDirection> pdirs = state_space_directions(res.model, res.parameters);
   for (size_t k = 0; k < pdirs.size(); ++k)
     if (!pfixed[k]) {
       slots.push_back(static_cast<int>(k));
-      cdirs.push_back(pdirs[k]);
+      cdirs.push_back(Point{pdirs[k].dA, pdirs[k].dB, pdirs[k].dC, pdirs[k].dD, no_x0});
     }
   const int np = static_cast<int>(cdirs.size());
   if (o.estimate_initial_state)
     for (int e = 0; e < E; ++e)
       for (int i = 0; i < nx; ++i) {
-        Point d = zero_point();
+        Point d{Eigen::MatrixXd::Zero(nx, nx), Eigen::MatrixXd::Zero(nx, nu), Eigen::MatrixXd::Zero(ny, nx),
+                Eigen::MatrixXd::Zero(ny, nu), no_x0};
         d.x0[static_cast<size_t>(e)](i) = 1.0;
         cdirs.push_back(std::move(d));
       }
@@ -804,7 +735,6 @@ void deliver(Result<StateSpace>& res, const std::vector<IdData>& ds, Point fin, 
       cov = full.topLeftCorner(np, np);
     }
   }
-  res.parameters.values = res.parameters.values;
   res.parameters.set_covariance(cov, slots);
   if (user_coordinates && similar > 0 && res.summary.succeeded()) {
     res.summary.termination = Termination::Unidentifiable;
@@ -816,7 +746,7 @@ void deliver(Result<StateSpace>& res, const std::vector<IdData>& ds, Point fin, 
 
   // Fits, noise, initial states, modes.
   if (ok) {
-    const Fits f = fits_of(ds, yhat, sy, n_free_params + (o.estimate_initial_state ? E * nx : 0));
+    const ss_detail::Fits f = ss_detail::fits_of(ds, yhat, sy, n_free_params + (o.estimate_initial_state ? E * nx : 0));
     res.fit = f.all;
     res.diagnostics.set(diagnostic::output_fit_percent, f.per_output);
     res.diagnostics.set(diagnostic::output_noise_variance, var);
@@ -846,10 +776,8 @@ Result<StateSpace> fit_from(const std::vector<IdData>& ds, Point start, bool use
   const int nx = static_cast<int>(start.A.rows()), nu = ds.front().nu(), ny = ds.front().ny();
   const int E = static_cast<int>(ds.size());
   const Layout L{nx, nu, ny, E};
-  const Eigen::VectorXd su = channel_scales(ds, false), sy = channel_scales(ds, true);
+  const Eigen::VectorXd su = ss_detail::channel_scales(ds, false), sy = ss_detail::channel_scales(ds, true);
   const std::vector<Record> recs = records_of(ds, su, sy);
-  Eigen::Index total = 0;
-  for (const IdData& d : ds) total += d.size();
 
   // Held entries: D (estimate_d false or fixed.D..), A/B/C (fixed.., with a starting model), x0 (from rest),
   // the integrators' columns of A.
@@ -862,23 +790,19 @@ Result<StateSpace> fit_from(const std::vector<IdData>& ds, Point start, bool use
     for (int j = 0; j < nx; ++j) names.push_back(entry_name('C', i, j));
   for (int i = 0; i < ny; ++i)
     for (int j = 0; j < nu; ++j) names.push_back(entry_name('D', i, j));
+  const ParameterConstraints c = resolve_constraints(
+      o.fixed, {}, names, "ssest", "an entry of A, B, C or D of this model (" + std::to_string(nx) + " states)");
   std::vector<bool> held(static_cast<size_t>(L.size()), false);
-  for (const auto& [name, value] : o.fixed) {
-    const auto it = std::find(names.begin(), names.end(), name);
-    if (it == names.end()) {
-      const std::vector<std::string> cands(names.begin(), names.end());
-      (void)resolve_constraints({{name, value}}, {}, cands, "ssest",
-                                "an entry of A, B, C or D of this model (" + std::to_string(nx) + " states)");
-    }
-    const auto k = static_cast<size_t>(it - names.begin());
-    CTID_REQUIRE_OPTION(user_coordinates || name[0] == 'D',
+  Eigen::VectorXd v = pack(L, start);
+  for (size_t k = 0; k < names.size(); ++k) {
+    if (!c.held[k]) continue;
+    CTID_REQUIRE_OPTION(user_coordinates || names[k][0] == 'D',
                         "ssest: fixed.{}: entries of A, B and C refer to the coordinates of a starting model; give "
-                        "one (ssest(data, initial, options); Python initial=...)", name);
+                        "one (ssest(data, initial, options); Python initial=...)", names[k]);
     held[k] = true;
-    Eigen::VectorXd v = pack(L, start);
-    v(static_cast<Eigen::Index>(k)) = value;
-    start = unpack(L, v);
+    v(static_cast<Eigen::Index>(k)) = c.value(static_cast<Eigen::Index>(k));
   }
+  start = unpack(L, v);
   hold_structure(L, o, start, held);
 
   // Scaled units; without held A/B/C entries (and integrators) also whitened states, again at each round.

@@ -16,6 +16,7 @@
 #include "ctid/signal/svf.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/validate/metrics.hpp"
+#include "estimate/state_space_common.hpp"
 #include "internal/least_squares.hpp"
 
 namespace ctid {
@@ -90,16 +91,7 @@ struct Scaled {
 };
 
 Scaled scales(const IdData& d) {
-  auto sd = [](const Eigen::MatrixXd& x) {
-    Eigen::VectorXd s(x.cols());
-    for (Eigen::Index j = 0; j < x.cols(); ++j) {
-      const double m = x.col(j).mean();
-      const double v = std::sqrt((x.col(j).array() - m).square().mean());
-      s(j) = v > 0 && std::isfinite(v) ? v : 1.0;
-    }
-    return s;
-  };
-  return {sd(d.u()), sd(d.y())};
+  return {ss_detail::channel_scales({&d, 1}, false), ss_detail::channel_scales({&d, 1}, true)};
 }
 
 // Gram matrix of z = [U_f; U_p; Y_f] of the lambda route (block row k of U_f: lambda^{r-1-k} u; U_p: lambda^{r+j} u).
@@ -257,28 +249,12 @@ Estimate estimate_at(const IdData& d, const Scaled& s, const SubspaceOptions& o,
   return e;
 }
 
-struct Fits {
-  FitReport all;
-  Eigen::VectorXd per_output;
-};
-
-Fits fits_of(const StateSpace& m, const IdData& d, const Scaled& s, const Eigen::VectorXd& x0, int n_parameters) {
+ss_detail::Fits fits_of(const StateSpace& m, const IdData& d, const Scaled& s, const Eigen::VectorXd& x0,
+                        int n_parameters) {
   LsimOptions lo;
   lo.x0 = x0;
   const Eigen::MatrixXd yhat = lsim(m, d, lo);
-  const int N = d.size(), ny = d.ny();
-  Eigen::VectorXd y(static_cast<Eigen::Index>(N) * ny), h(static_cast<Eigen::Index>(N) * ny);
-  Fits f;
-  f.per_output.resize(ny);
-  for (int j = 0; j < ny; ++j) {
-    // Each output about its own mean and scale, so that every output counts alike in the overall fit.
-    const double mean = d.y().col(j).mean();
-    y.segment(static_cast<Eigen::Index>(j) * N, N) = (d.y().col(j).array() - mean) / s.sy(j);
-    h.segment(static_cast<Eigen::Index>(j) * N, N) = (yhat.col(j).array() - mean) / s.sy(j);
-    f.per_output(j) = fit_report_or_inf(d.y().col(j), yhat.col(j), n_parameters).fit_percent;
-  }
-  f.all = fit_report_or_inf(y, h, n_parameters);
-  return f;
+  return ss_detail::fits_of({&d, 1}, {&yhat, 1}, s.sy, n_parameters);
 }
 
 }  // namespace
@@ -353,7 +329,7 @@ Result<StateSpace> subspace(const IdData& data, const SubspaceOptions& options) 
   // Among the taus tried (each with its order), the least BIC of the simulation error (every output scaled alike;
   // with one order that is the best fit), stable models first.
   Estimate best;
-  Fits best_fit;
+  ss_detail::Fits best_fit;
   best_fit.all.fit_percent = -INFINITY;
   best_fit.all.bic = INFINITY;
   double best_tau = 0.0;
@@ -381,7 +357,7 @@ Result<StateSpace> subspace(const IdData& data, const SubspaceOptions& options) 
       if (grid.size() == 1) throw;
       continue;
     }
-    Fits f;
+    ss_detail::Fits f;
     f.all.fit_percent = -INFINITY;
     f.all.bic = INFINITY;
     if (e.refusal.empty()) f = fits_of(e.model, data, scale, e.x0, n_free(e.model.nx()));
@@ -409,7 +385,7 @@ Result<StateSpace> subspace(const IdData& data, const SubspaceOptions& options) 
     return res;
   }
   const StateSpace& m = best.model;
-  const Fits& f = best_fit;
+  const ss_detail::Fits& f = best_fit;
   res.model = m;
   auto add = [&](const std::string& name, const Eigen::MatrixXd& M) {
     for (Eigen::Index i = 0; i < M.rows(); ++i)
