@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <numbers>
 #include <set>
 #include <type_traits>
 
@@ -27,6 +28,8 @@ struct FitArgs {
   std::string w = "w", re = "re", im = "im", u_re, u_im, y_re, y_im;
   std::string json, narx, report;
   std::string nx, initial;  ///< subspace/ssest: state dimension N or range A:B; ssest: a starting model (JSON)
+  int period = 0, skip = 1;  ///< subspace/ssest: periodic records -> their FRF matrix (frf_from_periodic)
+  double excited = 0.1;
   bool force = false;
   std::set<std::string> given;  ///< long names of the options given on the command line
 };
@@ -57,6 +60,11 @@ void reject_flags_that_do_not_apply(const FitArgs& a) {
   if (has("delay") && !tf_data) refuse("delay", "(delay estimation) needs --method srivc, oe or tfest (got " + m + ")");
   if (has("nx") && m != "subspace" && m != "ssest") refuse("nx", "sets a state dimension: it needs --method subspace or ssest (got " + m + ")");
   if (has("initial") && m != "ssest") refuse("initial", "gives ssest its starting model: it needs --method ssest (got " + m + ")");
+  if (has("period") && m != "subspace" && m != "ssest")
+    refuse("period", "fits the FRF of periodic records: it needs --method subspace or ssest (got " + m + ")");
+  for (const char* f : {"skip", "excited"})
+    if (has(f) && !has("period")) refuse(f, "belongs to --period (periodic records)");
+  if (has("period") && a.frequency) refuse("period", "computes frequency data from periodic records (not with --frequency)");
   for (const char* f : {"nb", "nf", "nk"})
     if (has(f) && (m == "narx" || m == "kia" || m == "fsf" || m == "physical" || m == "greybox" || m == "subspace" ||
                    m == "ssest"))
@@ -467,6 +475,21 @@ int run_subspace(const FitArgs& a, const IdData& d) {
   return finish(r, a.method, d, a, settings_of(o));
 }
 
+// --initial MODEL.json: ssest's starting model.
+StateSpace initial_state_space(const FitArgs& a) {
+  const LinearModel m = [&] {
+    try {
+      return read_model_json(a.initial);
+    } catch (const std::exception& e) {
+      throw InputError(std::string("--initial: ") + e.what());
+    }
+  }();
+  if (!std::holds_alternative<StateSpace>(m))
+    throw UsageError("--initial " + a.initial + " holds a transfer function; ssest starts from a state-space model "
+                     "(\"type\": \"state_space\")");
+  return std::get<StateSpace>(m);
+}
+
 // ssest: any number of inputs and outputs, one or several records; the subspace start or --initial MODEL.json.
 int run_ssest(const FitArgs& a, const std::vector<IdData>& ds) {
   SsestOptions o;
@@ -474,22 +497,36 @@ int run_ssest(const FitArgs& a, const std::vector<IdData>& ds) {
   const auto [nx, nx_max] = nx_of(a);
   if (nx > 0) o.nx = nx;
   if (nx_max > 0) o.nx_max = nx_max;
-  Result<StateSpace> r;
-  if (!a.initial.empty()) {
-    const LinearModel m = [&] {
-      try {
-        return read_model_json(a.initial);
-      } catch (const std::exception& e) {
-        throw InputError(std::string("--initial: ") + e.what());
-      }
-    }();
-    if (!std::holds_alternative<StateSpace>(m))
-      throw UsageError("--initial " + a.initial + " holds a transfer function; ssest starts from a state-space model "
-                       "(\"type\": \"state_space\")");
-    r = call_library([&] { return ssest(ds, std::get<StateSpace>(m), o); });
-  } else {
-    r = call_library([&] { return ssest(ds, o); });
+  const Result<StateSpace> r =
+      call_library([&] { return a.initial.empty() ? ssest(ds, o) : ssest(ds, initial_state_space(a), o); });
+  return finish(r, a.method, ds.front(), a, settings_of(o));
+}
+
+// --period N: periodic records (one per input) -> their FRF matrix with variances -> subspace or ssest on it.
+int run_periodic(const FitArgs& a) {
+  if (!a.report.empty()) throw UsageError("--report needs time-domain records (not --period: a fit to frequency data)");
+  const std::vector<IdData> ds = a.paths.size() > 1 ? a.data.load_each(a.paths, true) : std::vector<IdData>{a.data.load(true)};
+  const FrequencyData fd = call_library([&] { return frf_from_periodic(ds, a.period, a.skip, a.excited); });
+  const int periods = ds.front().size() / a.period - a.skip;
+  std::printf("FRF matrix of the periodic records: %d excited frequencies from %.6g to %.6g Hz, %d period(s) of %d "
+              "samples averaged (%d skipped)\n", fd.size(), fd.w()(0) / (2 * std::numbers::pi),
+              fd.w()(fd.size() - 1) / (2 * std::numbers::pi), periods, a.period, a.skip);
+  const auto [nx, nx_max] = nx_of(a);
+  if (a.method == "subspace") {
+    if (nx_max > 0) throw UsageError("--nx A:B (an order range) is for --method ssest; subspace takes one N");
+    SubspaceOptions o;
+    apply_sets("subspace", a.sets, o);
+    if (nx > 0) o.nx = nx;
+    const Result<StateSpace> r = call_library([&] { return subspace(fd, o); });
+    return finish(r, a.method, ds.front(), a, settings_of(o));
   }
+  SsestOptions o;
+  apply_sets("ssest", a.sets, o);
+  if (nx > 0) o.nx = nx;
+  if (nx_max > 0) o.nx_max = nx_max;
+  const Result<StateSpace> r = call_library([&] {
+    return a.initial.empty() ? ssest(fd, o) : ssest(fd, initial_state_space(a), o);
+  });
   return finish(r, a.method, ds.front(), a, settings_of(o));
 }
 
@@ -502,6 +539,7 @@ int run(const FitArgs& a) {
                 inputs, a.force);
   if (!a.controller.empty()) return run_closed_loop(a);
   if (a.method == "greybox") return run_greybox(a);
+  if (a.period > 0) return run_periodic(a);
   if (a.paths.size() > 1) return run_experiments(a);
   if (a.frequency && !a.report.empty()) throw UsageError("--report needs time-domain data (not --frequency)");
   if (a.frequency) return run_frequency(a);
@@ -626,6 +664,17 @@ void setup_fit(CLI::App& app) {
                  "fsf: write PREFIX_time.csv (step and impulse with standard deviations) and PREFIX_freq.csv (G(jw) with "
                  "standard deviations of its real and imaginary parts)");
   app.add_option("--narx", a->narx, "kia: the NARX model JSON to reconstruct from (otherwise a NARX model is fitted first)");
+  app.add_option("--period", a->period,
+                 "subspace, ssest: DATA are periodic records (one per input) of this many samples per period: fit "
+                 "the FRF matrix of the averaged periods, weighted by its variances")
+      ->check(CLI::Range(2, 1 << 30));
+  app.add_option("--skip", a->skip, "with --period: leading periods dropped (their transient)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1 << 20));
+  app.add_option("--excited", a->excited,
+                 "with --period: a frequency is used where an input's amplitude is at least this fraction of its "
+                 "largest")
+      ->capture_default_str();
   app.add_option("--nx", a->nx, "subspace, ssest: state dimension N, or ssest: a range A:B (the least BIC is kept)");
   app.add_option("--initial", a->initial, "ssest: starting model, a state-space JSON file (a result of ctid fit --json); "
                  "fixed.A1_2=.. entries refer to its coordinates");

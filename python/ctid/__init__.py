@@ -15,7 +15,7 @@ import numpy as _np
 
 from . import _ctid
 from ._ctid import (  # noqa: F401  (re-exported)
-    CorrelationTest, DeadbeatObserver, FileError, FrequencyData, FsfModel, GreyboxModel, GreyboxSimulation, IdData, InputGenerator, InvalidArgument,
+    CorrelationTest, DeadbeatObserver, average_periods, frf_from_periodic, FileError, FrequencyData, FsfModel, GreyboxModel, GreyboxSimulation, IdData, InputGenerator, InvalidArgument,
     InvalidOptions, MisoModel, ModalModel, ModalWindow, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm,
     NonlinearCorrelationTests, PhysicalModel, ResultFile, Simulation, StateSpace, TransferFunction, add_noise_snr, fit_percent, frequency_grid,
     generator_fitted_to_input, html_report,
@@ -364,7 +364,8 @@ def greybox(data, model, **options):
 def subspace(data, nx=0, **options):
     """MIMO continuous-time state space by subspace identification (as `ctid fit --method subspace`): Johansson's
     lambda operator (route='lambda', any sampling) or discrete MOESP + logm (route='discrete'); nx = 0 chooses the
-    order from the singular values (r.diagnostics['singular_values']). Options: SubspaceOptions
+    order from the singular values (r.diagnostics['singular_values']). data: an IdData, or a FrequencyData (an FRF
+    matrix, e.g. ctid.frf_from_periodic: McKelvey's frequency-domain subspace method). Options: SubspaceOptions
     (ctid.settings('subspace'))."""
     return _ctid.subspace(data, _options(_ctid.SubspaceOptions, "subspace", {"nx": nx, **options}))
 
@@ -375,9 +376,14 @@ def ssest(data, nx=0, initial=None, **options):
     with the parameter covariance, each mode's wn/zeta standard deviation (r.diagnostics['mode_wn_std'],
     ['mode_zeta_std']) and each record's initial state. data: an IdData or a list of them (several records of one
     system). nx = 0: the start's choice; nx_max=B fits nx..B and keeps the least BIC. Options: SsestOptions
-    (ctid.settings('ssest')), e.g. estimate_d=False, integrators=1, fixed={'D1_1': 0}."""
+    (ctid.settings('ssest')), e.g. estimate_d=False, integrators=1, fixed={'D1_1': 0}. data may also be a
+    FrequencyData (an FRF matrix, e.g. ctid.frf_from_periodic): weighted least squares from the frequency-domain
+    subspace start, weights the data's variances (use_variance=False: estimated from the residuals)."""
+    opts = _options(_ctid.SsestOptions, "ssest", {"nx": nx, **options})
+    if isinstance(data, FrequencyData):
+        return _ctid.ssest(data, initial, opts)
     records = list(data) if isinstance(data, (list, tuple)) else [data]
-    return _ctid.ssest(records, initial, _options(_ctid.SsestOptions, "ssest", {"nx": nx, **options}))
+    return _ctid.ssest(records, initial, opts)
 
 
 def ssest_crlb(truth, data, noise_variance, **options):

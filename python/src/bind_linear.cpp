@@ -40,7 +40,18 @@ void bind_linear(py::module_& m) {
   m.def("subspace", [](const IdData& d, const SubspaceOptions& o) { return interruptible([&] { return subspace(d, o); }); },
         py::arg("data"), py::arg("options") = SubspaceOptions{},
         "MIMO continuous-time state space by subspace identification.");
+  m.def("subspace",
+        [](const FrequencyData& d, const SubspaceOptions& o) { return interruptible([&] { return subspace(d, o); }); },
+        py::arg("data"), py::arg("options") = SubspaceOptions{},
+        "Continuous-time state space from an FRF matrix by frequency-domain subspace identification.");
   bind_options<SsestOptions>(m, "SsestOptions");
+  m.def("ssest",
+        [](const FrequencyData& d, const std::optional<StateSpace>& initial, const SsestOptions& o) {
+          return interruptible([&] { return initial ? ssest(d, *initial, o) : ssest(d, o); });
+        },
+        py::arg("data"), py::arg("initial") = std::nullopt, py::arg("options") = SsestOptions{},
+        "Continuous-time state space from an FRF matrix by weighted least squares from the frequency-domain subspace "
+        "start.");
   m.def("ssest",
         [](const std::vector<IdData>& d, const std::optional<StateSpace>& initial, const SsestOptions& o) {
           return interruptible([&] { return initial ? ssest(d, *initial, o) : ssest(d, o); });
@@ -74,14 +85,30 @@ void bind_linear(py::module_& m) {
 
   bind_options<SrivcMisoOptions>(m, "SrivcMisoOptions");
   bind_options<ClosedLoopOptions>(m, "ClosedLoopOptions");
-  py::class_<FrequencyData>(m, "FrequencyData", "G(jw) at angular frequencies w (rad/s).")
+  py::class_<FrequencyData>(m, "FrequencyData",
+                            "G(jw) at angular frequencies w (rad/s): one channel, or an ny x nu matrix per frequency "
+                            "with optional variances E|G_hat - G|^2 of its entries.")
       .def(py::init<Eigen::VectorXd, Eigen::VectorXcd>(), py::arg("w"), py::arg("response"))
+      .def(py::init<Eigen::VectorXd, std::vector<Eigen::MatrixXcd>, std::vector<Eigen::MatrixXd>>(), py::arg("w"),
+           py::arg("matrices"), py::arg("variance") = std::vector<Eigen::MatrixXd>{})
+      .def_property_readonly("matrices", &FrequencyData::matrices)
+      .def_property_readonly("variance", &FrequencyData::variance)
+      .def_property_readonly("outputs", &FrequencyData::outputs)
+      .def_property_readonly("inputs", &FrequencyData::inputs)
+      .def("channel", &FrequencyData::channel, py::arg("out"), py::arg("in"), "G_out,in(jw) (0-based indices).")
+      .def_readwrite("input_names", &FrequencyData::input_names)
+      .def_readwrite("output_names", &FrequencyData::output_names)
       .def_static("from_spectra", &FrequencyData::from_spectra, py::arg("w"), py::arg("U"), py::arg("Y"),
                   "G = Y / U from input and output spectra at w.")
       .def_property_readonly("w", &FrequencyData::w)
       .def_property_readonly("response", &FrequencyData::response)
       .def("__len__", &FrequencyData::size);
   bind_options<FrequencyFitOptions>(m, "FrequencyFitOptions");
+  m.def("average_periods", &average_periods, py::arg("data"), py::arg("period"), py::arg("skip") = 1,
+        "The mean period of a periodic record (period in samples; the first `skip` periods dropped).");
+  m.def("frf_from_periodic", &frf_from_periodic, py::arg("records"), py::arg("period"), py::arg("skip") = 1,
+        py::arg("excited") = 0.1,
+        "FRF matrix with variances from periodic records (one per input), at the excited DFT bins.");
   py::enum_<OrderCriterion>(m, "OrderCriterion")
       .value("Yic", OrderCriterion::Yic)
       .value("Rt2", OrderCriterion::Rt2)

@@ -397,3 +397,20 @@ def test_tfest_estimates_the_initial_condition_of_a_record_not_at_rest():
     assert np.allclose(r.diagnostics.vectors["x0"], [1.5, -0.7], atol=1e-5)
     with pytest.raises(ctid.InvalidOptions, match="alternatives"):
         ctid.tfest(d, nb=2, nf=2, estimate_initial_state=True, transient_time=1.0)
+
+
+def test_frequency_data_matrices_variances_and_named_errors():
+    """An FRF matrix with variances round-trips; channel() reads one entry over frequency; bad data are named."""
+    w = np.array([1.0, 2.0, 3.0])
+    G = [np.array([[1 + 1j], [2.0]]) * k for k in (1, 2, 3)]
+    V = [np.full((2, 1), 0.01)] * 3
+    fd = ctid.FrequencyData(w, G, V)
+    assert (fd.outputs, fd.inputs, len(fd)) == (2, 1, 3)
+    assert np.allclose(fd.channel(1, 0), [2, 4, 6])
+    assert np.allclose(fd.variance[2], 0.01)
+    with pytest.raises(ctid.InvalidArgument, match="variance matrix 0"):
+        ctid.FrequencyData(w, G, [np.zeros((2, 1))] * 3)
+    with pytest.raises(ctid.InvalidArgument, match="response\\(\\) is for one"):
+        fd.response
+    with pytest.raises(ctid.InvalidArgument, match="a transfer function has one input and one output"):
+        ctid.tf_from_frequency(fd, 1, 1)

@@ -63,6 +63,9 @@ Result<TransferFunction> tf_from_frequency(const FrequencyData& data, const TfOr
   const int n = orders.nf, nb = orders.nb, p = n + nb + (opt.estimate_delay ? 1 : 0);
   const int K = data.size();
   CTID_REQUIRE(2 * K > p, "tf_from_frequency: {} frequencies give {} real equations for {} parameters", K, 2 * K, p);
+  CTID_REQUIRE(data.outputs() == 1 && data.inputs() == 1,
+               "tf_from_frequency: a transfer function has one input and one output; the data have {} and {} (ssest "
+               "fits a state-space model to an FRF matrix)", data.inputs(), data.outputs());
   const Eigen::VectorXcd& G = data.response();
   const double w0 = std::exp(data.w().array().log().mean());
   Scaled sc{n, nb, data.w() / w0, data.w()};

@@ -114,13 +114,14 @@ const std::vector<MethodInfo>& methods() {
                              "MIMO continuous-time state space by subspace identification (lambda operator or "
                              "discrete MOESP + logm)",
                              {"SubspaceOptions"},
-                             reports(singular_values, output_fit_percent, x0, tau, tau_grid, tau_grid_fit_percent)),
+                             reports(singular_values, output_fit_percent, x0, tau, tau_grid, tau_grid_fit_percent, frequency_scale)),
       entry<SsestOptions>("ssest",
                           "MIMO continuous-time state space by output error from the subspace start (modal form, "
                           "covariance, several records)",
                           {"SsestOptions"},
                           reports(singular_values, output_fit_percent, output_noise_variance, x0, start_fit_percent,
-                                  mode_wn_std, mode_zeta_std, cost, experiments, nx_grid, nx_grid_bic)),
+                                  mode_wn_std, mode_zeta_std, cost, experiments, nx_grid, nx_grid_bic, chi2_per_dof,
+                                  frequency_scale)),
   };
   return all;
 }

@@ -39,6 +39,9 @@ const OptionTable<SsestOptions>& option_table<SsestOptions>() {
           .flag("enforce_stability", &O::enforce_stability,
                 "keep a stable start stable: steps that move a pole into the right half plane are rejected (false: "
                 "an unstable plant)")
+          .flag("use_variance", &O::use_variance,
+                "frequency data: weight by the variances given with them (false: estimate each output's error "
+                "variance from the residuals)")
           .integer("integrators", &O::integrators, "", at_least(0),
                    "known pure integrators: poles held at 0 (the first states integrate)")
           .named_reals("fixed", &O::fixed,
@@ -60,56 +63,9 @@ void SsestOptions::validate() const {
 
 namespace {
 
+using namespace ss_detail;
 using Clock = std::chrono::steady_clock;
 constexpr int kBatch = 128;  // samples gathered before one rank-k update of J^T W J
-
-// A model with one initial state per record.
-struct Point {
-  Eigen::MatrixXd A, B, C, D;
-  std::vector<Eigen::VectorXd> x0;
-};
-
-// The parameter vector theta = [A | B | C | D (row-major) | x0 of each record].
-struct Layout {
-  int nx, nu, ny, E;
-  Eigen::Index a(int i, int j) const { return i * nx + j; }
-  Eigen::Index b(int i, int j) const { return nx * nx + i * nu + j; }
-  Eigen::Index c(int i, int j) const { return nx * nx + nx * nu + i * nx + j; }
-  Eigen::Index d(int i, int j) const { return nx * nx + nx * nu + ny * nx + i * nu + j; }
-  Eigen::Index x0(int e, int i) const { return nx * nx + nx * nu + ny * nx + ny * nu + e * nx + i; }
-  Eigen::Index size() const { return x0(E, 0); }
-};
-
-Eigen::VectorXd pack(const Layout& L, const Point& m) {
-  Eigen::VectorXd v(L.size());
-  for (int i = 0; i < L.nx; ++i)
-    for (int j = 0; j < L.nx; ++j) v(L.a(i, j)) = m.A(i, j);
-  for (int i = 0; i < L.nx; ++i)
-    for (int j = 0; j < L.nu; ++j) v(L.b(i, j)) = m.B(i, j);
-  for (int i = 0; i < L.ny; ++i)
-    for (int j = 0; j < L.nx; ++j) v(L.c(i, j)) = m.C(i, j);
-  for (int i = 0; i < L.ny; ++i)
-    for (int j = 0; j < L.nu; ++j) v(L.d(i, j)) = m.D(i, j);
-  for (int e = 0; e < L.E; ++e)
-    for (int i = 0; i < L.nx; ++i) v(L.x0(e, i)) = m.x0[static_cast<size_t>(e)](i);
-  return v;
-}
-
-Point unpack(const Layout& L, const Eigen::VectorXd& v) {
-  Point m{Eigen::MatrixXd(L.nx, L.nx), Eigen::MatrixXd(L.nx, L.nu), Eigen::MatrixXd(L.ny, L.nx),
-          Eigen::MatrixXd(L.ny, L.nu), std::vector<Eigen::VectorXd>(static_cast<size_t>(L.E), Eigen::VectorXd(L.nx))};
-  for (int i = 0; i < L.nx; ++i)
-    for (int j = 0; j < L.nx; ++j) m.A(i, j) = v(L.a(i, j));
-  for (int i = 0; i < L.nx; ++i)
-    for (int j = 0; j < L.nu; ++j) m.B(i, j) = v(L.b(i, j));
-  for (int i = 0; i < L.ny; ++i)
-    for (int j = 0; j < L.nx; ++j) m.C(i, j) = v(L.c(i, j));
-  for (int i = 0; i < L.ny; ++i)
-    for (int j = 0; j < L.nu; ++j) m.D(i, j) = v(L.d(i, j));
-  for (int e = 0; e < L.E; ++e)
-    for (int i = 0; i < L.nx; ++i) m.x0[static_cast<size_t>(e)](i) = v(L.x0(e, i));
-  return m;
-}
 
 // One record as the search sees it: inputs and outputs divided by the channel scales.
 struct Record {
@@ -293,65 +249,6 @@ bool evaluate(const Point& m, const std::vector<Point>* dirs, const std::vector<
   return std::isfinite(cost) && (!sens || (JtJ->allFinite() && Jtr->allFinite()));
 }
 
-// Data-driven local coordinates: an orthonormal basis of the free entries of (A, B, C, D) orthogonal to the tangent of
-// the change-of-basis manifold that keeps the held entries (McKelvey et al. 2004 eq. 10: the tangent at T = I + X
-// is (XA - AX, XB, -CX, 0)), plus each free initial-state entry on its own (no change of basis moves (A, B, C, D)
-// and x0 alone, so this removes the same redundancy; a direction of x0 alone needs no sensitivity exponential).
-// `similar` receives the dimension of the tangent removed.
-Eigen::MatrixXd local_directions(const Layout& L, const Point& m, const std::vector<bool>& held, int* similar = nullptr) {
-  const Eigen::Index n = L.size(), nx = L.nx, nm = L.x0(0, 0);  // nm: the entries of (A, B, C, D)
-  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(nm, nx * nx);
-  for (int i = 0; i < L.nx; ++i)
-    for (int j = 0; j < L.nx; ++j) {
-      const Eigen::Index col = i * nx + j;  // X = e_i e_j^T
-      for (int c = 0; c < L.nx; ++c) M(L.a(i, c), col) += m.A(j, c);    // X A: row i gets A's row j
-      for (int r = 0; r < L.nx; ++r) M(L.a(r, j), col) -= m.A(r, i);    // A X: column j gets A's column i
-      for (int c = 0; c < L.nu; ++c) M(L.b(i, c), col) += m.B(j, c);    // X B
-      for (int r = 0; r < L.ny; ++r) M(L.c(r, j), col) -= m.C(r, i);    // -C X
-    }
-  std::vector<Eigen::Index> free_rows, held_rows, free_x0;
-  for (Eigen::Index k = 0; k < nm; ++k) (held[static_cast<size_t>(k)] ? held_rows : free_rows).push_back(k);
-  for (Eigen::Index k = nm; k < n; ++k)
-    if (!held[static_cast<size_t>(k)]) free_x0.push_back(k);
-  // Changes of basis that keep every held entry: the null space of the held rows of M.
-  Eigen::MatrixXd keep = Eigen::MatrixXd::Identity(nx * nx, nx * nx);
-  if (!held_rows.empty()) {
-    Eigen::MatrixXd Mh(static_cast<Eigen::Index>(held_rows.size()), nx * nx);
-    for (size_t k = 0; k < held_rows.size(); ++k) Mh.row(static_cast<Eigen::Index>(k)) = M.row(held_rows[k]);
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(Mh, Eigen::ComputeFullV);
-    const Eigen::VectorXd& s = svd.singularValues();
-    const double tol = 1e-10 * std::max(s.size() ? s(0) : 0.0, 1.0);
-    Eigen::Index rank = 0;
-    while (rank < s.size() && s(rank) > tol) ++rank;
-    keep = svd.matrixV().rightCols(nx * nx - rank);
-  }
-  const Eigen::Index nf = static_cast<Eigen::Index>(free_rows.size());
-  Eigen::MatrixXd T(nf, keep.cols());
-  const Eigen::MatrixXd MK = M * keep;
-  for (Eigen::Index k = 0; k < nf; ++k) T.row(k) = MK.row(free_rows[static_cast<size_t>(k)]);
-  Eigen::Index rank = 0;
-  Eigen::MatrixXd U = Eigen::MatrixXd::Identity(nf, nf);
-  if (T.cols() > 0 && nf > 0) {
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(T, Eigen::ComputeFullU);
-    const Eigen::VectorXd& s = svd.singularValues();
-    const double tol = 1e-10 * std::max(s.size() ? s(0) : 0.0, 1.0);
-    while (rank < s.size() && s(rank) > tol) ++rank;
-    U = svd.matrixU();
-  }
-  if (similar) *similar = static_cast<int>(rank);
-  const Eigen::Index nq = nf - rank, nx0 = static_cast<Eigen::Index>(free_x0.size());
-  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(n, nq + nx0);
-  for (Eigen::Index k = 0; k < nf; ++k) Q.row(free_rows[static_cast<size_t>(k)]).head(nq) = U.row(k).tail(nq);
-  for (Eigen::Index k = 0; k < nx0; ++k) Q(free_x0[static_cast<size_t>(k)], nq + k) = 1.0;
-  return Q;
-}
-
-std::vector<Point> directions_of(const Layout& L, const Eigen::MatrixXd& Q) {
-  std::vector<Point> dirs;
-  for (Eigen::Index d = 0; d < Q.cols(); ++d) dirs.push_back(unpack(L, Q.col(d)));
-  return dirs;
-}
-
 // Per-output residual variances of a model (scaled units), pooled over the records.
 Eigen::VectorXd residual_variances(const Point& m, const std::vector<Record>& recs) {
   std::vector<Eigen::MatrixXd> yh;
@@ -375,135 +272,6 @@ struct Search {
   bool failed_start = false;
 };
 
-// A change of state coordinates x = T z applied to a model.
-Point transformed(const Point& m, const Eigen::MatrixXd& T) {
-  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(T);
-  Point r{lu.solve(m.A * T), lu.solve(m.B), m.C * T, m.D, {}};
-  for (const auto& x : m.x0) r.x0.push_back(lu.solve(x));
-  return r;
-}
-
-// Input and output scaling of a model: u = su .* u_s, y = sy .* y_s.
-Point scaled(const Point& m, const Eigen::VectorXd& su, const Eigen::VectorXd& sy) {
-  return {m.A, m.B * su.asDiagonal(), sy.cwiseInverse().asDiagonal() * m.C,
-          sy.cwiseInverse().asDiagonal() * m.D * su.asDiagonal(), m.x0};
-}
-Point unscaled(const Point& m, const Eigen::VectorXd& su, const Eigen::VectorXd& sy) {
-  return scaled(m, su.cwiseInverse(), sy.cwiseInverse());
-}
-
-// Real modal form (see the header) of a model with distinct poles; the first `integrators` states keep their block
-// (poles at 0) with k x k rows of C set to the identity. Returns false when the eigenvectors are too ill-conditioned
-// (nearly repeated poles), leaving the model as it was.
-struct ModalForm {
-  Point model;
-  std::vector<std::string> names;    // the parameters of A: pole<a>, sigma<a>, omega<a> (in state order)
-  std::vector<std::tuple<int, int, double>> c_held;  // entries of C fixed by the normalisation (row, column, value)
-};
-bool modal_form(const Point& m, int integrators, ModalForm& out) {
-  const int nx = static_cast<int>(m.A.rows());
-  Eigen::EigenSolver<Eigen::MatrixXd> es(m.A);
-  if (es.info() != Eigen::Success) return false;
-  const Eigen::VectorXcd lam = es.eigenvalues();
-  const Eigen::MatrixXcd V = es.eigenvectors();
-  // The integrators' states come first and stay as they are (their columns of A are zero).
-  struct Entry {
-    double wn;
-    int index;
-  };
-  std::vector<Entry> order;
-  for (int i = 0; i < nx; ++i) {
-    if (lam(i).imag() < 0) continue;  // a pair is listed once, by its member with imag > 0
-    order.push_back({std::abs(lam(i)), i});
-  }
-  // The integrator poles: the `integrators` real eigenvalues nearest 0 (exactly 0 by construction).
-  std::sort(order.begin(), order.end(), [](const Entry& a, const Entry& b) { return a.wn < b.wn; });
-  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(nx, nx);
-  int col = 0;
-  out.names.clear();
-  out.c_held.clear();
-  if (integrators > 0) {
-    T.leftCols(integrators) = Eigen::MatrixXd::Identity(nx, integrators);
-    col = integrators;
-  }
-  int skipped = 0;
-  for (const Entry& en : order) {
-    const std::complex<double> l = lam(en.index);
-    if (skipped < integrators && l.imag() == 0.0) {
-      ++skipped;
-      continue;
-    }
-    if (l.imag() == 0.0) {
-      T.col(col) = V.col(en.index).real();
-      out.names.push_back("pole" + std::to_string(col + 1));
-      ++col;
-    } else {
-      if (col + 2 > nx) return false;
-      T.col(col) = V.col(en.index).real();
-      T.col(col + 1) = V.col(en.index).imag();
-      out.names.push_back("sigma" + std::to_string(col + 1));
-      out.names.push_back("omega" + std::to_string(col + 1));
-      col += 2;
-    }
-  }
-  if (col != nx) return false;
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(T);
-  const Eigen::VectorXd& sv = svd.singularValues();
-  if (!(sv(nx - 1) > 1e-10 * sv(0))) return false;
-  Point p = transformed(m, T);
-  // Exact block structure, and each mode's scale fixed by the largest entry of its C column(s).
-  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(nx, nx);
-  Eigen::MatrixXd S = Eigen::MatrixXd::Identity(nx, nx);  // the per-mode rescaling
-  if (integrators > 0) {
-    // Rows of C that make the integrators' block of C the identity.
-    const Eigen::MatrixXd Ci = p.C.leftCols(integrators);
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Ci.transpose());
-    if (qr.rank() < integrators) return false;
-    Eigen::MatrixXd sub(integrators, integrators);
-    for (int k = 0; k < integrators; ++k) {
-      const int row = static_cast<int>(qr.colsPermutation().indices()(k));
-      sub.row(k) = Ci.row(row);
-      for (int c = 0; c < integrators; ++c) out.c_held.emplace_back(row, c, c == k ? 1.0 : 0.0);
-    }
-    S.topLeftCorner(integrators, integrators) = sub.inverse();
-  }
-  for (int a = integrators; a < nx;) {
-    const bool pair = out.names[static_cast<size_t>(a - integrators)].rfind("sigma", 0) == 0;
-    Eigen::Index row = 0;
-    if (!pair) {
-      A(a, a) = p.A(a, a);
-      p.C.col(a).cwiseAbs().maxCoeff(&row);
-      if (!(std::abs(p.C(row, a)) > 0)) return false;
-      S(a, a) = 1.0 / p.C(row, a);
-      out.c_held.emplace_back(static_cast<int>(row), a, 1.0);
-      a += 1;
-    } else {
-      const double sigma = 0.5 * (p.A(a, a) + p.A(a + 1, a + 1)), omega = 0.5 * (p.A(a, a + 1) - p.A(a + 1, a));
-      A(a, a) = A(a + 1, a + 1) = sigma;
-      A(a, a + 1) = omega;
-      A(a + 1, a) = -omega;
-      (p.C.col(a).array().square() + p.C.col(a + 1).array().square()).maxCoeff(&row);
-      const double c1 = p.C(row, a), c2 = p.C(row, a + 1), n2 = c1 * c1 + c2 * c2;
-      if (!(n2 > 0)) return false;
-      // z -> (alpha I + beta J) z commutes with the block; it maps [c1, c2] to [1, 0].
-      const double al = c1 / n2, be = -c2 / n2;
-      S(a, a) = al;
-      S(a, a + 1) = be;
-      S(a + 1, a) = -be;
-      S(a + 1, a + 1) = al;
-      out.c_held.emplace_back(static_cast<int>(row), a, 1.0);
-      out.c_held.emplace_back(static_cast<int>(row), a + 1, 0.0);
-      a += 2;
-    }
-  }
-  p.A = A;
-  p = transformed(p, S);
-  p.A = A;  // exact (the scaling commutes with each block)
-  for (const auto& [r, c, v] : out.c_held) p.C(r, c) = v;  // exact normalisation
-  out.model = p;
-  return true;
-}
-
 // The model in state coordinates of unit covariance along its trajectory over the records (x = L z, L L^T the
 // states' second moment): every state of a comparable size, so the search's coordinates are well conditioned.
 Point whitened(const Point& m, const std::vector<Record>& recs) {
@@ -523,15 +291,6 @@ Point whitened(const Point& m, const std::vector<Record>& recs) {
   Eigen::LLT<Eigen::MatrixXd> llt(Sx + 1e-9 * std::max(Sx.trace(), 1e-300) * Eigen::MatrixXd::Identity(nx, nx));
   if (llt.info() != Eigen::Success || !Sx.allFinite()) return m;
   return transformed(m, llt.matrixL());
-}
-
-// Every pole in the open left half plane, apart from the k held integrators (A's first k columns are zero, so the
-// other poles are those of the lower-right block).
-bool stable(const Eigen::MatrixXd& A, int k) {
-  const Eigen::Index n = A.rows() - k;
-  if (n <= 0) return true;
-  const Eigen::VectorXcd p = A.bottomRightCorner(n, n).eigenvalues();
-  return p.allFinite() && (p.real().array() < 0.0).all();
 }
 
 // Rounds of Levenberg-Marquardt in local coordinates re-centred after each round, then the weights re-estimated and
@@ -615,8 +374,6 @@ void check_records(const std::vector<IdData>& ds) {
   }
 }
 
-std::string entry_name(char M, int i, int j) { return std::string(1, M) + std::to_string(i + 1) + "_" + std::to_string(j + 1); }
-
 // The entries the options hold (set to their held values in p): D (estimate_d false), x0 (records at rest), the
 // integrators' columns of A.
 void hold_structure(const Layout& L, const SsestOptions& o, Point& p, std::vector<bool>& held) {
@@ -649,50 +406,8 @@ void deliver(Result<StateSpace>& res, const std::vector<IdData>& ds, Point fin, 
   Eigen::Index total = 0;
   for (const IdData& d : ds) total += d.size();
   const int n_free_params = static_cast<int>(std::count(held.begin(), held.end(), false)) - similar;
-  // Back to the user's units (and, for a free structure, to the modal form).
-  std::vector<std::string> pnames;
-  std::vector<bool> pfixed;
-  std::vector<double> vals;
-  auto add = [&](std::string name, double value, bool fixed) {
-    pnames.push_back(std::move(name));
-    vals.push_back(value);
-    pfixed.push_back(fixed);
-  };
-  auto add_entries = [&](char M, const Eigen::MatrixXd& X, auto is_held) {
-    for (int i = 0; i < X.rows(); ++i)
-      for (int j = 0; j < X.cols(); ++j) add(entry_name(M, i, j), X(i, j), is_held(i, j));
-  };
-  auto held_at = [&](Eigen::Index (Layout::*at)(int, int) const) {
-    return [&, at](int i, int j) { return static_cast<bool>(held[static_cast<size_t>((L.*at)(i, j))]); };
-  };
-  ModalForm mf;
-  const bool modal = !user_coordinates && modal_form(fin, o.integrators, mf);
-  if (!user_coordinates && !modal)
-    res.diagnostics.warnings.push_back("the model has nearly repeated poles: it is returned in the search's coordinates, "
-                                       "where its entries are not determined (poles and responses are)");
-  if (modal) {
-    fin = mf.model;
-    for (int k = 0; k < o.integrators; ++k) add("pole" + std::to_string(k + 1), 0.0, true);  // held at 0
-    for (const std::string& n : mf.names) {
-      const int a = std::stoi(n.substr(n[0] == 'p' ? 4 : 5)) - 1;
-      add(n, n[0] == 'o' ? fin.A(a, a + 1) : fin.A(a, a), false);
-    }
-    add_entries('B', fin.B, [](int, int) { return false; });
-    add_entries('C', fin.C, [&](int i, int j) {
-      bool norm = false;
-      for (const auto& [r, c, v] : mf.c_held) norm = norm || (r == i && c == j);
-      return norm;
-    });
-  } else {
-    add_entries('A', fin.A, held_at(&Layout::a));
-    add_entries('B', fin.B, held_at(&Layout::b));
-    add_entries('C', fin.C, held_at(&Layout::c));
-  }
-  if (o.estimate_d) add_entries('D', fin.D, held_at(&Layout::d));
-  res.model = StateSpace(fin.A, fin.B, fin.C, fin.D);
-  res.parameters.names = pnames;
-  res.parameters.values = Eigen::Map<const Eigen::VectorXd>(vals.data(), static_cast<Eigen::Index>(vals.size()));
-  res.parameters.fixed = pfixed;
+  describe(res, fin, L, held, user_coordinates, o.integrators, o.estimate_d);
+  const std::vector<bool>& pfixed = res.parameters.fixed;
 
   // Covariance: (J^T W J)^-1 over the free parameters (their directions read from their names, the one reading of
   // validate/uncertainty.hpp) and the initial states at the final model, in the user's units (columns scaled before
@@ -725,15 +440,7 @@ void deliver(Result<StateSpace>& res, const std::vector<IdData>& ds, Point fin, 
                   evaluate(fin, &cdirs, raw, var.cwiseMax(1e-300).cwiseInverse().cwiseSqrt(), cost, &JtJ, &Jtr, &yhat);
   Eigen::MatrixXd cov;
   if (ok) {
-    const Eigen::VectorXd dg = JtJ.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
-    const Eigen::MatrixXd Sc = dg.asDiagonal() * JtJ * dg.asDiagonal();
-    Eigen::LDLT<Eigen::MatrixXd> ldlt(Sc);
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Sc, Eigen::EigenvaluesOnly);
-    if (ldlt.info() == Eigen::Success && eig.eigenvalues()(0) > 1e-13 * eig.eigenvalues().maxCoeff()) {
-      const Eigen::MatrixXd full = dg.asDiagonal() * ldlt.solve(Eigen::MatrixXd::Identity(Sc.rows(), Sc.cols())) *
-                                   dg.asDiagonal();
-      cov = full.topLeftCorner(np, np);
-    }
+    cov = inverse_normal(JtJ, np);
   }
   res.parameters.set_covariance(cov, slots);
   if (user_coordinates && similar > 0 && res.summary.succeeded()) {

@@ -1,13 +1,18 @@
-// ctid internal — what the state-space estimators (subspace, ssest) share: the channel scales they run in and the
-// fits they report (every output on its own, and all outputs together with each scaled by its standard deviation).
+// ctid internal — what the state-space estimators (subspace, ssest in time and frequency domain) share: the channel
+// scales they run in, the fits they report (every output on its own, and all outputs together with each scaled by its
+// standard deviation), the full parametrisation in data-driven local coordinates and the real modal form of a result.
 #pragma once
 
 #include <span>
+#include <string>
+#include <tuple>
+#include <vector>
 
 #include <Eigen/Dense>
 
 #include "ctid/core/types.hpp"
 #include "ctid/data/iddata.hpp"
+#include "ctid/model/state_space.hpp"
 
 namespace ctid::ss_detail {
 
@@ -21,5 +26,64 @@ struct Fits {
 /// Fits of the simulated outputs yhat (one N x ny matrix per record) against the records' outputs.
 Fits fits_of(std::span<const IdData> records, std::span<const Eigen::MatrixXd> yhat, const Eigen::VectorXd& sy,
              int n_parameters);
+
+// A model with one initial state per record.
+struct Point {
+  Eigen::MatrixXd A, B, C, D;
+  std::vector<Eigen::VectorXd> x0;
+};
+
+// The parameter vector theta = [A | B | C | D (row-major) | x0 of each record].
+struct Layout {
+  int nx, nu, ny, E;
+  Eigen::Index a(int i, int j) const { return i * nx + j; }
+  Eigen::Index b(int i, int j) const { return nx * nx + i * nu + j; }
+  Eigen::Index c(int i, int j) const { return nx * nx + nx * nu + i * nx + j; }
+  Eigen::Index d(int i, int j) const { return nx * nx + nx * nu + ny * nx + i * nu + j; }
+  Eigen::Index x0(int e, int i) const { return nx * nx + nx * nu + ny * nx + ny * nu + e * nx + i; }
+  Eigen::Index size() const { return x0(E, 0); }
+};
+
+// Real modal form (see the header) of a model with distinct poles; the first `integrators` states keep their block
+// (poles at 0) with k x k rows of C set to the identity. Returns false when the eigenvectors are too ill-conditioned
+// (nearly repeated poles), leaving the model as it was.
+struct ModalForm {
+  Point model;
+  std::vector<std::string> names;    // the parameters of A: pole<a>, sigma<a>, omega<a> (in state order)
+  std::vector<std::tuple<int, int, double>> c_held;  // entries of C fixed by the normalisation (row, column, value)
+};
+
+Eigen::VectorXd pack(const Layout& L, const Point& m);
+Point unpack(const Layout& L, const Eigen::VectorXd& v);
+/// Data-driven local coordinates (McKelvey et al. 2004 eq. 10): an orthonormal basis (columns, in pack's layout) of
+/// the free entries orthogonal to the change-of-basis tangent that keeps the held entries, plus each free x0 entry;
+/// `similar` receives the dimension of the tangent removed.
+Eigen::MatrixXd local_directions(const Layout& L, const Point& m, const std::vector<bool>& held, int* similar = nullptr);
+std::vector<Point> directions_of(const Layout& L, const Eigen::MatrixXd& Q);
+/// A change of state coordinates x = T z applied to a model.
+Point transformed(const Point& m, const Eigen::MatrixXd& T);
+/// Input and output scaling of a model: u = su .* u_s, y = sy .* y_s (unscaled: the inverse).
+Point scaled(const Point& m, const Eigen::VectorXd& su, const Eigen::VectorXd& sy);
+Point unscaled(const Point& m, const Eigen::VectorXd& su, const Eigen::VectorXd& sy);
+bool modal_form(const Point& m, int integrators, ModalForm& out);
+/// Every pole in the open left half plane, apart from the k held integrators.
+bool stable(const Eigen::MatrixXd& A, int k);
+/// "A1_2": the name of entry (i, j) of matrix M (1-based).
+std::string entry_name(char M, int i, int j);
+
+/// The result's model and parameters at `fin` (user units; fin becomes the model returned, its x0 transformed too): without user coordinates the real modal form (parameters
+/// pole<a> or sigma<a>/omega<a>, B, C with each mode's normalising entries held, D when estimated; a warning and
+/// the search's coordinates when the poles are nearly repeated); with user coordinates the entries of A, B, C (and D),
+/// `held` marking the held ones.
+void describe(Result<StateSpace>& res, Point& fin, const Layout& L, const std::vector<bool>& held, bool user_coordinates,
+              int integrators, bool estimate_d);
+/// The leading np x np block of JtJ^-1 (computed with the columns scaled to unit diagonal); empty when JtJ is singular
+/// to 1e-13 relative.
+Eigen::MatrixXd inverse_normal(const Eigen::MatrixXd& JtJ, Eigen::Index np);
+
+/// A and C's shift invariance: the least-squares A_d with O_up A_d = O_down (O has block rows of ny rows).
+Eigen::MatrixXd shift_invariance(const Eigen::MatrixXd& O, int ny);
+/// A with every eigenvalue re + j im of re > 0 moved to -re + j im (same eigenvectors).
+Eigen::MatrixXd reflected_into_left_half_plane(const Eigen::MatrixXd& A);
 
 }  // namespace ctid::ss_detail

@@ -186,26 +186,6 @@ int chosen_order(const Eigen::VectorXd& sigma, int nx, int ny, int r) {
   return best;
 }
 
-// A from shift invariance of O: O(ny:) = O(:-ny) A_step.
-Eigen::MatrixXd shift_invariance(const Eigen::MatrixXd& O, int ny) {
-  const Eigen::Index rows = O.rows() - ny;
-  return O.topRows(rows).completeOrthogonalDecomposition().solve(O.bottomRows(rows));
-}
-
-// A with each eigenvalue re + j im of re > 0 moved to -re + j im (same eigenvectors): the stable model nearest in
-// its modes. A spurious noise mode (typical of a subspace estimate from noisy, finely sampled data) then becomes a fast
-// stable mode instead of a response that overflows over the record.
-Eigen::MatrixXd reflected_into_left_half_plane(const Eigen::MatrixXd& A) {
-  Eigen::EigenSolver<Eigen::MatrixXd> es(A);
-  Eigen::VectorXcd l = es.eigenvalues();
-  if (es.info() != Eigen::Success || (l.real().array() <= 0.0).all()) return A;
-  for (Eigen::Index i = 0; i < l.size(); ++i)
-    if (l(i).real() > 0.0) l(i) = std::complex<double>(-l(i).real(), l(i).imag());
-  const Eigen::MatrixXcd V = es.eigenvectors();
-  const Eigen::MatrixXd R = (V * l.asDiagonal() * V.inverse()).real();
-  return R.allFinite() ? R : A;
-}
-
 // Subspace estimates at a given tau (or the discrete route), one per candidate order.
 struct Estimate {
   StateSpace model;
@@ -222,7 +202,7 @@ Estimate estimate_at(const IdData& d, const Scaled& s, const SubspaceOptions& o,
   Estimate e;
   e.sigma = range.sigma;
   const Eigen::MatrixXd O = range.O(n);
-  const Eigen::MatrixXd step = shift_invariance(O, ny);
+  const Eigen::MatrixXd step = ss_detail::shift_invariance(O, ny);
   Eigen::MatrixXd A;
   if (lambda) {
     A = (step - Eigen::MatrixXd::Identity(n, n)) / tau;
@@ -237,7 +217,7 @@ Estimate estimate_at(const IdData& d, const Scaled& s, const SubspaceOptions& o,
       }
     A = step.log() / d.ts();
   }
-  if (o.stabilize) A = reflected_into_left_half_plane(A);
+  if (o.stabilize) A = ss_detail::reflected_into_left_half_plane(A);
   const Eigen::MatrixXd C = s.sy.asDiagonal() * O.topRows(ny);
   try {
     e.model = subspace_bd(A, C, d, o.estimate_d, o.estimate_initial_state, &e.x0);

@@ -1432,6 +1432,50 @@ TEST(Cli, SubspaceFitsSeveralOutputsAndWritesAStateSpaceResult) {
   EXPECT_NE(nb.err.find("--nf sets transfer-function orders"), std::string::npos) << nb.err;
 }
 
+TEST(Cli, SsestFitsTheFrfMatrixOfPeriodicRecords) {
+  // Two periodic records of the two-mode system (one multisine per input, 6 periods of 512 samples, the first with a
+  // transient, output noise 0.01; tests/estimate/state_space_fixtures.hpp): --period fits the FRF matrix of periods
+  // 2-6; reference: the true modes, within 4 reported standard deviations.
+  const StateSpace truth = test::ss::two_modes();
+  std::vector<std::string> files;
+  for (int input = 0; input < 2; ++input) {
+    const IdData d = test::ss::periodic_record(truth, 512, 6, 0.05, input, 11 + input, 0.01);
+    Eigen::MatrixXd m(d.size(), 4);
+    m << d.u(), d.y();
+    files.push_back(test::temp_path("periodic_" + std::to_string(input) + ".csv"));
+    write_csv(files.back(), {"u1", "u2", "y1", "y2"}, m);
+  }
+  const std::string io = files[0] + " " + files[1] + " --ts 0.05 --input u1 --input u2 --output y1 --output y2";
+  const std::string json = test::temp_path("periodic_ssest.json");
+  const CliRun r = ctid_run("fit " + io + " --method ssest --nx 4 --period 512 --json " + json + " --force");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("FRF matrix of the periodic records: 59 excited frequencies"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("5 period(s) of 512 samples averaged (1 skipped)"), std::string::npos) << r.out;
+  const ResultFile file = read_result_file(json);
+  const StateSpace& fitted = std::get<StateSpace>(file.result.model);
+  const Eigen::VectorXd sd = file.result.diagnostics.get(diagnostic::mode_wn_std);
+  for (size_t k = 0; k < 2; ++k)
+    EXPECT_LT(std::abs(fitted.modes()[k].wn - truth.modes()[k].wn), 4 * sd(static_cast<Eigen::Index>(k))) << r.out;
+  // The subspace start alone on the same FRF.
+  const CliRun s = ctid_run("fit " + io + " --method subspace --nx 4 --period 512");
+  ASSERT_EQ(s.code, 0) << s.out << s.err;
+  // Bad use, one line each (exit 2): another method, --skip alone, one record for two inputs, too many skipped.
+  const CliRun other = ctid_run("fit " + io + " --method srivc --period 512");
+  EXPECT_EQ(other.code, 2);
+  EXPECT_NE(other.err.find("--period fits the FRF of periodic records: it needs --method subspace or ssest"),
+            std::string::npos) << other.err;
+  const CliRun skip = ctid_run("fit " + io + " --method ssest --skip 2");
+  EXPECT_EQ(skip.code, 2);
+  EXPECT_NE(skip.err.find("--skip belongs to --period"), std::string::npos) << skip.err;
+  const CliRun one = ctid_run("fit " + files[0] + " --ts 0.05 --input u1 --input u2 --output y1 --output y2 "
+                              "--method ssest --period 512");
+  EXPECT_EQ(one.code, 2);
+  EXPECT_NE(one.err.find("2 input(s) need 2 record(s)"), std::string::npos) << one.err;
+  const CliRun many = ctid_run("fit " + io + " --method ssest --period 512 --skip 5");
+  EXPECT_EQ(many.code, 2);
+  EXPECT_NE(many.err.find("skipping 5 leaves 1, 2 needed"), std::string::npos) << many.err;
+}
+
 TEST(Cli, SsestRefinesWithUncertaintyOrderRangeAndAStartingModel) {
   // The two-mode system of issue 16 with 10 dB white noise on each output (seeded); reference: the true modes.
   const int N = 2000;

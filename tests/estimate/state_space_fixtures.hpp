@@ -1,10 +1,11 @@
 // Shared fixtures of the state-space tests (subspace, ssest): the two-mode MIMO system of issue 16, held random
-// inputs, exactly simulated noisy records and a pole distance.
+// inputs, exactly simulated noisy records, periodic multisine records and a pole distance.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <numbers>
 #include <random>
 #include <vector>
 
@@ -66,4 +67,31 @@ inline double pole_error(const StateSpace& truth, const StateSpace& est) {
   }
   return worst;
 }
+// Samples of the steady-state response of m to the multisine u(t) = sum_l cos(w_l t + phi_l) (one input) plus a
+// decaying transient C e^{At} x0, with white noise of standard deviation `noise` on every output.
+inline IdData periodic_record(const StateSpace& m, int period, int periods, double ts, int input, unsigned seed, double noise) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> phase(0.0, 2 * std::numbers::pi);
+  std::normal_distribution<double> e(0.0, 1.0);
+  const int N = period * periods, nu = m.nu(), ny = m.ny();
+  Eigen::MatrixXd u = Eigen::MatrixXd::Zero(N, nu), y = Eigen::MatrixXd::Zero(N, ny);
+  const double w0 = 2 * std::numbers::pi / (period * ts);
+  for (int l = 2; l <= 60; ++l) {  // lines 2..60 excited
+    const double w = l * w0, ph = phase(rng);
+    const Eigen::MatrixXcd G = frequency_response(m, Eigen::VectorXd::Constant(1, w)).front();
+    for (int k = 0; k < N; ++k) {
+      const double t = k * ts;
+      u(k, input) += std::cos(w * t + ph);
+      for (int i = 0; i < ny; ++i) y(k, i) += std::abs(G(i, input)) * std::cos(w * t + ph + std::arg(G(i, input)));
+    }
+  }
+  Eigen::VectorXd x0 = Eigen::VectorXd::Ones(m.nx());
+  const Eigen::MatrixXd A = m.A();
+  for (int k = 0; k < N; ++k) {
+    y.row(k) += (m.C() * expm(A * (k * ts)) * x0).transpose();
+    for (int i = 0; i < ny; ++i) y(k, i) += noise * e(rng);
+  }
+  return IdData(u, y, ts);
+}
+
 }  // namespace ctid::test::ss

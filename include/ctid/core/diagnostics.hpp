@@ -99,6 +99,8 @@ inline constexpr ScalarDiagnostic start_fit_percent{"start_fit_percent", "%", "s
 inline constexpr VectorDiagnostic mode_wn_std{"mode_wn_std", "rad/s",
                                               "standard deviation of each mode's natural frequency (modes in model order)"};
 inline constexpr VectorDiagnostic mode_zeta_std{"mode_zeta_std", "", "standard deviation of each mode's damping ratio"};
+inline constexpr ScalarDiagnostic chi2_per_dof{
+    "chi2_per_dof", "", "weighted residual sum of squares per degree of freedom (1: residuals at the given noise level)"};
 inline constexpr VectorDiagnostic nx_grid{"nx_grid", "", "state dimensions tried by the order search"};
 inline constexpr VectorDiagnostic nx_grid_bic{"nx_grid_bic", "", "BIC of the fit at each state dimension tried"};
 inline constexpr ScalarDiagnostic start_scale{"start_scale", "",

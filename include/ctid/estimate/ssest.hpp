@@ -59,6 +59,11 @@ struct SsestOptions {
   /// Keep a stable start stable: a step that moves a pole (other than a held integrator) to Re >= 0 is rejected. An
   /// unstable start is searched without it. false: an unstable plant (with start.stabilize false).
   bool enforce_stability = true;
+  /// Frequency data with variances: weight each entry by its inverse variance (ML when measurement noise is the only
+  /// error). false: each output's error variance is estimated from the residuals instead — when systematic errors
+  /// dominate (chi2_per_dof >> 1, e.g. the nonlinear distortion of a single multisine realisation), the variances
+  /// would put the weight on the bins where the noise is lowest rather than where the model is right.
+  bool use_variance = true;
   /// Known pure integrators: k poles held at 0 (the first k states integrate; A's first k columns are zero).
   int integrators = 0;
   /// Entries held at a value by name: "D1_2" (row 1, column 2), and with a starting model "A1_1", "B2_1", "C1_3".
@@ -85,6 +90,20 @@ Result<StateSpace> ssest(const IdData& data, const SsestOptions& options = {});
 Result<StateSpace> ssest(const std::vector<IdData>& data, const SsestOptions& options = {});
 /// The same from a given starting model (its nx; options.nx must be 0 or equal): held A/B/C entries refer to it.
 Result<StateSpace> ssest(const std::vector<IdData>& data, const StateSpace& initial, const SsestOptions& options = {});
+
+/// Frequency-response data (an FRF matrix, e.g. frf_from_periodic) -> continuous-time state space: the
+/// frequency-domain subspace start (subspace(FrequencyData)) refined by weighted least squares
+/// V = 1/2 sum_k sum_ij 2 |G_ij(jw_k) - Ghat_ij(jw_k)|^2 / var_kij with the data's variances (ML for independent
+/// circular complex errors), or with each output's error variance estimated from the residuals when the data carry
+/// none; the same local coordinates, modal form and uncertainty as for records (estimate/ssest_frequency.cpp).
+/// Options as above; estimate_initial_state does not apply; integrators and held A/B/C entries are refused (only
+/// fixed.D<i>_<j>). Fit and output_fit_percent about 0 (100 (1 - ||G - Ghat|| / ||G||)); diagnostics as above plus
+/// chi2_per_dof (the weighted residual sum of squares per degree of freedom: near 1 when the variances given
+/// account for the errors; the covariance is multiplied by it when it exceeds 1, with a warning above 2) and
+/// frequency_scale (the start's alpha).
+Result<StateSpace> ssest(const FrequencyData& data, const SsestOptions& options = {});
+/// The same from a given starting model (e.g. the model of a neighbouring excitation level).
+Result<StateSpace> ssest(const FrequencyData& data, const StateSpace& initial, const SsestOptions& options = {});
 
 /// The Cramér-Rao bound of ssest's parameters at `truth` for records with these inputs and sample times, each starting
 /// at rest, under independent white output noise of the given variances (one per output): a Result in ssest's

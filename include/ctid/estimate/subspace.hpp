@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "ctid/core/types.hpp"
+#include "ctid/data/frequency_data.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/estimate/options.hpp"
 #include "ctid/model/state_space.hpp"
@@ -68,6 +69,16 @@ const OptionTable<SubspaceOptions>& option_table<SubspaceOptions>();
 /// bad options. A model whose A has no real logarithm (Discrete route) or whose fit is not above 0 is returned with
 /// usable() false and the reason.
 Result<StateSpace> subspace(const IdData& data, const SubspaceOptions& options = {});
+
+/// Frequency-domain subspace estimate from an FRF matrix (McKelvey, Akçay & Ljung 1996, Algorithm 2, after the
+/// bilinear map z = (alpha + s)/(alpha - s); estimate/ssest_frequency.cpp): A and C from the block rows z^i G(z_k)
+/// (i < horizon; horizon 0 = max(2 nx, nx + 2), with nx = 0: 20), B and D by least squares on the data (weighted by
+/// their variances when given). tau = 1/alpha (s); 0 = alpha the geometric mean of the lowest and highest data
+/// frequency. route must be lambda; estimate_initial_state does not apply. Result as above, without x0; its fit
+/// compares G and Ghat about 0 (100 (1 - ||G - Ghat|| / ||G||) per output); diagnostics singular_values,
+/// output_fit_percent, frequency_scale (alpha, rad/s). Throws InvalidArgument for too few frequencies for the
+/// horizon.
+Result<StateSpace> subspace(const FrequencyData& data, const SubspaceOptions& options = {});
 
 /// B, D and the initial state of a model with given A and C (the least-squares step above), on one record.
 /// Returns the model and writes x0 (nx values) when x0 != nullptr.
