@@ -21,7 +21,7 @@ struct ReportArgs {
 // covariance must be sound (finite, of the right size, positive semi-definite, no zero standard deviation unless
 // the fit was exact), else exit 3; a model that diverges on the record is not drawn (exit 1). Returns the simulated
 // output on d.
-Eigen::VectorXd check_result(const ResultFile& file, const IdData& d, const std::string& initial, const std::string& path) {
+Eigen::MatrixXd check_result(const ResultFile& file, const IdData& d, const std::string& initial, const std::string& path) {
   if (!file.bare) {
     FitReport f;  // only the rules about parameters and covariance (the record may be another one)
     if (file.result.fit.nrmse < 1e-6) {
@@ -32,7 +32,7 @@ Eigen::VectorXd check_result(const ResultFile& file, const IdData& d, const std:
     if (const std::string why = usability_problem(Summary{}, file.result.parameters, f); !why.empty())
       throw InputError(path + ": " + why + " (its uncertainty bands would be meaningless)");
   }
-  return simulate_result(file.result, d, initial).col(0);
+  return simulate_result(file.result, d, initial);
 }
 
 int run(const ReportArgs& a) {
@@ -43,12 +43,15 @@ int run(const ReportArgs& a) {
   ResultFile file = read_result(a.result);
   const std::vector<IdData> ds = columns_of(a.data, file.result.model).load_each(a.paths, true);
   const IdData& d = ds.front();
-  if (d.ny() != 1 || d.nu() != model_inputs(file.result.model))
-    throw UsageError(detail::format("report needs one --output and one --input per model input (the {} model has {})",
-                                    model_type_name(file.result.model), model_inputs(file.result.model)));
-  const Eigen::VectorXd yhat = check_result(file, d, a.initial, a.result);
-  // A bare model's fit is the one on this record.
-  if (file.bare) file.result.fit = fit_report_or_inf(d.y().col(0), yhat, model_coefficient_count(file.result.model));
+  const int nu = model_inputs(file.result.model), ny = model_outputs(file.result.model);
+  if (d.ny() != ny || d.nu() != nu)
+    throw UsageError(detail::format("report needs one --input per model input and one --output per model output (the {} "
+                                    "model has {} input(s) and {} output(s); selected {} and {})",
+                                    model_type_name(file.result.model), nu, ny, d.nu(), d.ny()));
+  const Eigen::MatrixXd yhat = check_result(file, d, a.initial, a.result);
+  // A bare model's fit is the one on this record (several outputs: each output's fit is in its section).
+  if (file.bare && ny == 1)
+    file.result.fit = fit_report_or_inf(d.y().col(0), yhat.col(0), model_coefficient_count(file.result.model));
   ReportOptions o;
   o.method = file.method.empty() ? model_type_name(file.result.model) : file.method;
   o.title = a.title.empty() ? "ctid report: " + a.result : a.title;

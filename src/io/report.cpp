@@ -264,6 +264,12 @@ std::string input_name(const IdData& d, int i) {
              : (d.nu() > 1 ? "u" + std::to_string(i + 1) : "u");
 }
 
+std::string output_name(const IdData& d, int j) {
+  return j < static_cast<int>(d.output_names().size()) && !d.output_names()[static_cast<size_t>(j)].empty()
+             ? d.output_names()[static_cast<size_t>(j)]
+             : (d.ny() > 1 ? "y" + std::to_string(j + 1) : "y");
+}
+
 template <class M>
 void overview(Page& page, const IdData& d, const Result<M>& r, const ReportOptions& o, const std::string& model_text) {
   page.section("Summary");
@@ -294,18 +300,22 @@ void overview(Page& page, const IdData& d, const Result<M>& r, const ReportOptio
   std::string inputs;
   for (int i = 0; i < d.nu(); ++i)
     inputs += (i ? ", " : "") + input_name(d, i) + " (" + to_string(d.intersample(i)) + ")";
+  std::string outputs;
+  for (int j = 0; j < d.ny(); ++j) outputs += (j ? ", " : "") + output_name(d, j);
   page.table({"", ""}, {{"source", o.data_source.empty() ? "-" : o.data_source},
                         {"samples", std::to_string(d.size())},
                         {"sampling", d.is_uniform() ? "Ts = " + fmt(d.ts()) + " s" : "irregular"},
                         {"duration", fmt(dur) + " s"},
                         {d.nu() > 1 ? "inputs" : "input", inputs},
-                        {"output", d.output_names().empty() ? "y" : d.output_names()[0]}});
+                        {d.ny() > 1 ? "outputs" : "output", outputs}});
   const auto k = keep(d.size(), o.max_points);
   const Eigen::VectorXd t = pick(d.times(), k);
   std::vector<Series> us;
   for (int i = 0; i < d.nu(); ++i) us.push_back({input_name(d, i), pick(d.u().col(i), k)});
   page.plot({d.nu() > 1 ? "Inputs" : "Input", "time (s)", "u", t, us});
-  page.plot({"Output", "time (s)", "y", t, {{"y", pick(d.y().col(0), k)}}});
+  std::vector<Series> ys;
+  for (int j = 0; j < d.ny(); ++j) ys.push_back({output_name(d, j), pick(d.y().col(j), k)});
+  page.plot({d.ny() > 1 ? "Outputs" : "Output", "time (s)", "y", t, ys});
 }
 
 // Method-specific numbers (the declared diagnostics the fit reported, with their units and meanings), e.g.
@@ -353,19 +363,20 @@ void parameters(Page& page, const ParameterSet& p, const Eigen::VectorXd* err = 
 }
 
 // Measured vs simulated output and the residual correlation tests.
-void validation(Page& page, const IdData& d, const Eigen::VectorXd& yhat, const ReportOptions& o) {
-  page.section("Measured and simulated output");
-  const Eigen::VectorXd y = d.y().col(0);
+void validation(Page& page, const IdData& d, const Eigen::VectorXd& yhat, const ReportOptions& o, int out = 0) {
+  const std::string of = d.ny() > 1 ? " (" + output_name(d, out) + ")" : "";
+  page.section("Measured and simulated output" + of);
+  const Eigen::VectorXd y = d.y().col(out);
   const auto k = keep(d.size(), o.max_points);
   Eigen::VectorXd e = y - yhat;
   const double fit = fit_report_or_inf(y, yhat, 0).fit_percent;
-  page.plot({"Output: measured and simulated (fit " + fmt(fit, 4) + " %)", "time (s)", "y", pick(d.times(), k),
+  page.plot({"Output" + of + ": measured and simulated (fit " + fmt(fit, 4) + " %)", "time (s)", "y", pick(d.times(), k),
              {{"measured", pick(y, k)}, {"simulated", pick(yhat, k)}}});
   if (!std::isfinite(e.squaredNorm())) {  // non-finite, or so large that the squares overflow
     page.text("<span class=\"warn\">The simulation does not stay finite on this record: no residual tests.</span>");
     return;
   }
-  page.section("Residual tests");
+  page.section("Residual tests" + of);
   const int lags = std::min(o.max_lag, d.size() / 4);
   if (lags < 1 || e.squaredNorm() == 0) {
     page.text("Too few samples or zero residuals: no correlation tests.");
@@ -497,6 +508,93 @@ std::string report_of(const IdData& d, const Result<TransferFunction>& r, const 
   const MagnitudeBand band = magnitude_band(r, w);
   bode(page, w, {{"G(jw)", h}}, band.empty() ? nullptr : &band.lower, band.empty() ? nullptr : &band.upper);
   time_responses(page, r.model, {"G"}, response_horizon({r.model}, d.duration()));
+  return page.render(o.title.empty() ? o.method + " fit" : o.title);
+}
+
+// A state-space model with any number of inputs and outputs: the singular values of its subspace step, the poles
+// with natural frequency, damping (and their standard deviations where the fit has a covariance) and mode shapes,
+// each output simulated and tested, the Bode magnitude of every channel, step responses per input.
+std::string report_of(const IdData& d, const Result<StateSpace>& r, const ReportOptions& o) {
+  const StateSpace& m = r.model;
+  CTID_REQUIRE(d.nu() == m.nu() && d.ny() == m.ny(), "html_report: the model has {} inputs and {} outputs (data: {}, {})",
+               m.nu(), m.ny(), d.nu(), d.ny());
+  Page page;
+  overview(page, d, r, o, detail::format("dx/dt = A x + B u, y = C x + D u ({} states, {} inputs, {} outputs)", m.nx(),
+                                         m.nu(), m.ny()));
+  if (r.diagnostics.has(diagnostic::singular_values)) {
+    const Eigen::VectorXd& sv = r.diagnostics.get(diagnostic::singular_values);
+    page.section("Singular values of the subspace step");
+    page.text("The order is where they drop (relative to the largest, log10); the model has " + std::to_string(m.nx()) +
+              " states.");
+    const Eigen::VectorXd n = Eigen::VectorXd::LinSpaced(sv.size(), 1, static_cast<double>(sv.size()));
+    page.plot({"Singular values", "index", "log10 (s_i / s_1)", n,
+               {{"log10 s", (sv / std::max(sv(0), 1e-300)).array().max(1e-300).log10().matrix()}}, false, true});
+  }
+  page.section("Modes");
+  const std::vector<Mode> modes = m.modes();
+  const bool with_std = r.diagnostics.has(diagnostic::mode_wn_std) &&
+                        r.diagnostics.get(diagnostic::mode_wn_std).size() == static_cast<Eigen::Index>(modes.size());
+  std::vector<std::string> header = {"pole (1/s)", "wn (rad/s)", "f (Hz)", "zeta"};
+  if (with_std) header.insert(header.begin() + 2, "wn std"), header.push_back("zeta std");
+  for (int j = 0; j < m.ny(); ++j) header.push_back("|shape| " + output_name(d, j));
+  std::vector<std::vector<std::string>> rows;
+  for (size_t k = 0; k < modes.size(); ++k) {
+    const Mode& md = modes[k];
+    std::vector<std::string> row = {fmt(md.pole.real(), 5) + (md.pole.imag() != 0 ? " ± " + fmt(md.pole.imag(), 5) + "j" : ""),
+                                    fmt(md.wn, 5), fmt(md.wn / (2 * std::numbers::pi), 5), fmt(md.zeta, 4)};
+    if (with_std) {
+      row.insert(row.begin() + 2, fmt(r.diagnostics.get(diagnostic::mode_wn_std)(static_cast<Eigen::Index>(k)), 3));
+      row.push_back(fmt(r.diagnostics.get(diagnostic::mode_zeta_std)(static_cast<Eigen::Index>(k)), 3));
+    }
+    for (Eigen::Index j = 0; j < md.shape.size(); ++j) row.push_back(fmt(std::abs(md.shape(j)), 3));
+    rows.push_back(row);
+  }
+  page.text("Mode shape: the output direction C v of the mode's eigenvector (unit norm).");
+  page.table(header, rows);
+  // Every output simulated on the record (one simulation) and tested.
+  SimulateOptions so;
+  so.initial = o.initial ? *o.initial : fit_initial_condition(AnyModel(m), r.diagnostics);
+  if (so.initial == InitialCondition::Estimated && r.diagnostics.has(diagnostic::x0)) so.x0 = r.diagnostics.get(diagnostic::x0);
+  const Simulation sim = simulate(AnyModel(m), d, so);
+  page.text("Simulated from the initial condition: " + std::string(to_string(so.initial)) + ".");
+  if (!sim.ok()) page.text("<span class=\"warn\">" + escape(sim.problem) + "</span>");
+  for (int j = 0; j < m.ny(); ++j) validation(page, d, sim.y.col(j), o, j);
+  for (size_t i = 0; i < o.more_records.size(); ++i) {
+    const auto& [name, rec] = o.more_records[i];
+    CTID_REQUIRE(rec.nu() == m.nu() && rec.ny() == m.ny(),
+                 "html_report: record {} ({}) has {} input(s) and {} output(s); the model has {} and {}", i + 2, name,
+                 rec.nu(), rec.ny(), m.nu(), m.ny());
+    page.section("Record " + std::to_string(i + 2) + ": " + name);
+    SimulateOptions ro;
+    ro.initial = o.initial ? *o.initial : InitialCondition::Rest;
+    const Simulation rs = simulate(AnyModel(m), rec, ro);
+    page.text(std::to_string(rec.size()) + " samples, " + fmt(rec.duration()) + " s; simulated from " +
+              to_string(ro.initial) + ".");
+    for (int j = 0; j < m.ny(); ++j) validation(page, rec, rs.y.col(j), o, j);
+  }
+  parameters(page, r.parameters);
+  diagnostics(page, r.diagnostics);
+  // The Bode magnitude matrix: one plot per input, one curve per output.
+  const Eigen::VectorXd w = frequency_grid(m.poles(), nyquist(d));
+  const std::vector<Eigen::MatrixXcd> G = frequency_response(m, w);
+  page.section("Frequency response (magnitude of every channel)");
+  for (int i = 0; i < m.nu(); ++i) {
+    std::vector<Series> ms;
+    for (int j = 0; j < m.ny(); ++j) {
+      Eigen::VectorXd mag(w.size());
+      for (Eigen::Index k = 0; k < w.size(); ++k) mag(k) = 20 * std::log10(std::abs(G[static_cast<size_t>(k)](j, i)));
+      ms.push_back({output_name(d, j), mag});
+    }
+    page.plot({"Bode magnitude from " + input_name(d, i), "frequency (rad/s)", "dB", w, ms, true});
+  }
+  page.section("Step responses");
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(400, 0.0, poles_response_horizon(m.poles(), d.duration()));
+  const std::vector<Eigen::MatrixXd> steps = step_response(m, t);
+  for (int i = 0; i < m.nu(); ++i) {
+    std::vector<Series> ss;
+    for (int j = 0; j < m.ny(); ++j) ss.push_back({output_name(d, j), steps[static_cast<size_t>(i)].col(j)});
+    page.plot({"Unit step on " + input_name(d, i), "time (s)", "y", t, ss});
+  }
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }
 
@@ -632,20 +730,8 @@ std::string html_report(const IdData& data, const Result<AnyModel>& result, cons
   return std::visit(
       [&](const auto& m) {
         using M = std::decay_t<decltype(m)>;
-        if constexpr (std::is_same_v<M, StateSpace>) {
-          // A single-input single-output state-space model is reported as its transfer function.
-          CTID_REQUIRE(m.nu() == 1 && m.ny() == 1,
-                       "html_report: a state_space model with {} inputs and {} outputs has no report (one input and "
-                       "one output only)",
-                       m.nu(), m.ny());
-          return report_of(data,
-                             Result<TransferFunction>{m.to_transfer_function(), result.parameters, result.fit,
-                                                      result.summary, result.diagnostics},
-                             options);
-        } else {
-          return report_of(data, Result<M>{m, result.parameters, result.fit, result.summary, result.diagnostics},
-                             options);
-        }
+        return report_of(data, Result<M>{m, result.parameters, result.fit, result.summary, result.diagnostics},
+                         options);
       },
       result.model);
 }

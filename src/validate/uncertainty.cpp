@@ -52,14 +52,22 @@ Eigen::VectorXd frequency_grid(const Eigen::VectorXcd& poles, double w_max, int 
   return w;
 }
 
+double poles_response_horizon(const Eigen::VectorXcd& poles, double fallback) {
+  double slow = INFINITY;
+  for (const auto& p : poles)
+    if (p.real() < 0) slow = std::min(slow, -p.real());
+  return std::isfinite(slow) ? 8.0 / slow : fallback;
+}
+
 double response_horizon(const std::vector<TransferFunction>& models, double fallback) {
-  double slow = INFINITY, delay = 0;
+  std::vector<std::complex<double>> poles;
+  double delay = 0;
   for (const auto& g : models) {
-    for (const auto& p : g.poles())
-      if (p.real() < 0) slow = std::min(slow, -p.real());
+    for (const auto& p : g.poles()) poles.push_back(p);
     delay = std::max(delay, g.io_delay());
   }
-  return std::isfinite(slow) ? 8.0 / slow + delay : fallback;
+  const double h = poles_response_horizon(Eigen::Map<const Eigen::VectorXcd>(poles.data(), static_cast<Eigen::Index>(poles.size())), -1.0);
+  return h > 0 ? h + delay : fallback;
 }
 
 MagnitudeBand magnitude_band(const Result<TransferFunction>& r, const Eigen::VectorXd& w, double level, int draws,

@@ -741,7 +741,15 @@ TEST(Cli, ReportsOpenInABrowserWithEveryPlotDrawn) {
   mm << mu, lsim(g2, IdData(mu, Eigen::VectorXd::Zero(2000), 0.02));
   const std::string miso = test::temp_path("miso_report.csv");
   write_csv(miso, {"u1", "u2", "y"}, mm);
+  // A MIMO record (the two-mode 2 x 2 system of issue 16, 20 dB) for the state-space report.
+  const Eigen::MatrixXd su = test::ss::levels(1500, 2, 7, 5);
+  Eigen::MatrixXd sm(1500, 4);
+  sm << su, test::ss::record(test::ss::two_modes(), su, Eigen::VectorXd::LinSpaced(1500, 0.0, 1499 * 0.05),
+                             Eigen::Vector4d::Zero(), 20.0, 5).y();
+  const std::string mimo = test::temp_path("mimo_report.csv");
+  write_csv(mimo, {"u1", "u2", "y1", "y2"}, sm);
   const std::vector<std::pair<std::string, std::string>> cases = {
+      {"ssest", "fit " + mimo + " --ts 0.05 --input u1 --input u2 --output y1 --output y2 --method ssest --nx 4"},
       {"miso", "fit " + miso + " --ts 0.02 --input u1 --input u2 --output y --method srivc --nb 2,1 --nf 2,1"},
       {"srivc", "fit " + dryer + base + "--method srivc --nb 2 --nf 2 --nk 2"},
       {"fsf", "fit " + dryer + base + "--method fsf --set T=4 --set n=21"},
@@ -790,8 +798,8 @@ TEST(Cli, ReportsOpenInABrowserWithEveryPlotDrawn) {
   r = ctid_run("fit " + dryer + " --frequency --report " + test::temp_path("x.html"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--report needs time-domain data"), std::string::npos) << r.err;
-  // A single-input single-output state-space model is reported as its transfer function; one with two outputs is
-  // refused (exit 2) by name.
+  // A state-space model is reported with its modes; one with two outputs needs two selected outputs (exit 2, by
+  // name, nothing written).
   const std::string ss1 = write("ss1.json", R"J({"type": "state_space", "A": [[-1]], "B": [[1]], "C": [[1]], "D": [[0]]})J");
   r = ctid_run("report " + ss1 + " " + dryer + base + "--out " + test::temp_path("ss1.html"));
   EXPECT_EQ(r.code, 0) << r.err;
@@ -1489,9 +1497,15 @@ TEST(Cli, SsestRefinesWithUncertaintyOrderRangeAndAStartingModel) {
   write_csv(csv, {"u1", "u2", "y1", "y2"}, m);
   const std::string io = csv + " --ts 0.05 --input u1 --input u2 --output y1 --output y2 --method ssest";
   const std::string json = test::temp_path("two_modes_ssest.json");
-  const CliRun r = ctid_run("fit " + io + " --nx 4 --set estimate_d=0 --json " + json + " --force");
+  const std::string html = test::temp_path("two_modes_ssest.html");
+  const CliRun r = ctid_run("fit " + io + " --nx 4 --set estimate_d=0 --json " + json + " --report " + html + " --force");
   ASSERT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("subspace start: fit"), std::string::npos) << r.out;
+  // The MIMO report: the modes table and a comparison per output.
+  const std::string page = read_text_file(html);
+  for (const char* s : {"<h2>Modes</h2>", "<h2>Measured and simulated output (y1)</h2>",
+                        "<h2>Measured and simulated output (y2)</h2>", "Bode magnitude from u2"})
+    EXPECT_NE(page.find(s), std::string::npos) << s;
   EXPECT_NE(r.out.find("termination: converged"), std::string::npos) << r.out;
   // Each mode with its standard deviation; the slow mode's wn within 4 of them of 2 rad/s.
   const ResultFile file = read_result_file(json);

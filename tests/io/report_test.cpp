@@ -6,6 +6,8 @@
 #include "ctid/estimate/fsf.hpp"
 #include "ctid/estimate/modal.hpp"
 #include "ctid/estimate/srivc.hpp"
+#include "ctid/estimate/ssest.hpp"
+#include "estimate/state_space_fixtures.hpp"
 #include "ctid/io/report.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "test_util.hpp"
@@ -60,6 +62,37 @@ TEST(Report, MultiInputReportHasAChannelPerInput) {
   // 10 plots: inputs, output, compare, autocorrelation, 2 cross-correlations, Bode magnitude and phase, step, impulse.
   EXPECT_EQ(count(html, "class=\"plot\""), 10);
   EXPECT_THROW(html_report(d.select({0}, {0}), r, {}), InvalidArgument);
+}
+
+TEST(Report, StateSpaceReportShowsModesEveryOutputAndEveryChannel) {
+  // The two-mode 2 x 2 system of issue 16, 20 dB noise, ssest with 4 states: the report holds the singular values, a
+  // modes table (2 rows, with standard deviations and a shape column per output), each output's comparison whose fit
+  // is the fit the estimator reported for that output (same initial state), its residual tests, one Bode magnitude
+  // plot and one step plot per input with a curve per output.
+  const int N = 1500;
+  const Eigen::MatrixXd u = test::ss::levels(N, 2, 7, 3);
+  IdData d = test::ss::record(test::ss::two_modes(), u, Eigen::VectorXd::LinSpaced(N, 0.0, (N - 1) * 0.05),
+                              Eigen::Vector4d::Zero(), 20.0, 3);
+  d.set_output_names({"left", "right"});
+  SsestOptions o;
+  o.nx = 4;
+  const Result<StateSpace> r = ssest(d, o);
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
+  const std::string html = html_report(d, r, {.method = "ssest"});
+  for (const char* s : {"<h2>Singular values of the subspace step</h2>", "<h2>Modes</h2>", "wn std", "zeta std",
+                        "|shape| left", "|shape| right", "<h2>Measured and simulated output (left)</h2>",
+                        "<h2>Residual tests (right)</h2>", "Bode magnitude from u1", "Bode magnitude from u2",
+                        "Unit step on u2", "outputs</td><td>left, right"})
+    EXPECT_NE(html.find(s), std::string::npos) << s;
+  for (int j = 0; j < 2; ++j) {
+    char fit[64];
+    std::snprintf(fit, sizeof fit, "(%s): measured and simulated (fit %.4g %%)", j ? "right" : "left",
+                  r.diagnostics.get(diagnostic::output_fit_percent)(j));
+    EXPECT_NE(html.find(fit), std::string::npos) << fit;
+  }
+  // Plots: inputs, outputs, singular values, 2 x (compare, autocorrelation, 2 cross-correlations), 2 Bode, 2 steps.
+  EXPECT_EQ(count(html, "class=\"plot\""), 3 + 2 * 4 + 2 + 2);
+  EXPECT_THROW(html_report(d.select({0, 1}, {0}), r, {}), InvalidArgument);
 }
 
 TEST(Report, DiagnosticsSectionShowsMethodNumbers) {

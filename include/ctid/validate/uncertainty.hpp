@@ -36,6 +36,8 @@ Eigen::VectorXd frequency_grid(const Eigen::VectorXcd& poles, double w_max = 0.0
 /// Time horizon (s) of step and impulse plots: 8 times the slowest stable time constant of the models plus their
 /// largest delay; `fallback` when none has a stable pole.
 double response_horizon(const std::vector<TransferFunction>& models, double fallback);
+/// The same from a set of poles (no delay): 8 / (the smallest -Re p over the stable poles), else `fallback`.
+double poles_response_horizon(const Eigen::VectorXcd& poles, double fallback);
 
 /// Pointwise band of |G(jw)|: lower and upper are empty when it cannot be computed.
 struct MagnitudeBand {
