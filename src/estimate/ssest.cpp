@@ -622,33 +622,8 @@ Result<StateSpace> ssest(const std::vector<IdData>& data, const SsestOptions& op
   options.validate();
   check_records(data);
   if (options.nx_max <= options.nx || options.nx_max == 0) return ssest_order(data, options.nx, options, t0);
-  // Order search: the least BIC among the usable fits (all fits when none is usable).
-  const int lo = std::max(options.nx, 1), hi = options.nx_max;
-  Eigen::VectorXd grid(hi - lo + 1), bic(hi - lo + 1);
-  Result<StateSpace> best;
-  bool best_usable = false;
-  double best_bic = INFINITY;
-  for (int n = lo; n <= hi; ++n) {
-    Result<StateSpace> r;
-    try {
-      r = ssest_order(data, n, options, t0);
-    } catch (const InvalidArgument&) {
-      if (n == lo) throw;
-      grid.conservativeResize(n - lo);
-      bic.conservativeResize(n - lo);
-      break;
-    }
-    grid(n - lo) = n;
-    bic(n - lo) = r.fit.n_samples > 0 ? r.fit.bic : INFINITY;
-    const bool usable = r.usable();
-    if ((usable && !best_usable) || (usable == best_usable && bic(n - lo) < best_bic) || best.model.nx() == 0) {
-      best_usable = usable;
-      best_bic = bic(n - lo);
-      best = std::move(r);
-    }
-  }
-  best.diagnostics.set(diagnostic::nx_grid, grid);
-  best.diagnostics.set(diagnostic::nx_grid_bic, bic);
+  Result<StateSpace> best = order_search(std::max(options.nx, 1), options.nx_max,
+                                         [&](int n) { return ssest_order(data, n, options, t0); });
   best.summary.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return best;
 }

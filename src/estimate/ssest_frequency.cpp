@@ -26,7 +26,6 @@
 #include <chrono>
 #include <cmath>
 #include <complex>
-#include <numeric>
 
 #include "ctid/core/check.hpp"
 #include "ctid/core/error.hpp"
@@ -593,32 +592,8 @@ Result<StateSpace> ssest(const FrequencyData& data, const SsestOptions& options)
   check_frequency_options(options);
   const Fd f = scaled_data(data, options.use_variance);
   if (options.nx_max <= options.nx || options.nx_max == 0) return frequency_order(f, options.nx, options, t0);
-  const int lo = std::max(options.nx, 1), hi = options.nx_max;
-  Eigen::VectorXd grid(hi - lo + 1), bic(hi - lo + 1);
-  Result<StateSpace> best;
-  bool best_usable = false;
-  double best_bic = INFINITY;
-  for (int n = lo; n <= hi; ++n) {
-    Result<StateSpace> r;
-    try {
-      r = frequency_order(f, n, options, t0);
-    } catch (const InvalidArgument&) {
-      if (n == lo) throw;
-      grid.conservativeResize(n - lo);
-      bic.conservativeResize(n - lo);
-      break;
-    }
-    grid(n - lo) = n;
-    bic(n - lo) = r.fit.n_samples > 0 ? r.fit.bic : INFINITY;
-    const bool usable = r.usable();
-    if ((usable && !best_usable) || (usable == best_usable && bic(n - lo) < best_bic) || best.model.nx() == 0) {
-      best_usable = usable;
-      best_bic = bic(n - lo);
-      best = std::move(r);
-    }
-  }
-  best.diagnostics.set(diagnostic::nx_grid, grid);
-  best.diagnostics.set(diagnostic::nx_grid_bic, bic);
+  Result<StateSpace> best = order_search(std::max(options.nx, 1), options.nx_max,
+                                         [&](int n) { return frequency_order(f, n, options, t0); });
   best.summary.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return best;
 }

@@ -3,6 +3,7 @@
 // standard deviation), the full parametrisation in data-driven local coordinates and the real modal form of a result.
 #pragma once
 
+#include <cmath>
 #include <span>
 #include <string>
 #include <tuple>
@@ -10,6 +11,8 @@
 
 #include <Eigen/Dense>
 
+#include "ctid/core/diagnostics.hpp"
+#include "ctid/core/error.hpp"
 #include "ctid/core/types.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/model/state_space.hpp"
@@ -85,5 +88,38 @@ Eigen::MatrixXd inverse_normal(const Eigen::MatrixXd& JtJ, Eigen::Index np);
 Eigen::MatrixXd shift_invariance(const Eigen::MatrixXd& O, int ny);
 /// A with every eigenvalue re + j im of re > 0 moved to -re + j im (same eigenvectors).
 Eigen::MatrixXd reflected_into_left_half_plane(const Eigen::MatrixXd& A);
+
+/// The order search of ssest (time and frequency data): fit(n) for n = lo..hi and keep the least BIC among the usable
+/// fits (all fits when none is usable), with diagnostics nx_grid and nx_grid_bic. An order the data cannot support
+/// (fit throws InvalidArgument) ends the search; at lo it is rethrown.
+template <class Fit>
+Result<StateSpace> order_search(int lo, int hi, Fit&& fit) {
+  Eigen::VectorXd grid(hi - lo + 1), bic(hi - lo + 1);
+  Result<StateSpace> best;
+  bool best_usable = false;
+  double best_bic = INFINITY;
+  for (int n = lo; n <= hi; ++n) {
+    Result<StateSpace> r;
+    try {
+      r = fit(n);
+    } catch (const InvalidArgument&) {
+      if (n == lo) throw;
+      grid.conservativeResize(n - lo);
+      bic.conservativeResize(n - lo);
+      break;
+    }
+    grid(n - lo) = n;
+    bic(n - lo) = r.fit.n_samples > 0 ? r.fit.bic : INFINITY;
+    const bool usable = r.usable();
+    if ((usable && !best_usable) || (usable == best_usable && bic(n - lo) < best_bic) || best.model.nx() == 0) {
+      best_usable = usable;
+      best_bic = bic(n - lo);
+      best = std::move(r);
+    }
+  }
+  best.diagnostics.set(diagnostic::nx_grid, grid);
+  best.diagnostics.set(diagnostic::nx_grid_bic, bic);
+  return best;
+}
 
 }  // namespace ctid::ss_detail
