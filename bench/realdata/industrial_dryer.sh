@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Real-data benchmark: industrial dryer (docs/gallery.md). Usage: see bench/realdata/common.sh.
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+source "$here/mimo_compare.sh"
 dryer2="$shared/daisy_industrial_dryer/dryer2.dat"
 [ -f "$dryer2" ] || skip "industrial dryer" "$dryer2 not available"
 echo "== industrial dryer (DaISy): order selection, then fuel flow, fan speed and raw-material flow -> each output,"
@@ -27,18 +28,10 @@ read -r s5 < <(fits_of dryer2_5.json dryer2_val.dat $i --output 5)
 read -r s6 < <(fits_of dryer2_6.json dryer2_val.dat $i --output 6)
 read -r s7 < <(fits_of dryer2_7.json dryer2_val.dat $i --output 7)
 echo "  MISO SRIVC: $s5 $s6 $s7"
-o="$i --output 5 --output 6 --output 7"
-"$ctid" fit dryer2_est.dat $o --method ssest --nx 1:6 --json dryer2_ss.json --force > dryer2_ss.txt
-nx=$(awk '/states$/ { print $(NF - 1); exit }' dryer2_ss.txt)
-grep "order search" dryer2_ss.txt
-read -r m5 m6 m7 < <(fits_of dryer2_ss.json dryer2_val.dat $o)
-echo "  MIMO ssest, nx = $nx: $m5 $m6 $m7"
-"$ctid" fit dryer2_est.dat $o --method subspace --set route=discrete --nx "$nx" --json dryer2_n4.json --force >/dev/null
-read -r n5 n6 n7 < <(fits_of dryer2_n4.json dryer2_val.dat $o)
-echo "  discrete N4SID (MOESP + logm), nx = $nx: $n5 $n6 $n7"
+ssest_and_n4sid dryer2 dryer2_est.dat dryer2_val.dat "$i" "5 6 7" 6
 check "ssest order chosen by BIC" "$nx" gt 1
 for k in 5 6 7; do
-  eval "m=\$m$k; s=\$s$k"
+  m=${ss[$((k - 5))]}; eval "s=\$s$k"
   check "output $k: ssest validation fit minus MISO SRIVC's (at least as good)" "$(awk -v a="$m" -v b="$s" 'BEGIN { print a - b }')" gt -0.5
 done
 exit $fail

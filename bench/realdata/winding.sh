@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Real-data benchmark: winding (docs/gallery.md). Usage: see bench/realdata/common.sh.
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+source "$here/mimo_compare.sh"
 winding="$shared/daisy_winding_process/winding.dat"
 [ -f "$winding" ] || skip "winding process" "$winding not available"
 echo "== winding process (DaISy): five inputs -> each web tension, MISO SRIVC with a common denominator;"
@@ -33,15 +34,7 @@ echo "   SRIVC models and the discrete N4SID route; the validation part's initia
 read -r s6 < <(fits_of winding_6s.json winding_val.dat $w --output 6)
 read -r s7 < <(fits_of winding_7c3.json winding_val.dat $w --output 7)
 echo "  best MISO SRIVC (T1 separate first-order denominators, T3 common third order): $s6 $s7"
-o="$w --output 6 --output 7"
-"$ctid" fit winding_est.dat $o --method ssest --nx 1:8 --json winding_ss.json --force > winding_ss.txt
-nx=$(awk '/states$/ { print $(NF - 1); exit }' winding_ss.txt)
-grep "order search" winding_ss.txt
-read -r m6 m7 < <(fits_of winding_ss.json winding_val.dat $o)
-echo "  MIMO ssest, nx = $nx: $m6 $m7"
-"$ctid" fit winding_est.dat $o --method subspace --set route=discrete --nx "$nx" --json winding_n4.json --force >/dev/null
-read -r n6 n7 < <(fits_of winding_n4.json winding_val.dat $o)
-echo "  discrete N4SID (MOESP + logm), nx = $nx: $n6 $n7"
-check "T1: ssest validation fit minus the best MISO SRIVC's" "$(awk -v a="$m6" -v b="$s6" 'BEGIN { print a - b }')" gt 10
-check "T3: ssest validation fit minus the best MISO SRIVC's" "$(awk -v a="$m7" -v b="$s7" 'BEGIN { print a - b }')" gt 8
+ssest_and_n4sid winding winding_est.dat winding_val.dat "$w" "6 7" 8
+check "T1: ssest validation fit minus the best MISO SRIVC's" "$(awk -v a="${ss[0]}" -v b="$s6" 'BEGIN { print a - b }')" gt 10
+check "T3: ssest validation fit minus the best MISO SRIVC's" "$(awk -v a="${ss[1]}" -v b="$s7" 'BEGIN { print a - b }')" gt 8
 exit $fail

@@ -144,19 +144,19 @@ FrequencyData frf_from_periodic(const std::vector<IdData>& records, int period, 
   // Spectra of every period: S[e][p] is period x (nu + ny).
   Eigen::FFT<double> fft;
   std::vector<std::vector<Eigen::MatrixXcd>> S(static_cast<size_t>(E));
+  std::vector<double> in(static_cast<size_t>(period));
+  std::vector<std::complex<double>> spectrum;
   for (int e = 0; e < E; ++e) {
     const IdData& d = records[static_cast<size_t>(e)];
     for (int p = skip; p < skip + P; ++p) {
       Eigen::MatrixXcd X(K, nu + ny);
-      std::vector<double> in(static_cast<size_t>(period));
-      std::vector<std::complex<double>> out;
       for (int c = 0; c < nu + ny; ++c) {
         const Eigen::MatrixXd& src = c < nu ? d.u() : d.y();
         const int col = c < nu ? c : c - nu;
         for (int i = 0; i < period; ++i)
           in[static_cast<size_t>(i)] = src(static_cast<Eigen::Index>(p) * period + i, col);
-        fft.fwd(out, in);
-        for (int k = 0; k < K; ++k) X(k, c) = out[static_cast<size_t>(k)];
+        fft.fwd(spectrum, in);
+        for (int k = 0; k < K; ++k) X(k, c) = spectrum[static_cast<size_t>(k)];
       }
       S[static_cast<size_t>(e)].push_back(std::move(X));
     }

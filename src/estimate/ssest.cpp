@@ -311,43 +311,23 @@ Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& h
   int left = o.max_iterations;
   for (int pass = 0; pass < 2; ++pass) {
     const Eigen::VectorXd sw = s.weights.cwiseSqrt();
-    double cost = INFINITY;  // at theta, with these weights
-    bool converged = false;
-    while (left > 0 && !converged) {
-      if (free_coordinates) theta = pack(L, whitened(unpack(L, theta), recs));
-      const Eigen::MatrixXd Q = local_directions(L, unpack(L, theta), held);
-      const std::vector<Point> dirs = directions_of(L, Q);
-      auto normal = [&](const Eigen::VectorXd& xi, double& cost, Eigen::MatrixXd* A, Eigen::VectorXd* g) {
-        const Point m = unpack(L, theta + Q * xi);
-        if (check_stability && !stable(m.A, o.integrators)) return false;  // a rejected step
-        return evaluate(m, A ? &dirs : nullptr, recs, sw, cost, A, g);
-      };
-      lmo.max_iterations = std::min(left, 5);
-      // The cost is in noise units (1/2 sum of e^2/sigma^2): a round ends when a step gains less than `tolerance`.
-      // It is the last round's final cost (a change of state coordinates does not change it), evaluated afresh only
-      // at the start of a pass.
-      if (!std::isfinite(cost) && !evaluate(unpack(L, theta), nullptr, recs, sw, cost, nullptr, nullptr)) cost = INFINITY;
-      if (std::isfinite(cost) && cost > 0) lmo.ftol = o.tolerance / cost;
-      internal::LmResult lm = internal::levenberg_marquardt(internal::LmNormalEvaluate(normal),
-                                                            Eigen::VectorXd::Zero(Q.cols()),
-                                                            Eigen::VectorXd::Constant(Q.cols(), -INFINITY),
-                                                            Eigen::VectorXd::Constant(Q.cols(), INFINITY), lmo);
-      if (!std::isfinite(lm.cost)) {
-        s.failed_start = s.iterations == 0;
-        s.last = lm;
-        s.theta = theta;
-        return s;
-      }
-      theta += Q * lm.x;
-      cost = lm.cost;
-      lmo.lambda0 = std::clamp(lm.lambda, 1e-12, 1e-3);  // the next round goes on with the damping reached
-      left -= std::max(lm.iterations, 1);
-      s.iterations += lm.iterations;
-      converged = lm.converged || lm.interrupted;
-      s.last = lm;
-      if (lm.interrupted) break;
+    const Rounds r = lm_rounds(
+        L, theta, held, check_stability, o.integrators, o.tolerance, left, lmo,
+        [&](const Point& m) { return free_coordinates ? whitened(m, recs) : m; },
+        [&](const Eigen::MatrixXd& Q) {
+          return [&, dirs = directions_of(L, Q)](const Point& m, double& cost, Eigen::MatrixXd* A, Eigen::VectorXd* g) {
+            return evaluate(m, A ? &dirs : nullptr, recs, sw, cost, A, g);
+          };
+        });
+    theta = r.theta;
+    s.iterations += r.iterations;
+    s.last = r.last;
+    if (r.failed) {
+      s.failed_start = s.iterations == 0;
+      s.theta = theta;
+      return s;
     }
-    if (s.last.interrupted || !converged) break;
+    if (s.last.interrupted || !r.converged) break;
     if (pass == 0) {
       const Eigen::VectorXd w = residual_variances(unpack(L, theta), recs).cwiseMax(1e-12).cwiseInverse();
       if (!w.allFinite()) break;
@@ -463,19 +443,7 @@ void deliver(Result<StateSpace>& res, const std::vector<IdData>& ds, Point fin, 
     res.fit.n_samples = static_cast<int>(total * ny);
   }
   for (int e = 0; e < E; ++e) res.diagnostics.set(diagnostic::x0, fin.x0[static_cast<size_t>(e)], e);
-  const std::vector<ModeUncertainty> mu = mode_uncertainty(res);
-  Eigen::VectorXd wn_std(static_cast<Eigen::Index>(mu.size())), zeta_std(static_cast<Eigen::Index>(mu.size()));
-  for (size_t k = 0; k < mu.size(); ++k) {
-    wn_std(static_cast<Eigen::Index>(k)) = mu[k].wn_std;
-    zeta_std(static_cast<Eigen::Index>(k)) = mu[k].zeta_std;
-  }
-  res.diagnostics.set(diagnostic::mode_wn_std, wn_std);
-  res.diagnostics.set(diagnostic::mode_zeta_std, zeta_std);
-  int unstable = 0;
-  for (const auto& p : res.model.poles()) unstable += p.real() > 1e-12 * (1.0 + std::abs(p));
-  if (unstable > 0)
-    res.diagnostics.warnings.push_back(
-        detail::format("the model has {} pole(s) in the right half plane", unstable));
+  report_modes(res);
   }
 
 Result<StateSpace> fit_from(const std::vector<IdData>& ds, Point start, bool user_coordinates,

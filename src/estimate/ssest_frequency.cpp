@@ -463,34 +463,17 @@ Result<StateSpace> fit_frequency_from(const Fd& f0, Point start, const Eigen::Ve
   internal::LmResult last;
   Eigen::VectorXd theta = pack(L, s);
   for (int pass = 0; pass < 2; ++pass) {
-    double cost = INFINITY;
-    bool converged = false;
-    while (left > 0 && !converged) {
-      theta = pack(L, balanced(unpack(L, theta), f));
-      const Eigen::MatrixXd Q = local_directions(L, unpack(L, theta), held);
-      auto normal = [&](const Eigen::VectorXd& xi, double& v, Eigen::MatrixXd* A, Eigen::VectorXd* g) {
-        const Point m = unpack(L, theta + Q * xi);
-        if (check_stability && !stable(m.A, 0)) return false;
-        return evaluate(m, f, L, A ? &Q : nullptr, v, A, g);
-      };
-      lmo.max_iterations = std::min(left, 5);
-      if (!std::isfinite(cost) && !evaluate(unpack(L, theta), f, L, nullptr, cost, nullptr, nullptr)) cost = INFINITY;
-      if (std::isfinite(cost) && cost > 0) lmo.ftol = o.tolerance / cost;
-      internal::LmResult lm = internal::levenberg_marquardt(internal::LmNormalEvaluate(normal),
-                                                            Eigen::VectorXd::Zero(Q.cols()),
-                                                            Eigen::VectorXd::Constant(Q.cols(), -INFINITY),
-                                                            Eigen::VectorXd::Constant(Q.cols(), INFINITY), lmo);
-      last = lm;
-      if (!std::isfinite(lm.cost)) break;
-      theta += Q * lm.x;
-      cost = lm.cost;
-      lmo.lambda0 = std::clamp(lm.lambda, 1e-12, 1e-3);
-      left -= std::max(lm.iterations, 1);
-      iterations += lm.iterations;
-      converged = lm.converged || lm.interrupted;
-      if (lm.interrupted) break;
-    }
-    if (f.given || last.interrupted || !converged || pass == 1) break;
+    const Rounds r = lm_rounds(
+        L, theta, held, check_stability, 0, o.tolerance, left, lmo, [&](const Point& m) { return balanced(m, f); },
+        [&](const Eigen::MatrixXd& Q) {
+          return [&f, &L, &Q](const Point& m, double& v, Eigen::MatrixXd* A, Eigen::VectorXd* g) {
+            return evaluate(m, f, L, A ? &Q : nullptr, v, A, g);
+          };
+        });
+    theta = r.theta;
+    iterations += r.iterations;
+    last = r.last;
+    if (f.given || last.interrupted || !r.converged || pass == 1) break;
     const std::vector<Eigen::MatrixXd> before = f.sw;
     if (!errors(unpack(L, theta), f, E)) break;
     estimate_weights(f, E);
@@ -541,18 +524,7 @@ Result<StateSpace> fit_frequency_from(const Fd& f0, Point start, const Eigen::Ve
         "the weighted residuals are {} times the variances given with the data: a systematic error (nonlinear "
         "distortion, too low an order) dominates; the covariance is multiplied by that factor (use_variance=false "
         "weights by the residuals instead)", chi2));
-  const std::vector<ModeUncertainty> mu = mode_uncertainty(res);
-  Eigen::VectorXd wn_std(static_cast<Eigen::Index>(mu.size())), zeta_std(static_cast<Eigen::Index>(mu.size()));
-  for (size_t k = 0; k < mu.size(); ++k) {
-    wn_std(static_cast<Eigen::Index>(k)) = mu[k].wn_std;
-    zeta_std(static_cast<Eigen::Index>(k)) = mu[k].zeta_std;
-  }
-  res.diagnostics.set(diagnostic::mode_wn_std, wn_std);
-  res.diagnostics.set(diagnostic::mode_zeta_std, zeta_std);
-  int unstable = 0;
-  for (const auto& p : res.model.poles()) unstable += p.real() > 1e-12 * (1.0 + std::abs(p));
-  if (unstable > 0)
-    res.diagnostics.warnings.push_back(detail::format("the model has {} pole(s) in the right half plane", unstable));
+  report_modes(res);
   finish();
   return res;
 }

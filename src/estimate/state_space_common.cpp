@@ -5,7 +5,9 @@
 #include <cmath>
 #include <complex>
 
+#include "ctid/core/check.hpp"
 #include "ctid/validate/metrics.hpp"
+#include "ctid/validate/uncertainty.hpp"
 
 namespace ctid::ss_detail {
 
@@ -362,6 +364,21 @@ Eigen::MatrixXd reflected_into_left_half_plane(const Eigen::MatrixXd& A) {
   const Eigen::MatrixXcd V = es.eigenvectors();
   const Eigen::MatrixXd R = (V * l.asDiagonal() * V.inverse()).real();
   return R.allFinite() ? R : A;
+}
+
+void report_modes(Result<StateSpace>& res) {
+  const std::vector<ModeUncertainty> mu = mode_uncertainty(res);
+  Eigen::VectorXd wn_std(static_cast<Eigen::Index>(mu.size())), zeta_std(static_cast<Eigen::Index>(mu.size()));
+  for (size_t k = 0; k < mu.size(); ++k) {
+    wn_std(static_cast<Eigen::Index>(k)) = mu[k].wn_std;
+    zeta_std(static_cast<Eigen::Index>(k)) = mu[k].zeta_std;
+  }
+  res.diagnostics.set(diagnostic::mode_wn_std, wn_std);
+  res.diagnostics.set(diagnostic::mode_zeta_std, zeta_std);
+  int unstable = 0;
+  for (const auto& p : res.model.poles()) unstable += p.real() > 1e-12 * (1.0 + std::abs(p));
+  if (unstable > 0)
+    res.diagnostics.warnings.push_back(detail::format("the model has {} pole(s) in the right half plane", unstable));
 }
 
 }  // namespace ctid::ss_detail

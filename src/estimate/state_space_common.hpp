@@ -3,6 +3,7 @@
 // standard deviation), the full parametrisation in data-driven local coordinates and the real modal form of a result.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <span>
 #include <string>
@@ -16,6 +17,7 @@
 #include "ctid/core/types.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/model/state_space.hpp"
+#include "internal/levenberg_marquardt.hpp"
 
 namespace ctid::ss_detail {
 
@@ -89,6 +91,58 @@ Eigen::MatrixXd shift_invariance(const Eigen::MatrixXd& O, int ny);
 /// A with every eigenvalue re + j im of re > 0 moved to -re + j im (same eigenvectors).
 Eigen::MatrixXd reflected_into_left_half_plane(const Eigen::MatrixXd& A);
 
+/// One search of ssest (time and frequency data) at fixed weights: rounds of at most 5 Levenberg-Marquardt
+/// iterations, each in the local coordinates at the round's start (theta first moved to better-conditioned state
+/// coordinates by `recentre`, Point -> Point), the damping carried from round to round (lmo.lambda0); a round ends
+/// when a step lowers the cost by less than `tolerance` (the cost is in noise units). Steps that make a stable start
+/// unstable are rejected when check_stability (the first `integrators` poles excepted). normal_for(Q) gives the
+/// round's evaluate(point, cost, JtJ, Jtr) in the directions Q (columns in pack's layout; JtJ, Jtr null: the cost
+/// alone). Ends when a round converges, is interrupted, cannot evaluate (failed: theta is where that round began)
+/// or the budget `left` (decremented) is spent.
+struct Rounds {
+  Eigen::VectorXd theta;
+  int iterations = 0;
+  internal::LmResult last;
+  bool converged = false, failed = false;
+};
+template <class Recentre, class NormalFor>
+Rounds lm_rounds(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& held, bool check_stability,
+                 int integrators, double tolerance, int& left, internal::LmOptions& lmo, Recentre&& recentre,
+                 NormalFor&& normal_for) {
+  Rounds r;
+  double cost = INFINITY;  // at theta (a change of state coordinates does not change it)
+  while (left > 0 && !r.converged) {
+    theta = pack(L, recentre(unpack(L, theta)));
+    const Eigen::MatrixXd Q = local_directions(L, unpack(L, theta), held);
+    auto evaluate = normal_for(Q);
+    auto normal = [&](const Eigen::VectorXd& xi, double& c, Eigen::MatrixXd* A, Eigen::VectorXd* g) {
+      const Point m = unpack(L, theta + Q * xi);
+      if (check_stability && !stable(m.A, integrators)) return false;  // a rejected step
+      return evaluate(m, c, A, g);
+    };
+    lmo.max_iterations = std::min(left, 5);
+    if (!std::isfinite(cost) && !evaluate(unpack(L, theta), cost, nullptr, nullptr)) cost = INFINITY;
+    if (std::isfinite(cost) && cost > 0) lmo.ftol = tolerance / cost;
+    const internal::LmResult lm = internal::levenberg_marquardt(
+        internal::LmNormalEvaluate(normal), Eigen::VectorXd::Zero(Q.cols()),
+        Eigen::VectorXd::Constant(Q.cols(), -INFINITY), Eigen::VectorXd::Constant(Q.cols(), INFINITY), lmo);
+    r.last = lm;
+    if (!std::isfinite(lm.cost)) {
+      r.failed = true;
+      break;
+    }
+    theta += Q * lm.x;
+    cost = lm.cost;
+    lmo.lambda0 = std::clamp(lm.lambda, 1e-12, 1e-3);
+    left -= std::max(lm.iterations, 1);
+    r.iterations += lm.iterations;
+    r.converged = lm.converged || lm.interrupted;
+    if (lm.interrupted) break;
+  }
+  r.theta = theta;
+  return r;
+}
+
 /// The order search of ssest (time and frequency data): fit(n) for n = lo..hi and keep the least BIC among the usable
 /// fits (all fits when none is usable), with diagnostics nx_grid and nx_grid_bic. An order the data cannot support
 /// (fit throws InvalidArgument) ends the search; at lo it is rethrown.
@@ -121,5 +175,9 @@ Result<StateSpace> order_search(int lo, int hi, Fit&& fit) {
   best.diagnostics.set(diagnostic::nx_grid_bic, bic);
   return best;
 }
+
+/// The modes' standard deviations (diagnostics mode_wn_std, mode_zeta_std, from the covariance) and a warning for
+/// poles in the right half plane: the last step of every ssest result.
+void report_modes(Result<StateSpace>& res);
 
 }  // namespace ctid::ss_detail

@@ -396,6 +396,11 @@ void validation(Page& page, const IdData& d, const Eigen::VectorXd& yhat, const 
   }
 }
 
+// validation() of every output of the simulation yhat (N x ny).
+void validations(Page& page, const IdData& d, const Eigen::MatrixXd& yhat, const ReportOptions& o) {
+  for (int j = 0; j < d.ny(); ++j) validation(page, d, yhat.col(j), o, j);
+}
+
 // Bode magnitude and (unwrapped) phase of one or more responses hs = {(label, H(jw))} on the grid w; the
 // 95 % magnitude band (lo_mag, hi_mag) goes with a single response.
 void bode(Page& page, const Eigen::VectorXd& w, const std::vector<std::pair<std::string, Eigen::VectorXcd>>& hs,
@@ -445,26 +450,26 @@ double nyquist(const IdData& d) { return d.is_uniform() ? std::numbers::pi / d.t
 // The model simulated on the record with the report's initial condition (Estimated takes the initial state a
 // fit estimated, its diagnostics "x0", where the result has one); a diverging simulation is drawn up to
 // where it stops being finite, with the reason.
-Eigen::VectorXd simulated(Page& page, const IdData& d, const AnyModel& m, const Diagnostics& g, const ReportOptions& o) {
+Eigen::MatrixXd simulated(Page& page, const IdData& d, const AnyModel& m, const Diagnostics& g, const ReportOptions& o) {
   SimulateOptions so;
   so.initial = o.initial ? *o.initial : fit_initial_condition(m, g);
   if (so.initial == InitialCondition::Estimated && g.has(diagnostic::x0)) so.x0 = g.get(diagnostic::x0);
   const Simulation s = simulate(m, d, so);
   page.text("Simulated from the initial condition: " + std::string(to_string(so.initial)) + ".");
   if (!s.ok()) page.text("<span class=\"warn\">" + escape(s.problem) + "</span>");
-  return s.y.col(0);
+  return s.y;
 }
 
 // The further records of ReportOptions::more_records, each in its own section.
 void more_records(Page& page, const AnyModel& m, const ReportOptions& o) {
   for (size_t i = 0; i < o.more_records.size(); ++i) {
     const auto& [name, d] = o.more_records[i];
-    CTID_REQUIRE(d.nu() == model_inputs(m) && d.ny() == 1,
-                 "html_report: record {} ({}) has {} input(s) and {} output(s); the model has {} input(s) and 1 output",
-                 i + 2, name, d.nu(), d.ny(), model_inputs(m));
+    CTID_REQUIRE(d.nu() == model_inputs(m) && d.ny() == model_outputs(m),
+                 "html_report: record {} ({}) has {} input(s) and {} output(s); the model has {} and {}", i + 2, name,
+                 d.nu(), d.ny(), model_inputs(m), model_outputs(m));
     page.section("Record " + std::to_string(i + 2) + ": " + name);
     page.text(std::to_string(d.size()) + " samples, " + fmt(d.duration()) + " s.");
-    validation(page, d, simulated(page, d, m, Diagnostics{}, o), o);
+    validations(page, d, simulated(page, d, m, Diagnostics{}, o), o);
   }
 }
 
@@ -478,7 +483,7 @@ template <class M>
 void opening(Page& page, const IdData& d, const Result<M>& r, const ReportOptions& o, bool simulate_on_records = true) {
   overview(page, d, r, o, describe(r.model));
   if (!simulate_on_records) return;
-  validation(page, d, simulated(page, d, r.model, r.diagnostics, o), o);
+  validations(page, d, simulated(page, d, r.model, r.diagnostics, o), o);
   more_records(page, r.model, o);
 }
 
@@ -511,16 +516,15 @@ std::string report_of(const IdData& d, const Result<TransferFunction>& r, const 
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }
 
-// A state-space model with any number of inputs and outputs: the singular values of its subspace step, the poles
-// with natural frequency, damping (and their standard deviations where the fit has a covariance) and mode shapes,
-// each output simulated and tested, the Bode magnitude of every channel, step responses per input.
+// A state-space model with any number of inputs and outputs: each output simulated and tested, the singular values of
+// its subspace step, the poles with natural frequency, damping (and their standard deviations where the fit has a
+// covariance) and mode shapes, the Bode magnitude of every channel, step responses per input.
 std::string report_of(const IdData& d, const Result<StateSpace>& r, const ReportOptions& o) {
   const StateSpace& m = r.model;
   CTID_REQUIRE(d.nu() == m.nu() && d.ny() == m.ny(), "html_report: the model has {} inputs and {} outputs (data: {}, {})",
                m.nu(), m.ny(), d.nu(), d.ny());
   Page page;
-  overview(page, d, r, o, detail::format("dx/dt = A x + B u, y = C x + D u ({} states, {} inputs, {} outputs)", m.nx(),
-                                         m.nu(), m.ny()));
+  opening(page, d, r, o);
   if (r.diagnostics.has(diagnostic::singular_values)) {
     const Eigen::VectorXd& sv = r.diagnostics.get(diagnostic::singular_values);
     page.section("Singular values of the subspace step");
@@ -551,27 +555,6 @@ std::string report_of(const IdData& d, const Result<StateSpace>& r, const Report
   }
   page.text("Mode shape: the output direction C v of the mode's eigenvector (unit norm).");
   page.table(header, rows);
-  // Every output simulated on the record (one simulation) and tested.
-  SimulateOptions so;
-  so.initial = o.initial ? *o.initial : fit_initial_condition(AnyModel(m), r.diagnostics);
-  if (so.initial == InitialCondition::Estimated && r.diagnostics.has(diagnostic::x0)) so.x0 = r.diagnostics.get(diagnostic::x0);
-  const Simulation sim = simulate(AnyModel(m), d, so);
-  page.text("Simulated from the initial condition: " + std::string(to_string(so.initial)) + ".");
-  if (!sim.ok()) page.text("<span class=\"warn\">" + escape(sim.problem) + "</span>");
-  for (int j = 0; j < m.ny(); ++j) validation(page, d, sim.y.col(j), o, j);
-  for (size_t i = 0; i < o.more_records.size(); ++i) {
-    const auto& [name, rec] = o.more_records[i];
-    CTID_REQUIRE(rec.nu() == m.nu() && rec.ny() == m.ny(),
-                 "html_report: record {} ({}) has {} input(s) and {} output(s); the model has {} and {}", i + 2, name,
-                 rec.nu(), rec.ny(), m.nu(), m.ny());
-    page.section("Record " + std::to_string(i + 2) + ": " + name);
-    SimulateOptions ro;
-    ro.initial = o.initial ? *o.initial : InitialCondition::Rest;
-    const Simulation rs = simulate(AnyModel(m), rec, ro);
-    page.text(std::to_string(rec.size()) + " samples, " + fmt(rec.duration()) + " s; simulated from " +
-              to_string(ro.initial) + ".");
-    for (int j = 0; j < m.ny(); ++j) validation(page, rec, rs.y.col(j), o, j);
-  }
   parameters(page, r.parameters);
   diagnostics(page, r.diagnostics);
   // The Bode magnitude matrix: one plot per input, one curve per output.
