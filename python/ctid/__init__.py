@@ -376,7 +376,8 @@ def ssest(data, nx=0, initial=None, **options):
     with the parameter covariance, each mode's wn/zeta standard deviation (r.diagnostics['mode_wn_std'],
     ['mode_zeta_std']) and each record's initial state. data: an IdData or a list of them (several records of one
     system). nx = 0: the start's choice; nx_max=B fits nx..B and keeps the least BIC. Options: SsestOptions
-    (ctid.settings('ssest')), e.g. estimate_d=False, integrators=1, fixed={'D1_1': 0}. data may also be a
+    (ctid.settings('ssest')), e.g. estimate_d=False, integrators=1, fixed={'D1_1': 0}; estimate_k=True is the
+    prediction-error variant (an innovation gain r.model.K; one-step predictions r.model.predict(data)). data may also be a
     FrequencyData (an FRF matrix, e.g. ctid.frf_from_periodic): weighted least squares from the frequency-domain
     subspace start, weights the data's variances (use_variance=False: estimated from the residuals)."""
     opts = _options(_ctid.SsestOptions, "ssest", {"nx": nx, **options})

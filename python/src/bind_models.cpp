@@ -28,13 +28,29 @@ void def_write_result(py::module_& m) {
 }  // namespace
 
 void bind_models(py::module_& m) {
-  py::class_<StateSpace>(m, "StateSpace", "Continuous-time state-space model x' = A x + B u, y = C x + D u.")
-      .def(py::init<Eigen::MatrixXd, Eigen::MatrixXd, Eigen::MatrixXd, Eigen::MatrixXd>(), py::arg("A"), py::arg("B"),
-           py::arg("C"), py::arg("D"))
+  py::class_<StateSpace>(m, "StateSpace",
+                         "Continuous-time state-space model x' = A x + B u, y = C x + D u; with an innovation gain K "
+                         "(nx x ny) the innovation form x' = A x + B u + K e, y = C x + D u + e.")
+      .def(py::init<Eigen::MatrixXd, Eigen::MatrixXd, Eigen::MatrixXd, Eigen::MatrixXd, Eigen::MatrixXd>(),
+           py::arg("A"), py::arg("B"), py::arg("C"), py::arg("D"), py::arg("K") = Eigen::MatrixXd())
       .def_property_readonly("A", &StateSpace::A)
       .def_property_readonly("B", &StateSpace::B)
       .def_property_readonly("C", &StateSpace::C)
       .def_property_readonly("D", &StateSpace::D)
+      .def_property_readonly("K", [](const StateSpace& ss) -> py::object {
+             if (!ss.has_innovation_gain()) return py::none();
+             return py::cast(ss.K());
+           }, "The innovation gain (nx x ny), None for an output-error model.")
+      .def("predict",
+           [](const StateSpace& ss, const IdData& d, const Eigen::VectorXd& x0) {
+             LsimOptions o;
+             o.x0 = x0;
+             py::gil_scoped_release release;
+             return predict(ss, d, o);
+           },
+           py::arg("data"), py::arg("x0") = Eigen::VectorXd(),
+           "One-step-ahead predictions (N x ny) with the innovation held between samples (exact for held and "
+           "first-order-hold inputs, any sample times); without K the simulation.")
       .def_property_readonly("nx", &StateSpace::nx)
       .def_property_readonly("nu", &StateSpace::nu)
       .def_property_readonly("ny", &StateSpace::ny)

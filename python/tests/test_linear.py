@@ -414,3 +414,34 @@ def test_frequency_data_matrices_variances_and_named_errors():
         fd.response
     with pytest.raises(ctid.InvalidArgument, match="a transfer function has one input and one output"):
         ctid.tf_from_frequency(fd, 1, 1)
+
+
+def test_innovation_gain_predictor_and_prediction_error_ssest():
+    # The innovation form x' = A x + B u + K e, y = C x + e with e held between samples, simulated exactly as the
+    # model with inputs [u; e]: the true model's one-step predictor leaves exactly e (1e-10), and ssest with
+    # estimate_k=True recovers the noise model C (jw - A)^-1 K at the resonance (within 15 %) and the innovation
+    # variance (within 8 %, 3000 samples). With K = (1, 2) the coloured part of the output noise has 1.4 times the
+    # white part's variance (discrete Lyapunov equation at Ts = 0.05 s): the noise model is well determined.
+    A = np.array([[0.0, 1.0], [-4.0, -0.4]])
+    B = np.array([[0.0], [1.0]])
+    C = np.array([[3.0, 0.5]])
+    K = np.array([[1.0], [2.0]])
+    n, sigma = 3000, 0.2
+    rng = np.random.default_rng(5)
+    u = ctid.prbs(n, register_length=10, clock_period=6)
+    e = sigma * rng.standard_normal(n)
+    aug = ctid.StateSpace(A, np.hstack([B, K]), C, np.array([[0.0, 1.0]]))
+    y = ctid.simulate(aug, ctid.IdData.from_arrays(np.column_stack([u, e]), np.zeros(n), ts=0.05))
+    d = ctid.IdData.from_arrays(u, np.asarray(y).reshape(-1), ts=0.05)
+    truth = ctid.StateSpace(A, B, C, np.zeros((1, 1)), K=K)
+    np.testing.assert_allclose(truth.K, K)
+    assert ctid.StateSpace(A, B, C, np.zeros((1, 1))).K is None
+    np.testing.assert_allclose(d.y[:, 0] - truth.predict(d)[:, 0], e, atol=1e-10)
+    r = ctid.ssest(d, 2, estimate_d=False, estimate_k=True)
+    assert r.usable(), r.why_not_usable()
+    assert r.model.K.shape == (2, 1)
+    noise = lambda m: (m.C @ np.linalg.solve(2j * np.eye(2) - m.A, m.K))[0, 0]
+    assert abs(noise(r.model) - noise(truth)) < 0.15 * abs(noise(truth))
+    assert abs(r.diagnostics.vectors["output_noise_variance"][0] / sigma ** 2 - 1) < 0.08
+    with pytest.raises(ctid.InvalidArgument, match="K must be 2x1"):
+        ctid.StateSpace(A, B, C, np.zeros((1, 1)), K=np.ones((2, 2)))

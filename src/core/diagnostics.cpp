@@ -58,6 +58,7 @@ const std::vector<DiagnosticInfo>& diagnostic_catalogue() {
       info(diagnostic::starts_cost), info(diagnostic::segments), info(diagnostic::continuity_defect),
       info(diagnostic::singular_values), info(diagnostic::output_fit_percent),
       info(diagnostic::output_noise_variance), info(diagnostic::start_fit_percent), info(diagnostic::mode_wn_std),
+      info(diagnostic::prediction_fit_percent), info(diagnostic::warm_up_iterations),
       info(diagnostic::mode_zeta_std), info(diagnostic::chi2_per_dof), info(diagnostic::nx_grid), info(diagnostic::nx_grid_bic)};
   return all;
 }

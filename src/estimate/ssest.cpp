@@ -1,6 +1,7 @@
-// ctid — ssest: output-error refinement of a MIMO continuous-time state-space model (estimate/ssest.hpp).
-// McKelvey, Helmersson & Ribarits (2004) eqs 9-12 (data-driven local coordinates of the full parametrisation);
-// Ljung (1999) §7.4, §9.4 (the weighted output-error / ML criterion and its covariance); Van Loan (1978) block
+// ctid — ssest: output-error (and, with an innovation gain, prediction-error) refinement of a MIMO continuous-time
+// state-space model (estimate/ssest.hpp). McKelvey, Helmersson & Ribarits (2004) eqs 9-12 (data-driven local
+// coordinates of the full parametrisation); Ljung (1999) §4.3 eq. 4.84 (the innovation form), §7.4, §9.4 (the
+// weighted output-error / ML criterion and its covariance); Van Loan (1978) block
 // exponentials for the exact sensitivities; the subspace start of estimate/subspace.hpp (JVC 1999).
 #include "ctid/estimate/ssest.hpp"
 
@@ -34,6 +35,9 @@ const OptionTable<SsestOptions>& option_table<SsestOptions>() {
                 "decrease of the cost (1/2 sum of squared errors in noise standard deviations) below which a round "
                 "ends")
           .flag("estimate_d", &O::estimate_d, "estimate the direct term D (false: D = 0)")
+          .flag("estimate_k", &O::estimate_k,
+                "prediction-error variant: estimate an innovation gain K (coloured output noise with the plant's "
+                "poles; false: output error)")
           .flag("estimate_initial_state", &O::estimate_initial_state,
                 "estimate each record's initial state (false: it starts at rest)")
           .flag("enforce_stability", &O::enforce_stability,
@@ -92,11 +96,22 @@ std::vector<Record> records_of(const std::vector<IdData>& ds, const Eigen::Vecto
 }
 
 // The exact one-interval maps of the model and of its sensitivities in P directions (stacked: block d of W1 is
-// nx x nx, of W2 and W3 nx x nu).
+// nx x nx, of W2 and W3 nx x (nu + nk)); the inputs are [u; e], the innovation e held (prediction-error variant,
+// nk = ny columns of K; nk = 0 for output error). With K: GK = the innovation's columns of G0 and PhiK = Phi - GK C,
+// the predictor's state map.
 struct Step {
   double h = -1.0;
-  Eigen::MatrixXd Phi, G0, G1, W1, W2, W3;
+  Eigen::MatrixXd Phi, G0, G1, W1, W2, W3, GK, PhiK;
 };
+
+// [B, K]: the input matrix of the inputs [u; e] (K empty: B; a direction without K: zeros for it).
+Point with_innovation_input(const Point& p, Eigen::Index nk) {
+  if (nk == 0) return p;
+  Point q = p;
+  q.B.conservativeResize(Eigen::NoChange, p.B.cols() + nk);
+  q.B.rightCols(nk) = p.K.size() ? p.K : Eigen::MatrixXd::Zero(p.B.rows(), nk);
+  return q;
+}
 
 // discretize(), without the linear-input block when every input is held (an exponential of size n + m instead of
 // n + 2m: the irregular grids compute one per interval and direction).
@@ -151,11 +166,21 @@ Step step_of(const Point& m, const std::vector<Point>& dirs, double h, const std
 // simulation overflows. The record is processed kBatch samples at a time: the model's states of a batch first (a
 // cheap recursion), then the sensitivities' forcing and output terms of the whole batch as matrix products, the
 // sensitivity recursion dX_{k+1} = Phi dX_k + F_k, and one rank-k update of J^T W J.
-bool evaluate(const Point& m, const std::vector<Point>* dirs, const std::vector<Record>& recs, const Eigen::VectorXd& sw,
+//
+// With an innovation gain K the residuals are the one-step prediction errors e_k = y_k - C x_k - D u_k of the
+// predictor x_{k+1} = Phi x_k + Gamma_u u_k + GK e_k (predict() in simulate/lsim.hpp), and the sensitivities follow
+// dX_{k+1} = PhiK dX_k + F_k - GK (dC x_k + dD u_k), F_k the forcing by [u; e] (the recursion of the prediction
+// error's own sensitivity -(C dX_k + dC x_k + dD u_k)).
+bool evaluate(const Point& m0, const std::vector<Point>* dirs0, const std::vector<Record>& recs, const Eigen::VectorXd& sw,
               double& cost, Eigen::MatrixXd* JtJ, Eigen::VectorXd* Jtr, std::vector<Eigen::MatrixXd>* yhat = nullptr) {
-  const Eigen::Index nx = m.A.rows(), nu = m.B.cols(), ny = m.C.rows();
-  const bool sens = dirs && JtJ && Jtr;
-  const Eigen::Index P = sens ? static_cast<Eigen::Index>(dirs->size()) : 0;
+  const Eigen::Index nx = m0.A.rows(), nu = m0.B.cols(), ny = m0.C.rows(), nk = m0.K.size() ? ny : 0;
+  const bool sens = dirs0 && JtJ && Jtr;
+  const Eigen::Index P = sens ? static_cast<Eigen::Index>(dirs0->size()) : 0;
+  const Point m = with_innovation_input(m0, nk);
+  std::vector<Point> augmented;
+  if (sens && nk > 0)
+    for (const Point& d : *dirs0) augmented.push_back(with_innovation_input(d, nk));
+  const std::vector<Point>* dirs = nk > 0 && sens ? &augmented : dirs0;
   const std::vector<Point> none;
   cost = 0.0;
   if (sens) {
@@ -170,19 +195,30 @@ bool evaluate(const Point& m, const std::vector<Point>* dirs, const std::vector<
   }
   // Per batch: states X, inputs U and their changes dU to the next sample, weighted residuals R, sensitivity states
   // (Dall: the nx x P block of each sample side by side), forcing F, output terms G, J rows.
-  Eigen::MatrixXd X(nx, kBatch), U(nu, kBatch), dU(nu, kBatch), R(ny, kBatch), Dall(nx, P * kBatch),
+  Eigen::MatrixXd X(nx, kBatch), U(nu, kBatch), dU(nu, kBatch), R(ny, kBatch), Eps(nk, kBatch), Dall(nx, P * kBatch),
       F(nx * P, kBatch), G(ny * P, kBatch), CD(ny, P * kBatch), Jb(kBatch * ny, P), Delta(nx, P);
   Eigen::VectorXd x(nx), xn(nx), yk(ny);
   for (size_t e = 0; e < recs.size(); ++e) {
     const Record& rec = recs[e];
     const Eigen::Index N = rec.u.rows();
+    std::vector<Intersample> is = rec.intersample;
+    is.resize(static_cast<size_t>(nu + nk), Intersample::Zoh);  // the innovation is held
     std::vector<Step> cache;
+    bool predictor_stable = true;
     auto step = [&](double h) -> const Step& {
       for (const Step& s : cache)
         if (std::abs(s.h - h) <= 1e-13 * h) return s;
       if (cache.size() >= 4) cache.erase(cache.begin());
-      cache.push_back(step_of(m, sens ? *dirs : none, h, rec.intersample));
-      return cache.back();
+      cache.push_back(step_of(m, sens ? *dirs : none, h, is));
+      Step& s = cache.back();
+      if (nk > 0) {
+        s.GK = s.G0.rightCols(nk);
+        s.PhiK = s.Phi - s.GK * m.C;
+        // The predictor must be stable: an unstable one amplifies its own errors (the criterion's minimum never has one).
+        const Eigen::VectorXcd ev = s.PhiK.eigenvalues();
+        predictor_stable = predictor_stable && ev.allFinite() && ev.cwiseAbs().maxCoeff() < 1.0;
+      }
+      return s;
     };
     auto h_at = [&](Eigen::Index k) { return rec.uniform ? rec.h : rec.t(k + 1) - rec.t(k); };
     x = m.x0[e];
@@ -198,7 +234,9 @@ bool evaluate(const Point& m, const std::vector<Point>* dirs, const std::vector<
         yk.noalias() = m.C * x;
         yk.noalias() += m.D * U.col(i);
         if (yhat) yhat->back().row(k) = yk.transpose();
-        R.col(i) = (rec.y.row(k).transpose() - yk).cwiseProduct(sw);
+        R.col(i) = rec.y.row(k).transpose() - yk;
+        if (nk > 0) Eps.col(i) = R.col(i);
+        R.col(i).array() *= sw.array();
         if (k + 1 == N) {
           dU.col(i).setZero();
           break;
@@ -206,12 +244,13 @@ bool evaluate(const Point& m, const std::vector<Point>* dirs, const std::vector<
         const Step& s = step(h_at(k));
         dU.col(i) = rec.u.row(k + 1).transpose() - U.col(i);
         xn.noalias() = s.Phi * x;
-        xn.noalias() += s.G0 * U.col(i);
-        xn.noalias() += s.G1 * dU.col(i);
+        xn.noalias() += s.G0.leftCols(nu) * U.col(i);
+        xn.noalias() += s.G1.leftCols(nu) * dU.col(i);
+        if (nk > 0) xn.noalias() += s.GK * Eps.col(i);
         x.swap(xn);
       }
       cost += 0.5 * R.leftCols(n).squaredNorm();
-      if (!x.allFinite() || !std::isfinite(cost)) return false;
+      if (!x.allFinite() || !std::isfinite(cost) || !predictor_stable) return false;
       if (!sens) continue;
       // Sensitivities: the output terms dC x + dD u, the forcing of the next sample's sensitivity states.
       G.leftCols(n).noalias() = dCs * X.leftCols(n);
@@ -220,8 +259,9 @@ bool evaluate(const Point& m, const std::vector<Point>* dirs, const std::vector<
       if (uniform && N > 1) {
         const Step& s = step(rec.h);
         F.leftCols(n).noalias() = s.W1 * X.leftCols(n);
-        F.leftCols(n).noalias() += s.W2 * U.leftCols(n);
-        F.leftCols(n).noalias() += s.W3 * dU.leftCols(n);
+        F.leftCols(n).noalias() += s.W2.leftCols(nu) * U.leftCols(n);
+        F.leftCols(n).noalias() += s.W3.leftCols(nu) * dU.leftCols(n);
+        if (nk > 0) F.leftCols(n).noalias() += s.W2.rightCols(nk) * Eps.leftCols(n);
       }
       for (Eigen::Index i = 0; i < n; ++i) {
         const Eigen::Index k = k0 + i;
@@ -230,10 +270,16 @@ bool evaluate(const Point& m, const std::vector<Point>* dirs, const std::vector<
         const Step& s = step(h_at(k));
         if (!uniform) {
           F.col(i).noalias() = s.W1 * X.col(i);
-          F.col(i).noalias() += s.W2 * U.col(i);
-          F.col(i).noalias() += s.W3 * dU.col(i);
+          F.col(i).noalias() += s.W2.leftCols(nu) * U.col(i);
+          F.col(i).noalias() += s.W3.leftCols(nu) * dU.col(i);
+          if (nk > 0) F.col(i).noalias() += s.W2.rightCols(nk) * Eps.col(i);
         }
-        Delta.noalias() = s.Phi.lazyProduct(Dall.middleCols(i * P, P));  // small: no GEMM packing
+        if (nk == 0) {
+          Delta.noalias() = s.Phi.lazyProduct(Dall.middleCols(i * P, P));  // small: no GEMM packing
+        } else {
+          Delta.noalias() = s.PhiK.lazyProduct(Dall.middleCols(i * P, P));
+          Delta.noalias() -= s.GK.lazyProduct(Eigen::Map<const Eigen::MatrixXd>(G.col(i).data(), ny, P));
+        }
         Delta += Eigen::Map<const Eigen::MatrixXd>(F.col(i).data(), nx, P);
       }
       CD.leftCols(n * P).noalias() = m.C * Dall.leftCols(n * P);
@@ -295,8 +341,8 @@ Point whitened(const Point& m, const std::vector<Record>& recs) {
 
 // Rounds of Levenberg-Marquardt in local coordinates re-centred after each round, then the weights re-estimated and
 // the search repeated once (weighted output error = ML for independent Gaussian output noise).
-Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& held, const std::vector<Record>& recs,
-              const SsestOptions& o, bool free_coordinates) {
+Search search_records(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& held,
+                      const std::vector<Record>& recs, const SsestOptions& o, bool free_coordinates) {
   Search s;
   // enforce_stability keeps a stable start stable (an unstable start is searched freely: it may be an unstable plant).
   const bool check_stability = o.enforce_stability && stable(unpack(L, theta).A, o.integrators);
@@ -342,6 +388,42 @@ Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& h
   return s;
 }
 
+// The warm-up's data: the records' beginnings, kWarmSamples samples in all (each record its share).
+constexpr Eigen::Index kWarmSamples = 20000;
+std::vector<Record> beginnings(const std::vector<Record>& recs, Eigen::Index total) {
+  std::vector<Record> out;
+  for (const Record& r : recs) {
+    const Eigen::Index n = std::max<Eigen::Index>(2, r.u.rows() * kWarmSamples / total);
+    out.push_back(Record{r.u.topRows(n), r.y.topRows(n), r.t.head(n), r.uniform, r.h, r.intersample});
+  }
+  return out;
+}
+
+// The search on long records (four times kWarmSamples or more) is warmed up on their beginnings: a poor start (a mode
+// tens of percent off, as subspace estimates of well-damped modes often are) costs tens of iterations whose price
+// grows with N, and most of them only bring the model near the optimum, which a fraction of the record locates as
+// well; the full records then finish in a few iterations. The warm-up's model is kept only when its cost on the full
+// records is below the start's, so it can make the search faster, never start it from a worse point.
+Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& held, const std::vector<Record>& recs,
+              const SsestOptions& o, bool free_coordinates, int* warm_iterations) {
+  Eigen::Index total = 0;
+  for (const Record& r : recs) total += r.u.rows();
+  *warm_iterations = 0;
+  if (total >= 4 * kWarmSamples) {
+    const Search w = search_records(L, theta, held, beginnings(recs, total), o, free_coordinates);
+    if (!w.failed_start && !w.last.interrupted) {
+      const Eigen::VectorXd sw = residual_variances(unpack(L, theta), recs).cwiseMax(1e-12).cwiseInverse().cwiseSqrt();
+      double before = INFINITY, after = INFINITY;
+      if (sw.allFinite() && evaluate(unpack(L, theta), nullptr, recs, sw, before, nullptr, nullptr) &&
+          evaluate(unpack(L, w.theta), nullptr, recs, sw, after, nullptr, nullptr) && after < before) {
+        theta = w.theta;
+        *warm_iterations = w.iterations;
+      }
+    }
+  }
+  return search_records(L, theta, held, recs, o, free_coordinates);
+}
+
 void check_records(const std::vector<IdData>& ds) {
   CTID_REQUIRE(!ds.empty(), "ssest: no records were given");
   const int nu = ds.front().nu(), ny = ds.front().ny();
@@ -381,7 +463,7 @@ void deliver(Result<StateSpace>& res, const std::vector<IdData>& ds, Point fin, 
              const std::vector<bool>& held, int similar, const SsestOptions& o, const Eigen::VectorXd* noise_variance) {
   const int nx = static_cast<int>(fin.A.rows()), nu = ds.front().nu(), ny = ds.front().ny();
   const int E = static_cast<int>(ds.size());
-  const Layout L{nx, nu, ny, E};
+  const Layout L{nx, nu, ny, E, fin.K.size() ? ny : 0};
   const Eigen::VectorXd sy = ss_detail::channel_scales(ds, true);
   Eigen::Index total = 0;
   for (const IdData& d : ds) total += d.size();
@@ -399,14 +481,14 @@ void deliver(Result<StateSpace>& res, const std::vector<IdData>& ds, Point fin, 
   for (size_t k = 0; k < pdirs.size(); ++k)
     if (!pfixed[k]) {
       slots.push_back(static_cast<int>(k));
-      cdirs.push_back(Point{pdirs[k].dA, pdirs[k].dB, pdirs[k].dC, pdirs[k].dD, no_x0});
+      cdirs.push_back(Point{pdirs[k].dA, pdirs[k].dB, pdirs[k].dC, pdirs[k].dD, no_x0, pdirs[k].dK});
     }
   const int np = static_cast<int>(cdirs.size());
   if (o.estimate_initial_state)
     for (int e = 0; e < E; ++e)
       for (int i = 0; i < nx; ++i) {
         Point d{Eigen::MatrixXd::Zero(nx, nx), Eigen::MatrixXd::Zero(nx, nu), Eigen::MatrixXd::Zero(ny, nx),
-                Eigen::MatrixXd::Zero(ny, nu), no_x0};
+                Eigen::MatrixXd::Zero(ny, nu), no_x0, {}};
         d.x0[static_cast<size_t>(e)](i) = 1.0;
         cdirs.push_back(std::move(d));
       }
@@ -433,7 +515,19 @@ void deliver(Result<StateSpace>& res, const std::vector<IdData>& ds, Point fin, 
 
   // Fits, noise, initial states, modes.
   if (ok) {
-    const ss_detail::Fits f = ss_detail::fits_of(ds, yhat, sy, n_free_params + (o.estimate_initial_state ? E * nx : 0));
+    const int n_fit = n_free_params + (o.estimate_initial_state ? E * nx : 0);
+    ss_detail::Fits f = ss_detail::fits_of(ds, yhat, sy, n_fit);
+    if (L.nk > 0) {
+      // yhat are the one-step predictions; the fit reported is the simulation's, as for every model.
+      res.diagnostics.set(diagnostic::prediction_fit_percent, f.per_output);
+      Point sim = fin;
+      sim.K.resize(0, 0);
+      double c = 0;
+      if (evaluate(sim, nullptr, raw, Eigen::VectorXd::Ones(ny), c, nullptr, nullptr, &yhat))
+        f = ss_detail::fits_of(ds, yhat, sy, n_fit);
+      else
+        f.all.fit_percent = -INFINITY, f.per_output.setConstant(-INFINITY);
+    }
     res.fit = f.all;
     res.diagnostics.set(diagnostic::output_fit_percent, f.per_output);
     res.diagnostics.set(diagnostic::output_noise_variance, var);
@@ -450,9 +544,11 @@ Result<StateSpace> fit_from(const std::vector<IdData>& ds, Point start, bool use
                             const Eigen::VectorXd& singular_values, const SsestOptions& o, Clock::time_point t0) {
   const int nx = static_cast<int>(start.A.rows()), nu = ds.front().nu(), ny = ds.front().ny();
   const int E = static_cast<int>(ds.size());
-  const Layout L{nx, nu, ny, E};
+  const Layout L{nx, nu, ny, E, o.estimate_k ? ny : 0};
   const Eigen::VectorXd su = ss_detail::channel_scales(ds, false), sy = ss_detail::channel_scales(ds, true);
   const std::vector<Record> recs = records_of(ds, su, sy);
+  if (!o.estimate_k) start.K.resize(0, 0);
+  else if (start.K.size() == 0) start.K = Eigen::MatrixXd::Zero(nx, ny);  // the output-error predictor
 
   // Held entries: D (estimate_d false or fixed.D..), A/B/C (fixed.., with a starting model), x0 (from rest),
   // the integrators' columns of A.
@@ -488,12 +584,14 @@ Result<StateSpace> fit_from(const std::vector<IdData>& ds, Point start, bool use
   (void)local_directions(L, s, held, &similar);
 
   Result<StateSpace> res;
-  Search sr = search(L, pack(L, s), held, recs, o, free_coordinates);
+  int warm = 0;
+  Search sr = search(L, pack(L, s), held, recs, o, free_coordinates, &warm);
+  if (warm > 0) res.diagnostics.set(diagnostic::warm_up_iterations, static_cast<double>(warm));
   auto finish = [&] { res.summary.seconds = std::chrono::duration<double>(Clock::now() - t0).count(); };
   if (singular_values.size() > 0) res.diagnostics.set(diagnostic::singular_values, singular_values);
   if (E > 1) res.diagnostics.set(diagnostic::experiments, static_cast<double>(E));
   if (sr.failed_start) {
-    res.model = StateSpace(start.A, start.B, start.C, start.D);
+    res.model = StateSpace(start.A, start.B, start.C, start.D, start.K);
     res.summary.termination = Termination::NumericalFailure;
     res.summary.message = "ssest: the starting model cannot be simulated on the data (its output overflows)";
     finish();
@@ -534,7 +632,7 @@ Start subspace_start(const std::vector<IdData>& ds, int nx, const SsestOptions& 
   s.sigma = r.diagnostics.get(diagnostic::singular_values);
   s.fit = r.fit.fit_percent;
   const StateSpace& m = r.model;
-  s.point = Point{m.A(), m.B(), m.C(), m.D(), {}};
+  s.point = Point{m.A(), m.B(), m.C(), m.D(), {}, {}};
   for (size_t e = 0; e < ds.size(); ++e) {
     if (e == longest) {
       s.point.x0.push_back(r.diagnostics.get(diagnostic::x0));
@@ -613,7 +711,7 @@ Result<StateSpace> ssest(const std::vector<IdData>& data, const StateSpace& init
   CTID_REQUIRE(initial.nx() >= 1, "ssest: the starting model has no states");
   bool user = false;
   for (const auto& [name, v] : options.fixed) user = user || name[0] != 'D';
-  Point p{initial.A(), initial.B(), initial.C(), initial.D(), {}};
+  Point p{initial.A(), initial.B(), initial.C(), initial.D(), {}, initial.K()};
   for (const IdData& d : data) {
     Eigen::VectorXd x0 = Eigen::VectorXd::Zero(initial.nx());
     if (options.estimate_initial_state) (void)subspace_bd(initial.A(), initial.C(), d, options.estimate_d, true, &x0);
@@ -638,9 +736,11 @@ Result<StateSpace> ssest_crlb(const StateSpace& truth, const std::vector<IdData>
   CTID_REQUIRE(noise_variance.size() == ny && (noise_variance.array() > 0).all() && noise_variance.allFinite(),
                "ssest_crlb: give one positive noise variance per output ({} outputs, {} values)", ny,
                noise_variance.size());
-  const Layout L{nx, nu, ny, static_cast<int>(data.size())};
+  const Layout L{nx, nu, ny, static_cast<int>(data.size()), options.estimate_k ? ny : 0};
   Point p{truth.A(), truth.B(), truth.C(), truth.D(),
-          std::vector<Eigen::VectorXd>(data.size(), Eigen::VectorXd::Zero(nx))};
+          std::vector<Eigen::VectorXd>(data.size(), Eigen::VectorXd::Zero(nx)),
+          options.estimate_k ? (truth.has_innovation_gain() ? truth.K() : Eigen::MatrixXd::Zero(nx, ny))
+                             : Eigen::MatrixXd()};
   std::vector<bool> held(static_cast<size_t>(L.size()), false);
   hold_structure(L, options, p, held);
   int similar = 0;

@@ -233,7 +233,7 @@ bool fit_bd(const Eigen::MatrixXd& A, const Eigen::MatrixXd& C, const Fd& f, boo
     Phi.push_back(C.cast<cd>() * Eigen::PartialPivLU<Eigen::MatrixXcd>(S).inverse());
     if (!Phi.back().allFinite()) return false;
   }
-  out = Point{A, Eigen::MatrixXd(nx, nu), C, Eigen::MatrixXd::Zero(ny, nu), {}};
+  out = Point{A, Eigen::MatrixXd(nx, nu), C, Eigen::MatrixXd::Zero(ny, nu), {}, {}};
   Eigen::MatrixXd X(2 * f.M * ny, p);
   Eigen::VectorXd y(2 * f.M * ny);
   for (Eigen::Index j = 0; j < nu; ++j) {
@@ -500,7 +500,7 @@ Result<StateSpace> fit_frequency_from(const Fd& f0, Point start, const Eigen::Ve
   Eigen::MatrixXd dirs(Lu.size(), np);
   for (int k = 0; k < np; ++k) {
     const StateSpaceDirection& d = pdirs[static_cast<size_t>(slots[static_cast<size_t>(k)])];
-    dirs.col(k) = pack(Lu, Point{d.dA, d.dB, d.dC, d.dD, {}});
+    dirs.col(k) = pack(Lu, Point{d.dA, d.dB, d.dC, d.dD, {}, {}});
   }
   Eigen::MatrixXd JtJ;
   Eigen::VectorXd Jtr;
@@ -532,6 +532,8 @@ Result<StateSpace> fit_frequency_from(const Fd& f0, Point start, const Eigen::Ve
 void check_frequency_options(const SsestOptions& o) {
   CTID_REQUIRE_OPTION(o.integrators == 0, "ssest: integrators = {} with frequency data: hold the pole at 0 by fitting "
                                           "s G(jw) instead, or use time-domain records", o.integrators);
+  CTID_REQUIRE_OPTION(!o.estimate_k, "ssest: estimate_k with frequency data: an FRF carries no noise sequence to "
+                                     "predict (use time-domain records for the prediction-error variant)");
   for (const auto& [name, v] : o.fixed)
     CTID_REQUIRE_OPTION(!name.empty() && name[0] == 'D',
                         "ssest: fixed.{}: with frequency data only entries of D can be held", name);
@@ -583,7 +585,7 @@ Result<StateSpace> ssest(const FrequencyData& data, const StateSpace& initial, c
                data.inputs(), data.outputs());
   CTID_REQUIRE(initial.nx() >= 1, "ssest: the starting model has no states");
   const Fd f = scaled_data(data, options.use_variance);
-  const Point p{initial.A(), initial.B(), initial.C(), initial.D(), {}};
+  const Point p{initial.A(), initial.B(), initial.C(), initial.D(), {}, {}};
   return fit_frequency_from(f, p, Eigen::VectorXd(), 0.0, frequency_fits(p, f, 0).all.fit_percent, options, t0);
 }
 

@@ -64,6 +64,8 @@ Eigen::VectorXd pack(const Layout& L, const Point& m) {
     for (int j = 0; j < L.nx; ++j) v(L.c(i, j)) = m.C(i, j);
   for (int i = 0; i < L.ny; ++i)
     for (int j = 0; j < L.nu; ++j) v(L.d(i, j)) = m.D(i, j);
+  for (int i = 0; i < L.nx; ++i)
+    for (int j = 0; j < L.nk; ++j) v(L.k(i, j)) = m.K(i, j);
   for (int e = 0; e < L.E; ++e)
     for (int i = 0; i < L.nx; ++i) v(L.x0(e, i)) = m.x0[static_cast<size_t>(e)](i);
   return v;
@@ -71,7 +73,7 @@ Eigen::VectorXd pack(const Layout& L, const Point& m) {
 
 Point unpack(const Layout& L, const Eigen::VectorXd& v) {
   Point m{Eigen::MatrixXd(L.nx, L.nx), Eigen::MatrixXd(L.nx, L.nu), Eigen::MatrixXd(L.ny, L.nx),
-          Eigen::MatrixXd(L.ny, L.nu), std::vector<Eigen::VectorXd>(static_cast<size_t>(L.E), Eigen::VectorXd(L.nx))};
+          Eigen::MatrixXd(L.ny, L.nu), std::vector<Eigen::VectorXd>(static_cast<size_t>(L.E), Eigen::VectorXd(L.nx)), Eigen::MatrixXd()};
   for (int i = 0; i < L.nx; ++i)
     for (int j = 0; j < L.nx; ++j) m.A(i, j) = v(L.a(i, j));
   for (int i = 0; i < L.nx; ++i)
@@ -80,6 +82,9 @@ Point unpack(const Layout& L, const Eigen::VectorXd& v) {
     for (int j = 0; j < L.nx; ++j) m.C(i, j) = v(L.c(i, j));
   for (int i = 0; i < L.ny; ++i)
     for (int j = 0; j < L.nu; ++j) m.D(i, j) = v(L.d(i, j));
+  if (L.nk > 0) m.K.resize(L.nx, L.nk);
+  for (int i = 0; i < L.nx; ++i)
+    for (int j = 0; j < L.nk; ++j) m.K(i, j) = v(L.k(i, j));
   for (int e = 0; e < L.E; ++e)
     for (int i = 0; i < L.nx; ++i) m.x0[static_cast<size_t>(e)](i) = v(L.x0(e, i));
   return m;
@@ -88,8 +93,8 @@ Point unpack(const Layout& L, const Eigen::VectorXd& v) {
 
 // Data-driven local coordinates: an orthonormal basis of the free entries of (A, B, C, D) orthogonal to the tangent of
 // the change-of-basis manifold that keeps the held entries (McKelvey et al. 2004 eq. 10: the tangent at T = I + X
-// is (XA - AX, XB, -CX, 0)), plus each free initial-state entry on its own (no change of basis moves (A, B, C, D)
-// and x0 alone, so this removes the same redundancy; a direction of x0 alone needs no sensitivity exponential).
+// is (XA - AX, XB, -CX, 0), and XK for an innovation gain), plus each free initial-state entry on its own (no change
+// of basis moves (A, B, C, D) and x0 alone, so this removes the same redundancy; a direction of x0 alone needs no sensitivity exponential).
 // `similar` receives the dimension of the tangent removed.
 Eigen::MatrixXd local_directions(const Layout& L, const Point& m, const std::vector<bool>& held, int* similar) {
   const Eigen::Index n = L.size(), nx = L.nx, nm = L.x0(0, 0);  // nm: the entries of (A, B, C, D)
@@ -101,6 +106,7 @@ Eigen::MatrixXd local_directions(const Layout& L, const Point& m, const std::vec
       for (int r = 0; r < L.nx; ++r) M(L.a(r, j), col) -= m.A(r, i);    // A X: column j gets A's column i
       for (int c = 0; c < L.nu; ++c) M(L.b(i, c), col) += m.B(j, c);    // X B
       for (int r = 0; r < L.ny; ++r) M(L.c(r, j), col) -= m.C(r, i);    // -C X
+      for (int c = 0; c < L.nk; ++c) M(L.k(i, c), col) += m.K(j, c);    // X K
     }
   std::vector<Eigen::Index> free_rows, held_rows, free_x0;
   for (Eigen::Index k = 0; k < nm; ++k) (held[static_cast<size_t>(k)] ? held_rows : free_rows).push_back(k);
@@ -150,15 +156,17 @@ std::vector<Point> directions_of(const Layout& L, const Eigen::MatrixXd& Q) {
 // A change of state coordinates x = T z applied to a model.
 Point transformed(const Point& m, const Eigen::MatrixXd& T) {
   const Eigen::PartialPivLU<Eigen::MatrixXd> lu(T);
-  Point r{lu.solve(m.A * T), lu.solve(m.B), m.C * T, m.D, {}};
+  Point r{lu.solve(m.A * T), lu.solve(m.B), m.C * T, m.D, {}, m.K.size() ? Eigen::MatrixXd(lu.solve(m.K)) : m.K};
   for (const auto& x : m.x0) r.x0.push_back(lu.solve(x));
   return r;
 }
 
 // Input and output scaling of a model: u = su .* u_s, y = sy .* y_s.
 Point scaled(const Point& m, const Eigen::VectorXd& su, const Eigen::VectorXd& sy) {
+  // The innovation e = y - yhat scales like y: K e = (K diag(sy)) e_s.
   return {m.A, m.B * su.asDiagonal(), sy.cwiseInverse().asDiagonal() * m.C,
-          sy.cwiseInverse().asDiagonal() * m.D * su.asDiagonal(), m.x0};
+          sy.cwiseInverse().asDiagonal() * m.D * su.asDiagonal(), m.x0,
+          m.K.size() ? Eigen::MatrixXd(m.K * sy.asDiagonal()) : m.K};
 }
 Point unscaled(const Point& m, const Eigen::VectorXd& su, const Eigen::VectorXd& sy) {
   return scaled(m, su.cwiseInverse(), sy.cwiseInverse());
@@ -329,7 +337,8 @@ void describe(Result<StateSpace>& res, Point& fin, const Layout& L, const std::v
     add_entries('C', fin.C, held_at(&Layout::c));
   }
   if (estimate_d) add_entries('D', fin.D, held_at(&Layout::d));
-  res.model = StateSpace(fin.A, fin.B, fin.C, fin.D);
+  if (L.nk > 0) add_entries('K', fin.K, held_at(&Layout::k));
+  res.model = StateSpace(fin.A, fin.B, fin.C, fin.D, fin.K);
   res.parameters.names = pnames;
   res.parameters.values = Eigen::Map<const Eigen::VectorXd>(vals.data(), static_cast<Eigen::Index>(vals.size()));
   res.parameters.fixed = pfixed;

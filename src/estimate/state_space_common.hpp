@@ -32,20 +32,23 @@ struct Fits {
 Fits fits_of(std::span<const IdData> records, std::span<const Eigen::MatrixXd> yhat, const Eigen::VectorXd& sy,
              int n_parameters);
 
-// A model with one initial state per record.
+// A model with one initial state per record, and an innovation gain K (nx x ny; empty for output error).
 struct Point {
   Eigen::MatrixXd A, B, C, D;
   std::vector<Eigen::VectorXd> x0;
+  Eigen::MatrixXd K;
 };
 
-// The parameter vector theta = [A | B | C | D (row-major) | x0 of each record].
+// The parameter vector theta = [A | B | C | D | K (row-major; K when nk = ny) | x0 of each record].
 struct Layout {
   int nx, nu, ny, E;
+  int nk = 0;  ///< columns of K: ny for the prediction-error variant, 0 for output error
   Eigen::Index a(int i, int j) const { return i * nx + j; }
   Eigen::Index b(int i, int j) const { return nx * nx + i * nu + j; }
   Eigen::Index c(int i, int j) const { return nx * nx + nx * nu + i * nx + j; }
   Eigen::Index d(int i, int j) const { return nx * nx + nx * nu + ny * nx + i * nu + j; }
-  Eigen::Index x0(int e, int i) const { return nx * nx + nx * nu + ny * nx + ny * nu + e * nx + i; }
+  Eigen::Index k(int i, int j) const { return nx * nx + nx * nu + ny * nx + ny * nu + i * nk + j; }
+  Eigen::Index x0(int e, int i) const { return nx * nx + nx * nu + ny * nx + ny * nu + nx * nk + e * nx + i; }
   Eigen::Index size() const { return x0(E, 0); }
 };
 
@@ -77,7 +80,7 @@ bool stable(const Eigen::MatrixXd& A, int k);
 std::string entry_name(char M, int i, int j);
 
 /// The result's model and parameters at `fin` (user units; fin becomes the model returned, its x0 transformed too): without user coordinates the real modal form (parameters
-/// pole<a> or sigma<a>/omega<a>, B, C with each mode's normalising entries held, D when estimated; a warning and
+/// pole<a> or sigma<a>/omega<a>, B, C with each mode's normalising entries held, D when estimated, K when L.nk; a warning and
 /// the search's coordinates when the poles are nearly repeated); with user coordinates the entries of A, B, C (and D),
 /// `held` marking the held ones.
 void describe(Result<StateSpace>& res, Point& fin, const Layout& L, const std::vector<bool>& held, bool user_coordinates,

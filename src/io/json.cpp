@@ -88,7 +88,9 @@ json model_json(const LinearModel& m) {
     return {{"type", "miso"}, {"channels", ch}};
   }
   const auto& ss = std::get<StateSpace>(m);
-  return {{"type", "state_space"}, {"A", mat(ss.A())}, {"B", mat(ss.B())}, {"C", mat(ss.C())}, {"D", mat(ss.D())}};
+  json j = {{"type", "state_space"}, {"A", mat(ss.A())}, {"B", mat(ss.B())}, {"C", mat(ss.C())}, {"D", mat(ss.D())}};
+  if (ss.has_innovation_gain()) j["K"] = mat(ss.K());
+  return j;
 }
 
 LinearModel model_from(const json& root, const Reader& rd) {
@@ -119,7 +121,8 @@ LinearModel model_from(const json& root, const Reader& rd) {
     }
     if (t == "state_space")
       return StateSpace(rd.matrix(rd.member(m, "A", "the model"), "A"), rd.matrix(rd.member(m, "B", "the model"), "B"),
-                        rd.matrix(rd.member(m, "C", "the model"), "C"), rd.matrix(rd.member(m, "D", "the model"), "D"));
+                        rd.matrix(rd.member(m, "C", "the model"), "C"), rd.matrix(rd.member(m, "D", "the model"), "D"),
+                        m.contains("K") ? rd.matrix(m.at("K"), "K") : Eigen::MatrixXd());
   } catch (const InvalidArgument& e) {
     rd.fail(std::string("invalid model: ") + e.what());
   }

@@ -20,6 +20,15 @@ StateSpace::StateSpace(Eigen::MatrixXd A, Eigen::MatrixXd B, Eigen::MatrixXd C, 
                "StateSpace: the matrices contain NaN or Inf");
 }
 
+StateSpace::StateSpace(Eigen::MatrixXd A, Eigen::MatrixXd B, Eigen::MatrixXd C, Eigen::MatrixXd D, Eigen::MatrixXd K)
+    : StateSpace(std::move(A), std::move(B), std::move(C), std::move(D)) {
+  if (K.size() == 0) return;
+  CTID_REQUIRE(K.rows() == A_.rows() && K.cols() == C_.rows(), "StateSpace: K must be {}x{} (nx x ny; got {}x{})",
+               A_.rows(), C_.rows(), K.rows(), K.cols());
+  CTID_REQUIRE(K.allFinite(), "StateSpace: K contains NaN or Inf");
+  K_ = std::move(K);
+}
+
 StateSpace StateSpace::controllable_canonical(const TransferFunction& tf) {
   const int n = tf.order();
   const Eigen::VectorXd& a = tf.den().coefficients();  // monic, length n+1

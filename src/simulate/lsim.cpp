@@ -264,6 +264,38 @@ Eigen::MatrixXd lsim(const StateSpace& sys, const IdData& data, const LsimOption
   return y;
 }
 
+Eigen::MatrixXd predict(const StateSpace& sys, const IdData& data, const LsimOptions& o) {
+  if (!sys.has_innovation_gain()) return lsim(sys, data, o);
+  const Eigen::Index nx = sys.nx(), nu = sys.nu(), ny = sys.ny(), N = data.size();
+  CTID_REQUIRE(data.nu() == nu && data.ny() == ny, "predict: the model has {} inputs and {} outputs, the data {} and {}",
+               nu, ny, data.nu(), data.ny());
+  CTID_REQUIRE(o.input_delay == 0.0, "predict: an input delay is not supported (got {} s)", o.input_delay);
+  CTID_REQUIRE(o.x0.size() == 0 || o.x0.size() == nx, "predict: x0 has {} entries, the model {} states", o.x0.size(), nx);
+  // The inputs [u; e]: u with the data's intersample behaviour, the innovation held.
+  Eigen::MatrixXd BK(nx, nu + ny);
+  BK << sys.B(), sys.K();
+  bool any_foh = false;
+  for (int j = 0; j < nu; ++j) any_foh = any_foh || data.intersample(j) != Intersample::Zoh;
+  Discretization dz;
+  Eigen::MatrixXd y(N, ny);
+  Eigen::VectorXd x = o.x0.size() ? o.x0 : Eigen::VectorXd::Zero(nx), e(ny);
+  const Eigen::VectorXd t = data.times();
+  for (Eigen::Index k = 0; k < N; ++k) {
+    const Eigen::VectorXd uk = data.u().row(k).transpose();
+    y.row(k) = (sys.C() * x + sys.D() * uk).transpose();
+    if (k + 1 == N) break;
+    e = data.y().row(k).transpose() - y.row(k).transpose();
+    const double h = t(k + 1) - t(k);
+    if (!(std::abs(dz.h - h) <= 1e-12 * h)) dz = discretize(sys.A(), BK, h);
+    Eigen::VectorXd xn = dz.Phi * x + dz.Gamma0.leftCols(nu) * uk + dz.Gamma0.rightCols(ny) * e;
+    if (any_foh)
+      for (int j = 0; j < nu; ++j)
+        if (data.intersample(j) != Intersample::Zoh) xn += dz.Gamma1.col(j) * (data.u()(k + 1, j) - uk(j));
+    x = std::move(xn);
+  }
+  return y;
+}
+
 Eigen::VectorXd lsim(const TransferFunction& tf, const Eigen::VectorXd& u, const Eigen::VectorXd& t, Intersample is) {
   LsimOptions o;
   o.input_delay = tf.io_delay();

@@ -131,7 +131,7 @@ std::vector<StateSpaceDirection> state_space_directions(const StateSpace& m, con
   std::vector<StateSpaceDirection> out;
   for (const std::string& name : p.names) {
     StateSpaceDirection d{Eigen::MatrixXd::Zero(nx, nx), Eigen::MatrixXd::Zero(nx, nu), Eigen::MatrixXd::Zero(ny, nx),
-                          Eigen::MatrixXd::Zero(ny, nu)};
+                          Eigen::MatrixXd::Zero(ny, nu), Eigen::MatrixXd::Zero(nx, m.has_innovation_gain() ? ny : 0)};
     int i = -1, j = -1;
     auto entry = [&](Eigen::MatrixXd& M) {
       CTID_REQUIRE(j >= 0 && i < M.rows() && j < M.cols(), "state_space_directions: parameter '{}' is outside the {}x{} "
@@ -146,6 +146,7 @@ std::vector<StateSpaceDirection> state_space_directions(const StateSpace& m, con
     else if (parse_indexed(name, "B", i, j)) entry(d.dB);
     else if (parse_indexed(name, "C", i, j)) entry(d.dC);
     else if (parse_indexed(name, "D", i, j)) entry(d.dD);
+    else if (parse_indexed(name, "K", i, j)) entry(d.dK);
     else if (parse_indexed(name, "pole", i, j)) { mode(false); d.dA(i, i) = 1.0; }
     else if (parse_indexed(name, "sigma", i, j)) { mode(true); d.dA(i, i) = d.dA(i + 1, i + 1) = 1.0; }
     else if (parse_indexed(name, "omega", i, j)) { mode(true); d.dA(i, i + 1) = 1.0; d.dA(i + 1, i) = -1.0; }

@@ -95,6 +95,10 @@ inline constexpr VectorDiagnostic x0{"x0", "", "fitted initial state of each rec
 // State-space output error (ssest, issue 16).
 inline constexpr VectorDiagnostic output_noise_variance{"output_noise_variance", "y^2",
                                                         "variance of each output's error (the weights 1/variance of the cost)"};
+inline constexpr VectorDiagnostic prediction_fit_percent{
+    "prediction_fit_percent", "%", "one-step-ahead prediction fit of each output (a model with an innovation gain)"};
+inline constexpr ScalarDiagnostic warm_up_iterations{
+    "warm_up_iterations", "", "iterations on the records' beginnings before the full records (long records)"};
 inline constexpr ScalarDiagnostic start_fit_percent{"start_fit_percent", "%", "simulation fit of the subspace start"};
 inline constexpr VectorDiagnostic mode_wn_std{"mode_wn_std", "rad/s",
                                               "standard deviation of each mode's natural frequency (modes in model order)"};

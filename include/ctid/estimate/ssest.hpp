@@ -6,7 +6,8 @@
 // w_j = 1/sigma_j^2 the inverse noise variance of output j, re-estimated from the residuals of the converged model
 // and the search repeated once when one moved by more than 10 % — the Gaussian maximum-likelihood estimate for
 // independent white output noise of unknown variances (Ljung 1999, "System Identification", §7.4 and §9.4:
-// asymptotic covariance (J^T W J)^-1).
+// asymptotic covariance (J^T W J)^-1). With estimate_k, yhat is instead the one-step prediction of the innovation
+// form dx/dt = A x + B u + K e, y = C x + D u + e (Ljung 1999, §4.3 eq. 4.84; predict() in simulate/lsim.hpp).
 //
 // Parametrisation: every entry of (A, B, C, D, x0_e) (the "full parametrisation" of McKelvey, Helmersson &
 // Ribarits 2004, "Data driven local coordinates for multivariable linear systems and their application to system
@@ -55,6 +56,11 @@ struct SsestOptions {
   /// standard deviations) by less than this: a move worth a small fraction of one standard deviation.
   double tolerance = 1e-3;
   bool estimate_d = true;       ///< false: D = 0 (a strictly proper model)
+  /// The prediction-error variant: also estimate an innovation gain K (nx x ny) of the innovation form
+  /// dx/dt = A x + B u + K e, y = C x + D u + e (e held between samples; predict() in simulate/lsim.hpp) and
+  /// minimise the one-step prediction errors — coloured output noise whose model shares the plant's poles. The search
+  /// starts from K = 0 (the output-error predictor). Time-domain records only.
+  bool estimate_k = false;
   bool estimate_initial_state = true;  ///< false: each record starts at rest
   /// Keep a stable start stable: a step that moves a pole (other than a held integrator) to Re >= 0 is rejected. An
   /// unstable start is searched without it. false: an unstable plant (with start.stabilize false).

@@ -1,4 +1,5 @@
-// ctid — continuous-time state space  dx/dt = A x + B u,  y = C x + D u.
+// ctid — continuous-time state space  dx/dt = A x + B u,  y = C x + D u, optionally with an innovation gain K (the
+// innovation form dx/dt = A x + B u + K e, y = C x + D u + e; see predict() in simulate/lsim.hpp).
 #pragma once
 
 #include <complex>
@@ -25,6 +26,8 @@ class StateSpace {
   StateSpace() = default;
   /// Throws InvalidArgument for inconsistent sizes or non-finite entries.
   StateSpace(Eigen::MatrixXd A, Eigen::MatrixXd B, Eigen::MatrixXd C, Eigen::MatrixXd D);
+  /// With an innovation gain K (nx x ny; empty: none). Throws InvalidArgument for a K of another size.
+  StateSpace(Eigen::MatrixXd A, Eigen::MatrixXd B, Eigen::MatrixXd C, Eigen::MatrixXd D, Eigen::MatrixXd K);
 
   /// Controllable canonical (companion) form of a proper SISO transfer function:
   /// A first row = -[a1 .. an], sub-diagonal ones, B = e1, C = remainder numerator, D = direct term.
@@ -36,6 +39,10 @@ class StateSpace {
   const Eigen::MatrixXd& B() const { return B_; }
   const Eigen::MatrixXd& C() const { return C_; }
   const Eigen::MatrixXd& D() const { return D_; }
+  /// The innovation gain (nx x ny), empty for an output-error model. It enters only predictions (predict()), never
+  /// a simulation, a response or the poles.
+  const Eigen::MatrixXd& K() const { return K_; }
+  bool has_innovation_gain() const { return K_.size() > 0; }
   int nx() const { return static_cast<int>(A_.rows()); }
   int nu() const { return static_cast<int>(B_.cols()); }
   int ny() const { return static_cast<int>(C_.rows()); }
@@ -51,7 +58,7 @@ class StateSpace {
   Eigen::VectorXcd frequency_response(const Eigen::VectorXd& w, int out = 0, int in = 0) const;
 
  private:
-  Eigen::MatrixXd A_, B_, C_, D_;
+  Eigen::MatrixXd A_, B_, C_, D_, K_;
 };
 
 }  // namespace ctid

@@ -45,6 +45,12 @@ Eigen::MatrixXd lsim(const StateSpace& sys, const Eigen::MatrixXd& u, const Eige
                      const std::vector<Intersample>& intersample, const LsimOptions& options = {});
 /// Same on an experiment: uses its inputs, times and intersample behaviour.
 Eigen::MatrixXd lsim(const StateSpace& sys, const IdData& data, const LsimOptions& options = {});
+/// One-step-ahead predictions (N x ny) of a model with an innovation gain (issue 16): the innovation form
+/// dx/dt = A x + B u + K e(t), y = C x + D u + e, with the innovation held between samples at e_k = y_k - yhat_k,
+/// yhat_k = C x_k + D u_k, x(t_0) = options.x0 (empty: zero) — exact for ZOH/FOH inputs on any sample times, and the
+/// predictor ssest's prediction-error variant minimises. Without K: the simulation (lsim). Throws InvalidArgument
+/// for mismatched sizes or an input delay (not supported here).
+Eigen::MatrixXd predict(const StateSpace& sys, const IdData& data, const LsimOptions& options = {});
 /// Simulate a SISO transfer function (with its delay) driven by input column `input`.
 Eigen::VectorXd lsim(const TransferFunction& tf, const IdData& data, int input = 0);
 /// Simulate a SISO transfer function on (u, t) with the given intersample behaviour.

@@ -57,8 +57,9 @@ MagnitudeBand magnitude_band(const Result<TransferFunction>& r, const Eigen::Vec
 /// The change of (A, B, C, D) per unit change of one parameter of a state-space result.
 struct StateSpaceDirection {
   Eigen::MatrixXd dA, dB, dC, dD;
+  Eigen::MatrixXd dK;  ///< nx x ny for a model with an innovation gain, else nx x 0
 };
-/// One direction per parameter of p, read from its name: A<i>_<j>, B<i>_<j>, C<i>_<j>, D<i>_<j> (that entry, 1-based),
+/// One direction per parameter of p, read from its name: A<i>_<j>, B<i>_<j>, C<i>_<j>, D<i>_<j>, K<i>_<j> (that entry, 1-based),
 /// pole<a> (A(a,a)), sigma<a> (A(a,a) and A(a+1,a+1)), omega<a> (A(a,a+1) and, negated, A(a+1,a)) — the names of
 /// ssest's and subspace's parameters. Throws InvalidArgument for another name or an index outside m.
 std::vector<StateSpaceDirection> state_space_directions(const StateSpace& m, const ParameterSet& p);
