@@ -56,7 +56,8 @@ for name, make in (("four modes", modal_system), ("random A", random_system)):
     t_all, r = median_time(lambda: ctid.ssest(data, nx, estimate_d=False, start_tau=tau))
     print(f"{name}: subspace start {t_search:.2f} s (tau searched, chose {tau:.3g} s), {t_given:.2f} s (tau given); "
           f"ssest from the start with tau given {t_all:.2f} s, refinement {t_all - t_given:.2f} s, "
-          f"{r.summary.iterations} iterations ({r.summary.termination}); fit {start.fit.fit_percent:.2f} -> "
+          f"{r.summary.iterations} iterations ({r.summary.termination}) after "
+          f"{r.diagnostics.scalars.get('warm_up_iterations', 0):.0f} on the record's beginnings; fit {start.fit.fit_percent:.2f} -> "
           f"{r.fit.fit_percent:.2f} % (noise limit 90.05 %); largest relative pole error {pole_error(system, start.model):.3g} "
           f"-> {pole_error(system, r.model):.3g}")
 print(f"peak resident memory of the process: {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB "

@@ -388,38 +388,43 @@ Search search_records(const Layout& L, Eigen::VectorXd theta, const std::vector<
   return s;
 }
 
-// The warm-up's data: the records' beginnings, kWarmSamples samples in all (each record its share).
-constexpr Eigen::Index kWarmSamples = 20000;
-std::vector<Record> beginnings(const std::vector<Record>& recs, Eigen::Index total) {
+// The warm-up's data: the records' beginnings, n samples in all (each record its share).
+std::vector<Record> beginnings(const std::vector<Record>& recs, Eigen::Index total, Eigen::Index n_all) {
   std::vector<Record> out;
   for (const Record& r : recs) {
-    const Eigen::Index n = std::max<Eigen::Index>(2, r.u.rows() * kWarmSamples / total);
+    const Eigen::Index n = std::max<Eigen::Index>(2, r.u.rows() * n_all / total);
     out.push_back(Record{r.u.topRows(n), r.y.topRows(n), r.t.head(n), r.uniform, r.h, r.intersample});
   }
   return out;
 }
 
-// The search on long records (four times kWarmSamples or more) is warmed up on their beginnings: a poor start (a mode
-// tens of percent off, as subspace estimates of well-damped modes often are) costs tens of iterations whose price
-// grows with N, and most of them only bring the model near the optimum, which a fraction of the record locates as
-// well; the full records then finish in a few iterations. The warm-up's model is kept only when its cost on the full
-// records is below the start's, so it can make the search faster, never start it from a worse point.
+// The search on long records (20 000 samples or more) is warmed up on their beginnings, 5 000 samples, then four times
+// as many while that is at most a quarter of the records: a poor start (a mode tens of percent off, as subspace
+// estimates of well-damped modes often are) costs tens of iterations whose price grows with N, and most of them only
+// bring the model near the optimum, which a fraction of the record locates as well; each longer part, and the full
+// records at the end, then finish in a few iterations. A warm-up's model is kept only when its cost on the full
+// records is below that of the model it started from, so it can make the search faster, never start it from a worse
+// point (a beginning too short to determine the slow modes gives a model that is rejected).
 Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& held, const std::vector<Record>& recs,
               const SsestOptions& o, bool free_coordinates, int* warm_iterations) {
   Eigen::Index total = 0;
   for (const Record& r : recs) total += r.u.rows();
   *warm_iterations = 0;
-  if (total >= 4 * kWarmSamples) {
-    const Search w = search_records(L, theta, held, beginnings(recs, total), o, free_coordinates);
-    if (!w.failed_start && !w.last.interrupted) {
-      const Eigen::VectorXd sw = residual_variances(unpack(L, theta), recs).cwiseMax(1e-12).cwiseInverse().cwiseSqrt();
-      double before = INFINITY, after = INFINITY;
-      if (sw.allFinite() && evaluate(unpack(L, theta), nullptr, recs, sw, before, nullptr, nullptr) &&
-          evaluate(unpack(L, w.theta), nullptr, recs, sw, after, nullptr, nullptr) && after < before) {
-        theta = w.theta;
-        *warm_iterations = w.iterations;
-      }
+  Eigen::VectorXd sw;  // the full records' weights, from the start's residuals
+  double current = INFINITY;
+  constexpr Eigen::Index kFirstWarmUp = 5000;  // samples of the first warm-up
+  for (Eigen::Index n = kFirstWarmUp; 4 * n <= total; n *= 4) {
+    const Search w = search_records(L, theta, held, beginnings(recs, total, n), o, free_coordinates);
+    if (w.failed_start || w.last.interrupted) break;
+    if (sw.size() == 0) {
+      sw = residual_variances(unpack(L, theta), recs).cwiseMax(1e-12).cwiseInverse().cwiseSqrt();
+      if (!sw.allFinite() || !evaluate(unpack(L, theta), nullptr, recs, sw, current, nullptr, nullptr)) break;
     }
+    double after = INFINITY;
+    if (!evaluate(unpack(L, w.theta), nullptr, recs, sw, after, nullptr, nullptr) || !(after < current)) continue;
+    theta = w.theta;
+    current = after;
+    *warm_iterations += w.iterations;
   }
   return search_records(L, theta, held, recs, o, free_coordinates);
 }

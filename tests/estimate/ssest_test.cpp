@@ -133,6 +133,24 @@ TEST(Ssest, ModalFormWithCovarianceAtTheCramerRaoBound) {
   EXPECT_GT(fs.magnitude(1), 5 * fs.magnitude(0));
 }
 
+TEST(Ssest, LongRecordIsWarmedUpOnItsBeginningAndEndsAtTheSameOptimum) {
+  // 20 000 samples: the search runs first on the first 5 000, then on the whole record.
+  const StateSpace m = two_modes();
+  const int N = 20000;
+  const IdData rec = record(m, levels(N, 2, 7, 5), uniform_times(N), Eigen::Vector4d::Zero(), 10.0, 25);
+  const IdData d = as_uniform(rec);
+  const Result<StateSpace> warmed = ssest(d, fourth_order());
+  ASSERT_TRUE(warmed.usable()) << warmed.why_not_usable();
+  EXPECT_GT(warmed.diagnostics.get(diagnostic::warm_up_iterations), 0.0);  // measured 3 (and 3 on the whole record)
+  // The same search started from the true system (where no warm-up helps: measured 0 warm-up iterations) ends at
+  // the same optimum. Measured: poles agree to 9e-8 relative, fits to 1e-6 %; the stopping rule (a step lowering
+  // the cost by less than 1e-3 noise units) allows about 0.05 standard deviations, i.e. ~5e-5 relative here.
+  const Result<StateSpace> from_truth = ssest(std::vector<IdData>{d}, m, fourth_order());
+  ASSERT_TRUE(from_truth.usable()) << from_truth.why_not_usable();
+  EXPECT_LT(pole_error(from_truth.model, warmed.model), 1e-4);
+  EXPECT_NEAR(warmed.fit.fit_percent, from_truth.fit.fit_percent, 1e-3);
+}
+
 // Issue 16's proof: 100 noise realisations on one input, uniform and irregular sampling, 10 dB on each output.
 TEST(Ssest, MonteCarloOfTheModesIsUnbiasedAtTheCramerRaoBound) {
   const StateSpace m = two_modes();
