@@ -50,7 +50,7 @@ int run(const DemoArgs& a) {
   print_result(r, "ivsvf", est);
   const Eigen::VectorXd yv = lsim(r.model, val, 0);
   const double fv = fit_percent(val.y().col(0), yv);
-  std::printf("\nvalidation on the last 500 samples: fit %.2f %%\n", fv);
+  std::printf("\nvalidation on the last 500 samples: fit %s %%\n", fit_percent_text(fv).c_str());
   const auto p = r.model.poles();
   std::printf("poles:");
   for (auto z : p) std::printf("  %.4g%+.4gj", z.real(), z.imag());

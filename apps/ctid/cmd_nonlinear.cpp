@@ -18,7 +18,8 @@ void print_narx(const Result<NarxModel>& r) {
   for (int i = 0; i < r.parameters.size(); ++i)
     std::printf("  %-22s %14.6g +- %-11.3g ERR %8.4f %%\n", r.parameters.names[i].c_str(), r.parameters.values(i),
                 r.parameters.std(i), i < err.size() ? err(i) : NAN);
-  std::printf("1 - sum(ERR) = %.3g   free-run fit %.2f %%\n", r.diagnostics.get(diagnostic::esr), r.fit.fit_percent);
+  std::printf("1 - sum(ERR) = %.3g   free-run fit %s %%\n", r.diagnostics.get(diagnostic::esr),
+              fit_percent_text(r.fit.fit_percent).c_str());
 }
 }  // namespace
 
@@ -78,8 +79,9 @@ int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, co
   const Eigen::VectorXd& err = k.diagnostics.get(diagnostic::err);
   for (int i = 0; i < k.parameters.size(); ++i)
     std::printf("  %-10s %14.6g   ERR %8.4f %%\n", k.parameters.names[i].c_str(), k.parameters.values(i), err(i));
-  std::printf("simulated output fit: %.2f %%   (hold factor %s)\n", k.fit.fit_percent, ko.linear.zoh ? "on" : "off");
-  std::printf("NARX model's free-run fit on the same record%s: %.2f %%\n", ds.size() > 1 ? "s" : "", run.narx_fit_percent);
+  std::printf("simulated output fit: %s %%   (hold factor %s)\n", fit_percent_text(k.fit.fit_percent).c_str(), ko.linear.zoh ? "on" : "off");
+  std::printf("NARX model's free-run fit on the same record%s: %s %%\n", ds.size() > 1 ? "s" : "",
+              fit_percent_text(run.narx_fit_percent).c_str());
   if (run.refined && run.refined->usable()) {
     const Result<NdeModel>& oe = *run.refined;
     std::printf("refined by output error (%d iterations): %s\n", oe.summary.iterations, oe.model.to_string(5).c_str());
@@ -87,7 +89,7 @@ int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, co
       std::printf("  %-10s %14.6g +- %.3g%s\n", oe.parameters.names[i].c_str(), oe.parameters.values(i),
                   oe.parameters.std(i), oe.parameters.fixed[static_cast<size_t>(i)] ? "  (reference)" : "");
     for (const auto& w : oe.diagnostics.warnings) std::printf("  note: %s\n", w.c_str());
-    std::printf("simulated output fit: %.2f %%\n", oe.fit.fit_percent);
+    std::printf("simulated output fit: %s %%\n", fit_percent_text(oe.fit.fit_percent).c_str());
   } else if (run.refined) {
     std::fprintf(stderr, "ctid: warning: the output-error refinement failed (%s); keeping the KIA model\n",
                  run.refined->why_not_usable().c_str());

@@ -43,7 +43,7 @@ nlohmann::ordered_json validate_output(const ValArgs& a, const IdData& d, const 
   const CorrelationTest ac = residual_autocorrelation(e, a.lags);
   std::vector<CorrelationTest> xcs;
   for (int i = 0; i < d.nu(); ++i) xcs.push_back(input_residual_crosscorrelation(d.u().col(i), e, a.lags));
-  std::printf("fit: %.2f %%   NRMSE %.4g   MSE %.4g   (%d samples)\n", f.fit_percent, f.nrmse, f.mse, f.n_samples);
+  std::printf("fit: %s %%   NRMSE %.4g   MSE %.4g   (%d samples)\n", fit_percent_text(f.fit_percent).c_str(), f.nrmse, f.mse, f.n_samples);
   std::printf("residual whiteness (lags 1..%d): %d outside the 99 %% bound %.3g -> %s\n", a.lags, ac.n_outside, ac.bound,
               ac.passed() ? "passed" : "not white");
   for (int i = 0; i < d.nu(); ++i)

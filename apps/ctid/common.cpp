@@ -244,7 +244,7 @@ void print_any(const Result<M>& r, const std::string& method, const IdData& d, c
   }
   if (r.diagnostics.has(diagnostic::tau))
     std::printf("filter time constant tau = %.6g s\n", r.diagnostics.get(diagnostic::tau));
-  std::printf("fit: %.2f %%   NRMSE %.4g   MSE %.4g   AIC %.6g   BIC %.6g\n", r.fit.fit_percent, r.fit.nrmse, r.fit.mse,
+  std::printf("fit: %s %%   NRMSE %.4g   MSE %.4g   AIC %.6g   BIC %.6g\n", fit_percent_text(r.fit.fit_percent).c_str(), r.fit.nrmse, r.fit.mse,
               r.fit.aic, r.fit.bic);
   if (r.diagnostics.condition_number > 0) std::printf("condition number %.3g   ", r.diagnostics.condition_number);
   std::printf("termination: %s   %.3g s\n", to_string(r.summary.termination), r.summary.seconds);
@@ -318,7 +318,7 @@ void print_result(const Result<StateSpace>& r, const std::string& method, const 
   }
   if (r.diagnostics.has(diagnostic::tau)) std::printf("filter time constant tau = %.6g s\n", r.diagnostics.get(diagnostic::tau));
   if (r.diagnostics.has(diagnostic::start_fit_percent))
-    std::printf("subspace start: fit %.2f %%; ", r.diagnostics.get(diagnostic::start_fit_percent));
+    std::printf("subspace start: fit %s %%; ", fit_percent_text(r.diagnostics.get(diagnostic::start_fit_percent)).c_str());
   if (r.diagnostics.has(diagnostic::cost)) std::printf("output-error refinement: %d iterations\n", r.summary.iterations);
   if (r.diagnostics.has(diagnostic::nx_grid)) {
     const Eigen::VectorXd& g = r.diagnostics.get(diagnostic::nx_grid);
@@ -327,11 +327,14 @@ void print_result(const Result<StateSpace>& r, const std::string& method, const 
     for (Eigen::Index i = 0; i < g.size(); ++i) std::printf("  nx = %.0f: %.6g", g(i), b(i));
     std::printf("\n");
   }
-  std::printf("fit: %.2f %% (every output scaled alike)", r.fit.fit_percent);
+  std::printf("fit: %s %% (every output scaled alike)", fit_percent_text(r.fit.fit_percent).c_str());
   if (r.diagnostics.has(diagnostic::output_fit_percent)) {
     const Eigen::VectorXd& f = r.diagnostics.get(diagnostic::output_fit_percent);
     for (Eigen::Index j = 0; j < f.size(); ++j)
-      std::printf("   %s %.2f %%", j < static_cast<Eigen::Index>(d.output_names().size()) ? d.output_names()[static_cast<size_t>(j)].c_str() : "y", f(j));
+      std::printf("   %s %s %%",
+                  j < static_cast<Eigen::Index>(d.output_names().size()) ? d.output_names()[static_cast<size_t>(j)].c_str()
+                                                                          : "y",
+                  fit_percent_text(f(j)).c_str());
   }
   std::printf("\ntermination: %s   %.3g s\n", to_string(r.summary.termination), r.summary.seconds);
   if (!r.summary.message.empty()) std::printf("note: %s\n", r.summary.message.c_str());

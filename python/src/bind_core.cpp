@@ -123,6 +123,9 @@ void bind_core(py::module_& m) {
   m.def("add_noise_snr", &add_noise_snr, py::arg("x"), py::arg("snr_db"), py::arg("seed"),
         "x plus white Gaussian noise at the given signal-to-noise ratio (dB, power of x - mean).");
   m.def("fit_percent", &fit_percent, py::arg("y"), py::arg("yhat"), "100 (1 - ||y - yhat|| / ||y - mean(y)||).");
+  m.def("fit_percent_text", &fit_percent_text, py::arg("fit_percent"),
+        "A fit in percent as text: two decimals, three significant digits from a magnitude of 10 000 (a diverging "
+        "simulation), 'nan'/'inf'.");
 
   py::class_<CorrelationTest>(m, "CorrelationTest")
       .def_readonly("lags", &CorrelationTest::lags)

@@ -129,8 +129,11 @@ void bind_linear(py::module_& m) {
       .def_readonly("usable", &OrderCandidate::usable)
       .def_readonly("termination", &OrderCandidate::termination)
       .def("__repr__", [](const OrderCandidate& c) {
-        return detail::format("[nb={} nf={} nk={}] yic {:.4g}, rt2 {:.4g}, fit {:.2f} %{}", c.orders.nb, c.orders.nf,
-                              c.orders.nk, c.yic, c.rt2, c.fit_percent, c.usable ? "" : " (not usable: " + c.termination + ")");
+        char criteria[64];
+        std::snprintf(criteria, sizeof criteria, "yic %.4g, rt2 %.4g", c.yic, c.rt2);
+        return detail::format("[nb={} nf={} nk={}] {}, fit {} %{}", c.orders.nb, c.orders.nf, c.orders.nk, criteria,
+                              fit_percent_text(c.fit_percent),
+                              c.usable ? "" : " (not usable: " + c.termination + ")");
       });
   py::class_<MisoModel>(m, "MisoModel", "y = sum_i G_i(s) u_i: one transfer function per input.")
       .def(py::init<>())

@@ -165,6 +165,20 @@ def test_select_order_ranks_the_true_structure_first(plant):
         assert ranked[0].usable and ranked[0].fit_percent > 85
     with pytest.raises(ValueError, match="must be one of"):
         ctid.select_order(d, nb=(1, 1), nf=(1, 2), rank_by="mdl")
+    # repr reads as numbers (it printed the raw placeholders "{:.4g}"): yic and rt2 in 4 significant digits, the fit
+    # in two decimals, e.g. "[nb=1 nf=2 nk=0] yic -7.891, rt2 0.9876, fit 88.83 %".
+    c = ranked[0]
+    assert "{" not in repr(c)
+    assert repr(c).startswith("[nb=1 nf=2 nk=0] yic ")
+    assert f"fit {c.fit_percent:.2f} %" in repr(c)
+    assert f"rt2 {c.rt2:.4g}," in repr(c)
+
+
+def test_fit_percent_text_keeps_a_diverging_fit_short():
+    # The helper every printed fit uses (CLI, reprs): two decimals, 3 significant digits from 10 000 on.
+    assert ctid._ctid.fit_percent_text(87.254) == "87.25"
+    assert ctid._ctid.fit_percent_text(-1.2345e138) == "-1.23e+138"
+    assert ctid._ctid.fit_percent_text(float("nan")) == "nan"
 
 
 def _second_order_record(n, seed=3):

@@ -93,9 +93,13 @@ ranked:
     }
     return c.yic;
   };
+  // Usable structures first, then by the criterion; a criterion that is not a number (a fit that failed) ranks last
+  // in its group (compared as a number it would make the order undefined and land anywhere).
   std::stable_sort(out.begin(), out.end(), [&](const OrderCandidate& a, const OrderCandidate& b) {
     if (a.usable != b.usable) return a.usable;
-    return key(a) < key(b);
+    const double ka = key(a), kb = key(b);
+    if (std::isnan(ka) || std::isnan(kb)) return !std::isnan(ka) && std::isnan(kb);
+    return ka < kb;
   });
   return out;
 }

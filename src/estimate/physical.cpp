@@ -163,8 +163,12 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
   if (poles.size() > 0 && !(a > slowest))
     res.diagnostics.warnings.push_back(detail::format(
         "the window a = {} does not exceed the largest real part of the fitted plant's poles ({}): G(s + a) is not "
-        "stable and the compressed response is not meaningful; increase a",
-        a, slowest));
+        "stable and {}; increase a",
+        a, slowest,
+        std::string(route) == "raw"
+            ? "the windowed simulation e^(-a t) y(t) the fit compares grows over the record, so the record's end "
+              "dominates the fit"
+            : "the compressed response is not meaningful"));
   internal::set_termination(res.summary, lm, "the model cannot be evaluated at the initial parameters", unidentifiable);
   res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return res;

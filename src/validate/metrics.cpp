@@ -1,6 +1,7 @@
 #include "ctid/validate/metrics.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "ctid/core/check.hpp"
@@ -14,6 +15,13 @@ void check_pair(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, const cha
 }
 constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
+
+std::string fit_percent_text(double v) {
+  if (std::isnan(v)) return "nan";  // printf may write "-nan"
+  char b[32];
+  std::snprintf(b, sizeof b, std::isfinite(v) && std::abs(v) >= 1e4 ? "%.3g" : "%.2f", v);
+  return b;
+}
 
 double nrmse(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat) {
   check_pair(y, yhat, "nrmse");

@@ -116,6 +116,33 @@ TEST(Cli, FitWritesJsonThatSimulateAndValidateRead) {
   EXPECT_NE(r.out.find("note: the model is unstable; unstable poles: 0.1+0j"), std::string::npos) << r.out;
 }
 
+TEST(Cli, BiproperModelsAsInTheLibraryAndShortFitsOfDivergingModels) {
+  // nb = nf + 1 (a direct feedthrough) is accepted by SRIVC and tfest in C++ and Python; the CLI accepted it only for
+  // strictly proper orders. On the noise-free second-order record the s^2 coefficient comes out 0 (to 1e-3: the
+  // O(Ts^2) interpolation error of the record), a1 = 1.2, a2 = 4.
+  const std::string json = test::temp_path("biproper.json");
+  fs::remove(json);
+  CliRun r = ctid_run("fit " + good_csv() + " --time time --input force --output position --nf 2 --nb 3 --method srivc "
+                      "--json " + json);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Result<TransferFunction> res = parse_result_json(read_text_file(json));
+  EXPECT_EQ(res.parameters.size(), 5);  // a1, a2, b0, b1, b2
+  EXPECT_NEAR(res.parameters.value("b0"), 0.0, 1e-3);
+  EXPECT_NEAR(res.parameters.value("a1"), 1.2, 1e-3);
+  EXPECT_NEAR(res.parameters.value("a2"), 4.0, 1e-3);
+  // LSSVF's regression needs a strictly proper model: refused by the library with its reason.
+  r = ctid_run("fit " + good_csv() + " --time time --input force --output position --nf 2 --nb 3 --method lssvf");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("strictly proper"), std::string::npos) << r.err;
+  // A model whose simulation grows like e^{5 t} over 20 s: its fit (about -1e43 %) in three significant digits.
+  const std::string fast = write("fast_unstable.json", R"({"type": "transfer_function", "num": [1], "den": [1, -5]})");
+  r = ctid_run("validate " + fast + " " + good_csv() + " --time time --input force --output position");
+  const size_t at = r.out.find("fit: -");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  EXPECT_NE(r.out.substr(at, 20).find("e+"), std::string::npos) << r.out;
+  EXPECT_LT(r.out.find('\n', at) - at, 80u) << r.out;
+}
+
 TEST(Cli, IvsvfAndRlsMethods) {
   CliRun r = ctid_run("fit " + good_csv() + " --time time --input force --output position --nf 2 --nb 1 --method ivsvf");
   EXPECT_EQ(r.code, 0) << r.err;

@@ -163,6 +163,22 @@ TEST(GawthropWang, UnstableCircuitTwoStageReachesThePhysicalParameters) {
   EXPECT_LT((raw.parameters.values.array() - 1.0).abs().maxCoeff(), 1e-6);
   EXPECT_NEAR(raw.diagnostics.get(diagnostic::max_pole_real_part), 1.0, 1e-6);  // poles +-1 < a = 2: no window warning
   for (const auto& w : raw.diagnostics.warnings) EXPECT_EQ(w.find("does not exceed"), std::string::npos) << w;
+  // A window below the pole at +1 (a = 0.5; k2 held and k1 bounded near the truth so that the fitted plant keeps it):
+  // the warning names what the raw route compares (the windowed simulation), not a compressed response, which this
+  // route does not form.
+  PhysicalFitOptions near;
+  near.fixed = {{"k2", 1.0}};
+  near.bounds = {{"k1", {0.999, 1.001}}};
+  const auto narrow = fit_physical_raw(m, start, d, 0.5, near);
+  EXPECT_NEAR(narrow.diagnostics.get(diagnostic::max_pole_real_part), 1.0, 2e-3);
+  int named = 0;
+  for (const auto& w : narrow.diagnostics.warnings)
+    if (w.find("does not exceed") != std::string::npos) {
+      ++named;
+      EXPECT_NE(w.find("windowed simulation"), std::string::npos) << w;
+      EXPECT_EQ(w.find("compressed"), std::string::npos) << w;
+    }
+  EXPECT_EQ(named, 1);
   // The options' constraint vocabulary (fixed.NAME, bounds.NAME, as for oe) is the declarations': k2 fixed at its
   // true value 1 leaves k1 = 1 (to 1e-6) with k2's std 0; the same through a PhysicalParameter declaration gives the
   // same numbers to 1e-12; a bound that excludes the truth holds (k1 <= 0.8: k1 ends at the bound); a name that is

@@ -201,6 +201,27 @@ TEST(OrderSelection, TrueStructureRanksFirst) {
   }
 }
 
+TEST(OrderSelection, StructuresWithoutACriterionRankLast) {
+  // Noise-free set-up 1 with nf above the true 4: the over-parameterised fits are rank deficient and have no YIC
+  // (NaN). Usable structures first, each group in increasing YIC, the NaN rows at the end of theirs (before the fix
+  // a NaN compared as a number left them between others, the order undefined).
+  const auto c = select_order(rao_data(INFINITY, 0), {2, 3}, {4, 6}, {0, 0});
+  ASSERT_EQ(c.size(), 6u);
+  EXPECT_EQ(c[0].orders.nf, 4);  // measured: [2 4] then [3 4], both usable with a 100 % fit
+  EXPECT_TRUE(c[0].usable);
+  int nan_rows = 0;
+  for (size_t i = 1; i < c.size(); ++i) {
+    const OrderCandidate &a = c[i - 1], &b = c[i];
+    nan_rows += std::isnan(b.yic);
+    EXPECT_TRUE(a.usable || !b.usable) << "row " << i;  // usable first
+    if (a.usable == b.usable) {
+      EXPECT_FALSE(std::isnan(a.yic) && !std::isnan(b.yic)) << "row " << i;
+      if (!std::isnan(b.yic)) EXPECT_LE(a.yic, b.yic) << "row " << i;
+    }
+  }
+  EXPECT_GE(nan_rows, 2);  // measured 4: nf = 5 and 6
+}
+
 TEST(Srivc, BadInputs) {
   const IdData d = rao_data(INFINITY, 0);
   EXPECT_THROW(srivc(d, {3, 1, 0}), InvalidOptions);  // nb > nf + 1

@@ -24,6 +24,17 @@ TEST(Metrics, DefinitionsByHand) {
   EXPECT_THROW(mse(y, Eigen::VectorXd::Ones(3)), InvalidArgument);
 }
 
+TEST(Metrics, FitPercentTextStaysShortForADivergingModel) {
+  // Two decimals as before; a diverging simulation's fit (about -1e138 %) was printed with 140 digits.
+  EXPECT_EQ(fit_percent_text(87.254), "87.25");
+  EXPECT_EQ(fit_percent_text(-9999.994), "-9999.99");
+  EXPECT_EQ(fit_percent_text(-1.2345e138), "-1.23e+138");
+  EXPECT_EQ(fit_percent_text(12345.0), "1.23e+04");
+  EXPECT_EQ(fit_percent_text(-INFINITY), "-inf");
+  EXPECT_EQ(fit_percent_text(NAN), "nan");
+  EXPECT_EQ(fit_percent_text(-NAN), "nan");
+}
+
 TEST(Residuals, WhiteNoisePassesColouredFails) {
   const int N = 5000;
   const Eigen::VectorXd e = white_noise(N, 1.0, 5);

@@ -1,6 +1,8 @@
 // ctid — goodness-of-fit metrics (definitions in ctid::FitReport, core/types.hpp).
 #pragma once
 
+#include <string>
+
 #include <Eigen/Dense>
 
 #include "ctid/core/types.hpp"
@@ -10,6 +12,10 @@ namespace ctid {
 /// 100 (1 - ||y - yhat|| / ||y - mean(y)||). Throws InvalidArgument for size mismatch,
 /// fewer than 2 samples or a constant y.
 double fit_percent(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat);
+
+/// A fit in percent as text for people: two decimals ("87.25"), three significant digits when its magnitude is
+/// 10 000 or more ("-1.23e+138": the simulation of an unusable model that diverges), "nan", "inf" or "-inf".
+std::string fit_percent_text(double fit_percent);
 /// ||y - yhat|| / ||y - mean(y)||.
 double nrmse(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat);
 /// mean((y - yhat)^2).
