@@ -1,5 +1,7 @@
 #include "common.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <numbers>
 #include <cstdio>
@@ -12,7 +14,8 @@ namespace ctid::cli {
 void DataArgs::add_to(CLI::App& app, bool need_output) {
   app.add_option("--input", inputs, "Input column(s): name or 1-based position (repeatable)");
   if (need_output) app.add_option("--output", outputs, "Output column: name or 1-based position");
-  auto* t = app.add_option("--time", time, "Time column (strictly increasing; irregular sampling allowed)");
+  auto* t = app.add_option("--time", time, "Time column (strictly increasing; irregular sampling allowed). Default without --ts: the column named t or "
+                           "time (any case)");
   auto* s = app.add_option("--ts", ts, "Sampling period in seconds (when there is no time column)");
   t->excludes(s);
   app.add_option("--intersample", intersample, "Input intersample behaviour: zoh, foh or bl")->capture_default_str();
@@ -22,10 +25,8 @@ void DataArgs::add_to(CLI::App& app, bool need_output) {
 IdData DataArgs::load(bool need_output) const {
   if (detrend != "none" && detrend != "mean" && detrend != "linear")
     throw UsageError("--detrend must be none, mean or linear (got '" + detrend + "')");
-  if (time.empty() && ts == 0.0) throw UsageError("give the time axis: --time COLUMN or --ts SECONDS");
   if (!(ts >= 0) || !std::isfinite(ts)) throw UsageError("--ts must be a positive number of seconds (got " + std::to_string(ts) + ")");
   DataSpec spec;
-  spec.time = time;
   spec.ts = ts;
   try {
     spec.intersample = intersample_from_string(intersample);
@@ -47,12 +48,28 @@ IdData DataArgs::load(bool need_output) const {
     }
     // Two selections are the same column when they name the same position (CSV) or variable (.mat).
     auto same = [&](const std::string& a, const std::string& b) { return tab ? tab->column(a) == tab->column(b) : a == b; };
+    // Without --time and --ts, a column named t or time (any case) is the time axis, said on stderr.
+    std::string time_col = time;
+    if (time_col.empty() && ts == 0.0) {
+      for (const auto& n : names) {
+        std::string lower = n;
+        std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+        if (lower != "t" && lower != "time") continue;
+        if (!time_col.empty())
+          throw UsageError(path + ": columns '" + time_col + "' and '" + n + "' could both be the time axis; give --time");
+        time_col = n;
+      }
+      if (time_col.empty())
+        throw UsageError("give the time axis: --time COLUMN or --ts SECONDS (no column is named t or time)");
+      std::fprintf(stderr, "note: column '%s' is the time axis (no --time or --ts given)\n", time_col.c_str());
+    }
+    spec.time = time_col;
     if (inputs.empty() || (need_output && outputs.empty())) {
       // Default columns (documented in --help and docs/guide.md): everything that is not the time column, inputs
       // first, output last.
       std::vector<std::string> rest;
       for (const auto& n : names)
-        if (time.empty() || !same(n, time)) rest.push_back(n);
+        if (time_col.empty() || !same(n, time_col)) rest.push_back(n);
       if (need_output && outputs.empty()) {
         if (rest.size() != 2 && inputs.empty()) {
           std::string cols;

@@ -143,6 +143,26 @@ TEST(Cli, BiproperModelsAsInTheLibraryAndShortFitsOfDivergingModels) {
   EXPECT_LT(r.out.find('\n', at) - at, 80u) << r.out;
 }
 
+TEST(Cli, AColumnNamedTimeIsTheTimeAxisWhenNoneIsGiven) {
+  // good_csv's columns are time, force, position: without --time and --ts the fit is the one with --time time.
+  const CliRun with = ctid_run("fit " + good_csv() + " --time time --input force --output position --nf 2 --nb 1");
+  const CliRun without = ctid_run("fit " + good_csv() + " --input force --output position --nf 2 --nb 1");
+  ASSERT_EQ(without.code, 0) << without.err;
+  EXPECT_NE(without.err.find("note: column 'time' is the time axis"), std::string::npos) << without.err;
+  const size_t at = with.out.find("fit: ");
+  ASSERT_NE(at, std::string::npos) << with.out;
+  EXPECT_EQ(without.out.substr(at, 20), with.out.substr(at, 20));
+  // Two candidates, or none: a usage error naming them.
+  const std::string two = write("two_times.csv", "T,time,u,y\n0,0,1,0\n1,1,0,1\n2,2,1,0\n");
+  CliRun r = ctid_run("fit " + two + " --input u --output y");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("columns 'T' and 'time' could both be the time axis"), std::string::npos) << r.err;
+  const std::string none = write("no_time.csv", "a,u,y\n0,1,0\n1,0,1\n2,1,0\n");
+  r = ctid_run("fit " + none + " --input u --output y");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("no column is named t or time"), std::string::npos) << r.err;
+}
+
 TEST(Cli, IvsvfAndRlsMethods) {
   CliRun r = ctid_run("fit " + good_csv() + " --time time --input force --output position --nf 2 --nb 1 --method ivsvf");
   EXPECT_EQ(r.code, 0) << r.err;
@@ -184,7 +204,8 @@ TEST(Cli, BadInputGivesOneLineAndTheDocumentedExitCode) {
       {"fit " + good_csv() + base + "--method rls-svf --set tau=0", 2, "tau must be > 0 (got 0 s)"},
       {"fit " + good_csv() + base + "--set bogus=1", 2, "--set bogus: not a setting of lssvf"},
       {"fit " + good_csv() + base + "--method magic", 2, "magic"},
-      {"fit " + good_csv() + " --input force --output position", 2, "--time COLUMN or --ts SECONDS"},
+      {"fit " + write("untimed.csv", "a,force,position\n0,1,0\n1,0,1\n2,1,0\n") + " --input force --output position", 2,
+       "--time COLUMN or --ts SECONDS"},
       {"simulate /nonexistent.json " + good_csv() + " --time time --input force", 3, "cannot open '/nonexistent.json'"},
   };
   for (const Case& c : cases) {
