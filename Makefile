@@ -1,5 +1,6 @@
 # Thin wrapper around CMake (DESIGN.md §2).
-#   make demo   install dependencies, build, run `ctid demo` on the bundled data
+#   make demo   install dependencies, build the library and the command-line tool only, run `ctid demo` on the
+#               bundled data
 #   make test   install dependencies, build, run every test (ctest), then the sanitizer build's tests
 #               (AddressSanitizer + UBSan, Debug with -O1 and line tables only (-g1: file:line in every report,
 #               40 % less compile time than -g): assertions on; the long Monte Carlo tests, ctest label
@@ -23,7 +24,9 @@ build: deps
 	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS) >/dev/null
 	@cmake --build $(BUILD) -j $(JOBS)
 
-demo: build
+demo: deps
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS) >/dev/null
+	@cmake --build $(BUILD) -j $(JOBS) --target ctid_cli
 	@$(BUILD)/ctid demo
 
 test-fast: build
