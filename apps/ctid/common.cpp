@@ -94,6 +94,10 @@ IdData DataArgs::load(bool need_output) const {
           if (same(o, in)) throw UsageError(detail::format("'{}' is selected both as an input and as the output", o));
     if (!need_output) spec.outputs = {spec.inputs.front()};  // placeholder output for loading only
     IdData d = tab ? iddata_from_table(*tab, spec) : load_iddata(path, spec);
+    if (d.uniform_time_deviation() > 1e-9)
+      std::fprintf(stderr, "note: %s: the sample times are within %.2g Ts of a uniform grid (threshold %g Ts): read as "
+                   "uniform, Ts = %.10g s\n", path.c_str(), d.uniform_time_deviation(), IdData::kUniformTimeTolerance,
+                   d.ts());
     return detrend == "none" ? d : d.detrend(detrend == "mean" ? Detrend::Mean : Detrend::Linear);
   } catch (const FileError& e) {
     throw InputError(e.what());

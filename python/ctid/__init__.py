@@ -91,7 +91,8 @@ def _columns(a, name):
 
 def _from_arrays(cls, u, y, ts=None, t=None, t0=0.0, input_names=None, output_names=None, intersample=None):
     """A record from arrays shaped (n_samples,) or (n_samples, n_channels): uniform with ts (and t0), or at the
-    strictly increasing times t (uniform when every step is within 1e-6 of the mean step, as in ctid.load).
+    strictly increasing times t (uniform when every time is within 1e-3 Ts of a uniform grid, as in ctid.load;
+    the distance is data.uniform_time_deviation).
     u may be None or empty for a time series."""
     y = _columns(y, "y")
     u = _np.zeros((y.shape[0], 0)) if u is None else _columns(u, "u")

@@ -56,6 +56,8 @@ void bind_core(py::module_& m) {
       .def_property_readonly("t0", &IdData::t0)
       .def_property_readonly("times", &IdData::times)
       .def_property_readonly("is_uniform", &IdData::is_uniform)
+      .def_property_readonly("uniform_time_deviation", &IdData::uniform_time_deviation,
+                             "largest distance (in Ts) of a given time from the uniform grid the data were read as")
       .def_property_readonly("nu", &IdData::nu)
       .def_property_readonly("ny", &IdData::ny)
       .def("__len__", &IdData::size)

@@ -53,9 +53,14 @@ IdData IdData::from_times(Eigen::MatrixXd u, Eigen::MatrixXd y, Eigen::VectorXd 
                u.rows());
   if (N > 1 && t.allFinite()) {
     const double h = (t(N - 1) - t(0)) / double(N - 1);
-    bool uniform = h > 0;
-    for (Eigen::Index k = 1; k < N && uniform; ++k) uniform = std::abs((t(k) - t(k - 1)) - h) <= 1e-6 * h;
-    if (uniform) return IdData(std::move(u), std::move(y), h, t(0));
+    double deviation = 0.0;  // the largest |t_k - (t_0 + k h)| / h
+    for (Eigen::Index k = 1; k < N && h > 0 && deviation <= kUniformTimeTolerance; ++k)
+      deviation = std::max(deviation, std::abs(t(k) - (t(0) + double(k) * h)) / h);
+    if (h > 0 && deviation <= kUniformTimeTolerance) {
+      IdData d(std::move(u), std::move(y), h, t(0));
+      d.snapped_ = deviation;
+      return d;
+    }
   }
   return IdData(std::move(u), std::move(y), std::move(t));
 }

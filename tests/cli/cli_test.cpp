@@ -163,6 +163,28 @@ TEST(Cli, AColumnNamedTimeIsTheTimeAxisWhenNoneIsGiven) {
   EXPECT_NE(r.err.find("no column is named t or time"), std::string::npos) << r.err;
 }
 
+TEST(Cli, ALoggersClockJitterIsReadAsUniformSamplingWithANote) {
+  // good_csv's record with each time moved by +-2.4e-5 Ts (the relative jitter of a real dSPACE log): uniform data
+  // (so --nk, which needs a sampling period, is accepted) with a note giving the deviation; the estimate equals the
+  // one from exact times to the printed digits.
+  const CsvTable g = read_csv(good_csv());
+  Eigen::MatrixXd m = g.values;
+  for (Eigen::Index k = 0; k < m.rows(); ++k) m(k, 0) += (k % 2 ? 2.4e-5 : -2.4e-5) * 0.01;
+  const std::string jittered = test::temp_path("jittered.csv");
+  write_csv(jittered, g.names, m);
+  const std::string args = " --time time --input force --output position --nf 2 --nb 1 --nk 1 --method srivc";
+  const CliRun exact = ctid_run("fit " + good_csv() + args), r = ctid_run("fit " + jittered + args);
+  ASSERT_EQ(r.code, exact.code) << r.err;
+  // Measured: 4.8e-05 Ts (the grid through the first and last times, themselves moved in opposite directions).
+  EXPECT_NE(r.err.find("within 4.8e-05 Ts of a uniform grid (threshold 0.001 Ts): read as uniform"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(exact.err.find("uniform grid"), std::string::npos) << exact.err;
+  const size_t at = exact.out.find("model:"), at_r = r.out.find("model:");
+  ASSERT_NE(at, std::string::npos) << exact.out;
+  ASSERT_NE(at_r, std::string::npos) << r.out;
+  EXPECT_EQ(r.out.substr(at_r, 60), exact.out.substr(at, 60));
+}
+
 TEST(Cli, IvsvfAndRlsMethods) {
   CliRun r = ctid_run("fit " + good_csv() + " --time time --input force --output position --nf 2 --nb 1 --method ivsvf");
   EXPECT_EQ(r.code, 0) << r.err;

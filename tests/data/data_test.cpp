@@ -18,15 +18,29 @@ TEST(IdData, UniformAndIrregularTimes) {
   EXPECT_FALSE(r.is_uniform());
   EXPECT_THROW(r.ts(), InvalidArgument);
   EXPECT_DOUBLE_EQ(r.time(2), 0.35);
-  // from_times: steps of 0.1 with rounding (0.30000000000000004) are uniform; a 1e-5 relative jitter is not.
+  // from_times: steps of 0.1 with rounding (0.30000000000000004) are uniform; so is a time 1e-6 s = 1e-5 Ts off the
+  // grid (a logger's jitter, reported as the deviation); 2e-3 Ts off (above kUniformTimeTolerance = 1e-3) is not.
   Eigen::VectorXd t(5);
   for (int k = 0; k < 5; ++k) t(k) = 1.0 + k * 0.1;
   const IdData f = IdData::from_times(Eigen::VectorXd::Ones(5), Eigen::VectorXd::Ones(5), t);
   ASSERT_TRUE(f.is_uniform());
   EXPECT_NEAR(f.ts(), 0.1, 1e-15);
   EXPECT_DOUBLE_EQ(f.t0(), 1.0);
+  EXPECT_LT(f.uniform_time_deviation(), 1e-12);
   t(2) += 1e-6;
+  const IdData jittered = IdData::from_times(Eigen::VectorXd::Ones(5), Eigen::VectorXd::Ones(5), t);
+  ASSERT_TRUE(jittered.is_uniform());
+  EXPECT_NEAR(jittered.uniform_time_deviation(), 1e-5, 1e-12);
+  EXPECT_NEAR(jittered.ts(), 0.1, 1e-15);
+  t(2) += 2e-4 - 1e-6;
   EXPECT_FALSE(IdData::from_times(Eigen::VectorXd::Ones(5), Eigen::VectorXd::Ones(5), t).is_uniform());
+  // A clock drift (steps growing from 0.1 to 0.101 s): the middle sample is 1.24 Ts off the uniform grid through the
+  // ends: irregular.
+  Eigen::VectorXd drift(1001);
+  for (int k = 0; k <= 1000; ++k) drift(k) = 0.1 * k + 0.1 * 1e-5 * k * k / 2;
+  const IdData dr = IdData::from_times(Eigen::VectorXd::Ones(1001), Eigen::VectorXd::Ones(1001), drift);
+  EXPECT_FALSE(dr.is_uniform());
+  EXPECT_EQ(dr.uniform_time_deviation(), 0.0);
   EXPECT_THROW(IdData::from_times(Eigen::VectorXd::Ones(2), Eigen::VectorXd::Ones(2), Eigen::Vector2d(1.0, 1.0)),
                InvalidArgument);
 }

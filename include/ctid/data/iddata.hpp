@@ -38,9 +38,16 @@ class IdData {
   /// Explicit, strictly increasing sample times t (length N).
   IdData(Eigen::MatrixXd u, Eigen::MatrixXd y, Eigen::VectorXd t);
   /// Samples at the strictly increasing times t, kept as uniform data (Ts = mean step, t0 = t[0]) when every
-  /// step is within 1e-6 of the mean step (a time column written with rounding), else irregular. Used by the
-  /// file readers and Python's from_arrays; errors as the constructors.
+  /// sample lies within kUniformTimeTolerance * Ts of that grid (a time column written with rounding, or a data
+  /// logger's clock jitter), else irregular; the largest distance is uniform_time_deviation(). Used by the file
+  /// readers and Python's from_arrays; errors as the constructors.
   static IdData from_times(Eigen::MatrixXd u, Eigen::MatrixXd y, Eigen::VectorXd t);
+  /// Largest distance, in units of Ts, of a time given to from_times from the uniform grid the data were read as
+  /// (0 for data built uniform or kept irregular). The CLI notes a value above 1e-9.
+  double uniform_time_deviation() const { return snapped_; }
+  /// from_times's threshold: times within 1e-3 Ts of a uniform grid are uniform samples (e.g. a dSPACE log's
+  /// relative clock jitter of 2.4e-5 Ts); the model error of that time shift is of order 1e-3 of one sample's change.
+  static constexpr double kUniformTimeTolerance = 1e-3;
 
   int size() const { return static_cast<int>(y_.rows()); }
   int nu() const { return static_cast<int>(u_.cols()); }
@@ -90,6 +97,7 @@ class IdData {
   Eigen::VectorXd t_;  // only for irregular data
   double ts_ = 0.0, t0_ = 0.0;
   bool uniform_ = true;
+  double snapped_ = 0.0;  // uniform_time_deviation()
   std::vector<Intersample> intersample_;
   std::vector<std::string> input_names_, output_names_, input_units_, output_units_;
 };
