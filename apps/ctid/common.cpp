@@ -14,8 +14,9 @@ namespace ctid::cli {
 void DataArgs::add_to(CLI::App& app, bool need_output) {
   app.add_option("--input", inputs, "Input column(s): name or 1-based position (repeatable)");
   if (need_output) app.add_option("--output", outputs, "Output column: name or 1-based position");
-  auto* t = app.add_option("--time", time, "Time column (strictly increasing; irregular sampling allowed). Default without --ts: the column named t or "
-                           "time (any case)");
+  auto* t = app.add_option("--time", time,
+                           "Time column (strictly increasing; irregular sampling allowed). Default without --ts: the "
+                           "column named t or time (any case)");
   auto* s = app.add_option("--ts", ts, "Sampling period in seconds (when there is no time column)");
   t->excludes(s);
   app.add_option("--intersample", intersample, "Input intersample behaviour: zoh, foh or bl")->capture_default_str();

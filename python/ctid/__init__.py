@@ -147,7 +147,8 @@ def _report(result):
             sd = "fixed" if p.fixed and p.fixed[i] else f"{p.std[i]:.4g}" if len(p.std) else "-"
             lines.append(f"{name:<16}{p.values[i]:>14.6g}{sd:>12}")
     f = result.fit
-    lines.append(f"fit: {_ctid.fit_percent_text(f.fit_percent)} %  (mse {f.mse:.4g}, aic {f.aic:.4g}, {f.n_samples} samples)")
+    lines.append(f"fit: {_ctid.fit_percent_text(f.fit_percent)} %  (mse {f.mse:.4g}, aic {f.aic:.4g}, "
+                 f"{f.n_samples} samples)")
     lines += [f"warning: {w}" for w in result.diagnostics.warnings]
     return "\n".join(lines)
 

@@ -58,7 +58,7 @@ IdData IdData::from_times(Eigen::MatrixXd u, Eigen::MatrixXd y, Eigen::VectorXd 
       deviation = std::max(deviation, std::abs(t(k) - (t(0) + double(k) * h)) / h);
     if (h > 0 && deviation <= kUniformTimeTolerance) {
       IdData d(std::move(u), std::move(y), h, t(0));
-      d.snapped_ = deviation;
+      d.uniform_deviation_ = deviation;
       return d;
     }
   }

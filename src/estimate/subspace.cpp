@@ -8,6 +8,7 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <optional>
 
 #include <unsupported/Eigen/MatrixFunctions>
 
@@ -334,7 +335,9 @@ Result<StateSpace> subspace(const IdData& data, const SubspaceOptions& options) 
   std::vector<double> grid;
   const bool search_beginning = options.route == SubspaceRoute::Lambda && options.tau <= 0 &&
                                 N >= 8 * kTauSearchSamples;
-  const IdData searched = search_beginning ? data.slice(0, kTauSearchSamples) : data;
+  std::optional<IdData> beginning;  // the searched part when it is not the whole record (no copy of the record)
+  if (search_beginning) beginning = data.slice(0, kTauSearchSamples);
+  const IdData& searched = beginning ? *beginning : data;
   if (options.route == SubspaceRoute::Lambda) {
     if (options.tau > 0) {
       grid = {options.tau};

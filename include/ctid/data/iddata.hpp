@@ -44,7 +44,7 @@ class IdData {
   static IdData from_times(Eigen::MatrixXd u, Eigen::MatrixXd y, Eigen::VectorXd t);
   /// Largest distance, in units of Ts, of a time given to from_times from the uniform grid the data were read as
   /// (0 for data built uniform or kept irregular). The CLI notes a value above 1e-9.
-  double uniform_time_deviation() const { return snapped_; }
+  double uniform_time_deviation() const { return uniform_deviation_; }
   /// from_times's threshold: times within 1e-3 Ts of a uniform grid are uniform samples (e.g. a dSPACE log's
   /// relative clock jitter of 2.4e-5 Ts); the model error of that time shift is of order 1e-3 of one sample's change.
   static constexpr double kUniformTimeTolerance = 1e-3;
@@ -97,7 +97,7 @@ class IdData {
   Eigen::VectorXd t_;  // only for irregular data
   double ts_ = 0.0, t0_ = 0.0;
   bool uniform_ = true;
-  double snapped_ = 0.0;  // uniform_time_deviation()
+  double uniform_deviation_ = 0.0;  // uniform_time_deviation()
   std::vector<Intersample> intersample_;
   std::vector<std::string> input_names_, output_names_, input_units_, output_units_;
 };
