@@ -70,6 +70,7 @@ namespace {
 using namespace ss_detail;
 using Clock = std::chrono::steady_clock;
 constexpr int kBatch = 128;  // samples gathered before one rank-k update of J^T W J
+constexpr double kInitialDamping = 1e-6;  // Levenberg-Marquardt's first damping (see search())
 
 // One record as the search sees it: inputs and outputs divided by the channel scales.
 struct Record {
@@ -340,9 +341,10 @@ Point whitened(const Point& m, const std::vector<Record>& recs) {
 }
 
 // Rounds of Levenberg-Marquardt in local coordinates re-centred after each round, then the weights re-estimated and
-// the search repeated once (weighted output error = ML for independent Gaussian output noise).
+// the search repeated once (weighted output error = ML for independent Gaussian output noise). `damping` is the
+// Levenberg-Marquardt damping to start with, and receives the one reached (a warm-up hands it to the next stage).
 Search search_records(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& held,
-                      const std::vector<Record>& recs, const SsestOptions& o, bool free_coordinates) {
+                      const std::vector<Record>& recs, const SsestOptions& o, bool free_coordinates, double& damping) {
   Search s;
   // enforce_stability keeps a stable start stable (an unstable start is searched freely: it may be an unstable plant).
   const bool check_stability = o.enforce_stability && stable(unpack(L, theta).A, o.integrators);
@@ -354,6 +356,7 @@ Search search_records(const Layout& L, Eigen::VectorXd theta, const std::vector<
   }
   internal::LmOptions lmo;
   lmo.xtol = 1e-10;
+  lmo.lambda0 = damping;
   int left = o.max_iterations;
   for (int pass = 0; pass < 2; ++pass) {
     const Eigen::VectorXd sw = s.weights.cwiseSqrt();
@@ -368,6 +371,7 @@ Search search_records(const Layout& L, Eigen::VectorXd theta, const std::vector<
     theta = r.theta;
     s.iterations += r.iterations;
     s.last = r.last;
+    damping = lmo.lambda0;
     if (r.failed) {
       s.failed_start = s.iterations == 0;
       s.theta = theta;
@@ -412,9 +416,15 @@ Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& h
   *warm_iterations = 0;
   Eigen::VectorXd sw;  // the full records' weights, from the start's residuals
   double current = INFINITY;
+  // Levenberg-Marquardt damping (relative to diag(J^T W J)) to start with, then carried from stage to stage: the
+  // search's directions are badly scaled (slow and fast modes, x0), so a damping of 1e-3 shrinks the step along the
+  // weakly determined ones a thousandfold and each stage would spend iterations reducing it again (the full record's
+  // stage took 5 Jacobians instead of 3 in the four-mode benchmark of docs/benchmarks.md).
+  double damping = kInitialDamping;
   constexpr Eigen::Index kFirstWarmUp = 5000;  // samples of the first warm-up
   for (Eigen::Index n = kFirstWarmUp; 4 * n <= total; n *= 4) {
-    const Search w = search_records(L, theta, held, beginnings(recs, total, n), o, free_coordinates);
+    double d = damping;
+    const Search w = search_records(L, theta, held, beginnings(recs, total, n), o, free_coordinates, d);
     if (w.failed_start || w.last.interrupted) break;
     if (sw.size() == 0) {
       sw = residual_variances(unpack(L, theta), recs).cwiseMax(1e-12).cwiseInverse().cwiseSqrt();
@@ -424,9 +434,10 @@ Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& h
     if (!evaluate(unpack(L, w.theta), nullptr, recs, sw, after, nullptr, nullptr) || !(after < current)) continue;
     theta = w.theta;
     current = after;
+    damping = d;
     *warm_iterations += w.iterations;
   }
-  return search_records(L, theta, held, recs, o, free_coordinates);
+  return search_records(L, theta, held, recs, o, free_coordinates, damping);
 }
 
 void check_records(const std::vector<IdData>& ds) {

@@ -124,6 +124,7 @@ Rounds lm_rounds(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>
       return evaluate(m, c, A, g);
     };
     lmo.max_iterations = std::min(left, 5);
+    lmo.final_normal = false;  // the callers' covariance is computed at the final model in its own parameters
     if (!std::isfinite(cost) && !evaluate(unpack(L, theta), cost, nullptr, nullptr)) cost = INFINITY;
     if (std::isfinite(cost) && cost > 0) lmo.ftol = tolerance / cost;
     const internal::LmResult lm = internal::levenberg_marquardt(

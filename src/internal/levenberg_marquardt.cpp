@@ -95,10 +95,14 @@ LmResult lm(const Evaluate& normal, Eigen::VectorXd x, const Eigen::VectorXd& lo
         for (Eigen::Index i = 0; i < p; ++i) dx = std::max(dx, std::abs(xt(i) - x(i)) / std::max(std::abs(xt(i)), 1e-8));
         const double rel = (cost - ct) / std::max(cost, 1e-300);
         x = xt;
-        if (!normal(x, cost, &A, &g)) { res.message = "evaluation failed at an accepted point"; break; }
         lambda = std::max(lambda / 10, 1e-12);
         accepted = true;
         if (rel < o.ftol || dx < o.xtol) res.converged = true;
+        if (!o.final_normal && (res.converged || it == o.max_iterations)) {
+          cost = ct;  // the search ends here and the caller needs no J^T J
+          continue;
+        }
+        if (!normal(x, cost, &A, &g)) { res.message = "evaluation failed at an accepted point"; break; }
         continue;
       }
       lambda *= 10;

@@ -21,6 +21,9 @@ struct LmOptions {
   double ftol = 1e-12;     // stop when the relative cost decrease of an accepted step is below
   double xtol = 1e-10;     // stop when max |dx_i| / max(|x_i|, 1e-8) is below
   double lambda0 = 1e-3;
+  /// false: no J^T J at the final point (the result's jtj is then the last one evaluated) — for callers that compute
+  /// their covariance themselves; a search that converges or reaches max_iterations then costs one Jacobian less.
+  bool final_normal = true;
 };
 
 struct LmResult {
