@@ -1,4 +1,4 @@
-// ctid fit DATA --method lssvf|ivsvf|rls-svf ...
+// ctid fit DATA [--method srivc-auto|srivc|tfest|oe|lssvf|ivsvf|rls-svf|fsf|physical|greybox|modal|narx|kia|subspace|ssest] ...
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -17,7 +17,7 @@ namespace {
 struct FitArgs {
   DataArgs data;
   std::vector<std::string> paths;  ///< DATA arguments: several are several experiments of one system (srivc)
-  std::string method = "lssvf";
+  std::string method;  ///< empty: srivc-auto, or srivc when orders are given (resolved after parsing)
   std::vector<int> nb, nf{1}, nk{0};
   std::vector<std::string> sets;
   bool delay = false;
@@ -66,6 +66,10 @@ void reject_flags_that_do_not_apply(const FitArgs& a) {
     if (has(f) && !has("period")) refuse(f, "belongs to --period (periodic records)");
   if (has("period") && a.frequency) refuse("period", "computes frequency data from periodic records (not with --frequency)");
   for (const char* f : {"nb", "nf", "nk"})
+    if (has(f) && m == "srivc-auto")
+      refuse(f, "sets transfer-function orders, which srivc-auto chooses (--set nf_max=N bounds them); give --method "
+                "srivc for fixed orders");
+  for (const char* f : {"nb", "nf", "nk"})
     if (has(f) && (m == "narx" || m == "kia" || m == "fsf" || m == "physical" || m == "greybox" || m == "subspace" ||
                    m == "ssest"))
       refuse(f, "sets transfer-function orders; " + m + " has its own structure settings (--set)");
@@ -76,11 +80,32 @@ void reject_flags_that_do_not_apply(const FitArgs& a) {
 
 
 
+// A linear model through the origin cannot follow an offset: after a fit by a linear method of data that keep a
+// large one (--detrend none), a warning naming the channel, its mean and how many standard deviations that is.
+void warn_offsets(const FitArgs& a, const IdData& d) {
+  static const std::set<std::string> linear = {"srivc", "tfest", "oe", "lssvf", "ivsvf", "rls-svf", "subspace", "ssest"};
+  if (a.data.detrend != "none" || !linear.count(a.method)) return;
+  auto check = [](const Eigen::VectorXd& x, const std::string& name) {
+    const double m = x.mean(), sd = std::sqrt((x.array() - m).square().mean());
+    if (std::abs(m) > 0.5 * sd && sd > 0)
+      std::fprintf(stderr, "warning: %s has a mean of %.4g, %.2g times its standard deviation: a linear model "
+                   "through the origin cannot fit that offset; add --detrend mean (or linear)\n", name.c_str(), m,
+                   std::abs(m) / sd);
+  };
+  auto name = [](const std::vector<std::string>& n, int j) {
+    return static_cast<int>(n.size()) > j && !n[static_cast<size_t>(j)].empty() ? n[static_cast<size_t>(j)]
+                                                                                : std::to_string(j + 1);
+  };
+  for (int j = 0; j < d.nu(); ++j) check(d.u().col(j), "input " + name(d.input_names(), j));
+  for (int j = 0; j < d.ny(); ++j) check(d.y().col(j), "output " + name(d.output_names(), j));
+}
+
 // Print, write the JSON file and the HTML report if asked, and map usability to the exit code.
 template <class M>
 int finish(const Result<M>& r, const std::string& method, const IdData& d, const FitArgs& a, const Settings& settings,
            const std::vector<std::pair<std::string, IdData>>& more_records = {}) {
   print_result(r, method, d);
+  warn_offsets(a, d);
   if (!a.json.empty()) {
     write_result_json(a.json, r, method);
     std::printf("wrote %s\n", a.json.c_str());
@@ -120,6 +145,21 @@ int run_tf(const FitArgs& a, const IdData& d, Result<TransferFunction> (*estimat
   // The estimator checks the orders itself (SRIVC and tfest take biproper models, nb = nf + 1; LSSVF does not).
   const Result<TransferFunction> r = call_library([&] { return estimator(d, orders, o); });
   return finish(r, a.method, d, a, settings_of(o));
+}
+
+// srivc-auto (the default without --method and orders): the first line says which structure it chose and why.
+int run_srivc_auto(const FitArgs& a, const IdData& d) {
+  SrivcAutoOptions o;
+  apply_sets("srivc_auto", a.sets, o);
+  const Result<TransferFunction> r = call_library([&] { return srivc_auto(d, o); });
+  const Eigen::VectorXd& nb = r.diagnostics.get(diagnostic::structure_nb);
+  const TransferFunction& m = r.model;
+  char delay[64] = "";
+  if (m.io_delay() > 0) std::snprintf(delay, sizeof delay, " and an input delay of %.3g s", m.io_delay());
+  std::printf("srivc-auto chose SRIVC with nb = %d, nf = %d%s: the least BIC of %d structures (nf = 1..%d, nb = 1..nf%s)\n",
+              m.num().degree() + 1, m.den().degree(), delay, static_cast<int>(nb.size()), o.nf_max,
+              o.try_delay ? ", each with and without a delay" : "");
+  return finish(r, "srivc_auto", d, a, settings_of(o));
 }
 
 std::vector<std::pair<std::string, IdData>> more_records_of(const FitArgs& a, const std::vector<IdData>& ds);
@@ -557,6 +597,7 @@ int run(const FitArgs& a) {
 
 const std::map<std::string, FitMethod>& fit_methods() {
   static const std::map<std::string, FitMethod> m = {
+      {"srivc-auto", {{"srivc_auto"}, run_srivc_auto}},
       {"lssvf", {{"lssvf"}, [](const FitArgs& a, const IdData& d) { return run_tf(a, d, &lssvf); }}},
       {"ivsvf", {{"ivsvf"}, [](const FitArgs& a, const IdData& d) { return run_tf(a, d, &ivsvf); }}},
       {"rls-svf", {{"rls_svf"}, [](const FitArgs& a, const IdData& d) { return run_tf(a, d, &rls_svf); }}},
@@ -617,10 +658,10 @@ void setup_fit(CLI::App& app) {
   std::vector<std::string> names;
   for (const auto& [name, m] : fit_methods()) names.push_back(name);
   app.add_option("--method", a->method,
-                 "Estimator: srivc, tfest, oe, lssvf, ivsvf, rls-svf, fsf, physical, greybox, modal, narx, kia, subspace or "
-                 "ssest (with --help: its settings)")
-      ->check(CLI::IsMember(names))
-      ->capture_default_str();
+                 "Estimator: srivc-auto, srivc, tfest, oe, lssvf, ivsvf, rls-svf, fsf, physical, greybox, modal, narx, "
+                 "kia, subspace or ssest (with --help: its settings). Default: srivc-auto (the orders and a delay "
+                 "chosen by BIC, means removed) without --nb/--nf/--nk, srivc with them")
+      ->check(CLI::IsMember(names));
   g_fit_args = a;
   a->data.add_to(app, true);
   app.add_option("--nb", a->nb, "Number of numerator coefficients (default: nf); one per input with several inputs (1,2)")
@@ -683,6 +724,10 @@ void setup_fit(CLI::App& app) {
       if (o->count() > 0)
         for (const auto& n : o->get_lnames()) a->given.insert(n);
     a->data.path = a->paths.empty() ? "" : a->paths.front();
+    if (a->method.empty())
+      a->method = a->given.count("nb") || a->given.count("nf") || a->given.count("nk") ? "srivc" : "srivc-auto";
+    // srivc-auto removes the means unless told otherwise (said on stderr by the loader).
+    if (a->method == "srivc-auto" && !a->given.count("detrend")) a->data.detrend = "auto-mean";
     g_run = [a] { return run(*a); };
   });
 }

@@ -31,6 +31,7 @@
 #include "ctid/estimate/physical.hpp"
 #include "ctid/estimate/rls_svf.hpp"
 #include "ctid/estimate/srivc.hpp"
+#include "ctid/estimate/srivc_auto.hpp"
 #include "ctid/io/csv.hpp"
 #include "ctid/io/file.hpp"
 #include "ctid/io/report.hpp"

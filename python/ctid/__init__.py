@@ -222,6 +222,14 @@ def srivc(data, nb, nf, nk=0, **options):
     return _ctid.srivc(data, nb, nf, nk, _options(_ctid.SrivcOptions, "srivc", options))
 
 
+def srivc_auto(data, **options):
+    """A transfer function without hand-picked orders: SRIVC for every nf = 1..nf_max (default 3), nb = 1..nf, each
+    with and without a delay search, the usable fit of least BIC (options: SrivcAutoOptions; ctid.settings("srivc_auto")
+    lists them). The structures tried are in result.diagnostics.vectors["structure_nb"], "structure_nf",
+    "structure_delay" and "structure_bic". The means are not removed: use data.detrend() first."""
+    return _ctid.srivc_auto(data, _options(_ctid.SrivcAutoOptions, "srivc_auto", options))
+
+
 def oe(data, nb, nf, nk=0, **options):
     """Continuous-time output error by Levenberg-Marquardt (options: OeOptions). data: an IdData or a list of IdData
     (several experiments of one system, fitted jointly)."""

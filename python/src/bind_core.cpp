@@ -1,5 +1,6 @@
 // ctid Python module — data, results, linear models, simulation and validation.
 #include "common.hpp"
+#include "ctid/core/check.hpp"
 
 namespace ctid::python {
 
@@ -49,7 +50,17 @@ void bind_core(py::module_& m) {
            py::arg("t0") = 0.0)
       .def(py::init<Eigen::MatrixXd, Eigen::MatrixXd, Eigen::VectorXd>(), py::arg("u"), py::arg("y"), py::arg("t"))
       .def_static("from_times", &IdData::from_times, py::arg("u"), py::arg("y"), py::arg("t"),
-                  "Samples at times t; uniform when every step is within 1e-6 of the mean step.")
+                  "Samples at times t; uniform when every time is within kUniformTimeTolerance (1e-3) sampling "
+                  "periods of a uniform grid (uniform_time_deviation() says how far).")
+      .def(
+          "detrend",
+          [](const IdData& d, const std::string& kind) {
+            CTID_REQUIRE(kind == "mean" || kind == "linear", "IdData.detrend: kind must be 'mean' or 'linear' (got '{}')",
+                         kind);
+            return d.detrend(kind == "mean" ? Detrend::Mean : Detrend::Linear);
+          },
+          py::arg("kind") = "mean",
+          "A copy with each channel's mean (kind='mean') or least-squares line in time (kind='linear') removed.")
       .def_property_readonly("u", &IdData::u)
       .def_property_readonly("y", &IdData::y)
       .def_property_readonly("ts", &IdData::ts)

@@ -83,6 +83,7 @@ void bind_linear(py::module_& m) {
   bind_options<OeOptions>(m, "OeOptions");
   bind_options<RlsSvfOptions>(m, "RlsSvfOptions");
 
+  bind_options<SrivcAutoOptions>(m, "SrivcAutoOptions");
   bind_options<SrivcMisoOptions>(m, "SrivcMisoOptions");
   bind_options<ClosedLoopOptions>(m, "ClosedLoopOptions");
   py::class_<FrequencyData>(m, "FrequencyData",
@@ -149,6 +150,11 @@ void bind_linear(py::module_& m) {
   def_tf_estimator<LssvfOptions>(m, "lssvf", &lssvf, "Johansson (1986) least squares on state-variable-filtered signals.");
   def_tf_estimator<IvsvfOptions>(m, "ivsvf", &ivsvf, "Johansson's regression with instrumental variables.");
   def_tf_estimator<SrivcOptions>(m, "srivc", &srivc, "Simplified refined instrumental variables (SISO).");
+  m.def(
+      "srivc_auto",
+      [](const IdData& d, const SrivcAutoOptions& o) { return interruptible([&] { return srivc_auto(d, o); }); },
+      py::arg("data"), py::arg("options") = SrivcAutoOptions{},
+      "SRIVC over nf = 1..nf_max, nb = 1..nf, each with and without a delay search; the least BIC.");
   // Several experiments (a list of IdData) of one system: one parameter set.
   def_experiments_estimator<SrivcOptions>(m, "srivc", &srivc);
   def_experiments_estimator<LssvfOptions>(m, "lssvf", &lssvf);

@@ -59,7 +59,9 @@ const std::vector<DiagnosticInfo>& diagnostic_catalogue() {
       info(diagnostic::singular_values), info(diagnostic::output_fit_percent),
       info(diagnostic::output_noise_variance), info(diagnostic::start_fit_percent), info(diagnostic::mode_wn_std),
       info(diagnostic::prediction_fit_percent), info(diagnostic::warm_up_iterations),
-      info(diagnostic::mode_zeta_std), info(diagnostic::chi2_per_dof), info(diagnostic::nx_grid), info(diagnostic::nx_grid_bic)};
+      info(diagnostic::mode_zeta_std), info(diagnostic::chi2_per_dof), info(diagnostic::nx_grid), info(diagnostic::nx_grid_bic),
+      info(diagnostic::structure_nb), info(diagnostic::structure_nf), info(diagnostic::structure_delay),
+      info(diagnostic::structure_bic)};
   return all;
 }
 

@@ -17,6 +17,7 @@
 #include "ctid/estimate/physical.hpp"
 #include "ctid/estimate/rls_svf.hpp"
 #include "ctid/estimate/srivc.hpp"
+#include "ctid/estimate/srivc_auto.hpp"
 #include "ctid/estimate/ssest.hpp"
 #include "ctid/estimate/subspace.hpp"
 
@@ -61,6 +62,12 @@ const std::vector<MethodInfo>& methods() {
                            {"RlsSvfOptions"}, reports(tau, experiments)),
       entry<SrivcOptions>("srivc", "simplified refined instrumental variables, one input", {"SrivcOptions"},
                           reports(delay, noise_variance, delay_grid, delay_grid_mse, time_scale, experiments)),
+      entry<SrivcAutoOptions>("srivc_auto",
+                              "SRIVC over nf = 1..nf_max, nb = 1..nf, with and without a delay; the least BIC "
+                              "(the default of ctid fit)",
+                              {"SrivcAutoOptions"},
+                              reports(delay, noise_variance, delay_grid, delay_grid_mse, time_scale, structure_nb,
+                                      structure_nf, structure_delay, structure_bic)),
       entry<SrivcMisoOptions>("srivc_miso", "SRIVC with several inputs (one transfer function per input)",
                               {"SrivcMisoOptions"}, reports(noise_variance, time_scale, experiments)),
       entry<ClosedLoopOptions>(

@@ -217,14 +217,14 @@ TEST(Cli, BadInputGivesOneLineAndTheDocumentedExitCode) {
       {"fit " + text_csv + base, 3, "text.csv:3: column 'force' (field 2): cannot read 'abc' as a number"},
       {"fit " + nan_csv + base, 3, "nan.csv:3: column 'force' (field 2): value 'nan' is not finite"},
       {"fit " + inf_csv + base, 3, "inf.csv:2: column 'position' (field 3): value '-Inf' is not finite"},
-      {"fit " + tiny + base + "--nf 2 --set tau=0.1", 2, "3 samples in the criterion cannot determine 4 free parameters"},
+      {"fit " + tiny + base + "--method lssvf --nf 2 --set tau=0.1", 2, "3 samples in the criterion cannot determine 4 free parameters"},
       {"fit " + tiny + base + "--method srivc --nb 2 --nf 4", 2, "srivc: 3 samples cannot determine 6 parameters"},
       {"fit " + nonincr + base, 3, "nonincr.csv:4: time column 'time' is not strictly increasing (0.1 after 0.2)"},
-      {"fit " + good_csv() + base + "--nf 0", 2, "nf (model order) must be >= 1 (got 0)"},
-      {"fit " + good_csv() + base + "--nf -2", 2, "nf (model order) must be >= 1 (got -2)"},
-      {"fit " + good_csv() + base + "--set tau=-0.5", 2, "tau must be > 0, or 0 (automatic) (got -0.5 s)"},
+      {"fit " + good_csv() + base + "--method lssvf --nf 0", 2, "nf (model order) must be >= 1 (got 0)"},
+      {"fit " + good_csv() + base + "--method lssvf --nf -2", 2, "nf (model order) must be >= 1 (got -2)"},
+      {"fit " + good_csv() + base + "--method lssvf --set tau=-0.5", 2, "tau must be > 0, or 0 (automatic) (got -0.5 s)"},
       {"fit " + good_csv() + base + "--method rls-svf --set tau=0", 2, "tau must be > 0 (got 0 s)"},
-      {"fit " + good_csv() + base + "--set bogus=1", 2, "--set bogus: not a setting of lssvf"},
+      {"fit " + good_csv() + base + "--method lssvf --set bogus=1", 2, "--set bogus: not a setting of lssvf"},
       {"fit " + good_csv() + base + "--method magic", 2, "magic"},
       {"fit " + write("untimed.csv", "a,force,position\n0,1,0\n1,0,1\n2,1,0\n") + " --input force --output position", 2,
        "--time COLUMN or --ts SECONDS"},
@@ -247,10 +247,10 @@ TEST(Cli, NoPartialOutputOnFailure) {
   EXPECT_FALSE(fs::exists(json));
   // No excitation: refused (exit 2); the input file is never overwritten.
   const std::string flat = write("flat.csv", "time,force,position\n0,0,0\n0.1,0,0\n0.2,0,0\n0.3,0,0\n0.4,0,0\n0.5,0,0\n");
-  r = ctid_run("fit " + flat + " --time time --input force --output position --set tau=1");
+  r = ctid_run("fit " + flat + " --time time --input force --output position --method lssvf --set tau=1");
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("input 'force' is constant (0)"), std::string::npos) << r.err;
-  r = ctid_run("fit " + flat + " --time time --input force --output position --set tau=1 --json " + flat + " --force");
+  r = ctid_run("fit " + flat + " --time time --input force --output position --method lssvf --set tau=1 --json " + flat + " --force");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("it is the input file"), std::string::npos) << r.err;
   EXPECT_EQ(read_csv(flat).values.rows(), 6);
@@ -261,6 +261,35 @@ TEST(Cli, DemoRunsOnBundledData) {
   ASSERT_EQ(r.code, 0) << r.err;
   // The DaISy dryer: a second-order model with 0.16 s delay; validation fit measured 88.3 %.
   EXPECT_NE(r.out.find("validation on the last 500 samples: fit 8"), std::string::npos) << r.out;
+}
+
+TEST(Cli, WithoutMethodAndOrdersTheDefaultChoosesTheStructureAndRemovesTheMeans) {
+  // Issue 17: `ctid fit DATA` on the bundled hair dryer (DaISy; no header: column 1 the input, 2 the output) runs
+  // srivc-auto, says on its first line which structure it chose, removes the means with a note naming them, and its
+  // model validates on the record's second half as SrivcAuto.HairDryerValidatesAbove85Percent does in the library.
+  const std::string dryer = std::string(CTID_EXAMPLES_DATA_DIR) + "/dryer.dat";
+  const std::string json = test::temp_path("auto.json");
+  fs::remove(json);
+  const CliRun r = ctid_run("fit " + dryer + " --ts 0.08 --input 1 --output 2 --json " + json);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("srivc-auto chose SRIVC with nb = ", 0), 0u) << r.out;  // the first line
+  EXPECT_NE(r.out.find("the least BIC of 12 structures"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("note: the means were removed (input 1 "), std::string::npos) << r.err;
+  // The first line's orders are the model's.
+  const auto res = parse_result_json(read_text_file(json));
+  const std::string orders = detail::format("nb = {}, nf = {}", res.model.num().degree() + 1, res.model.den().degree());
+  EXPECT_NE(r.out.substr(0, r.out.find('\n')).find(orders), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find(", output 2 4.89"), std::string::npos) << r.err;  // the dryer's output mean, 4.8901
+  // --detrend none keeps the offset and is warned about (the dryer's output mean is 4.9, 12 times its deviation).
+  const CliRun n = ctid_run("fit " + dryer + " --ts 0.08 --input 1 --output 2 --method srivc --nf 2 --detrend none");
+  EXPECT_NE(n.err.find("warning: output 2 has a mean of"), std::string::npos) << n.err;
+  // Orders without a method: SRIVC with them; orders with srivc-auto: refused, naming the alternative.
+  const CliRun o = ctid_run("fit " + dryer + " --ts 0.08 --input 1 --output 2 --detrend mean --nb 2 --nf 2 --nk 2");
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ(o.out.rfind("method: srivc ", 0), 0u) << o.out;
+  const CliRun bad = ctid_run("fit " + dryer + " --ts 0.08 --input 1 --output 2 --method srivc-auto --nf 2");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("srivc-auto chooses"), std::string::npos) << bad.err;
 }
 
 TEST(Cli, SrivcTfestWithDelayAndOrderSelection) {
@@ -1020,8 +1049,8 @@ TEST(Cli, TrustCampaign) {
   };
   const std::vector<Case> cases = {
       // Crashes of before: no input selection with a .mat file (default: every variable but time and output).
-      {"fit " + mat + " --time t --output y --nf 2 --nb 1 --set tau=0.3", 0, ""},
-      {"fit " + upper + " --time t --input u --output y --nf 2 --nb 1 --set tau=0.3", 0, ""},
+      {"fit " + mat + " --time t --output y --nf 2 --nb 1 --method lssvf --set tau=0.3", 0, ""},
+      {"fit " + upper + " --time t --input u --output y --nf 2 --nb 1 --method lssvf --set tau=0.3", 0, ""},
       // Non-regular files and files that are not text tables.
       {"fit /dev/zero --ts 1", 3, "'/dev/zero': it is a character device, not a data file"},
       {"fit " + dir + " --ts 1", 3, "it is a directory, not a data file"},
@@ -1029,11 +1058,11 @@ TEST(Cli, TrustCampaign) {
       {"fit " + good_csv() + base + "--input force", 2, "inputs 'force' and 'force' are the same column"},
       {"fit " + good_csv() + " --time time --input position --output position", 2, "both as an input and as the output"},
       // A BOM on a header-less file: the first row is data, the fit is that of the clean file.
-      {"fit " + bom + " --time 1 --input 2 --output 3 --nf 2 --nb 1 --set tau=0.3", 0, ""},
+      {"fit " + bom + " --time 1 --input 2 --output 3 --nf 2 --nb 1 --method lssvf --set tau=0.3", 0, ""},
       // Caps on grids and searches.
       {"fit " + good_csv() + base + "--method srivc --delay --set delay_grid=1e8", 2, "delay_grid must be in [1, 10000], or 0"},
-      {"fit " + good_csv() + base + "--set tau_grid_size=1e9", 2, "tau_grid_size must be in [2, 1000] (got 1000000000)"},
-      {"fit " + good_csv() + base + "--set tau_grid=20", 2, "not a setting of lssvf; did you mean 'tau_grid_size'?"},
+      {"fit " + good_csv() + base + "--method lssvf --set tau_grid_size=1e9", 2, "tau_grid_size must be in [2, 1000] (got 1000000000)"},
+      {"fit " + good_csv() + base + "--method lssvf --set tau_grid=20", 2, "not a setting of lssvf; did you mean 'tau_grid_size'?"},
       {"order " + good_csv() + base + "--nb 1:100 --nf 1:100 --nk 0:100", 2, "more than the limit of 2000"},
       // Flags that do not apply.
       {"fit " + good_csv() + base + "--method srivc --reference force", 2, "--reference needs --closed-loop-controller"},
@@ -1042,7 +1071,7 @@ TEST(Cli, TrustCampaign) {
       {"fit " + good_csv() + base + "--method srivc --narx " + narx, 2, "--narx gives KIA its NARX model"},
       {"fit " + good_csv() + base + "--method physical --via bogus", 2, "--via must be fsf, frequency or raw (got 'bogus')"},
       {"fit " + good_csv() + base + "--method narx --nf 2", 2, "--nf sets transfer-function orders"},
-      {"fit " + good_csv() + base + "--set tau=0.3 --set tau=0.4", 2, "--set tau is given twice"},
+      {"fit " + good_csv() + base + "--method lssvf --set tau=0.3 --set tau=0.4", 2, "--set tau is given twice"},
       {"fit " + good_csv() + base + "--closed-loop-controller " + ctrl + " --method oe", 2, "needs --method srivc"},
       // A fit the data cannot tell from no model.
       {"fit " + noise_csv + base + "--method tfest --nf 2", 1, "the data cannot tell this model from no model"},
@@ -1063,8 +1092,8 @@ TEST(Cli, TrustCampaign) {
     }
   }
   // The BOM file gives the clean file's numbers: a1 = 1.2 of 3/(s^2 + 1.2 s + 4) to the LSSVF accuracy (1e-2).
-  const CliRun b = ctid_run("fit " + bom + " --time 1 --input 2 --output 3 --nf 2 --nb 1 --set tau=0.3");
-  const CliRun g = ctid_run("fit " + good_csv() + base + "--nf 2 --nb 1 --set tau=0.3");
+  const CliRun b = ctid_run("fit " + bom + " --time 1 --input 2 --output 3 --nf 2 --nb 1 --method lssvf --set tau=0.3");
+  const CliRun g = ctid_run("fit " + good_csv() + base + "--nf 2 --nb 1 --method lssvf --set tau=0.3");
   auto params = [](const std::string& out) { return out.substr(out.find("a1"), out.find("filter time") - out.find("a1")); };
   EXPECT_EQ(params(b.out), params(g.out)) << b.out << g.out;
 }
@@ -1072,7 +1101,7 @@ TEST(Cli, TrustCampaign) {
 // Issue 13: outputs are checked against every input file and each other before the fit; special files and
 // symlinks are never replaced.
 TEST(Cli, OutputFilesNeverReplaceWhatTheUserGave) {
-  const std::string base = " --time time --input force --output position --nf 2 --nb 1 --set tau=0.3 ";
+  const std::string base = " --time time --input force --output position --nf 2 --nb 1 --method lssvf --set tau=0.3 ";
   const std::string narx = write("os_narx.json", R"J({"type": "narx", "ts": 0.01, "terms": [{"name": "y(k-1)", "value": 0.5}]})J");
   const std::string narx_text = read_text_file(narx);
   CliRun r = ctid_run("fit " + good_csv() + " --time time --input force --output position --method kia --narx " + narx +
@@ -1152,7 +1181,7 @@ TEST(Cli, ReportRefusesUnsoundResults) {
 // (set to its own default, the fit must not stop with a usage error naming it).
 TEST(Cli, MethodHelpListsEveryRegisteredSettingAndSetAcceptsIt) {
   const std::map<std::string, std::vector<std::string>> cli_methods = {
-      {"lssvf", {"lssvf"}}, {"ivsvf", {"ivsvf"}}, {"rls-svf", {"rls_svf"}},
+      {"srivc-auto", {"srivc_auto"}}, {"lssvf", {"lssvf"}}, {"ivsvf", {"ivsvf"}}, {"rls-svf", {"rls_svf"}},
       {"srivc", {"srivc", "srivc_miso", "srivc_closed_loop"}}, {"oe", {"oe", "tf_from_frequency"}},
       {"tfest", {"tfest", "tf_from_frequency"}}, {"fsf", {"fsf"}}, {"physical", {"physical"}},
       {"modal", {"modal"}}, {"narx", {"narx"}}, {"kia", {"kia", "narx"}}, {"greybox", {"greybox"}}, {"subspace", {"subspace"}},

@@ -24,6 +24,22 @@ foreach(exe consumer consumer_pc)
   endif()
   message(STATUS "${exe}: ${out}")
 endforeach()
+# The Python package lands under the prefix (not in the system's dist-packages) and imports from there.
+file(GLOB_RECURSE py_init ${prefix}/lib/python3*/__init__.py)
+list(FILTER py_init INCLUDE REGEX "/ctid/__init__.py$")
+if(PYTHON_EXE AND NOT py_init)
+  message(FATAL_ERROR "the Python package was not installed under ${prefix}")
+endif()
+if(py_init)
+  get_filename_component(pkg ${py_init} DIRECTORY)
+  get_filename_component(site ${pkg} DIRECTORY)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env PYTHONPATH=${site} ${PYTHON_EXE} -c
+                          "import ctid, sys; assert ctid.__file__.startswith('${prefix}'), ctid.__file__"
+                  WORKING_DIRECTORY ${WORK_DIR} RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(rc)
+    message(FATAL_ERROR "the installed Python package does not import from ${site}: ${err}")
+  endif()
+endif()
 # The installed CLI finds the installed demo data.
 execute_process(COMMAND ${prefix}/bin/ctid demo RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
 if(rc)

@@ -105,6 +105,12 @@ inline constexpr VectorDiagnostic mode_wn_std{"mode_wn_std", "rad/s",
 inline constexpr VectorDiagnostic mode_zeta_std{"mode_zeta_std", "", "standard deviation of each mode's damping ratio"};
 inline constexpr ScalarDiagnostic chi2_per_dof{
     "chi2_per_dof", "", "weighted residual sum of squares per degree of freedom (1: residuals at the given noise level)"};
+// srivc_auto: every structure tried, in the order tried.
+inline constexpr VectorDiagnostic structure_nb{"structure_nb", "", "numerator coefficients of each structure tried"};
+inline constexpr VectorDiagnostic structure_nf{"structure_nf", "", "model order of each structure tried"};
+inline constexpr VectorDiagnostic structure_delay{"structure_delay", "s",
+                                                  "input delay of each structure tried (0: fitted without delay)"};
+inline constexpr VectorDiagnostic structure_bic{"structure_bic", "", "BIC of each structure tried (NaN: not usable)"};
 inline constexpr VectorDiagnostic nx_grid{"nx_grid", "", "state dimensions tried by the order search"};
 inline constexpr VectorDiagnostic nx_grid_bic{"nx_grid_bic", "", "BIC of the fit at each state dimension tried"};
 inline constexpr ScalarDiagnostic start_scale{"start_scale", "",

@@ -4,6 +4,9 @@
 
 #include <ctid/ctid.hpp>
 
+// The project sets no C++ standard: ctid::ctid (INTERFACE_COMPILE_FEATURES cxx_std_20) and ctid.pc (-std=c++20) must.
+static_assert(__cplusplus >= 202002L, "the ctid target did not carry its C++20 requirement");
+
 int main() {
   const ctid::TransferFunction g(Eigen::VectorXd{{2.0}}, Eigen::VectorXd{{1.0, 2.0}});
   ctid::PrbsOptions po;

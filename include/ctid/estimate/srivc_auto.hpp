@@ -1,0 +1,43 @@
+// ctid — srivc_auto: a transfer function without hand-picked orders (issue 17; the default of `ctid fit`).
+//
+// What an expert does first with a new single-input record: SRIVC (Young & Jakeman 1980; estimate/srivc.hpp) for
+// every structure nf = 1..nf_max, nb = 1..nf (strictly proper), each once without an input delay and, with
+// try_delay, once with SRIVC's delay search (a grid over [delay_min, delay_max], then refinement); the structure of
+// least BIC among the usable fits is returned (Schwarz 1978; the delay counts as a parameter, so it is kept only
+// when the data show one). A fit is usable as in select_order (estimate/order_selection.hpp): converged, stable, no
+// pole beyond ten times the Nyquist frequency, no pole-zero pair cancelling within its confidence region.
+#pragma once
+
+#include "ctid/core/types.hpp"
+#include "ctid/data/iddata.hpp"
+#include "ctid/estimate/options.hpp"
+#include "ctid/estimate/srivc.hpp"
+#include "ctid/model/transfer_function.hpp"
+
+namespace ctid {
+
+struct SrivcAutoOptions {
+  int nf_max = 3;          ///< largest model order tried (nf = 1..nf_max, nb = 1..nf)
+  bool try_delay = true;   ///< also fit each structure with SRIVC's delay search; kept when its BIC is lower
+  /// The fits' settings (estimate_delay is set by the route); the delay search on a grid of 40 points (SRIVC's own
+  /// default is one per sample period, up to 200: the route runs it for every structure, and the refinement after
+  /// the grid finds the delay between its points).
+  SrivcOptions srivc = [] {
+    SrivcOptions s;
+    s.delay_grid = 40;
+    return s;
+  }();
+  void validate() const;
+};
+/// The settings of SrivcAutoOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
+template <>
+const OptionTable<SrivcAutoOptions>& option_table<SrivcAutoOptions>();
+
+/// The least-BIC usable SRIVC fit over the structures above (one input, one output). The result is that fit's, with
+/// diagnostics structure_nb, structure_nf, structure_delay (s; 0: fitted without delay) and structure_bic (NaN:
+/// not usable) of every structure tried, in the order tried. When no fit is usable the one of least BIC is returned
+/// (not usable, its own reason). Throws InvalidArgument for data that are not single-input single-output or too
+/// short, InvalidOptions for bad options.
+Result<TransferFunction> srivc_auto(const IdData& data, const SrivcAutoOptions& options = {});
+
+}  // namespace ctid
