@@ -92,12 +92,8 @@ void warn_offsets(const FitArgs& a, const IdData& d) {
                    "through the origin cannot fit that offset; add --detrend mean (or linear)\n", name.c_str(), m,
                    std::abs(m) / sd);
   };
-  auto name = [](const std::vector<std::string>& n, int j) {
-    return static_cast<int>(n.size()) > j && !n[static_cast<size_t>(j)].empty() ? n[static_cast<size_t>(j)]
-                                                                                : std::to_string(j + 1);
-  };
-  for (int j = 0; j < d.nu(); ++j) check(d.u().col(j), "input " + name(d.input_names(), j));
-  for (int j = 0; j < d.ny(); ++j) check(d.y().col(j), "output " + name(d.output_names(), j));
+  for (int j = 0; j < d.nu(); ++j) check(d.u().col(j), "input " + channel_name(d.input_names(), j));
+  for (int j = 0; j < d.ny(); ++j) check(d.y().col(j), "output " + channel_name(d.output_names(), j));
 }
 
 // Print, write the JSON file and the HTML report if asked, and map usability to the exit code.
@@ -727,7 +723,10 @@ void setup_fit(CLI::App& app) {
     if (a->method.empty())
       a->method = a->given.count("nb") || a->given.count("nf") || a->given.count("nk") ? "srivc" : "srivc-auto";
     // srivc-auto removes the means unless told otherwise (said on stderr by the loader).
-    if (a->method == "srivc-auto" && !a->given.count("detrend")) a->data.detrend = "auto-mean";
+    if (a->method == "srivc-auto" && !a->given.count("detrend")) {
+      a->data.detrend = "mean";
+      a->data.announce_means = true;
+    }
     g_run = [a] { return run(*a); };
   });
 }

@@ -24,26 +24,6 @@ void DataArgs::add_to(CLI::App& app, bool need_output) {
 }
 
 IdData DataArgs::load(bool need_output) const {
-  if (detrend == "auto-mean") {
-    // A command's own default (fit's srivc-auto): the means removed and said, with the values.
-    DataArgs plain = *this;
-    plain.detrend = "none";
-    const IdData d = plain.load(need_output);
-    auto name = [](const std::vector<std::string>& n, int j) {
-      return static_cast<int>(n.size()) > j && !n[static_cast<size_t>(j)].empty() ? n[static_cast<size_t>(j)]
-                                                                                  : std::to_string(j + 1);
-    };
-    std::string means;
-    char value[64];
-    for (int j = 0; j < d.nu() + d.ny(); ++j) {
-      const bool in = j < d.nu();
-      std::snprintf(value, sizeof value, "%.6g", in ? d.u().col(j).mean() : d.y().col(j - d.nu()).mean());
-      means += (j > 0 ? ", " : "") + std::string(in ? "input " : "output ") +
-               name(in ? d.input_names() : d.output_names(), in ? j : j - d.nu()) + " " + value;
-    }
-    std::fprintf(stderr, "note: the means were removed (%s); --detrend none keeps them\n", means.c_str());
-    return d.detrend(Detrend::Mean);
-  }
   if (detrend != "none" && detrend != "mean" && detrend != "linear")
     throw UsageError("--detrend must be none, mean or linear (got '" + detrend + "')");
   if (!(ts >= 0) || !std::isfinite(ts)) throw UsageError("--ts must be a positive number of seconds (got " + std::to_string(ts) + ")");
@@ -119,7 +99,21 @@ IdData DataArgs::load(bool need_output) const {
       std::fprintf(stderr, "note: %s: the sample times are within %.2g Ts of a uniform grid (threshold %g Ts): read as "
                    "uniform, Ts = %.10g s\n", path.c_str(), d.uniform_time_deviation(), IdData::kUniformTimeTolerance,
                    d.ts());
-    return detrend == "none" ? d : d.detrend(detrend == "mean" ? Detrend::Mean : Detrend::Linear);
+    if (detrend == "none") return d;
+    TrendInfo removed;
+    IdData out = d.detrend(detrend == "mean" ? Detrend::Mean : Detrend::Linear, &removed);
+    if (announce_means && detrend == "mean") {
+      std::string means;
+      char value[32];
+      for (int j = 0; j < d.nu() + d.ny(); ++j) {
+        const bool in = j < d.nu();
+        std::snprintf(value, sizeof value, "%.6g", in ? removed.u_offset(j) : removed.y_offset(j - d.nu()));
+        means += detail::format("{}{} {} {}", j > 0 ? ", " : "", in ? "input" : "output",
+                                channel_name(in ? d.input_names() : d.output_names(), in ? j : j - d.nu()), value);
+      }
+      std::fprintf(stderr, "note: the means were removed (%s); --detrend none keeps them\n", means.c_str());
+    }
+    return out;
   } catch (const FileError& e) {
     throw InputError(e.what());
   } catch (const InvalidArgument& e) {
@@ -131,6 +125,11 @@ IdData DataArgs::load(bool need_output) const {
       throw UsageError(what);
     throw InputError(path + ": " + what);
   }
+}
+
+std::string channel_name(const std::vector<std::string>& names, int j) {
+  const auto k = static_cast<size_t>(j);
+  return k < names.size() && !names[k].empty() ? names[k] : std::to_string(j + 1);
 }
 
 std::vector<IdData> DataArgs::load_each(const std::vector<std::string>& paths, bool need_output) const {

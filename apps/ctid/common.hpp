@@ -39,6 +39,8 @@ struct DataArgs {
   double ts = 0.0;
   std::string intersample = "zoh";
   std::string detrend = "none";
+  /// With detrend "mean": say on stderr which means were removed (a command's own default, not the user's option).
+  bool announce_means = false;
   void add_to(CLI::App& app, bool need_output);
   /// Load, select and detrend; maps every failure to InputError (file/content) or
   /// UsageError (inconsistent options).
@@ -190,6 +192,9 @@ void setup_poles(CLI::App& app);
 void setup_response(CLI::App& app);
 void setup_simulate(CLI::App& app);
 void setup_validate(CLI::App& app);
+/// The name of channel j (0-based) of a record: its name, or its 1-based position when it has none.
+std::string channel_name(const std::vector<std::string>& names, int j);
+
 void setup_demo(CLI::App& app);
 void setup_order(CLI::App& app);
 void setup_report(CLI::App& app);

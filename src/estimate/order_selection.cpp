@@ -76,11 +76,10 @@ std::vector<OrderCandidate> select_order(const IdData& data, OrderRange nb, Orde
         c.fit_percent = r.fit.fit_percent;
         if (!std::isfinite(c.yic)) c.usable = false;
         // A pole the data cannot resolve: the lower order describes them as well, so this one ranks after it.
-        for (const auto& pole : r.model.poles())
-          if (c.usable && std::abs(pole) > 10 * tf_detail::nyquist(data)) {
-            c.usable = false;
-            c.termination = "pole beyond the bandwidth";
-          }
+        if (c.usable && tf_detail::pole_beyond_bandwidth(r.model, data)) {
+          c.usable = false;
+          c.termination = "pole beyond the bandwidth";
+        }
         out.push_back(c);
       }
 ranked:

@@ -59,9 +59,7 @@ Result<TransferFunction> srivc_auto(const IdData& data, const SrivcAutoOptions& 
           if (!have) throw;
           goto done;
         }
-        bool usable = r.usable();
-        for (const auto& p : r.model.poles())
-          usable = usable && std::abs(p) <= 10 * tf_detail::nyquist(data);  // a pole the data cannot resolve
+        const bool usable = r.usable() && !tf_detail::pole_beyond_bandwidth(r.model, data);
         const double bic = r.fit.n_samples > 0 && std::isfinite(r.fit.bic) ? r.fit.bic : INFINITY;
         add(nbs, nb);
         add(nfs, nf);

@@ -58,6 +58,13 @@ double nyquist(const IdData& d) {
   return 3.14159265358979323846 / h;
 }
 
+bool pole_beyond_bandwidth(const TransferFunction& g, const IdData& d) {
+  const double wn = nyquist(d);
+  for (const auto& p : g.poles())
+    if (std::abs(p) > 10 * wn) return true;
+  return false;
+}
+
 bool warn_poles_beyond_bandwidth(Result<TransferFunction>& r, const IdData& d) {
   const double wn = nyquist(d);
   for (const auto& p : r.model.poles())

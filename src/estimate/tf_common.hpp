@@ -33,6 +33,9 @@ TransferFunction stabilized(const TransferFunction& tf);
 std::string poles_text(const TransferFunction& g);
 /// The Nyquist frequency of d in rad/s (pi over the mean sample interval).
 double nyquist(const IdData& d);
+/// Whether a pole of g is faster than 10 times the data's Nyquist frequency (the data cannot resolve it: a lower
+/// order describes them as well) — a structure that ranks after the usable ones in select_order and srivc_auto.
+bool pole_beyond_bandwidth(const TransferFunction& g, const IdData& d);
 /// A warning for each pole of r.model faster than 10 times the data's Nyquist frequency: the data cannot
 /// resolve it (a lower order likely describes them as well). Returns whether there was one.
 bool warn_poles_beyond_bandwidth(Result<TransferFunction>& r, const IdData& d);
