@@ -235,11 +235,6 @@ int run_frequency(const FitArgs& a) {
   return r.usable() ? kOk : kNotUsable;
 }
 
-// Gawthrop & Wang: the FSF window needs its settling time (the library's validate() checks the rest).
-void require_fsf_window(const FsfOptions& o) {
-  if (o.T == 0) throw UsageError("the FSF window needs --set T=SECONDS (settling time of the, possibly shifted, system)");
-}
-
 void write_fsf_responses(const std::string& prefix, const FsfModel& f) {
   const int K = 501;
   Eigen::MatrixXd tm(K, 5);
@@ -264,7 +259,6 @@ void write_fsf_responses(const std::string& prefix, const FsfModel& f) {
 int run_fsf(const FitArgs& a, const IdData& d) {
   FsfOptions o;
   apply_sets("fsf", a.sets, o);
-  require_fsf_window(o);
   const Result<FsfModel> r = call_library([&] { return fsf(d, o); });
   const int code = finish(r, "fsf", d, a, settings_of(o));
   if (!a.responses.empty()) write_fsf_responses(a.responses, r.model);
@@ -324,11 +318,11 @@ int run_physical_records(const FitArgs& a, const std::vector<IdData>& ds) {
                           fo.a);
       return fit_physical_raw(model, ps, ds, fo.a, po);
     }
-    require_fsf_window(fo);
     const Result<FsfModel> c = fsf(d, fo);
     Result<TransferFunction> q =
         a.via == "frequency" ? fit_physical_frequency(model, ps, c.model, po, &d) : fit_physical_step(model, ps, c.model, po, &d);
     for (const auto& w : c.diagnostics.warnings) q.diagnostics.warnings.push_back("fsf: " + w);
+    for (const auto& w : c.diagnostics.choices) q.diagnostics.choices.push_back("fsf: " + w);
     return q;
   });
   Settings settings = a.via == "raw" ? Settings{{"a", options_detail::format_real(fo.a)}} : settings_of(fo);

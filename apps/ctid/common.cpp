@@ -267,6 +267,13 @@ int to_int(const std::string& key, const std::string& value) {
 }
 
 namespace {
+// The automatic choices, the summary's note and the warnings: the lines after every result.
+void print_notes(const Summary& s, const Diagnostics& dg) {
+  for (const auto& c : dg.choices) std::printf("chosen: %s\n", c.c_str());
+  if (!s.message.empty()) std::printf("note: %s\n", s.message.c_str());
+  for (const auto& w : dg.warnings) std::printf("warning: %s\n", w.c_str());
+}
+
 template <class M>
 void print_any(const Result<M>& r, const std::string& method, const IdData& d, const std::string& model) {
   std::printf("method: %s   samples: %d   %s\n", method.c_str(), d.size(),
@@ -289,8 +296,7 @@ void print_any(const Result<M>& r, const std::string& method, const IdData& d, c
               r.fit.aic, r.fit.bic);
   if (r.diagnostics.condition_number > 0) std::printf("condition number %.3g   ", r.diagnostics.condition_number);
   std::printf("termination: %s   %.3g s\n", to_string(r.summary.termination), r.summary.seconds);
-  if (!r.summary.message.empty()) std::printf("note: %s\n", r.summary.message.c_str());
-  for (const auto& w : r.diagnostics.warnings) std::printf("warning: %s\n", w.c_str());
+  print_notes(r.summary, r.diagnostics);
 }
 }  // namespace
 
@@ -378,8 +384,7 @@ void print_result(const Result<StateSpace>& r, const std::string& method, const 
                   fit_percent_text(f(j)).c_str());
   }
   std::printf("\ntermination: %s   %.3g s\n", to_string(r.summary.termination), r.summary.seconds);
-  if (!r.summary.message.empty()) std::printf("note: %s\n", r.summary.message.c_str());
-  for (const auto& w : r.diagnostics.warnings) std::printf("warning: %s\n", w.c_str());
+  print_notes(r.summary, r.diagnostics);
 }
 
 void print_result(const Result<FsfModel>& r, const std::string& method, const IdData& d) {
@@ -396,7 +401,7 @@ void print_result(const Result<FsfModel>& r, const std::string& method, const Id
     std::printf("  t = %8.4g s   y = %10.5g +- %.3g\n", t, f.step_response(tv)(0), f.step_response_std(tv)(0));
   }
   std::printf("termination: %s   %.3g s\n", to_string(r.summary.termination), r.summary.seconds);
-  for (const auto& w : r.diagnostics.warnings) std::printf("warning: %s\n", w.c_str());
+  print_notes(r.summary, r.diagnostics);
 }
 
 }  // namespace ctid::cli

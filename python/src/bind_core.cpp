@@ -42,6 +42,8 @@ void bind_core(py::module_& m) {
   py::class_<Diagnostics>(m, "Diagnostics", "Numerical diagnostics: condition number, warnings, method-specific numbers.")
       .def_readonly("condition_number", &Diagnostics::condition_number)
       .def_readonly("warnings", &Diagnostics::warnings)
+      .def_readonly("choices", &Diagnostics::choices,
+                    "settings the estimator chose itself (left automatic), one line each: 'NAME = VALUE: why'")
       .def_property_readonly("scalars", &Diagnostics::scalars, "method-specific numbers by name (ctid.diagnostics())")
       .def_property_readonly("vectors", &Diagnostics::vectors, "method-specific vectors by name (ctid.diagnostics())");
 

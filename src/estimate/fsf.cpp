@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <complex>
 #include <numbers>
@@ -15,6 +16,7 @@
 #include "ctid/model/transfer_function.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/validate/metrics.hpp"
+#include "estimate/tf_common.hpp"
 #include "internal/least_squares.hpp"
 
 namespace ctid {
@@ -26,9 +28,12 @@ const OptionTable<FsfOptions>& option_table<FsfOptions>() {
   using O = FsfOptions;
   static const OptionTable<O> t =
       OptionTable<O>("fsf")
-          .real("T", &O::T, "s", above(0), "settling time of the (shifted) system; T/Ts must be a whole number")
-          .integer("n", &O::n, "", at_least(1), "number of frequency-sampling filters, odd, <= T/Ts")
-          .real("a", &O::a, "1/s", at_least(0), "exponential window e^{-at}; > every unstable pole's real part")
+          .real("T", &O::T, "s", or_special(above(0), 0, "automatic"),
+                "window: settling time of the (shifted) system, rounded to whole sampling periods; 0: a pre-estimate's")
+          .integer("n", &O::n, "", or_special(at_least(1), 0, "automatic"),
+                   "number of frequency-sampling filters, odd, <= T/Ts; 0: to cover a pre-estimate's bandwidth")
+          .real("a", &O::a, "1/s", at_least(0),
+                "exponential window e^{-at}; > every unstable pole's real part; 0 and unstable: chosen")
           .real("b", &O::b, "1/s", at_least(0), "residual weighting e^{bt}, <= a (b > 0 is risky, see the method page)")
           .reals("weights", &O::weights, "", at_least(0), "per-sample residual weights; none: 1")
           .flag("unstable", &O::unstable, "the plant is unstable: then the window a must be > 0");
@@ -37,12 +42,105 @@ const OptionTable<FsfOptions>& option_table<FsfOptions>() {
 
 void FsfOptions::validate() const {
   option_table<FsfOptions>().check(*this);
-  CTID_REQUIRE_OPTION(n % 2 == 1, "fsf: the number of filters n must be odd and >= 1 (got {})", n);
+  CTID_REQUIRE_OPTION(n == 0 || n % 2 == 1, "fsf: the number of filters n must be odd and >= 1, or 0: automatic (got {})", n);
   CTID_REQUIRE_OPTION(b <= a, "fsf: b = {} must not exceed a = {} (e^{(b-a)t} must not grow)", b, a);
-  CTID_REQUIRE_OPTION(!unstable || a > 0,
-                      "fsf: the plant is declared unstable: give a window a > 0 larger than its fastest unstable pole "
-                      "(got a = {})",
-                      a);
+}
+
+namespace {
+std::string g4(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", x);
+  return b;
+}
+}  // namespace
+
+FsfOptions fsf_settings(const IdData& data, const FsfOptions& given, std::vector<std::string>* choices) {
+  given.validate();
+  require_io_data(data, "fsf");
+  CTID_REQUIRE(data.is_uniform(), "fsf: needs uniformly sampled data");
+  FsfOptions o = given;
+  const double Ts = data.ts(), duration = data.size() * Ts;
+  const int M = data.size();
+  auto note = [&](std::string line) {
+    if (choices) choices->push_back(std::move(line));
+  };
+  if (o.T > 0) {  // a given window: whole sampling periods
+    const double Nd = o.T / Ts;
+    CTID_REQUIRE(Nd <= 1e9, "fsf: T = {} s is more than 1e9 sampling periods of {} s", o.T, Ts);
+    const long long N = std::max(1LL, std::llround(Nd));
+    if (std::abs(Nd - N) > 1e-9 * std::max(1.0, Nd)) {
+      note(detail::format("T = {} s (N = {}): the given {} s rounded to whole sampling periods of {} s", N * Ts, N, o.T, Ts));
+      o.T = N * Ts;
+    }
+  }
+  // The pre-estimate, when anything is automatic.
+  const bool auto_a = o.a == 0 && o.unstable;
+  if (o.T > 0 && o.n > 0 && !auto_a) return o;
+  Result<TransferFunction> pre;
+  try {
+    pre = tf_detail::pre_estimate(data, 0, o.unstable);
+  } catch (const InvalidArgument& e) {
+    CTID_REQUIRE(false, "fsf: no pre-estimate for the automatic settings ({}); give T, n (and a) with the options",
+                 e.what());
+  }
+  const TransferFunction& g = pre.model;
+  const std::string source = detail::format("pre-estimate {}", g.to_string(4));
+  double max_re = -INFINITY;
+  for (const auto& p : g.poles()) max_re = std::max(max_re, p.real());
+  if (o.a == 0 && (o.unstable || max_re >= 0)) {
+    o.a = std::max(1.5 * std::max(max_re, 0.0), 20.0 / duration);
+    note(detail::format("a = {} 1/s: the window of {}, 1.5 times the largest real part {} of the {}'s poles (at least "
+                        "20 / record duration){}",
+                        g4(o.a), o.unstable ? "a plant declared unstable" : "an unstable or integrating pre-estimate", g4(max_re),
+                        source, max_re < 0 ? "; it has no unstable pole although the plant is declared unstable: check a" : ""));
+  }
+  if (o.T == 0) {
+    double settle = 0;
+    try {
+      settle = fsf_settling_time(g, o.a, 1e-3, duration);
+    } catch (const InvalidArgument&) {
+      CTID_REQUIRE(false, "fsf: the window a = {} does not stabilise the pre-estimate (poles {}); give a larger a", o.a,
+                   tf_detail::poles_text(g));
+    }
+    long long N = std::max(3LL, static_cast<long long>(std::ceil(settle / Ts - 1e-9)));
+    std::string why = detail::format("settling time (impulse response below 1e-3 of its peak) of the {}{}", source,
+                                     o.a > 0 ? ", shifted by a = " + g4(o.a) : std::string());
+    if (N > M / 2) {
+      N = std::max(3, M / 2);
+      why += detail::format("; limited to half the record: the record ({} s) is shorter than twice the settling time "
+                            "({} s), so late parts of the response are cut off — a longer record or a window a > 0 helps",
+                            g4(duration), g4(settle));
+    }
+    o.T = N * Ts;
+    note(detail::format("T = {} s (N = {}): {}", g4(o.T), N, why));
+  }
+  if (o.n == 0) {
+    const long long N = std::llround(o.T / Ts);
+    // The frequency where |G(a + jw)| has fallen to 3 % of its largest value on [0, Nyquist].
+    const double w_nyq = std::numbers::pi / Ts, w_1 = 2 * std::numbers::pi / o.T;
+    const int K = 400;
+    std::vector<double> w(K + 1), mag(K + 1);
+    w[0] = 0;
+    double peak = 0;
+    for (int k = 0; k <= K; ++k) {
+      if (k > 0) w[k] = w_1 * 0.1 * std::pow(10 * w_nyq / w_1, double(k - 1) / (K - 1));
+      mag[k] = std::abs(g(std::complex<double>(o.a, w[k])));
+      peak = std::max(peak, mag[k]);
+    }
+    double wc = w_nyq;
+    for (int k = K; k >= 0; --k)
+      if (mag[k] > 0.03 * peak) {
+        wc = std::min(w_nyq, k < K ? w[k + 1] : w[K]);
+        break;
+      }
+    const long long m_band = static_cast<long long>(std::ceil(wc / w_1));
+    const long long cap = std::min<long long>({101, N % 2 ? N : N - 1, std::max(3, M / 10) | 1});
+    o.n = static_cast<int>(std::max<long long>(std::min<long long>(2 * m_band + 1, cap), std::min<long long>(3, cap)));
+    note(detail::format("n = {}: filter frequencies up to {} rad/s, where |G(a + jw)| of the {} has fallen to 3 % of "
+                        "its peak{}",
+                        o.n, g4((o.n - 1) / 2 * w_1), source, 2 * m_band + 1 > cap ? detail::format(" (limited to {})", cap) : std::string()));
+  }
+  return o;
 }
 
 namespace {
@@ -65,19 +163,15 @@ Result<FsfModel> fsf_result(const internal::LinearSolution& sol, double Ts, int 
 }
 }  // namespace
 
-Result<FsfModel> fsf(const IdData& data, const FsfOptions& o) {
+Result<FsfModel> fsf(const IdData& data, const FsfOptions& given) {
   const auto start = std::chrono::steady_clock::now();
-  o.validate();
-  require_io_data(data, "fsf");
-  CTID_REQUIRE(data.is_uniform(), "fsf: needs uniformly sampled data");
+  std::vector<std::string> choices;
+  const FsfOptions o = fsf_settings(data, given, &choices);
   const double Ts = data.ts();
-  const double Nd = o.T / Ts;
-  CTID_REQUIRE(Nd <= 1e9, "fsf: T = {} s is more than 1e9 sampling periods of {} s", o.T, Ts);
-  const int N = static_cast<int>(std::lround(Nd));
-  CTID_REQUIRE(std::abs(Nd - N) <= 1e-9 * std::max(1.0, Nd) && N >= 1,
-               "fsf: T = {} s is not a whole multiple of the sampling period {} s (T/Ts = {})", o.T, Ts, Nd);
   const int M = data.size();
-  CTID_REQUIRE(N <= M, "fsf: T = {} s ({} samples) is longer than the record ({} samples, {} s)", o.T, N, M, M * Ts);
+  CTID_REQUIRE(o.T / Ts <= M + 0.5, "fsf: T = {} s ({} samples) is longer than the record ({} samples, {} s)", o.T,
+               std::llround(o.T / Ts), M, M * Ts);
+  const int N = static_cast<int>(std::lround(o.T / Ts));
   CTID_REQUIRE(o.n <= N, "fsf: n = {} filters exceed N = T/Ts = {}", o.n, N);
   CTID_REQUIRE(o.a * o.T <= 300, "fsf: a*T = {} is too large (a = {}, T = {} s): the window e^(-aT) would leave "
                "nothing of the record after the first T seconds; choose a <= {}", o.a * o.T, o.a, o.T, 300 / o.T);
@@ -179,6 +273,7 @@ Result<FsfModel> fsf(const IdData& data, const FsfOptions& o) {
   }
 
   Result<FsfModel> r = fsf_result(sol, Ts, N, o.n, o.a);
+  r.diagnostics.choices = std::move(choices);
   // fit is the simulation fit on the estimation data, as for every estimator: the FSF model (a finite impulse
   // response) simulated from rest. The regression's own figure, on the windowed and weighted data, has its own
   // name. With a window a > 0 the model is G(s + a), which cannot be simulated as the system: no fit.
@@ -219,6 +314,9 @@ Result<FsfModel> fsf_from_spectra(const Eigen::VectorXcd& Uin, const Eigen::Vect
                                   const FsfOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   o.validate();
+  CTID_REQUIRE_OPTION(o.T > 0 && o.n > 0, "fsf_from_spectra: give the window T (s) and the number of filters n (got T = {}, "
+                      "n = {}): spectra leave no record to pre-estimate them from", o.T, o.n);
+  CTID_REQUIRE_OPTION(!o.unstable || o.a > 0, "fsf_from_spectra: the plant is declared unstable: give a window a > 0");
   CTID_REQUIRE_OPTION(o.b == 0.0, "fsf_from_spectra: b must be 0 in the frequency domain (got {})", o.b);
   CTID_REQUIRE(std::isfinite(Ts) && Ts > 0, "fsf_from_spectra: the sampling period must be > 0 (got {})", Ts);
   CTID_REQUIRE(L >= 2 && L % 2 == 0, "fsf_from_spectra: the DFT length L must be even (got {})", L);

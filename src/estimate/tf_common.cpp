@@ -12,6 +12,8 @@
 #include "ctid/core/check.hpp"
 #include "ctid/core/types.hpp"
 #include "ctid/estimate/lssvf.hpp"
+#include "ctid/estimate/srivc.hpp"
+#include "ctid/estimate/srivc_auto.hpp"
 #include <limits>
 
 #include "ctid/simulate/lsim.hpp"
@@ -63,6 +65,36 @@ bool pole_beyond_bandwidth(const TransferFunction& g, const IdData& d) {
   for (const auto& p : g.poles())
     if (std::abs(p) > 10 * wn) return true;
   return false;
+}
+
+Result<TransferFunction> pre_estimate(const IdData& data, int nf, bool equation_error) {
+  const IdData d = data.detrend(Detrend::Mean);
+  auto good = [](const Result<TransferFunction>& r) { return r.usable() && r.model.is_stable(); };
+  // SRIVC first (consistent under output noise); it needs a stable plant and an open loop, so LSSVF (equation
+  // error) is the fallback.
+  if (!equation_error) try {
+    Result<TransferFunction> r;
+    if (nf > 0) {
+      r = srivc(d, TfOrders{nf, nf, 0});
+    } else {
+      SrivcAutoOptions o;
+      o.try_delay = false;
+      r = srivc_auto(d, o);
+    }
+    if (good(r)) return r;
+  } catch (const InvalidArgument&) {
+  }
+  if (nf > 0 || equation_error) return lssvf(d, TfOrders{nf > 0 ? nf : 2, nf > 0 ? nf : 2, 0});
+  Result<TransferFunction> best;
+  bool have = false;
+  for (int n = 1; n <= 3; ++n) {
+    Result<TransferFunction> r = lssvf(d, TfOrders{n, n, 0});
+    if (good(r) && std::isfinite(r.fit.bic) && (!have || r.fit.bic < best.fit.bic)) {
+      best = std::move(r);
+      have = true;
+    }
+  }
+  return have ? best : lssvf(d, TfOrders{2, 2, 0});
 }
 
 bool warn_poles_beyond_bandwidth(Result<TransferFunction>& r, const IdData& d) {

@@ -40,6 +40,16 @@ bool pole_beyond_bandwidth(const TransferFunction& g, const IdData& d);
 /// resolve it (a lower order likely describes them as well). Returns whether there was one.
 bool warn_poles_beyond_bandwidth(Result<TransferFunction>& r, const IdData& d);
 
+/// A rough model of d for the automatic settings of other methods (the FSF window, modal shifts), fitted to the
+/// record with its means removed: SRIVC of order nf (nb = nf; nf = 0: srivc_auto without the delay search) when
+/// that fit is usable and stable; otherwise LSSVF with the automatic tau (equation error: it also serves unstable
+/// plants and closed-loop records) of order nf, or for nf = 0 the least BIC over nf = 1..3 among the usable stable
+/// fits (nf = 2 when there is none). equation_error: LSSVF only, of order nf or 2 (a plant known to be unstable:
+/// its records come from a closed loop, where SRIVC would describe the loop, and a simulation criterion cannot
+/// rank unstable fits). Throws InvalidArgument when no fit is possible
+/// (constant input, too short a record).
+Result<TransferFunction> pre_estimate(const IdData& d, int nf = 0, bool equation_error = false);
+
 /// Time and amplitude normalisation of a SISO transfer-function estimation (issue 13: results must not depend
 /// on the units of time, input and output). With t' = t / c, u' = u / su, y' = y / sy, the model
 /// G(s) = B(s)/A(s) (A monic of degree n, B with nb coefficients b_j of s^(nb-1-j)) becomes

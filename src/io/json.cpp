@@ -431,6 +431,7 @@ std::string result_json(const Result<AnyModel>& r, const std::string& method, in
   json d;
   d["condition_number"] = num(r.diagnostics.condition_number);
   d["warnings"] = r.diagnostics.warnings;
+  d["choices"] = r.diagnostics.choices;
   d["scalars"] = json::object();
   for (const auto& [k, v] : r.diagnostics.scalars()) d["scalars"][k] = num(v);
   d["vectors"] = json::object();
@@ -475,6 +476,7 @@ void read_envelope(const json& j, const Reader& rd, Result<M>& r) {
       const json& d = j.at("diagnostics");
       r.diagnostics.condition_number = to_num(d.at("condition_number"));
       r.diagnostics.warnings = d.at("warnings").get<std::vector<std::string>>();
+      if (d.contains("choices")) r.diagnostics.choices = d.at("choices").get<std::vector<std::string>>();
       for (const auto& [k, v] : d.at("scalars").items()) r.diagnostics.set_stored(k, to_num(v));
       for (const auto& [k, v] : d.at("vectors").items()) r.diagnostics.set_stored(k, rd.vector(v, "diagnostics.vectors"));
     }

@@ -291,6 +291,10 @@ void overview(Page& page, const IdData& d, const Result<M>& r, const ReportOptio
     page.section("Method settings");
     page.table({"setting", "value"}, s);
   }
+  if (!r.diagnostics.choices.empty()) {
+    page.section("Automatic choices");
+    for (const auto& c : r.diagnostics.choices) page.text(escape(c));
+  }
   if (!r.diagnostics.warnings.empty()) {
     page.section("Warnings");
     for (const auto& w : r.diagnostics.warnings) page.text("<span class=\"warn\">" + escape(w) + "</span>");

@@ -502,14 +502,25 @@ TEST(Cli, GawthropWangFsfAndPhysical) {
   EXPECT_NEAR(res.parameters.value("k2"), 1.0, 0.05);
   r = ctid_run("fit " + csv + " --time t --method physical --model \"k1/(s^2-k2)\" --param k1=2 --param k2=0 --via raw --set a=2");
   EXPECT_EQ(r.code, 0) << r.err;
+  // Issue 17: declaring the plant unstable is enough; the window, T and n are chosen, printed and recorded.
+  fs::remove(json);
+  r = ctid_run("fit " + csv + " --time t --method physical --model \"k1/(s^2-k2)\" --param k1=2 --param k2=0 --set unstable=1 "
+               "--json " + json);
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* line : {"chosen: fsf: a = ", "chosen: fsf: T = ", "chosen: fsf: n = "})
+    EXPECT_NE(r.out.find(line), std::string::npos) << line << "\n" << r.out;
+  const auto automatic = parse_result_json(read_text_file(json));
+  EXPECT_EQ(automatic.diagnostics.choices.size(), 3u);
+  EXPECT_NEAR(automatic.parameters.value("k1"), 1.0, 0.05);
+  EXPECT_NEAR(automatic.parameters.value("k2"), 1.0, 0.05);
   struct Case {
     std::string args, message;
   };
   const std::vector<Case> bad = {
-      {"--method fsf --set T=8 --set n=20 --set a=2", "n must be odd and >= 1 (got 20)"},
-      {"--method fsf --set T=8.005 --set a=2", "is not a whole multiple of the sampling period"},
+      {"--method fsf --set T=8 --set n=20 --set a=2", "n must be odd and >= 1, or 0: automatic (got 20)"},
+      {"--method fsf --set T=8 --set n=0.5", "n must be a whole number"},
       {"--method fsf --set T=80 --set a=2", "longer than the record"},
-      {"--method fsf --set T=8 --set unstable=1", "declared unstable"},
+      {"--method fsf --set T=8 --set a=2 --set b=3", "must not exceed a"},
       {"--method physical --model \"k1/(s^2-k3)\" --param k1=2 --param k2=0 --set T=8 --set a=2",
        "unknown symbol 'k3' (parameters: k1, k2) at column 9"},
       {"--method physical --model \"k1/(s^2-k2\" --param k1=2 --param k2=0 --set T=8 --set a=2", "expected ')' at column 11"},

@@ -150,7 +150,7 @@ TEST(Options, RegistryListsEachMethodOnceWithDocumentedDefaults) {
   EXPECT_EQ(default_of("srivc", "max_iterations"), std::to_string(SrivcOptions{}.max_iterations));
   EXPECT_EQ(default_of("oe", "tolerance"), "1e-12");
   EXPECT_EQ(default_of("lssvf", "tau_grid_size"), "12");
-  EXPECT_EQ(default_of("fsf", "n"), "21");
+  EXPECT_EQ(default_of("fsf", "n"), "0");
   EXPECT_EQ(default_of("physical", "step_points"), "1000");
   EXPECT_EQ(default_of("tfest", "start_max_iterations"), "50");
   EXPECT_EQ(default_of("srivc_closed_loop", "reference_at_plant_input"), "1");
@@ -166,8 +166,8 @@ TEST(Options, ValidateUsesTheTableAndKeepsCrossFieldRules) {
   f.n = 20;
   EXPECT_NE(error_of([&] { f.validate(); }).find("must be odd"), std::string::npos);
   f.n = 21;
-  f.unstable = true;
-  EXPECT_NE(error_of([&] { f.validate(); }).find("declared unstable"), std::string::npos);
+  f.b = 1;
+  EXPECT_NE(error_of([&] { f.validate(); }).find("must not exceed a"), std::string::npos);
   f.a = 2;
   f.validate();
   SrivcOptions s;

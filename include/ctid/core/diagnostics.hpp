@@ -60,7 +60,7 @@ inline constexpr ScalarDiagnostic B_at_minus_1_over_tau{"B_at_minus_1_over_tau",
 inline constexpr VectorDiagnostic tau_grid{"tau_grid", "s", "filter time constants tried by the automatic choice"};
 inline constexpr VectorDiagnostic tau_grid_fit_percent{"tau_grid_fit_percent", "%", "simulation fit at each tau tried"};
 // FSF (Gawthrop & Wang 2005) and physical parameters.
-inline constexpr ScalarDiagnostic fsf_N{"N", "", "number of frequency-sampling filters"};
+inline constexpr ScalarDiagnostic fsf_N{"N", "", "FSF window length T / Ts in samples"};
 inline constexpr ScalarDiagnostic fsf_a{"a", "1/s", "exponential window: the model is G(s + a)"};
 inline constexpr ScalarDiagnostic fsf_b{"b", "1/s", "FSF filter pole shift b"};
 inline constexpr ScalarDiagnostic regression_fit_percent{"regression_fit_percent", "%",
@@ -140,6 +140,10 @@ class Diagnostics {
  public:
   double condition_number = 0.0;             ///< of the column-scaled regressor / information matrix
   std::vector<std::string> warnings;         ///< things the user should look at; empty when none
+  /// Settings the estimator chose itself because they were left automatic, one line each:
+  /// "NAME = VALUE (unit): why" (e.g. the FSF window from a pre-estimate's settling time). Empty when every
+  /// setting was given.
+  std::vector<std::string> choices;
 
   void set(const ScalarDiagnostic& key, double value) { scalars_[std::string(key.name)] = value; }
   /// record: the record of a per-record diagnostic (0 = the first).

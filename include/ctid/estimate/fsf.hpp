@@ -11,6 +11,9 @@
 // The fitted model is then that of the shifted system G(s + a).
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include <Eigen/Dense>
 
 #include "ctid/core/types.hpp"
@@ -21,27 +24,43 @@
 namespace ctid {
 
 struct FsfOptions {
-  double T = 0.0;     ///< settling time (s) of the (shifted) system; N = T/Ts must be a whole number
-  int n = 21;         ///< number of filters, odd, <= N
-  double a = 0.0;     ///< exponential window e^{-at} (1/s), >= 0; choose a > max Re(poles) for unstable plants
+  /// Window T (s): the settling time of the (shifted) system, rounded to a whole number N of sampling periods.
+  /// 0: automatic — the time after which a pre-estimate's impulse response (of G(s + a)) stays below 1e-3 of its
+  /// peak, at most half the record.
+  double T = 0.0;
+  /// Number of filters, odd, <= N. 0: automatic — the filter frequencies 2 pi k / T (k <= (n-1)/2) reach the
+  /// frequency where the pre-estimate's |G(a + jw)| has fallen to 3 % of its largest value (n <= 101 and <= 1/10
+  /// of the record's samples).
+  int n = 0;
+  /// Exponential window e^{-at} (1/s), >= 0; must exceed every unstable pole's real part. 0 for a plant declared
+  /// unstable or a pre-estimate with a pole at Re >= 0: automatic, 1.5 times the largest such real part (at least
+  /// 20 / record duration) — the smallest a with a margin for the pre-estimate's error (GW: "use the minimum
+  /// appropriate a"; on the unstable-circuit stand-in a = 1.5 gives a 2 to 6 times smaller spread than a = 2).
+  double a = 0.0;
   double b = 0.0;     ///< residual weighting e^{bt} (1/s), 0 <= b <= a; b > 0 is risky (see the method page)
   Eigen::VectorXd weights;  ///< optional per-sample residual weights (>= 0, length N_data); empty: 1
-  bool unstable = false;    ///< the plant is declared unstable: validate() then requires a > 0
+  bool unstable = false;    ///< the plant is declared unstable: a window a > 0 is used (chosen when a = 0)
   void validate() const;
 };
 /// The settings of FsfOptions (name, unit, range, default, doc): validate(), the CLI and Python use it.
 template <>
 const OptionTable<FsfOptions>& option_table<FsfOptions>();
 
-/// Fit an FSF model to one input and one output (uniform Ts). Throws InvalidArgument /
-/// InvalidOptions for: even n, n > N, T not a whole multiple of Ts (to 1e-9) or longer than
-/// the record, b > a, negative weights, non-SISO or irregular data. A warning is reported
-/// when b > 0 and the record is longer than T (SEEDS-SPEC GW-A2 pitfall).
+/// Fit an FSF model to one input and one output (uniform Ts). T, n and a left automatic (0) are chosen from a
+/// pre-estimate (LSSVF, equation error: also for unstable plants and closed-loop records) as documented in
+/// FsfOptions; each choice, and a T rounded to whole sampling periods, is a line of diagnostics.choices. Throws
+/// InvalidArgument / InvalidOptions for: even n, n > N, T longer than the record, b > a, negative weights, non-SISO
+/// or irregular data. A warning is reported when b > 0 and the record is longer than T (SEEDS-SPEC GW-A2 pitfall).
 /// Parameters: "theta0", "re_theta1", "im_theta1", ...; fit: one-step output of the discrete
 /// FSF model against the windowed output.
 Result<FsfModel> fsf(const IdData& data, const FsfOptions& options);
 
-/// Stage 1 from spectra (GW 24-29, SEEDS-SPEC GW-A4): U and Y are the one-sided DFTs (bins
+/// The settings fsf() runs with on `data`: T (a whole number of sampling periods), n and a completed as
+/// documented in FsfOptions; `choices` (if given) receives one line per setting chosen or rounded. Throws
+/// InvalidArgument when a setting is automatic and no pre-estimate can be made.
+FsfOptions fsf_settings(const IdData& data, const FsfOptions& options, std::vector<std::string>* choices = nullptr);
+
+/// Stage 1 from spectra (GW 24-29, SEEDS-SPEC GW-A4); T and n must be given (there is no record to pre-estimate): U and Y are the one-sided DFTs (bins
 /// 0..L/2, L even) of input and output records of M samples at Ts, zero-padded to L >= M + N so
 /// that linear and circular convolution coincide. The window a is applied as inverse FFT ->
 /// e^{-at} -> FFT (the paper's recommendation); b must be 0 (the authors define no frequency-
