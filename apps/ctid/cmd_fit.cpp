@@ -369,9 +369,10 @@ int run_modal_records(const FitArgs& a, const std::vector<IdData>& ds) {
   if (nk < 0) throw UsageError("--nk must be >= 0");
   std::map<std::string, std::string> own;
   ModalOptions o = modal_options("modal", a.sets, d.ts(), {"frequencies"}, own);
-  if (o.shifts.size() != n)
+  if (o.shifts.size() == 0) o.order = n;  // the shifts are chosen (and stated)
+  else if (o.shifts.size() != n)
     throw UsageError(detail::format("modal needs one shift per pole: --set shifts=T1,..,T{} (s) or shift_samples=S1,..,S{} "
-                                    "(samples; got {} for --nf {})",
+                                    "(samples; got {} for --nf {}), or none (chosen automatically)",
                                     n, n, o.shifts.size(), n));
   if (nk > 0) {
     if (o.delay > 0) throw UsageError("give the input delay once: --nk (samples) or --set delay (s)");

@@ -46,14 +46,6 @@ void FsfOptions::validate() const {
   CTID_REQUIRE_OPTION(b <= a, "fsf: b = {} must not exceed a = {} (e^{(b-a)t} must not grow)", b, a);
 }
 
-namespace {
-std::string g4(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", x);
-  return b;
-}
-}  // namespace
-
 FsfOptions fsf_settings(const IdData& data, const FsfOptions& given, std::vector<std::string>* choices) {
   given.validate();
   require_io_data(data, "fsf");
@@ -91,7 +83,7 @@ FsfOptions fsf_settings(const IdData& data, const FsfOptions& given, std::vector
     o.a = std::max(1.5 * std::max(max_re, 0.0), 20.0 / duration);
     note(detail::format("a = {} 1/s: the window of {}, 1.5 times the largest real part {} of the {}'s poles (at least "
                         "20 / record duration){}",
-                        g4(o.a), o.unstable ? "a plant declared unstable" : "an unstable or integrating pre-estimate", g4(max_re),
+                        detail::significant(o.a), o.unstable ? "a plant declared unstable" : "an unstable or integrating pre-estimate", detail::significant(max_re),
                         source, max_re < 0 ? "; it has no unstable pole although the plant is declared unstable: check a" : ""));
   }
   if (o.T == 0) {
@@ -104,15 +96,15 @@ FsfOptions fsf_settings(const IdData& data, const FsfOptions& given, std::vector
     }
     long long N = std::max(3LL, static_cast<long long>(std::ceil(settle / Ts - 1e-9)));
     std::string why = detail::format("settling time (impulse response below 1e-3 of its peak) of the {}{}", source,
-                                     o.a > 0 ? ", shifted by a = " + g4(o.a) : std::string());
+                                     o.a > 0 ? ", shifted by a = " + detail::significant(o.a) : std::string());
     if (N > M / 2) {
       N = std::max(3, M / 2);
       why += detail::format("; limited to half the record: the record ({} s) is shorter than twice the settling time "
                             "({} s), so late parts of the response are cut off — a longer record or a window a > 0 helps",
-                            g4(duration), g4(settle));
+                            detail::significant(duration), detail::significant(settle));
     }
     o.T = N * Ts;
-    note(detail::format("T = {} s (N = {}): {}", g4(o.T), N, why));
+    note(detail::format("T = {} s (N = {}): {}", detail::significant(o.T), N, why));
   }
   if (o.n == 0) {
     const long long N = std::llround(o.T / Ts);
@@ -138,7 +130,7 @@ FsfOptions fsf_settings(const IdData& data, const FsfOptions& given, std::vector
     o.n = static_cast<int>(std::max<long long>(std::min<long long>(2 * m_band + 1, cap), std::min<long long>(3, cap)));
     note(detail::format("n = {}: filter frequencies up to {} rad/s, where |G(a + jw)| of the {} has fallen to 3 % of "
                         "its peak{}",
-                        o.n, g4((o.n - 1) / 2 * w_1), source, 2 * m_band + 1 > cap ? detail::format(" (limited to {})", cap) : std::string()));
+                        o.n, detail::significant((o.n - 1) / 2 * w_1), source, 2 * m_band + 1 > cap ? detail::format(" (limited to {})", cap) : std::string()));
   }
   return o;
 }

@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "ctid/core/check.hpp"
+#include "ctid/model/modal.hpp"
 #include "ctid/estimate/lssvf.hpp"
 #include "ctid/signal/walsh.hpp"
 #include "ctid/simulate/lsim.hpp"
@@ -56,7 +57,9 @@ const OptionTable<ModalOptions>& option_table<ModalOptions>() {
   static const OptionTable<O> t = [] {
     OptionTable<O> x("modal");
     x.reals("shifts", &O::shifts, "s", above(0),
-            "T_1 < .. < T_n, one per system pole, whole multiples of Ts (the CLI also takes shift_samples)")
+            "T_1 < .. < T_n, one per system pole, whole multiples of Ts (the CLI also takes shift_samples); none: "
+            "chosen for `order` by the conditioning of a pre-estimate")
+        .integer("order", &O::order, "", at_least(0), "system order n when shifts are left automatic")
         .choice("basis", &O::basis,
                 {{"automatic", std::optional<ModalBasis>()}, {"fourier", std::optional(ModalBasis::Fourier)},
                  {"walsh", std::optional(ModalBasis::Walsh)}, {"discrete", std::optional(ModalBasis::Discrete)}},
@@ -96,7 +99,10 @@ ModalOptions ModalOptions::resolved(bool piecewise_constant) const {
 
 void ModalOptions::validate() const {
   option_table<ModalOptions>().check(*this);
-  CTID_REQUIRE_OPTION(shifts.size() >= 1, "modal: at least one shift is needed (one per system pole)");
+  CTID_REQUIRE_OPTION(shifts.size() >= 1 || order >= 1,
+                      "modal: give the system order (order = n: the shifts are then chosen) or the shifts (one per pole)");
+  CTID_REQUIRE_OPTION(shifts.size() == 0 || order == 0 || order == shifts.size(),
+                      "modal: order = {} but {} shifts are given (one per pole)", order, shifts.size());
   for (Eigen::Index i = 0; i < shifts.size(); ++i) {
     CTID_REQUIRE_OPTION(std::isfinite(shifts(i)) && shifts(i) > 0, "modal: shift {} must be > 0 (got {} s)", i + 1,
                         shifts(i));
@@ -412,6 +418,7 @@ Result<TransferFunction> modal_transfer_function(const IdData& data, const Input
 namespace {
 Result<TransferFunction> modal_fit_undelayed(const std::vector<IdData>& data, int nb, ModalOptions o,
                                              const InputGenerator* input);
+Eigen::VectorXd automatic_shifts(const IdData& d, int n, bool piecewise_constant, std::vector<std::string>& choices);
 }  // namespace
 
 Result<TransferFunction> modal_fit(const IdData& data, int nb, ModalOptions o, const InputGenerator* input) {
@@ -426,29 +433,73 @@ Result<TransferFunction> modal_fit(const std::vector<IdData>& data, int nb, Moda
                "{} records are fitted jointly with piecewise-constant inputs, or one at a time", data.size());
   for (std::size_t e = 0; e < data.size(); ++e)
     require_io_data(data[e], data.size() > 1 ? detail::format("modal_fit (record {})", e + 1).c_str() : "modal_fit");
-  if (o.delay == 0.0) return modal_fit_undelayed(data, nb, o.resolved(input == nullptr), input);
   // The delayed input (zero before each record): the fit sees a delay-free system.
   std::vector<IdData> delayed;
-  for (const IdData& d : data) {
-    CTID_REQUIRE(d.is_uniform(), "modal_fit: a delay needs uniformly sampled data");
-    const double k = o.delay / d.ts();
-    CTID_REQUIRE_OPTION(std::abs(k - std::round(k)) <= 1e-9 * std::max(1.0, k),
-                        "modal_fit: delay = {} s is not a whole multiple of the sampling period {} s", o.delay, d.ts());
-    const int nk = static_cast<int>(std::lround(k));
-    CTID_REQUIRE(nk < d.size(), "modal_fit: the delay {} s is not shorter than the record ({} samples)", o.delay, d.size());
-    Eigen::MatrixXd u = Eigen::MatrixXd::Zero(d.size(), 1);
-    u.bottomRows(d.size() - nk) = d.u().topRows(d.size() - nk);
-    delayed.emplace_back(u, d.y(), d.ts(), d.t0());
-    delayed.back().set_intersample(0, d.intersample(0));
+  if (o.delay > 0.0) {
+    for (const IdData& d : data) {
+      CTID_REQUIRE(d.is_uniform(), "modal_fit: a delay needs uniformly sampled data");
+      const double k = o.delay / d.ts();
+      CTID_REQUIRE_OPTION(std::abs(k - std::round(k)) <= 1e-9 * std::max(1.0, k),
+                          "modal_fit: delay = {} s is not a whole multiple of the sampling period {} s", o.delay, d.ts());
+      const int nk = static_cast<int>(std::lround(k));
+      CTID_REQUIRE(nk < d.size(), "modal_fit: the delay {} s is not shorter than the record ({} samples)", o.delay, d.size());
+      Eigen::MatrixXd u = Eigen::MatrixXd::Zero(d.size(), 1);
+      u.bottomRows(d.size() - nk) = d.u().topRows(d.size() - nk);
+      delayed.emplace_back(u, d.y(), d.ts(), d.t0());
+      delayed.back().set_intersample(0, d.intersample(0));
+    }
   }
+  const std::vector<IdData>& fitted = o.delay > 0.0 ? delayed : data;
+  std::vector<std::string> choices;
+  if (o.shifts.size() == 0) o.shifts = automatic_shifts(fitted.front(), o.order, input == nullptr, choices);
   const double delay = o.delay;
   o.delay = 0.0;
-  Result<TransferFunction> r = modal_fit_undelayed(delayed, nb, o.resolved(input == nullptr), input);
-  r.model.set_io_delay(delay);
+  Result<TransferFunction> r = modal_fit_undelayed(fitted, nb, o.resolved(input == nullptr), input);
+  if (delay > 0.0) r.model.set_io_delay(delay);
+  r.diagnostics.choices = std::move(choices);
   return r;
 }
 
 namespace {
+// The shifts of modal_fit left automatic: see modal.hpp.
+Eigen::VectorXd automatic_shifts(const IdData& d, int n, bool piecewise_constant, std::vector<std::string>& choices) {
+  CTID_REQUIRE(d.is_uniform(), "modal_fit: automatic shifts need uniformly sampled data");
+  const double Ts = d.ts(), duration = d.size() * Ts;
+  double max_shift = duration / 4;
+  std::string limit = "a quarter of the record";
+  if (piecewise_constant) {
+    std::vector<int> runs;
+    int run = 1;
+    for (int i = 1; i < d.size(); ++i) {
+      if (d.u()(i, 0) == d.u()(i - 1, 0)) {
+        ++run;
+      } else {
+        runs.push_back(run);
+        run = 1;
+      }
+    }
+    runs.push_back(run);
+    std::nth_element(runs.begin(), runs.begin() + static_cast<std::ptrdiff_t>(runs.size() / 2), runs.end());
+    const double half_level = 0.5 * runs[runs.size() / 2] * Ts;
+    if (half_level < max_shift) {
+      max_shift = half_level;
+      limit = "half the median level duration";
+    }
+  }
+  CTID_REQUIRE(max_shift >= n * Ts,
+               "modal_fit: no room for {} automatic shifts: {} is {} s, less than n Ts = {} s; give the shifts", n, limit,
+               max_shift, n * Ts);
+  const Result<TransferFunction> pre = tf_detail::pre_estimate(d, n);
+  const ShiftChoice c = choose_modal_shifts(pre.model, Ts, max_shift);
+  const double spacing = c.shifts(0);
+  choices.push_back(detail::format("shifts = i * {} s (i = 1..{}; {} samples apart): the spacing that minimises cond(psi) "
+                                   "(= {}) of the pre-estimate {}, T_n at most {} ({} s)",
+                                   detail::significant(spacing), n, std::lround(spacing / Ts),
+                                   detail::significant(c.condition, 3), pre.model.to_string(4), limit,
+                                   detail::significant(max_shift)));
+  return c.shifts;
+}
+
 Result<TransferFunction> modal_fit_undelayed(const std::vector<IdData>& data, int nb, ModalOptions o,
                                              const InputGenerator* input) {
   const auto t_start = std::chrono::steady_clock::now();

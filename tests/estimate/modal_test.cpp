@@ -497,6 +497,18 @@ TEST(ModalFit, PiecewiseConstantInputsGiveTheTransferFunctionByBothRoutes) {
     EXPECT_NEAR(r.parameters.value("b0"), 13.0, 1e-5);
     EXPECT_NEAR(r.parameters.value("b1"), 52.0, 1e-5);
   }
+  // Issue 17: the shifts left to modal_fit (order 3 only): uniform shifts with T_3 <= half the 80-sample levels, from
+  // the conditioning scan of an SRIVC pre-estimate (chosen: 10 samples apart); noise-free the same S3 to 1e-6 (measured
+  // 5e-8), the choice stated.
+  {
+    const auto r = modal_fit(d, 2, {.order = 3});
+    ASSERT_TRUE(r.usable()) << r.why_not_usable();
+    EXPECT_LT(max_rel(r.model.den().coefficients(), kS3.den().coefficients()), 1e-6);
+    ASSERT_EQ(r.diagnostics.choices.size(), 1u);
+    EXPECT_NE(r.diagnostics.choices[0].find("half the median level duration"), std::string::npos) << r.diagnostics.choices[0];
+    EXPECT_THROW(modal_fit(d, 2, {}), InvalidOptions);  // neither shifts nor order
+    EXPECT_THROW(modal_fit(d, 2, {.shifts = shifts, .order = 2}), InvalidOptions);
+  }
   EXPECT_THROW(modal_fit(d, 4, {.shifts = shifts}), InvalidArgument);  // nb > n
   EXPECT_THROW(modal_fit(d, 2, {.shifts = Eigen::Vector3d(16, 32, 56) * Ts, .basis = ModalBasis::Discrete}),
                InvalidArgument);  // non-uniform shifts on the Discrete route

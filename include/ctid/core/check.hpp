@@ -41,6 +41,14 @@ std::string format(std::string_view f, const Args&... args) {
   return os.str();
 }
 
+/// `v` to `digits` significant digits ("1.365", "16.57", "8.523") — for numbers in prose (automatic choices).
+inline std::string significant(double v, int digits = 4) {
+  std::ostringstream os;
+  os.precision(digits);
+  os << v;
+  return os.str();
+}
+
 /// The shortest text that reads back as exactly `v` ("0.1", "1e-300", "inf", "nan").
 inline std::string round_trip(double v) {
   char buf[32];

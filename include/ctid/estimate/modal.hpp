@@ -51,7 +51,10 @@ enum class ModalBasis {
 };
 
 struct ModalOptions {
-  Eigen::VectorXd shifts;            ///< T_1 < ... < T_n (seconds, > 0, multiples of Ts); n = system order
+  /// T_1 < ... < T_n (seconds, > 0, multiples of Ts); n = system order. Empty in modal_fit: uniform shifts chosen
+  /// for `order` (choose_modal_shifts on a pre-estimate of that order; see modal_fit).
+  Eigen::VectorXd shifts;
+  int order = 0;                     ///< system order n when shifts is empty (0 with shifts given, or their count)
   /// none: automatic — Walsh for a piecewise-constant input in modal_fit (the thesis' choice for step inputs),
   /// Fourier otherwise.
   std::optional<ModalBasis> basis;
@@ -104,6 +107,10 @@ Result<TransferFunction> modal_transfer_function(const IdData& data, const Input
 ///    T_i = i T, the poles are s_k = ln(z_k)/T from z^n + p_01 z^{n-1} + .. + p_0n = 0 (ES-C1 scalar form).
 ///    The numerator (nb coefficients b_0..b_{nb-1}) is linear once A(s) is known: least squares of the
 ///    output on the exact responses of s^j/A(s) to the held input, from rest.
+/// Shifts left empty (options.order = n): T_i = i d with the spacing d (a multiple of Ts) that minimises cond(psi)
+/// of a pre-estimate of order n (SRIVC, or LSSVF when SRIVC is not usable) — choose_modal_shifts — with T_n at
+/// most half the median level duration of a piecewise-constant input (a quarter of the record for a generated
+/// one), so that windows remain after every switch; stated in diagnostics.choices.
 /// fit compares the model's simulated output with the data. Throws InvalidArgument as modal_estimate,
 /// or when nb is outside [1, n], or the shifts are not uniform for the Discrete piecewise route.
 Result<TransferFunction> modal_fit(const IdData& data, int nb, ModalOptions options,
