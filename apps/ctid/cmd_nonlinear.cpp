@@ -75,6 +75,7 @@ int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, co
     throw UsageError(e.what());
   }
   const Result<NdeModel>& k = run.reconstructed;
+  for (const auto& c : k.diagnostics.choices) std::printf("chosen: %s\n", c.c_str());
   std::printf("NDE: %s\n", k.model.to_string(5).c_str());
   const Eigen::VectorXd& err = k.diagnostics.get(diagnostic::err);
   for (int i = 0; i < k.parameters.size(); ++i)

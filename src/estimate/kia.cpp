@@ -329,7 +329,9 @@ void fill_parameters(R& res, const std::vector<std::string>& names, const Eigen:
   res.summary.iterations = g.iterations;
   if (g.order > 0) {
     res.summary.termination = g.converged ? Termination::Converged : Termination::MaxIterations;
-    if (!g.converged) res.summary.message = "the GLS iterations did not converge; the last iterate is returned";
+    if (!g.converged)
+      res.summary.message = detail::format("the iteration limit ended the GLS iterations, not convergence ({} iterations); "
+                                           "the last iterate is returned; raise max_iterations", g.iterations);
   }
 }
 // The model plus the retained candidates with their estimated coefficients (linear, quadratic and cubic stages).
@@ -471,6 +473,28 @@ KiaRun kia(const IdData& d, const NarxModel& narx, const KiaOptions& o) {
   return kia(std::vector<IdData>{d}, narx, o);
 }
 
+std::vector<NdeTerm> kia_product_candidates(int degree, int y_order, int u_order) {
+  CTID_REQUIRE(degree >= 1 && y_order >= 0 && u_order >= 0, "kia_product_candidates: degree {} >= 1, orders {} and {} >= 0",
+               degree, y_order, u_order);
+  std::vector<NdeFactor> factors;
+  for (int l = 0; l < y_order; ++l) factors.push_back({false, l});  // D^{y_order} y appears once, linearly
+  for (int l = 0; l <= u_order; ++l) factors.push_back({true, l});
+  std::vector<NdeTerm> out;
+  std::vector<int> idx(static_cast<size_t>(degree), 0);  // non-decreasing indices: unordered products
+  const int F = static_cast<int>(factors.size());
+  while (true) {
+    NdeTerm t;
+    for (int i : idx) t.factors.push_back(factors[static_cast<size_t>(i)]);
+    out.push_back(t);
+    int k = degree - 1;
+    while (k >= 0 && idx[static_cast<size_t>(k)] == F - 1) --k;
+    if (k < 0) break;
+    ++idx[static_cast<size_t>(k)];
+    for (int j = k + 1; j < degree; ++j) idx[static_cast<size_t>(j)] = idx[static_cast<size_t>(k)];
+  }
+  return out;
+}
+
 KiaRun kia(const std::vector<IdData>& ds, const NarxModel& narx, const KiaOptions& o) {
   CTID_REQUIRE(!ds.empty(), "kia: no records");
   const int E = static_cast<int>(ds.size());
@@ -498,8 +522,28 @@ KiaRun kia(const std::vector<IdData>& ds, const NarxModel& narx, const KiaOption
     next.diagnostics.set(diagnostic::err, e);
     return next;
   };
-  if (!o.quadratic.candidates.empty()) r = stack(r, kia_quadratic(narx, r.model, o.quadratic));
-  if (!o.cubic.candidates.empty()) r = stack(r, kia_cubic(narx, r.model, o.cubic));
+  // Stages of degree 2 and 3: the given candidates, or every product (when the NARX model has such terms).
+  std::vector<std::string> choices;
+  auto stage = [&](auto options, int degree) {
+    bool narx_has = false;
+    for (const NarxTerm& t : narx.terms()) narx_has = narx_has || t.degree() == degree;
+    if (options.candidates.empty() && narx_has) {
+      options.candidates = kia_product_candidates(degree, o.linear.y_order, o.linear.u_order);
+      if (options.err_threshold == 0.0) options.err_threshold = 0.01;
+      options.points.count = std::max(options.points.count, 2 * static_cast<int>(options.candidates.size()));
+      choices.push_back(detail::format(
+          "{} candidates: all {} products of y..D^{}y, u..D^{}u ({} point {}), pruned below ERR {} % after convergence "
+          "(the NARX model has terms of degree {})",
+          degree == 2 ? "quadratic" : "cubic", options.candidates.size(), o.linear.y_order - 1, o.linear.u_order,
+          options.points.count, degree == 2 ? "pairs" : "triples", options.err_threshold, degree));
+    }
+    return options;
+  };
+  const KiaQuadraticOptions quadratic = stage(o.quadratic, 2);
+  const KiaCubicOptions cubic = stage(o.cubic, 3);
+  if (!quadratic.candidates.empty()) r = stack(r, kia_quadratic(narx, r.model, quadratic));
+  if (!cubic.candidates.empty()) r = stack(r, kia_cubic(narx, r.model, cubic));
+  r.diagnostics.choices = choices;
   // The equation's simulated output on each record (from rest), pooled.
   Eigen::Index total = 0;
   for (const IdData& d : ds) total += d.size();
@@ -544,7 +588,10 @@ KiaRun kia(const std::vector<IdData>& ds, const NarxModel& narx, const KiaOption
         "or the sampling is too slow for kernel invariance",
         std::round(r.fit.fit_percent * 100) / 100, std::round(run.narx_fit_percent * 100) / 100);
   }
-  if (o.refine) run.refined = nde_oe(ds, r.model, o.refinement);
+  if (o.refine) {
+    run.refined = nde_oe(ds, r.model, o.refinement);
+    run.refined->diagnostics.choices.insert(run.refined->diagnostics.choices.begin(), choices.begin(), choices.end());
+  }
   return run;
 }
 

@@ -392,7 +392,8 @@ Result<TransferFunction> ivsvf(const std::vector<IdData>& data, const TfOrders& 
   if (!converged && out.summary.termination == Termination::Completed) {
     out.summary.termination = term;
     if (term == Termination::MaxIterations)
-      out.summary.message = detail::format("IV iterations did not converge to a relative change of {} within {} iterations",
+      out.summary.message = detail::format("the iteration limit ended the IV iterations, not convergence: no relative change below {} in "
+                                           "{} iterations; raise max_iterations",
                                            options.tolerance, options.max_iterations);
     else if (out.summary.message.empty())
       out.summary.message = "the instrumental-variable equations became singular or non-finite";

@@ -96,7 +96,8 @@ void set_termination(Result<M>& r, bool rank_deficient, bool converged, double t
     r.summary.message = singular_message;
   } else if (!converged) {
     r.summary.termination = Termination::MaxIterations;
-    r.summary.message = detail::format("no convergence to a relative change of {} in {} iterations", tolerance, max_iterations);
+    r.summary.message = detail::format("the iteration limit ended the IV iterations, not convergence: no relative change "
+                                       "below {} in {} iterations; raise max_iterations", tolerance, max_iterations);
   } else {
     r.summary.termination = Termination::Converged;
   }

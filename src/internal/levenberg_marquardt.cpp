@@ -68,7 +68,7 @@ LmResult lm(const Evaluate& normal, Eigen::VectorXd x, const Eigen::VectorXd& lo
     res.message = "the model cannot be evaluated at the initial parameters";
     return res;
   }
-  double lambda = o.lambda0;
+  double lambda = o.lambda0, last_rel = NAN;
   for (int it = 1; it <= o.max_iterations; ++it) {
     if (!report_progress("levenberg_marquardt", it, cost)) {
       res.interrupted = true;
@@ -97,6 +97,7 @@ LmResult lm(const Evaluate& normal, Eigen::VectorXd x, const Eigen::VectorXd& lo
         x = xt;
         lambda = std::max(lambda / 10, 1e-12);
         accepted = true;
+        last_rel = rel;
         if (rel < o.ftol || dx < o.xtol) res.converged = true;
         if (!o.final_normal && (res.converged || it == o.max_iterations)) {
           cost = ct;  // the search ends here and the caller needs no J^T J
@@ -115,7 +116,11 @@ LmResult lm(const Evaluate& normal, Eigen::VectorXd x, const Eigen::VectorXd& lo
     }
     if (res.converged) break;
   }
-  if (!res.converged && res.message.empty()) res.message = "iteration limit reached";
+  if (!res.converged && res.message.empty())
+    res.message = detail::format("the iteration limit ended the search, not convergence: {} iterations, the cost still "
+                                 "falling (by a relative {} in the last); raise max_iterations (e.g. {}) or check the "
+                                 "start and the scaling",
+                                 o.max_iterations, detail::significant(last_rel, 2), 4 * o.max_iterations);
   res.x = x;
   res.cost = cost;
   res.lambda = lambda;

@@ -20,7 +20,7 @@ namespace ctid {
 struct FrequencyFitOptions {
   int sk_iterations = 30;        ///< Sanathanan-Koerner iterations (>= 1)
   bool refine = true;            ///< output-error refinement after SK
-  int max_iterations = 100;      ///< LM iterations of the refinement
+  int max_iterations = 500;      ///< LM iterations of the refinement (a well-posed fit converges long before)
   double tolerance = 1e-12;
   bool estimate_delay = false;   ///< add an input delay T (s) to the refinement ("delay")
   double delay = 0.0;            ///< fixed or initial delay (s)

@@ -27,7 +27,7 @@
 namespace ctid {
 
 struct GreyboxOptions {
-  int max_iterations = 100;      ///< Levenberg-Marquardt iterations per start
+  int max_iterations = 500;      ///< Levenberg-Marquardt iterations per start (a well-posed fit converges long before)
   double tolerance = 1e-8;       ///< relative cost decrease or parameter change that stops a search
   int starts = 1;                ///< multi-start: the model's values plus starts - 1 drawn within the bounds
   int seed = 1;                  ///< seed of the drawn starts

@@ -106,14 +106,23 @@ const OptionTable<KiaCubicOptions>& option_table<KiaCubicOptions>();
 /// NdeModel::h3). Returns model + the retained cubic terms (normalised).
 Result<NdeModel> kia_cubic(const NarxModel& narx, const NdeModel& model, const KiaCubicOptions& options);
 
+/// The default candidates of a stage: every product of `degree` factors (unordered, repetition allowed) of y,
+/// D y .. D^{y_order - 1} y, u .. D^{u_order} u, in the order y-factors first, lower derivatives first.
+std::vector<NdeTerm> kia_product_candidates(int degree, int y_order, int u_order);
+
 /// The whole workflow from a record and the NARX model identified from it (what `ctid fit --method kia` and
 /// Python's ctid.kia run): the linear stage, the quadratic and cubic stages when they have candidates, stacked
 /// into one equation; its simulation on the record; the check that it reproduces its NARX model; and the
 /// output-error refinement (nde_oe, consistent under output noise), which replaces the equation when usable.
 struct KiaOptions {
   KiaLinearOptions linear;
-  KiaQuadraticOptions quadratic;  ///< no candidates: no quadratic stage
-  KiaCubicOptions cubic;          ///< no candidates: no cubic stage
+  /// Candidates left empty: when the NARX model has terms of degree 2 (3), all products of two (three) of y,
+  /// D y .. D^{y_order - 1} y, u .. D^{u_order} u (linear stage's orders; the highest derivative of y appears once,
+  /// linearly, so that the equation can be solved for it), pruned after convergence at err_threshold, or
+  /// at 0.01 % when that is 0 (Billings & Li's over-parameterise -> converge -> prune -> re-estimate; their example's
+  /// threshold). No stage when the NARX model has no terms of that degree.
+  KiaQuadraticOptions quadratic;
+  KiaCubicOptions cubic;          ///< as quadratic, for degree 3
   bool refine = true;             ///< refine the reconstructed equation by output error on the record
   NdeOeOptions refinement;
   void validate() const;

@@ -20,7 +20,7 @@
 namespace ctid {
 
 struct NdeOeOptions {
-  int max_iterations = 50;
+  int max_iterations = 500;  ///< Levenberg-Marquardt iterations (a well-posed fit converges long before)
   double tolerance = 1e-9;             ///< relative cost decrease or parameter change that stops the search
   bool estimate_initial_state = true;  ///< estimate [y, Dy, .., D^{L-1}y] at the first sample; false: from rest
   /// Coefficients held at a value, by term name (fixed.u=-1.1) — the constraint vocabulary of oe, lssvf and

@@ -27,7 +27,7 @@
 namespace ctid {
 
 struct OeOptions {
-  int max_iterations = 100;
+  int max_iterations = 500;  ///< Levenberg-Marquardt iterations (a well-posed fit converges long before)
   double tolerance = 1e-12;      ///< relative cost decrease / parameter change that stops the search
   /// Starting model; empty: LSSVF with an automatic filter (oe) or SRIVC (tfest).
   std::optional<TransferFunction> initial;

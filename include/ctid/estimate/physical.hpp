@@ -27,7 +27,7 @@ struct PhysicalParameter {
 };
 
 struct PhysicalFitOptions {
-  int max_iterations = 100;
+  int max_iterations = 500;  ///< Levenberg-Marquardt iterations (a well-posed fit converges long before)
   double tolerance = 1e-12;
   int step_points = 1000;   ///< samples of the compressed step response on [0, T] (step route)
   /// Raw route: estimate each record's initial state instead of starting it from rest — the free response of the
