@@ -117,6 +117,7 @@ int run_poles(PolesArgs a) {
     for (const auto& w : p.warnings) std::printf("  warning: %s\n", w.c_str());
   };
   std::printf("free response: %d samples, Ts = %.6g s, order %d\n", d.size(), Ts, a.order);
+  for (const auto& choice : c.choices) std::printf("chosen: %s\n", choice.c_str());
   print("data-matrix method (Theorem 4.3, El-Shafey 1987):", c.data_matrix);
   if (o.generator.size() > 0) std::printf("  before deflation by the generator: %s\n", c.data_matrix.augmented.to_string("s", 6).c_str());
   const PronyOptions& po = c.prony_options;
@@ -125,7 +126,7 @@ int run_poles(PolesArgs a) {
   else
     std::printf("Prony: not computed (%s)\n", c.prony_problem.c_str());
   if (!a.json.empty()) {
-    write_text_file(a.json, poles_to_json(c.data_matrix, c.prony ? &*c.prony : nullptr, c.prony_problem, a.order, Ts));
+    write_text_file(a.json, poles_to_json(c, a.order, Ts));
     std::printf("wrote %s\n", a.json.c_str());
   }
   return kOk;

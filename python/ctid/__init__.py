@@ -18,7 +18,7 @@ from ._ctid import (  # noqa: F401  (re-exported)
     CorrelationTest, DeadbeatObserver, average_periods, frf_from_periodic, FileError, FrequencyData, FsfModel, GreyboxModel, GreyboxSimulation, IdData, InputGenerator, InvalidArgument,
     InvalidOptions, MisoModel, ModalModel, ModalWindow, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm,
     NonlinearCorrelationTests, PhysicalModel, ResultFile, Simulation, StateSpace, TransferFunction, add_noise_snr, fit_percent, frequency_grid,
-    generator_fitted_to_input, html_report,
+    generator_fitted_to_input, html_report, kia_product_candidates,
     input_residual_crosscorrelation, load, magnitude_band, mode_uncertainty, frequency_response_std, methods, settings, diagnostics, narx_candidates, narx_noise_candidates,
     nonlinear_correlation_tests, one_sided_dft, piecewise_constant_windows, prbs, read_narx_json, read_nde_json,
     greybox_initial_state, read_result, residual_autocorrelation, response_horizon, time_grid, write_result,
@@ -338,6 +338,8 @@ def kia(data, narx, **options):
     """The whole Kernel Invariance workflow (as `ctid fit --method kia`): stages, stacking, the check that the
     equation reproduces its NARX model, and the output-error refinement. Options: KiaOptions with the CLI's names,
     e.g. y_order=2, quadratic=['y^2', 'y*Dy'], cubic=['y^3'], qpoints=70, refine=True (ctid.settings('kia')).
+    A stage without candidates runs when the NARX model has terms of its degree, with every product of that degree
+    (ctid.kia_product_candidates) pruned by ERR at 0.01 % (err_threshold); run.result().diagnostics.choices says so.
     data: an IdData, or a list of IdData (several experiments of one system: the NARX model should come from all of
     them, e.g. ctid.narx([a, b], ...)). Returns a KiaRun; its result() is the answer."""
     return _ctid.kia(data, narx, _options(_ctid.KiaOptions, "kia", options))

@@ -146,7 +146,8 @@ void bind_modal(py::module_& m) {
       .def_readonly("prony", &PolesComparison::prony)
       .def_readonly("prony_problem", &PolesComparison::prony_problem)
       .def_readonly("free_response", &PolesComparison::free_response)
-      .def_readonly("prony_options", &PolesComparison::prony_options);
+      .def_readonly("prony_options", &PolesComparison::prony_options)
+      .def_readonly("choices", &PolesComparison::choices);
   m.def("compare_poles", &compare_poles, py::arg("y"), py::arg("ts"), py::arg("order"), py::arg("options"),
         "El-Shafey's data-matrix poles beside Prony's, instants chosen from the record unless given (ctid poles).");
 }

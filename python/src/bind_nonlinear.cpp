@@ -112,6 +112,9 @@ void bind_nonlinear(py::module_& m) {
   m.def("kia_linear", &kia_linear, py::arg("narx"), py::arg("options") = KiaLinearOptions{});
   m.def("kia_quadratic", &kia_quadratic, py::arg("narx"), py::arg("linear"), py::arg("options"));
   m.def("kia_cubic", &kia_cubic, py::arg("narx"), py::arg("model"), py::arg("options"));
+  m.def("kia_product_candidates", &kia_product_candidates, py::arg("degree"), py::arg("y_order"), py::arg("u_order"),
+        "The default candidates of a KIA stage: every product of `degree` factors of y, Dy .. D^(y_order-1) y and "
+        "u .. D^u_order u.");
 
   bind_options<NdeOeOptions>(m, "NdeOeOptions");
   m.def("nde_oe", [](const IdData& d, const NdeModel& initial, const NdeOeOptions& o) {

@@ -71,6 +71,10 @@ def test_compare_poles_is_what_ctid_poles_prints():
     assert max(abs(c.prony.poles.imag)) <= math.pi / (33 * tw) + 1e-9
     with pytest.raises(ctid.InvalidOptions, match="3 shifts; order 4 needs 4"):
         ctid.compare_poles(y, tw, 4, shifts=np.array([33, 66, 99]) * tw)
+    # Shifts left out: chosen on Prony's pre-estimate and stated; 100 rad/s still found (C++ test: within 0.1).
+    a = ctid.compare_poles(y, tw, 4)
+    assert len(a.choices) == 1 and "Prony's pre-estimate" in a.choices[0]
+    assert max(abs(a.data_matrix.poles.imag)) == pytest.approx(100, abs=0.1)
 
 
 def test_modal_frequency_response_from_a_square_wave():

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <complex>
 #include <numbers>
+#include <optional>
 
 #include "ctid/core/check.hpp"
 #include "estimate/modal_common.hpp"
@@ -146,6 +147,50 @@ PoleEstimate prony(const Eigen::VectorXd& y, double Ts, const PronyOptions& o) {
   return r;
 }
 
+namespace {
+// Shifts of compare_poles left empty: T_i = i d by choose_modal_shifts on Prony's estimate of the augmented order.
+// The response's active part is where |y| is still at least 5 % of its peak (a free response decays into noise;
+// a forced one is active throughout): Prony's sample spacing is the one of least cond(R^T R) with n' spacings
+// within half of it (a geometric grid), and T_n' is at most half of it, so that the instants keep the signal.
+Eigen::VectorXd automatic_pole_shifts(const Eigen::VectorXd& y, double Ts, int n, std::vector<std::string>& choices) {
+  const int N = static_cast<int>(y.size());
+  const double peak = y.cwiseAbs().maxCoeff();
+  CTID_REQUIRE(peak > 0, "poles: the response is zero throughout; no pole can be estimated");
+  int active = N;
+  while (active > 1 && std::abs(y(active - 1)) < 0.05 * peak) --active;
+  const int half = active / 2;
+  CTID_REQUIRE(half >= 2 * n,
+               "poles: no room for {} automatic shifts: the response stays above 5 % of its peak for {} samples only "
+               "(need >= {}); give the shifts",
+               n, active, 4 * n);
+  std::optional<PoleEstimate> best;
+  PronyOptions best_options;
+  for (int k = 1; k * n <= half; k = std::max(k + 1, static_cast<int>(std::lround(k * 1.25)))) {
+    PronyOptions p;
+    p.order = n;
+    p.spacing = k;
+    p.equations = (N - 1) / k - n + 1;
+    if (p.equations < 2 * n) break;
+    PoleEstimate e = prony(y, Ts, p);
+    if (std::isfinite(e.condition) && (!best || e.condition < best->condition)) {
+      best = std::move(e);
+      best_options = p;
+    }
+  }
+  CTID_REQUIRE(best.has_value(), "poles: Prony's pre-estimate failed at every spacing; give the shifts");
+  const TransferFunction prior(Polynomial{1.0}, best->characteristic);
+  const ShiftChoice sc = choose_modal_shifts(prior, Ts, half * Ts);
+  const double d = sc.shifts(0);
+  choices.push_back(detail::format(
+      "shifts = i * {} s (i = 1..{}; {} samples apart): the spacing that minimises cond(psi) (= {}) of Prony's "
+      "pre-estimate {} (samples {} apart, the best conditioned), T_n at most half the time the response stays above "
+      "5 % of its peak ({} s)",
+      detail::significant(d), n, std::lround(d / Ts), detail::significant(sc.condition, 3),
+      best->characteristic.to_string("s", 4), best_options.spacing, detail::significant(half * Ts)));
+  return sc.shifts;
+}
+}  // namespace
+
 template <>
 const OptionTable<PolesOptions>& option_table<PolesOptions>() {
   using O = PolesOptions;
@@ -153,7 +198,7 @@ const OptionTable<PolesOptions>& option_table<PolesOptions>() {
       OptionTable<O>("poles")
           .reals("shifts", &O::shifts, "s", above(0),
                  "T_1..T_n', one per pole of the system and of the generator, whole multiples of Ts (the CLI also takes "
-                 "shift_samples)")
+                 "shift_samples); empty: uniform shifts chosen on Prony's pre-estimate")
           .real("start", &O::start, "s", or_special(above(0), 0, "the largest shift"), "first instant t_o1")
           .real("interval", &O::interval, "s", or_special(above(0), 0, "the first shift, at least 2 Ts"),
                 "integration interval t_fk - t_ok")
@@ -181,20 +226,20 @@ PolesComparison compare_poles(const Eigen::VectorXd& y, double Ts, int order, co
   for (Eigen::Index i = 0; i < o.generator.size(); ++i)
     g = g + (o.generator(i) == 0 ? InputGenerator::constant(1.0) : InputGenerator::sinusoid(o.generator(i), 1.0));
   const int n_aug = order + g.order();
-  CTID_REQUIRE_OPTION(o.shifts.size() > 0, "poles: give the shifts (shifts=T1,..,T{} in s; one per pole{})", n_aug,
-                      g.order() ? " of the system and of the generator" : "");
-  CTID_REQUIRE_OPTION(o.shifts.size() == n_aug, "poles: {} shifts; order {}{} needs {}", o.shifts.size(), order,
-                      g.order() ? " plus the generator's modes" : "", n_aug);
+  CTID_REQUIRE_OPTION(o.shifts.size() == 0 || o.shifts.size() == n_aug, "poles: {} shifts; order {}{} needs {}",
+                      o.shifts.size(), order, g.order() ? " plus the generator's modes" : "", n_aug);
+  CTID_REQUIRE(y.allFinite(), "poles: the response has non-finite samples");
   const int N = static_cast<int>(y.size());
+  PolesComparison c;
+  const Eigen::VectorXd shifts = o.shifts.size() ? o.shifts : automatic_pole_shifts(y, Ts, n_aug, c.choices);
   auto samples = [&](double seconds, const char* what) { return modal_detail::samples_of(seconds, Ts, what); };
   int max_shift = 0;
-  for (int i = 0; i < n_aug; ++i) max_shift = std::max(max_shift, samples(o.shifts(i), "shift"));
-  const int first = samples(o.shifts(0), "shift");
+  for (int i = 0; i < n_aug; ++i) max_shift = std::max(max_shift, samples(shifts(i), "shift"));
+  const int first = samples(shifts(0), "shift");
   const int interval = o.interval > 0 ? samples(o.interval, "interval") : std::max(2, first);
   const int spacing = o.spacing > 0 ? samples(o.spacing, "spacing") : interval;
   const int start = o.start > 0 ? samples(o.start, "start") : max_shift;
-  PolesComparison c;
-  c.free_response.shifts = o.shifts;
+  c.free_response.shifts = shifts;
   c.free_response.start = start * Ts;
   c.free_response.interval = interval * Ts;
   c.free_response.spacing = spacing * Ts;

@@ -582,8 +582,7 @@ std::string table_to_json(const std::string& type, const std::vector<std::pair<s
   return j.dump(indent) + "\n";
 }
 
-std::string poles_to_json(const PoleEstimate& dm, const PoleEstimate* prony, const std::string& prony_error, int order,
-                          double ts, int indent) {
+std::string poles_to_json(const PolesComparison& c, int order, double ts, int indent) {
   auto estimate = [](const PoleEstimate& p) {
     json poles = json::array();
     for (const auto& z : p.poles) poles.push_back({{"re", num(z.real())}, {"im", num(z.imag())}});
@@ -596,9 +595,11 @@ std::string poles_to_json(const PoleEstimate& dm, const PoleEstimate* prony, con
   const json j = {{"type", "poles"},
                   {"order", order},
                   {"ts", ts},
-                  {"data_matrix", estimate(dm)},
-                  {"prony", prony ? estimate(*prony) : json(nullptr)},
-                  {"prony_error", prony_error}};
+                  {"data_matrix", estimate(c.data_matrix)},
+                  {"prony", c.prony ? estimate(*c.prony) : json(nullptr)},
+                  {"prony_error", c.prony_problem},
+                  {"shifts", vec(c.free_response.shifts)},
+                  {"choices", c.choices}};
   return j.dump(indent) + "\n";
 }
 

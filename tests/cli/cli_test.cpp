@@ -634,6 +634,16 @@ TEST(Cli, ModalFitPolesAndResponses) {
   for (int i = 0; i < 4; ++i) EXPECT_NEAR(cp[i], s3[i], 1e-6 * 52) << i;
   EXPECT_EQ(pjs.at("data_matrix").at("poles").size(), 3u);
   EXPECT_FALSE(pjs.at("prony").is_null());
+  // Without shifts (issue 17): uniform shifts chosen on Prony's pre-estimate, printed as 'chosen:' and kept in the
+  // JSON; noise-free, the same polynomial to its 6 printed digits.
+  fs::remove(pj);
+  r = ctid_run("poles " + free + " --ts " + ts320() + " --order 3 --json " + pj);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("chosen: shifts = i * "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("s^3 + 4 s^2 + 30 s + 52"), std::string::npos) << r.out;
+  const nlohmann::json auto_js = nlohmann::json::parse(read_text_file(pj));
+  EXPECT_EQ(auto_js.at("choices").size(), 1u);
+  EXPECT_EQ(auto_js.at("shifts").size(), 3u);
   // A response forced by sin 4t (ES Ex. 4.7): order 3 + 2 generator modes, deflated by s^2 + 16.
   Eigen::MatrixXd forced(600, 1);
   forced.col(0) = lsim(kS3.to_state_space(), InputGenerator::sinusoid(4.0, 1.0), time_grid(kTs320, 600));
@@ -673,7 +683,7 @@ TEST(Cli, ModalBadInputs) {
       {base + "--set shift_samples=16,32,48 --set windows=0.1", "windows are pairs START,LENGTH"},
       {base + "--set shift_samples=16,32,48 --set colour=red", "not a setting of modal"},
       {base + "--set shift_samples=16,32,48 --set iv=2", "not a setting of modal; did you mean 'iv_shift'?"},
-      {"poles " + data + " --ts " + ts320() + " --output y --order 3", "shifts"},
+      {"poles " + data + " --ts " + ts320() + " --output y --order 3 --set shift_samples=16,32", "2 shifts; order 3 needs 3"},
       {"response " + data + " --ts " + ts320() + " --order 3 --kind step", "period"},
   };
   for (const auto& c : cases) {

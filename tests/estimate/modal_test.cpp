@@ -646,3 +646,45 @@ TEST(ModalFit, SeveralRecordsArePooledIntoOneEstimateMoreAccurateThanEither) {
   std::printf("modal several records: relative RMS error a %.4g, b %.4g, joint %.4g\n", rms_a, rms_b, rms_joint);
   EXPECT_LT(rms_joint, 0.8 * std::min(rms_a, rms_b));
 }
+
+TEST(ComparePoles, ShiftsLeftEmptyAreChosenOnPronysPreEstimate) {
+  // Issue 17 (no hand-picked settings): shifts T_i = i d with d of least cond(psi) for Prony's pre-estimate.
+  // Noise-free, the data-matrix method is exact whatever well-conditioned shifts it gets (SEEDS-SPEC Appendix B:
+  // ~1e-6 with Simpson); measured 2.5e-7 on the Ex. 4.6 record (the hand-picked shifts of Table 4.8: 2.6e-7).
+  const Eigen::VectorXd t = time_grid(kTs420, 600);
+  const Eigen::VectorXd y =
+      lsim(phase_variable_form(kS4), InputGenerator::constant(0.0), t, Eigen::Vector4d(0.2, 10.0, 0.0, 0.0));
+  const PolesComparison c = compare_poles(y, kTs420, 4, PolesOptions{});
+  EXPECT_LT(max_rel(c.data_matrix.characteristic.coefficients(), kS4.den().coefficients()), 1e-6);
+  ASSERT_EQ(c.choices.size(), 1u);
+  EXPECT_NE(c.choices[0].find("Prony's pre-estimate"), std::string::npos) << c.choices[0];
+  ASSERT_EQ(c.free_response.shifts.size(), 4);
+  for (int i = 1; i < 4; ++i) EXPECT_NEAR(c.free_response.shifts(i), (i + 1) * c.free_response.shifts(0), 1e-12);
+  // Ex. 4.8: the best-conditioned Prony spacing aliases cos 100t, yet the shifts it suggests keep the data-matrix
+  // method alias-free: 100 rad/s within 0.1, -1 +- 3j within 1e-2 (measured 2.5e-4 relative on the coefficients;
+  // hand-picked shifts of Table 4.11: 1e-3 on each exponent).
+  const double Ts = 2 * kPi / 3 / 666;
+  const Eigen::VectorXd t8 = time_grid(Ts, 2000);
+  const Eigen::VectorXd y8 = (-t8).array().exp() * (3 * t8).array().sin() + (100 * t8).array().cos();
+  const PolesComparison c8 = compare_poles(y8, Ts, 4, PolesOptions{});
+  int fast = 0;
+  for (auto z : c8.data_matrix.poles) {
+    if (std::abs(z.imag()) > 10) {
+      EXPECT_NEAR(std::abs(z.imag()), 100.0, 0.1);
+      ++fast;
+    } else {
+      EXPECT_NEAR(z.real(), -1.0, 1e-2);
+      EXPECT_NEAR(std::abs(z.imag()), 3.0, 1e-2);
+    }
+  }
+  EXPECT_EQ(fast, 2);
+  // A response forced by sin 4t (Ex. 4.7): 3 + 2 shifts chosen on the augmented pre-estimate, then deflated.
+  const IdData d = sine_record(800);
+  PolesOptions forced;
+  forced.generator = Eigen::VectorXd{{4.0}};
+  const PolesComparison cf = compare_poles(d.y().col(0), kTs420, 3, forced);
+  EXPECT_EQ(cf.free_response.shifts.size(), 5);
+  EXPECT_LT(max_rel(cf.data_matrix.characteristic.coefficients(), kS3.den().coefficients()), 1e-5);
+  // A zero response is named, not estimated.
+  EXPECT_THROW(compare_poles(Eigen::VectorXd::Zero(400), kTs420, 2, PolesOptions{}), InvalidArgument);
+}

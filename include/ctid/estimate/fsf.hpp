@@ -47,8 +47,8 @@ template <>
 const OptionTable<FsfOptions>& option_table<FsfOptions>();
 
 /// Fit an FSF model to one input and one output (uniform Ts). T, n and a left automatic (0) are chosen from a
-/// pre-estimate (LSSVF, equation error: also for unstable plants and closed-loop records) as documented in
-/// FsfOptions; each choice, and a T rounded to whole sampling periods, is a line of diagnostics.choices. Throws
+/// pre-estimate (srivc_auto without delay; LSSVF, equation error, for a plant declared unstable: it serves
+/// closed-loop records) as documented in FsfOptions; each choice, and a T rounded to whole sampling periods, is a line of diagnostics.choices. Throws
 /// InvalidArgument / InvalidOptions for: even n, n > N, T longer than the record, b > a, negative weights, non-SISO
 /// or irregular data. A warning is reported when b > 0 and the record is longer than T (SEEDS-SPEC GW-A2 pitfall).
 /// Parameters: "theta0", "re_theta1", "im_theta1", ...; fit: one-step output of the discrete

@@ -179,7 +179,10 @@ PoleEstimate prony(const Eigen::VectorXd& y, double Ts, const PronyOptions& opti
 
 /// Settings of compare_poles (the `ctid poles` command), in seconds; 0 means "chosen from the record".
 struct PolesOptions {
-  Eigen::VectorXd shifts;      ///< T_1..T_n' (s, distinct whole multiples of Ts): one per pole of the system and of the generator
+  /// T_1..T_n' (s, distinct whole multiples of Ts): one per pole of the system and of the generator. Empty: T_i = i d,
+  /// d the spacing of least cond(psi) (choose_modal_shifts) for Prony's pre-estimate of order n' (its sample spacing
+  /// the best conditioned), T_n' at most half the time the response stays above 5 % of its peak.
+  Eigen::VectorXd shifts;
   double start = 0.0;          ///< t_o1 (s); 0: the largest shift
   double interval = 0.0;       ///< t_fk - t_ok (s); 0: the first shift, at least 2 Ts
   double spacing = 0.0;        ///< t_o(k+1) - t_ok (s); 0: the interval
@@ -204,12 +207,13 @@ struct PolesComparison {
   std::string prony_problem;          ///< why Prony was not computed ("" when it was)
   FreeResponseOptions free_response;  ///< the data-matrix settings used
   PronyOptions prony_options;         ///< Prony's settings used
+  std::vector<std::string> choices;   ///< automatic choices (the shifts when left empty), one sentence each
 };
 
 /// El-Shafey's data-matrix poles (free_response_poles) of a free or generator-forced response y (uniform, Ts s)
 /// next to Prony's (prony) at the augmented order `order` + the generator's modes — the comparison of ES Ex. 4.8,
-/// with every instant chosen from the record unless given. Throws InvalidOptions when the shifts are missing or
-/// their count is not order + generator modes, InvalidArgument when the record cannot hold the instants.
+/// with every instant (the shifts too) chosen from the record unless given. Throws InvalidOptions when the count of
+/// the shifts is not order + generator modes, InvalidArgument when the record cannot hold the instants or is zero.
 PolesComparison compare_poles(const Eigen::VectorXd& y, double Ts, int order, const PolesOptions& options);
 
 // ---- Nonparametric responses (ES-C10 .. ES-C12) ----------------------------------------------

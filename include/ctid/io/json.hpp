@@ -48,10 +48,10 @@ Result<MisoModel> parse_miso_result_json(const std::string& text, const std::str
 std::string order_selection_to_json(const std::vector<OrderCandidate>& candidates, OrderCriterion rank_by,
                                     bool interrupted, int indent = 2);
 /// Poles from a free response (ctid poles --json): {"type": "poles", "order": n, "ts": s, "data_matrix": E,
-/// "prony": E or null, "prony_error": "" or why Prony was not computed}, E = {"poles": [{"re", "im"}, ...],
-/// "characteristic": [descending coefficients], "augmented": [...], "condition": c, "warnings": [...]}.
-std::string poles_to_json(const PoleEstimate& data_matrix, const PoleEstimate* prony, const std::string& prony_error,
-                          int order, double ts, int indent = 2);
+/// "prony": E or null, "prony_error": "" or why Prony was not computed, "shifts": [s, the data matrix's],
+/// "choices": [automatic choices]}, E = {"poles": [{"re", "im"}, ...], "characteristic": [descending coefficients],
+/// "augmented": [...], "condition": c, "warnings": [...]}.
+std::string poles_to_json(const PolesComparison& comparison, int order, double ts, int indent = 2);
 /// A computed table (ctid response --json, ctid gfrf --json): {"type": type, <each field: name -> text, or a number
 /// when the text is one>, "columns": {name: [values, non-finite as null], ...}} with the columns of `values` named
 /// by `names` in order. Throws InvalidArgument when names and columns differ in number.
