@@ -196,6 +196,7 @@ void setup_validate(CLI::App& app);
 std::string channel_name(const std::vector<std::string>& names, int j);
 
 void setup_demo(CLI::App& app);
+void setup_example_data(CLI::App& app);
 void setup_order(CLI::App& app);
 void setup_report(CLI::App& app);
 

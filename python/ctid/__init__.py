@@ -18,7 +18,7 @@ from ._ctid import (  # noqa: F401  (re-exported)
     CorrelationTest, DeadbeatObserver, average_periods, frf_from_periodic, FileError, FrequencyData, FsfModel, GreyboxModel, GreyboxSimulation, IdData, InputGenerator, InvalidArgument,
     InvalidOptions, MisoModel, ModalModel, ModalWindow, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm,
     NonlinearCorrelationTests, PhysicalModel, ResultFile, Simulation, StateSpace, TransferFunction, add_noise_snr, fit_percent, frequency_grid,
-    generator_fitted_to_input, html_report, kia_product_candidates,
+    example_data, example_data_names, generator_fitted_to_input, html_report, kia_product_candidates,
     input_residual_crosscorrelation, load, magnitude_band, mode_uncertainty, frequency_response_std, methods, settings, diagnostics, narx_candidates, narx_noise_candidates,
     nonlinear_correlation_tests, one_sided_dft, piecewise_constant_windows, prbs, read_narx_json, read_nde_json,
     greybox_initial_state, read_result, residual_autocorrelation, response_horizon, time_grid, write_result,

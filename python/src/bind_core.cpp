@@ -1,6 +1,7 @@
 // ctid Python module — data, results, linear models, simulation and validation.
 #include "common.hpp"
 #include "ctid/core/check.hpp"
+#include "ctid/simulate/example_data.hpp"
 
 namespace ctid::python {
 
@@ -131,6 +132,17 @@ void bind_core(py::module_& m) {
   def_report<TransferFunction>(m);
 
   m.def("time_grid", &time_grid, py::arg("ts"), py::arg("n"));
+  py::class_<ExampleData>(m, "ExampleData", "A simulated example record (ctid example-data): its table and what it is.")
+      .def_readonly("name", &ExampleData::name)
+      .def_readonly("description", &ExampleData::description)
+      .def_readonly("columns", &ExampleData::columns)
+      .def_readonly("values", &ExampleData::values)
+      .def("__repr__", [](const ExampleData& e) {
+        return "ExampleData('" + e.name + "', " + std::to_string(e.values.rows()) + " rows: " + e.description + ")";
+      });
+  m.def("example_data", &example_data, py::arg("name"),
+        "The simulated example record `name` the README and docs use (as `ctid example-data NAME OUT.csv`).");
+  m.def("example_data_names", &example_data_names, "The names example_data knows.");
   m.def("prbs", [](int n, int register_length, int clock_period, std::uint32_t initial_state) {
           return prbs(n, {.register_length = register_length, .clock_period = clock_period, .initial_state = initial_state});
         }, py::arg("n"), py::arg("register_length") = 10, py::arg("clock_period") = 1, py::arg("initial_state") = 1,
