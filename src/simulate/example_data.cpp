@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <complex>
+#include <cstdint>
 
 #include "ctid/core/check.hpp"
 #include "ctid/core/names.hpp"
@@ -120,26 +121,26 @@ ExampleData billings_li() {
           {"u", "y"}, columns({u, y})};
 }
 
-ExampleData rao_garnier() {
-  const double Ts = 0.01;
-  const int N = 4000;
-  const Eigen::VectorXd u = prbs(N, {.register_length = 10, .clock_period = 4});
+// A PRBS record (t, u, y) of `g` with white output noise at 20 dB SNR.
+ExampleData prbs_record(const char* name, const std::string& system, const TransferFunction& g, double Ts, int N,
+                        int register_length, std::uint64_t noise_seed) {
+  const Eigen::VectorXd u = prbs(N, {.register_length = register_length, .clock_period = 4});
   const Eigen::VectorXd t = time_grid(Ts, N);
-  return {"data",
-          "The Rao-Garnier benchmark (-6400 s + 1600)/(s^4 + 5 s^3 + 408 s^2 + 416 s + 1600), PRBS input (10-bit "
-          "register, 4 samples per bit), Ts = 0.01 s, 4000 samples, white output noise at 20 dB SNR",
-          {"t", "u", "y"}, columns({t, u, add_noise_snr(lsim(kRaoGarnier, u, t), 20.0, 5)})};
+  return {name,
+          detail::format("{}, PRBS input ({}-bit register, 4 samples per bit), Ts = {} s, {} samples, white output noise "
+                         "at 20 dB SNR",
+                         system, register_length, Ts, N),
+          {"t", "u", "y"}, columns({t, u, add_noise_snr(lsim(g, u, t), 20.0, noise_seed)})};
+}
+
+ExampleData rao_garnier() {
+  return prbs_record("data",
+                     "The Rao-Garnier benchmark (-6400 s + 1600)/(s^4 + 5 s^3 + 408 s^2 + 416 s + 1600)",
+                     kRaoGarnier, 0.01, 4000, 10, 5);
 }
 
 ExampleData second_order() {
-  const double Ts = 0.05;
-  const int N = 2000;
-  const Eigen::VectorXd u = prbs(N, {.register_length = 9, .clock_period = 4});
-  const Eigen::VectorXd t = time_grid(Ts, N);
-  return {"second",
-          "(s + 3)/(s^2 + 1.2 s + 4), PRBS input (9-bit register, 4 samples per bit), Ts = 0.05 s, 2000 samples, "
-          "white output noise at 20 dB SNR",
-          {"t", "u", "y"}, columns({t, u, add_noise_snr(lsim(kSecond, u, t), 20.0, 6)})};
+  return prbs_record("second", "(s + 3)/(s^2 + 1.2 s + 4)", kSecond, 0.05, 2000, 9, 6);
 }
 
 ExampleData miso() {
