@@ -1,6 +1,6 @@
 # Thin wrapper around CMake (DESIGN.md §2).
-#   make demo   install dependencies, build the library and the command-line tool only, run `ctid demo` on the
-#               bundled data
+#   make demo   install dependencies, build the library and the command-line tool only (unity build,
+#               CTID_UNITY_BUILD: about 3.5 min on 2 cores), run `ctid demo` on the bundled data
 #   make test   install dependencies, build, run every test (ctest), then the sanitizer build's tests
 #               (AddressSanitizer + UBSan, Debug with -O1 and line tables only (-g1: file:line in every report,
 #               40 % less compile time than -g): assertions on; the long Monte Carlo tests, ctest label
@@ -21,11 +21,11 @@ deps:
 	@scripts/install-deps.sh
 
 build: deps
-	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS) >/dev/null
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DCTID_UNITY_BUILD=ON $(CMAKE_ARGS) >/dev/null
 	@cmake --build $(BUILD) -j $(JOBS)
 
 demo: deps
-	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS) >/dev/null
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DCTID_UNITY_BUILD=ON $(CMAKE_ARGS) >/dev/null
 	@cmake --build $(BUILD) -j $(JOBS) --target ctid_cli
 	@$(BUILD)/ctid demo
 

@@ -49,8 +49,15 @@ inline double zoh_response(const TransferFunction& g, const Eigen::VectorXd& ts,
   return y;
 }
 
+/// The folder is emptied the first time a process asks for it: a process id can be reused by a later test run on
+/// the same machine (CI runs the Release and the sanitizer builds one after the other), and a file left by that
+/// earlier run must not be mistaken for one this run wrote, nor make a command refuse to overwrite it.
 inline std::string temp_path(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("ctid_test_" + std::to_string(::getpid()));
+  static const std::filesystem::path dir = [] {
+    const auto d = std::filesystem::temp_directory_path() / ("ctid_test_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(d);
+    return d;
+  }();
   std::filesystem::create_directories(dir);
   return (dir / name).string();
 }

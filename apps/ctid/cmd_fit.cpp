@@ -1,9 +1,11 @@
 // ctid fit DATA [--method srivc-auto|srivc|tfest|oe|lssvf|ivsvf|rls-svf|fsf|physical|greybox|modal|narx|kia|subspace|ssest] ...
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <type_traits>
 
@@ -32,6 +34,10 @@ struct FitArgs {
   double excited = 0.1;
   bool force = false;
   std::set<std::string> given;  ///< long names of the options given on the command line
+  /// --validate DATA and/or --validate-samples A:B: a held-out record (DATA, or the estimation file), loaded with the
+  /// same columns and with the estimation record's trend removed; set by run() as (description, record).
+  std::string validate, validate_samples;
+  std::optional<std::pair<std::string, IdData>> validation;
 };
 
 // A method of `ctid fit`: the library registry entries whose settings --set takes (estimate/methods.hpp; empty:
@@ -65,6 +71,14 @@ void reject_flags_that_do_not_apply(const FitArgs& a) {
   for (const char* f : {"skip", "excited"})
     if (has(f) && !has("period")) refuse(f, "belongs to --period (periodic records)");
   if (has("period") && a.frequency) refuse("period", "computes frequency data from periodic records (not with --frequency)");
+  for (const char* f : {"validate", "validate-samples"}) {
+    if (!has(f)) continue;
+    if (m == "narx" || m == "kia" || m == "greybox")
+      refuse(f, "is not available with --method " + m + " yet: validate its result with ctid validate RESULT.json DATA");
+    if (a.frequency || has("period") || has("closed-loop-controller") || a.paths.size() > 1)
+      refuse(f, "holds out a record of a single open-loop time-domain fit (not with --frequency, --period, "
+                "--closed-loop-controller or several DATA files): use ctid validate RESULT.json DATA");
+  }
   for (const char* f : {"nb", "nf", "nk"})
     if (has(f) && m == "srivc-auto")
       refuse(f, "sets transfer-function orders, which srivc-auto chooses (--set nf_max=N bounds them); give --method "
@@ -96,17 +110,46 @@ void warn_offsets(const FitArgs& a, const IdData& d) {
   for (int j = 0; j < d.ny(); ++j) check(d.y().col(j), "output " + channel_name(d.output_names(), j));
 }
 
+// The model simulated on the held-out record (validation_initial_condition: for a linear model the initial state that
+// fits it best, as MATLAB's compare), its fit per output printed.
+void print_validation(const AnyModel& m, const std::pair<std::string, IdData>& v) {
+  const auto& [name, d] = v;
+  SimulateOptions so;
+  so.initial = validation_initial_condition(m);
+  Simulation s;
+  try {
+    s = simulate(m, d, so);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(std::string("--validate: ") + e.what());
+  }
+  std::printf("\nvalidation on %s (%d samples, initial state: %s):", name.c_str(), d.size(),
+              so.initial == InitialCondition::Estimated ? "the one that fits them best" : to_string(so.initial));
+  if (!s.ok()) {
+    std::printf(" %s\n", s.problem.c_str());
+    return;
+  }
+  for (int j = 0; j < d.ny(); ++j)
+    std::printf("%s fit %s %%", d.ny() > 1 ? ("  " + channel_name(d.output_names(), j)).c_str() : "",
+                fit_percent_text(fit_percent(d.y().col(j), s.y.col(j))).c_str());
+  std::printf("\n");
+}
+
 // Print, write the JSON file and the HTML report if asked, and map usability to the exit code.
 template <class M>
 int finish(const Result<M>& r, const std::string& method, const IdData& d, const FitArgs& a, const Settings& settings,
-           const std::vector<std::pair<std::string, IdData>>& more_records = {}) {
+           std::vector<std::pair<std::string, IdData>> more_records = {}) {
   print_result(r, method, d);
   warn_offsets(a, d);
+  if (a.validation) {
+    print_validation(to_any(r).model, *a.validation);
+    more_records.insert(more_records.begin(), {"validation, " + a.validation->first, a.validation->second});
+  }
   if (!a.json.empty()) {
     write_result_json(a.json, r, method);
     std::printf("wrote %s\n", a.json.c_str());
   }
-  write_report(a.report, d, r, method, settings, a.paths.empty() ? a.data.path : a.paths.front(), more_records);
+  write_report(a.report, d, r, method, settings, a.paths.empty() ? a.data.path : a.paths.front(), more_records,
+               a.validation ? std::optional(validation_initial_condition(to_any(r).model)) : std::nullopt);
   if (!r.usable()) {
     std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", r.why_not_usable().c_str());
     return kNotUsable;
@@ -558,10 +601,27 @@ int run_periodic(const FitArgs& a) {
   return finish(r, a.method, ds.front(), a, settings_of(o));
 }
 
-int run(const FitArgs& a) {
+// --validate / --validate-samples: the held-out record, with the estimation record's trend (none with --detrend
+// none) removed, so that no statistic of the validation record enters the model.
+std::pair<std::string, IdData> validation_record(const FitArgs& a, const TrendInfo& trend) {
+  DataArgs v = a.data;
+  v.path = a.validate.empty() ? a.data.path : a.validate;
+  v.samples = a.validate_samples;
+  v.samples_option = "--validate-samples";
+  v.detrend = "none";
+  v.announce_means = false;
+  std::pair<int, int> rows;
+  IdData d = v.load(true, nullptr, &rows);
+  if (a.data.detrend != "none") d = d.remove_trend(trend);
+  std::string name = v.path;
+  if (!v.samples.empty()) name += detail::format(" rows {}..{}", rows.first, rows.second);
+  return {name, d};
+}
+
+int run(FitArgs a) {
   reject_flags_that_do_not_apply(a);
   std::vector<std::string> inputs = a.paths;
-  inputs.insert(inputs.end(), {a.narx, a.controller, a.initial, a.method == "greybox" ? a.model_expr : ""});
+  inputs.insert(inputs.end(), {a.narx, a.controller, a.initial, a.validate, a.method == "greybox" ? a.model_expr : ""});
   check_outputs({a.json, a.report, a.responses.empty() ? "" : a.responses + "_time.csv",
                  a.responses.empty() ? "" : a.responses + "_freq.csv"},
                 inputs, a.force);
@@ -571,7 +631,9 @@ int run(const FitArgs& a) {
   if (a.paths.size() > 1) return run_experiments(a);
   if (a.frequency && !a.report.empty()) throw UsageError("--report needs time-domain data (not --frequency)");
   if (a.frequency) return run_frequency(a);
-  const IdData d = a.data.load(true);
+  TrendInfo trend;
+  const IdData d = a.data.load(true, &trend);
+  if (!a.validate.empty() || !a.validate_samples.empty()) a.validation = validation_record(a, trend);
   // A constant channel carries no information on the dynamics (the library's check, made before any other).
   call_library([&] {
     require_io_data(d, a.method.c_str(), -1, -1);
@@ -640,7 +702,9 @@ std::string fit_method_help(const CLI::App& fit) {
   return out;
 }
 
-void setup_fit(CLI::App& app) {
+namespace {
+// The options of ctid fit on `app`; after parsing, resolve_fit_args fills the defaults that depend on what was given.
+std::shared_ptr<FitArgs> add_fit_options(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
   app.add_option("DATA", a->paths,
                  "CSV/.dat table (header row optional) or .mat file; several files are several experiments of one system, "
@@ -653,7 +717,6 @@ void setup_fit(CLI::App& app) {
                  "kia, subspace or ssest (with --help: its settings). Default: srivc-auto (the orders and a delay "
                  "chosen by BIC, means removed) without --nb/--nf/--nk, srivc with them")
       ->check(CLI::IsMember(names));
-  g_fit_args = a;
   a->data.add_to(app, true);
   app.add_option("--nb", a->nb, "Number of numerator coefficients (default: nf); one per input with several inputs (1,2)")
       ->delimiter(',');
@@ -707,23 +770,53 @@ void setup_fit(CLI::App& app) {
   app.add_option("--nx", a->nx, "subspace, ssest: state dimension N, or ssest: a range A:B (the least BIC is kept)");
   app.add_option("--initial", a->initial, "ssest: starting model, a state-space JSON file (a result of ctid fit --json); "
                  "fixed.A1_2=.. entries refer to its coordinates");
+  app.add_option("--validate", a->validate,
+                 "A held-out record (same columns) the model is simulated on: its fit is printed and reported; the "
+                 "estimation record's means/trend are removed from it");
+  app.add_option("--validate-samples", a->validate_samples,
+                 "Rows A:B of the --validate file (without --validate: of the DATA file), e.g. --samples 1:500 "
+                 "--validate-samples 501:");
   app.add_option("--json", a->json, "Write the result (model, parameters, fit) to this JSON file");
   app.add_option("--report", a->report, "Write a self-contained HTML report (plots, tests, parameters) to this file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
+  return a;
+}
+
+void resolve_fit_args(FitArgs& a, const CLI::App& app) {
+  for (const CLI::Option* o : app.get_options())
+    if (o->count() > 0)
+      for (const auto& n : o->get_lnames()) a.given.insert(n);
+  a.data.path = a.paths.empty() ? "" : a.paths.front();
+  if (a.method.empty())
+    a.method = a.given.count("nb") || a.given.count("nf") || a.given.count("nk") ? "srivc" : "srivc-auto";
+  // srivc-auto removes the means unless told otherwise (said on stderr by the loader).
+  if (a.method == "srivc-auto" && !a.given.count("detrend")) {
+    a.data.detrend = "mean";
+    a.data.announce_means = true;
+  }
+}
+}  // namespace
+
+void setup_fit(CLI::App& app) {
+  auto a = add_fit_options(app);
+  g_fit_args = a;
   app.callback([a, &app] {
-    for (const CLI::Option* o : app.get_options())
-      if (o->count() > 0)
-        for (const auto& n : o->get_lnames()) a->given.insert(n);
-    a->data.path = a->paths.empty() ? "" : a->paths.front();
-    if (a->method.empty())
-      a->method = a->given.count("nb") || a->given.count("nf") || a->given.count("nk") ? "srivc" : "srivc-auto";
-    // srivc-auto removes the means unless told otherwise (said on stderr by the loader).
-    if (a->method == "srivc-auto" && !a->given.count("detrend")) {
-      a->data.detrend = "mean";
-      a->data.announce_means = true;
-    }
+    resolve_fit_args(*a, app);
     g_run = [a] { return run(*a); };
   });
+}
+
+int run_fit(std::vector<std::string> args) {
+  CLI::App app{"ctid fit"};
+  const auto a = add_fit_options(app);
+  std::reverse(args.begin(), args.end());  // CLI11 parses a vector from its back
+  try {
+    app.parse(args);
+  } catch (const CLI::ParseError& e) {
+    throw UsageError(e.what());
+  }
+  resolve_fit_args(*a, app);
+  return run(*a);
 }
 
 }  // namespace ctid::cli

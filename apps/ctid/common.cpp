@@ -21,9 +21,38 @@ void DataArgs::add_to(CLI::App& app, bool need_output) {
   t->excludes(s);
   app.add_option("--intersample", intersample, "Input intersample behaviour: zoh, foh or bl")->capture_default_str();
   app.add_option("--detrend", detrend, "Remove none, mean or linear trend before use")->capture_default_str();
+  app.add_option("--samples", samples,
+                 "Use only rows A:B of the file (1-based, inclusive; '1:500' the first 500, '501:' from row 501 on)");
 }
 
-IdData DataArgs::load(bool need_output) const {
+namespace {
+// --samples A:B as [begin, end) of a record of n rows; UsageError naming the option, its value and the record size.
+std::pair<int, int> row_range(const std::string& option, const std::string& text, int n) {
+  const auto colon = text.find(':');
+  auto bad = [&](const std::string& why) {
+    return UsageError(option + " " + text + ": " + why + " (the record has " + std::to_string(n) + " rows)");
+  };
+  if (colon == std::string::npos || text.find(':', colon + 1) != std::string::npos)
+    throw bad("give A:B, the first and last row (1-based; '1:500', '501:')");
+  auto number = [&](const std::string& part, int fallback) {
+    if (part.empty()) return fallback;
+    size_t used = 0;
+    long v = 0;
+    try {
+      v = std::stol(part, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != part.size() || v < 1 || v > n) throw bad("'" + part + "' is not a row number from 1 to " + std::to_string(n));
+    return static_cast<int>(v);
+  };
+  const int first = number(text.substr(0, colon), 1), last = number(text.substr(colon + 1), n);
+  if (last - first + 1 < 2) throw bad("the range holds fewer than 2 rows");
+  return {first - 1, last};
+}
+}  // namespace
+
+IdData DataArgs::load(bool need_output, TrendInfo* removed_trend, std::pair<int, int>* rows) const {
   if (detrend != "none" && detrend != "mean" && detrend != "linear")
     throw UsageError("--detrend must be none, mean or linear (got '" + detrend + "')");
   if (!(ts >= 0) || !std::isfinite(ts)) throw UsageError("--ts must be a positive number of seconds (got " + std::to_string(ts) + ")");
@@ -95,6 +124,12 @@ IdData DataArgs::load(bool need_output) const {
           if (same(o, in)) throw UsageError(detail::format("'{}' is selected both as an input and as the output", o));
     if (!need_output) spec.outputs = {spec.inputs.front()};  // placeholder output for loading only
     IdData d = tab ? iddata_from_table(*tab, spec) : load_iddata(path, spec);
+    if (rows) *rows = {1, d.size()};
+    if (!samples.empty()) {
+      const auto [begin, end] = row_range(samples_option, samples, d.size());
+      d = d.slice(begin, end);
+      if (rows) *rows = {begin + 1, end};
+    }
     if (d.uniform_time_deviation() > 1e-9)
       std::fprintf(stderr, "note: %s: the sample times are within %.2g Ts of a uniform grid (threshold %g Ts): read as "
                    "uniform, Ts = %.10g s\n", path.c_str(), d.uniform_time_deviation(), IdData::kUniformTimeTolerance,
@@ -102,6 +137,7 @@ IdData DataArgs::load(bool need_output) const {
     if (detrend == "none") return d;
     TrendInfo removed;
     IdData out = d.detrend(detrend == "mean" ? Detrend::Mean : Detrend::Linear, &removed);
+    if (removed_trend) *removed_trend = removed;
     if (announce_means && detrend == "mean") {
       std::string means;
       char value[32];

@@ -3,6 +3,7 @@
 
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -39,12 +40,16 @@ struct DataArgs {
   double ts = 0.0;
   std::string intersample = "zoh";
   std::string detrend = "none";
+  /// --samples A:B: only rows A..B (1-based, inclusive; either end may be left out) of the file; "" = all.
+  std::string samples;
+  std::string samples_option = "--samples";  ///< the option's name in messages (--validate-samples for a validation record)
   /// With detrend "mean": say on stderr which means were removed (a command's own default, not the user's option).
   bool announce_means = false;
   void add_to(CLI::App& app, bool need_output);
-  /// Load, select and detrend; maps every failure to InputError (file/content) or
-  /// UsageError (inconsistent options).
-  IdData load(bool need_output) const;
+  /// Load, select the columns and the rows (--samples), detrend (the removed trend in `removed`, left empty with
+  /// --detrend none); maps every failure to InputError (file/content) or UsageError (inconsistent options).
+  /// With `rows`: the rows used, 1-based first and last.
+  IdData load(bool need_output, TrendInfo* removed = nullptr, std::pair<int, int>* rows = nullptr) const;
   /// The same selection loaded from each of `paths` (several records of one system), in order.
   std::vector<IdData> load_each(const std::vector<std::string>& paths, bool need_output) const;
 };
@@ -150,9 +155,11 @@ std::vector<std::pair<std::string, std::string>> settings_of(const O&... o) {
 template <class M>
 void write_report(const std::string& path, const IdData& d, const Result<M>& r, const std::string& method,
                   const std::vector<std::pair<std::string, std::string>>& settings, const std::string& source,
-                  const std::vector<std::pair<std::string, IdData>>& more_records = {}) {
+                  const std::vector<std::pair<std::string, IdData>>& more_records = {},
+                  std::optional<InitialCondition> more_records_initial = std::nullopt) {
   if (path.empty()) return;
   ReportOptions o;
+  o.more_records_initial = more_records_initial;
   o.method = method;
   o.title = "ctid " + method + " fit";
   o.data_source = source;
@@ -184,6 +191,9 @@ int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, co
                     const std::vector<std::pair<std::string, IdData>>& more_records);
 
 void setup_fit(CLI::App& app);
+/// `ctid fit ARGS...` run from inside another command (ctid demo): the same parsing, defaults, output and exit code.
+/// A parse error is a UsageError.
+int run_fit(std::vector<std::string> args);
 /// After `ctid fit --method M --help`: M's settings (names, units, ranges, defaults) from the library's registry;
 /// "" without --method.
 std::string fit_method_help(const CLI::App& fit);

@@ -48,6 +48,18 @@ void bind_core(py::module_& m) {
       .def_property_readonly("scalars", &Diagnostics::scalars, "method-specific numbers by name (ctid.diagnostics())")
       .def_property_readonly("vectors", &Diagnostics::vectors, "method-specific vectors by name (ctid.diagnostics())");
 
+  py::class_<TrendInfo>(m, "TrendInfo", "What IdData.detrend_with_trend removed, per channel: offset + slope * (t - t_ref).")
+      .def_readonly("u_offset", &TrendInfo::u_offset)
+      .def_readonly("u_slope", &TrendInfo::u_slope)
+      .def_readonly("y_offset", &TrendInfo::y_offset)
+      .def_readonly("y_slope", &TrendInfo::y_slope)
+      .def_readonly("t_ref", &TrendInfo::t_ref)
+      .def("__repr__", [](const TrendInfo& t) {
+        return detail::format("TrendInfo(u_offset={}, u_slope={}, y_offset={}, y_slope={}, t_ref={})",
+                              Eigen::RowVectorXd(t.u_offset), Eigen::RowVectorXd(t.u_slope), Eigen::RowVectorXd(t.y_offset),
+                              Eigen::RowVectorXd(t.y_slope), t.t_ref);
+      });
+
   py::class_<IdData>(m, "IdData", "Sampled input/output record (columns = channels).")
       .def(py::init<Eigen::MatrixXd, Eigen::MatrixXd, double, double>(), py::arg("u"), py::arg("y"), py::arg("ts"),
            py::arg("t0") = 0.0)
@@ -64,6 +76,20 @@ void bind_core(py::module_& m) {
           },
           py::arg("kind") = "mean",
           "A copy with each channel's mean (kind='mean') or least-squares line in time (kind='linear') removed.")
+      .def(
+          "detrend_with_trend",
+          [](const IdData& d, const std::string& kind) {
+            CTID_REQUIRE(kind == "mean" || kind == "linear",
+                         "IdData.detrend_with_trend: kind must be 'mean' or 'linear' (got '{}')", kind);
+            TrendInfo t;
+            IdData out = d.detrend(kind == "mean" ? Detrend::Mean : Detrend::Linear, &t);
+            return py::make_tuple(out, t);
+          },
+          py::arg("kind") = "mean", "detrend, and the TrendInfo it removed: (data, trend).")
+      .def("remove_trend", &IdData::remove_trend, py::arg("trend"),
+           "A copy with another record's trend (detrend_with_trend) removed at this record's times: a held-out "
+           "validation record treated with the estimation record's means, so that none of its statistics enters the "
+           "model.")
       .def_property_readonly("u", &IdData::u)
       .def_property_readonly("y", &IdData::y)
       .def_property_readonly("ts", &IdData::ts)

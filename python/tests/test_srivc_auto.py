@@ -32,3 +32,19 @@ def test_srivc_auto_options_and_detrend_kinds():
         d.detrend("quadratic")
     with pytest.raises(TypeError, match="nf_max"):
         ctid.srivc_auto(d, nf_maximum=2)
+
+
+def test_a_held_out_record_takes_the_estimation_records_trend():
+    # IdData.remove_trend: the validation part of a record gets the estimation part's means (not its own), as
+    # `ctid fit --validate-samples` does. y = 2 t + 1 at Ts = 0.1: the first 30 samples' mean is 3.9; removed from
+    # the last 20 samples (t = 3.0 .. 4.9) it leaves 2 t + 1 - 3.9.
+    d = ctid.IdData.from_arrays(np.arange(50.0), 2 * (0.1 * np.arange(50.0)) + 1, ts=0.1)
+    est, val = d.slice(0, 30), d.slice(30, 50)
+    e, trend = est.detrend_with_trend("mean")
+    assert np.allclose(e.y.mean(), 0.0, atol=1e-12)
+    assert abs(trend.y_offset[0] - 3.9) < 1e-12
+    held = val.remove_trend(trend)
+    assert np.allclose(held.y[:, 0], 2 * val.times + 1 - 3.9, atol=1e-12)
+    assert "TrendInfo(" in repr(trend)
+    with pytest.raises(Exception, match="the trend is of 1 input"):
+        ctid.IdData.from_arrays(np.ones((5, 2)), np.arange(5.0), ts=0.1).remove_trend(trend)

@@ -201,6 +201,18 @@ IdData IdData::detrend(Detrend kind, TrendInfo* removed) const {
   return d;
 }
 
+IdData IdData::remove_trend(const TrendInfo& trend) const {
+  CTID_REQUIRE(trend.u_offset.size() == nu() && trend.y_offset.size() == ny() && trend.u_slope.size() == nu() &&
+                   trend.y_slope.size() == ny(),
+               "IdData: the trend is of {} input(s) and {} output(s); the record has {} and {}", trend.u_offset.size(),
+               trend.y_offset.size(), nu(), ny());
+  IdData d = *this;
+  const Eigen::ArrayXd tc = times().array() - trend.t_ref;
+  for (Eigen::Index j = 0; j < d.u_.cols(); ++j) d.u_.col(j).array() -= trend.u_offset(j) + trend.u_slope(j) * tc;
+  for (Eigen::Index j = 0; j < d.y_.cols(); ++j) d.y_.col(j).array() -= trend.y_offset(j) + trend.y_slope(j) * tc;
+  return d;
+}
+
 void require_io_data(const IdData& d, const char* who, int nu, int ny) {
   CTID_REQUIRE((nu < 0 || d.nu() == nu) && (ny < 0 || d.ny() == ny),
                "{}: needs {} input(s) and {} output(s) (the data have {} and {}); select channels first", who,

@@ -58,7 +58,7 @@ std::string json_string(const std::string& s) {
   return o + "\"";
 }
 
-std::string num(double v, int digits = 6) {
+std::string js_number(double v, int digits = 6) {
   if (!std::isfinite(v)) return "null";
   char b[32];
   std::snprintf(b, sizeof b, "%.*g", digits, v);
@@ -69,7 +69,7 @@ std::string json_array(const Eigen::VectorXd& v) {
   std::string o = "[";
   for (Eigen::Index i = 0; i < v.size(); ++i) {
     if (i) o += ',';
-    o += num(v(i));
+    o += js_number(v(i));
   }
   return o + "]";
 }
@@ -473,7 +473,9 @@ void more_records(Page& page, const AnyModel& m, const ReportOptions& o) {
                  d.nu(), d.ny(), model_inputs(m), model_outputs(m));
     page.section("Record " + std::to_string(i + 2) + ": " + name);
     page.text(std::to_string(d.size()) + " samples, " + fmt(d.duration()) + " s.");
-    validations(page, d, simulated(page, d, m, Diagnostics{}, o), o);
+    ReportOptions ro = o;
+    if (o.more_records_initial) ro.initial = o.more_records_initial;
+    validations(page, d, simulated(page, d, m, Diagnostics{}, ro), o);
   }
 }
 

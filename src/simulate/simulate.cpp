@@ -29,6 +29,12 @@ InitialCondition fit_initial_condition(const AnyModel& model, const Diagnostics&
   return diagnostics.has(diagnostic::x0) ? InitialCondition::Estimated : InitialCondition::Rest;
 }
 
+InitialCondition validation_initial_condition(const AnyModel& model) {
+  if (std::holds_alternative<NarxModel>(model) || std::holds_alternative<NdeModel>(model)) return InitialCondition::Measured;
+  if (std::holds_alternative<FsfModel>(model)) return InitialCondition::Rest;
+  return InitialCondition::Estimated;
+}
+
 namespace {
 
 // One linear state-space block of a model: its realisation, the input column that drives it and its delay.

@@ -258,10 +258,94 @@ TEST(Cli, NoPartialOutputOnFailure) {
 }
 
 TEST(Cli, DemoRunsOnBundledData) {
+  // Issue 17: the demo is ctid fit with its defaults on the first half of the DaISy dryer, validated on the second
+  // half (SrivcAuto.HairDryerValidatesAbove85Percent: >= 85 %), and prints that command: run as printed, it gives the
+  // same output.
   const CliRun r = ctid_run("demo");
   ASSERT_EQ(r.code, 0) << r.err;
-  // The DaISy dryer: a second-order model with 0.16 s delay; validation fit measured 88.3 %.
-  EXPECT_NE(r.out.find("validation on the last 500 samples: fit 8"), std::string::npos) << r.out;
+  const auto at = r.out.find("validation on ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  double fit = 0;
+  const auto f = r.out.find("fit ", r.out.find("):", at));
+  ASSERT_EQ(std::sscanf(r.out.c_str() + f, "fit %lf", &fit), 1) << r.out;
+  EXPECT_GE(fit, 85.0) << r.out;
+  const std::string marker = "the same fit from the command line:\n  ctid ";
+  const auto c = r.out.find(marker);
+  ASSERT_NE(c, std::string::npos) << r.out;
+  const std::string command = r.out.substr(c + marker.size(), r.out.find('\n', c + marker.size()) - c - marker.size());
+  EXPECT_NE(r.out.find("\nwhat it did: "), std::string::npos) << r.out;
+  // The printed path is relative to the folder the demo ran in: run the command there.
+  const CliRun same = ctid_run(command);
+  ASSERT_EQ(same.code, 0) << command << "\n" << same.err;
+  const std::string fit_part = r.out.substr(r.out.find("srivc-auto chose"), c - r.out.find("srivc-auto chose"));
+  // The printed model, fit and validation of the demo are the command's output, line for line (bar the timing).
+  auto without_time = [](std::string s) {
+    const auto t = s.find("termination:");
+    if (t != std::string::npos) s.erase(t, s.find('\n', t) - t);
+    while (!s.empty() && s.back() == '\n') s.pop_back();
+    return s;
+  };
+  EXPECT_EQ(without_time(fit_part), without_time(same.out));
+}
+
+TEST(Cli, SamplesAndValidateHoldOutPartOfARecord) {
+  // --samples A:B selects the estimation rows; --validate-samples (of the same file) or --validate FILE a held-out
+  // record, from which the estimation record's means are removed. The printed validation fit is the library's:
+  // srivc on rows 1..500 minus their means, simulated on rows 501..1000 minus the same means from the initial state
+  // that fits them best (validation_initial_condition).
+  const std::string dryer = std::string(CTID_EXAMPLES_DATA_DIR) + "/dryer.dat";
+  const std::string base = " --ts 0.08 --input 1 --output 2 --detrend mean --method srivc --nb 1 --nf 2 --nk 2 ";
+  DataSpec spec;
+  spec.ts = 0.08;
+  spec.inputs = {"1"};
+  spec.outputs = {"2"};
+  const IdData all = iddata_from_table(read_csv(dryer), spec);
+  TrendInfo trend;
+  const IdData est = all.slice(0, 500).detrend(Detrend::Mean, &trend);
+  const IdData val = all.slice(500, 1000).remove_trend(trend);
+  const Result<TransferFunction> lib = srivc(est, {1, 2, 2});
+  SimulateOptions so;
+  so.initial = InitialCondition::Estimated;
+  const std::string expected =
+      "fit " + fit_percent_text(fit_percent(val.y().col(0), simulate(AnyModel(lib.model), val, so).y.col(0))) + " %";
+  CliRun r = ctid_run("fit " + dryer + base + "--samples 1:500 --validate-samples 501:");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("samples: 500 "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("validation on " + dryer + " rows 501..1000 (500 samples, initial state: the one that fits them best): " +
+                       expected),
+            std::string::npos)
+      << r.out << "\nexpected " << expected;
+  // The same held-out rows as a file of their own.
+  Eigen::MatrixXd second(500, 2);
+  second << all.slice(500, 1000).u(), all.slice(500, 1000).y();
+  const std::string held = test::temp_path("dryer_second_half.csv");
+  write_csv(held, {"u", "y"}, second);
+  r = ctid_run("fit " + dryer + base + "--samples :500 --validate " + held);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("validation on " + held + " (500 samples"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(expected), std::string::npos) << r.out;
+  // The report shows the held-out record in a section of its own.
+  const std::string html = test::temp_path("held_out.html");
+  fs::remove(html);
+  r = ctid_run("fit " + dryer + base + "--samples 1:500 --validate-samples 501: --report " + html);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(read_text_file(html).find("Record 2: validation, " + dryer + " rows 501..1000"), std::string::npos);
+  // Bad ranges and flags: one line naming the option, the value and the record's size; exit 2.
+  for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+           {"--samples 0:10", "--samples 0:10: '0' is not a row number from 1 to 1000 (the record has 1000 rows)"},
+           {"--samples 1:5000", "'5000' is not a row number from 1 to 1000"},
+           {"--samples 7:7", "--samples 7:7: the range holds fewer than 2 rows"},
+           {"--samples 500", "--samples 500: give A:B"},
+           {"--validate-samples 1:x", "--validate-samples 1:x: 'x' is not a row number"}}) {
+    r = ctid_run("fit " + dryer + base + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
+  }
+  r = ctid_run("fit " + dryer + " --ts 0.08 --input 1 --output 2 --method narx --validate-samples 501:");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("ctid validate RESULT.json DATA"), std::string::npos) << r.err;
+  r = ctid_run("fit " + dryer + base + "--validate " + dryer + " --json " + dryer + " --force");
+  EXPECT_EQ(r.code, 2);  // an output that is an input file is refused before any work
 }
 
 TEST(Cli, WithoutMethodAndOrdersTheDefaultChoosesTheStructureAndRemovesTheMeans) {

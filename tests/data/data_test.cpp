@@ -89,6 +89,17 @@ TEST(IdData, SliceSplitSelectDetrend) {
   const IdData mean = d.detrend(Detrend::Mean);
   EXPECT_NEAR(mean.y().mean(), 0.0, 1e-14);
   EXPECT_THROW(d.slice(50, 40), InvalidArgument);
+  // The trend of the first 70 samples removed from the last 30 (a held-out record): input 1 is the line 3 + 2 t
+  // (slope 2, offset 3 at t = 0), so the estimation record's line removes it exactly from the later samples too,
+  // while the validation record's own mean would not be used.
+  TrendInfo est_trend;
+  (void)est.detrend(Detrend::Linear, &est_trend);
+  const IdData held = val.remove_trend(est_trend);
+  EXPECT_LT(held.u().col(0).cwiseAbs().maxCoeff(), 1e-11);
+  TrendInfo est_mean;
+  (void)est.detrend(Detrend::Mean, &est_mean);
+  EXPECT_NEAR(val.remove_trend(est_mean).y()(0, 0), val.y()(0, 0) - est.y().mean(), 1e-14);
+  EXPECT_THROW((void)s.remove_trend(est_trend), InvalidArgument);  // 1 input, the trend has 2
 }
 
 TEST(InputDesign, PrbsHasMaximalPeriod) {

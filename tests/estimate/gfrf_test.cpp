@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "estimate/billings_li_models.hpp"
 #include "ctid/core/error.hpp"
 #include "ctid/io/json.hpp"
 #include "ctid/estimate/gfrf.hpp"
@@ -20,10 +21,6 @@ NarxModel model(const std::vector<std::string>& terms, const std::vector<double>
   return NarxModel(t, Eigen::Map<const Eigen::VectorXd>(c.data(), static_cast<Eigen::Index>(c.size())), Ts);
 }
 
-// Billings & Li (1999) NARX model (34), process part, as printed (SEEDS-SPEC BL.3).
-NarxModel bl34() {  // Billings & Li (1999) model (34) as printed (SEEDS-SPEC BL.3)
-  return read_narx_json(std::string(CTID_EXAMPLES_DATA_DIR) + "/bl34_narx.json");
-}
 }  // namespace
 
 TEST(NarxGfrf, ClosedFormsOfFirstSecondAndThirdOrder) {

@@ -16,15 +16,12 @@
 #include "ctid/estimate/nde_oe.hpp"
 #include "ctid/io/load.hpp"
 #include "ctid/simulate/lsim.hpp"
+#include "estimate/billings_li_models.hpp"
 #include "test_util.hpp"
 
 using namespace ctid;
 
 namespace {
-NarxModel bl34() {  // Billings & Li (1999) model (34) as printed (SEEDS-SPEC BL.3)
-  return read_narx_json(std::string(CTID_EXAMPLES_DATA_DIR) + "/bl34_narx.json");
-}
-
 double value(const Result<NdeModel>& r, const std::string& name) { return r.parameters.value(name); }
 double err(const Result<NdeModel>& r, const std::string& name) {
   return r.diagnostics.get(diagnostic::err)(r.parameters.index(name));
@@ -114,16 +111,9 @@ TEST(Kia, PointsAndBadInputs) {
 }
 
 namespace {
-// Billings & Li system (33) driven by a +-1 random sequence held per sample at 400 Hz, 1000 samples
-// (SEEDS-SPEC BL.3 set-up), simulated by the adaptive NDE integrator.
-NdeModel bl33() {
-  std::vector<NdeTerm> t;
-  for (const char* s : {"y", "Dy", "D^2y", "u", "y^2", "y*Dy"}) t.push_back(NdeTerm::parse(s));
-  return NdeModel(t, (Eigen::VectorXd(6) << 1, 0.002, 1e-4, -1, 0.1, -0.006).finished());
-}
-
-// Relative errors of the reconstructed Dy, D^2y, u, y^2, y*Dy for one record: row 0 KIA, row 1 KIA refined by
-// output error (nde_oe on the same record).
+// Billings & Li system (33) driven by a +-1 random sequence held per sample at 400 Hz, 1000 samples (SEEDS-SPEC BL.3
+// set-up), simulated by the adaptive NDE integrator: the relative errors of the reconstructed Dy, D^2y, u, y^2, y*Dy,
+// row 0 KIA, row 1 KIA refined by output error (nde_oe on the same record).
 Eigen::MatrixXd end_to_end(unsigned seed, double snr_db) {
   const int N = 1000;
   const double T = 0.0025;

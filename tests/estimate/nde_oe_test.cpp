@@ -8,6 +8,7 @@
 #include "ctid/core/error.hpp"
 #include "ctid/estimate/nde_oe.hpp"
 #include "ctid/simulate/lsim.hpp"
+#include "estimate/billings_li_models.hpp"
 #include "test_util.hpp"
 
 using namespace ctid;
@@ -20,10 +21,6 @@ NdeModel model(std::initializer_list<const char*> names, std::initializer_list<d
   int i = 0;
   for (double v : values) c(i++) = v;
   return NdeModel(t, c);
-}
-
-NdeModel bl33(double ydy = -0.006, double u = -1.0) {
-  return model({"y", "Dy", "D^2y", "u", "y^2", "y*Dy"}, {1, 0.002, 1e-4, u, 0.1, ydy});
 }
 
 // +-1 random input held per sample at 400 Hz, the response from the state x0.

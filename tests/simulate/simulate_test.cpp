@@ -13,8 +13,8 @@
 using namespace ctid;
 
 namespace {
-const TransferFunction kSecond(Eigen::VectorXd{{1.0, 3.0}}, Eigen::VectorXd{{1.0, 1.2, 4.0}});  // (s+3)/(s^2+1.2s+4)
-const TransferFunction kFirst(Eigen::VectorXd{{2.0}}, Eigen::VectorXd{{1.0, 0.5}}, 0.13);       // 2 e^{-0.13s}/(s+0.5)
+const TransferFunction kSecondSim(Eigen::VectorXd{{1.0, 3.0}}, Eigen::VectorXd{{1.0, 1.2, 4.0}});  // (s+3)/(s^2+1.2s+4)
+const TransferFunction kFirstDelayed(Eigen::VectorXd{{2.0}}, Eigen::VectorXd{{1.0, 0.5}}, 0.13);       // 2 e^{-0.13s}/(s+0.5)
 
 Eigen::VectorXd random_input(int n, unsigned seed) {
   std::mt19937 rng(seed);
@@ -45,19 +45,19 @@ TEST(Simulate, EstimatedInitialStateOfLinearModelsIsTheOneThatMadeTheRecord) {
   const Eigen::VectorXd x0{{0.8, -1.5}};
   LsimOptions o;
   o.x0 = x0;
-  const Eigen::MatrixXd y = lsim(kSecond.to_state_space(), Eigen::MatrixXd(u1), t, {Intersample::Zoh}, o);
+  const Eigen::MatrixXd y = lsim(kSecondSim.to_state_space(), Eigen::MatrixXd(u1), t, {Intersample::Zoh}, o);
   const IdData d(u1, y, ts);
-  const Simulation est = simulate(kSecond, d, {InitialCondition::Estimated, {}});
+  const Simulation est = simulate(kSecondSim, d, {InitialCondition::Estimated, {}});
   ASSERT_TRUE(est.ok()) << est.problem;
   EXPECT_LT((est.x0 - x0).norm(), 1e-7 * x0.norm());
   EXPECT_LT((est.y - y).cwiseAbs().maxCoeff(), 1e-9 * (y.maxCoeff() - y.minCoeff()));
-  const Simulation rest = simulate(kSecond, d);
+  const Simulation rest = simulate(kSecondSim, d);
   EXPECT_EQ(rest.x0.size(), 0);
   EXPECT_GT(std::abs(rest.y(0, 0) - y(0, 0)), 0.5);  // y(0) = C x0 = -1.5 + 3 * 0.8 = 0.9 against 0 from rest
-  EXPECT_NE(message_of([&] { simulate(kSecond, d, {InitialCondition::Measured, {}}); }).find("no output history"),
+  EXPECT_NE(message_of([&] { simulate(kSecondSim, d, {InitialCondition::Measured, {}}); }).find("no output history"),
             std::string::npos);
   // MISO with a delayed channel: the channels' states stacked (2 + 1).
-  const MisoModel miso{{kSecond, kFirst}};
+  const MisoModel miso{{kSecondSim, kFirstDelayed}};
   Eigen::MatrixXd u(n, 2);
   u << u1, u2;
   const IdData d2(u, Eigen::VectorXd::Zero(n), ts);
@@ -114,7 +114,7 @@ TEST(Simulate, DivergenceIsReportedAndMismatchesAreRefused) {
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.problem.find("not finite from sample"), std::string::npos) << s.problem;
   EXPECT_NE(s.problem.find("unstable poles: 5+0j"), std::string::npos) << s.problem;
-  EXPECT_NE(message_of([&] { simulate(MisoModel{{kSecond, kFirst}}, d); }).find("has 2 input(s) but the record has 1"),
+  EXPECT_NE(message_of([&] { simulate(MisoModel{{kSecondSim, kFirstDelayed}}, d); }).find("has 2 input(s) but the record has 1"),
             std::string::npos);
   const FsfModel fsf(0.1, 20, 3, Eigen::VectorXd{{1.0, 0.2, -0.1}});
   EXPECT_TRUE(simulate(fsf, d.slice(0, 100)).ok());
@@ -148,12 +148,12 @@ TEST(Simulate, ResponsesOfEveryModelType) {
     for (int i = 0; i < 2; ++i) EXPECT_LT(std::abs(g(k, i) - direct(0, i)), 1e-12 * std::abs(direct(0, i)));
   }
   MisoModel miso;
-  miso.channels = {kSecond, kFirst};
+  miso.channels = {kSecondSim, kFirstDelayed};
   const Eigen::MatrixXd ms = model_step_response(miso, t), mi = model_impulse_response(miso, t);
-  EXPECT_EQ(ms.col(0), step_response(kSecond, t));
-  EXPECT_EQ(mi.col(1), impulse_response(kFirst, t));
+  EXPECT_EQ(ms.col(0), step_response(kSecondSim, t));
+  EXPECT_EQ(mi.col(1), impulse_response(kFirstDelayed, t));
   EXPECT_EQ(ms(1, 1), 0.0);  // t = 0.1 s < the delay 0.13 s
-  EXPECT_EQ(model_frequency_response(miso, w).col(1), kFirst.frequency_response(w));
+  EXPECT_EQ(model_frequency_response(miso, w).col(1), kFirstDelayed.frequency_response(w));
 
   const NarxModel narx({NarxTerm::parse("y(k-1)"), NarxTerm::parse("u(k-1)")}, Eigen::VectorXd{{0.6, 1.0}}, 0.1);
   const Eigen::MatrixXd ns = model_step_response(narx, t);
@@ -166,6 +166,6 @@ TEST(Simulate, ResponsesOfEveryModelType) {
   EXPECT_NE(message_of([&] { model_frequency_response(nde, w); }).find("GFRFs"), std::string::npos);
   const FsfModel windowed(0.1, 40, 3, Eigen::VectorXd{{1.0, 0.2, -0.1}}, {}, 0.5);
   EXPECT_NE(message_of([&] { model_step_response(windowed, t); }).find("G(s + a)"), std::string::npos);
-  EXPECT_NE(message_of([&] { model_step_response(kSecond, Eigen::VectorXd{{0.0, 0.2, 0.1}}); }).find("increase"),
+  EXPECT_NE(message_of([&] { model_step_response(kSecondSim, Eigen::VectorXd{{0.0, 0.2, 0.1}}); }).find("increase"),
             std::string::npos);
 }

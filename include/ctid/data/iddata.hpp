@@ -90,6 +90,10 @@ class IdData {
   std::pair<IdData, IdData> split(double fraction) const;
   /// Remove the mean or a least-squares line (in time) from every channel.
   IdData detrend(Detrend kind, TrendInfo* removed = nullptr) const;
+  /// Subtract a trend found on another record (detrend's `removed`): offset + slope * (t - t_ref) per channel, at
+  /// this record's times. A validation record is treated so, with the estimation record's trend, so that no
+  /// statistic of the validation record enters the model. Throws InvalidArgument when the channel counts differ.
+  IdData remove_trend(const TrendInfo& trend) const;
 
  private:
   void check_and_init();

@@ -39,6 +39,9 @@ struct ReportOptions {
   /// section of its own after the first record's; simulated from `initial` (unset: rest, or the measured history
   /// for NARX — a fitted x0 belongs to the first record).
   std::vector<std::pair<std::string, IdData>> more_records;
+  /// The initial condition of the further records' simulations when set (a held-out validation record: Estimated,
+  /// the state that fits its first samples best, as MATLAB's compare does); unset: as `initial` above.
+  std::optional<InitialCondition> more_records_initial;
 };
 
 /// Report of a result on the record `data` (single input and output — for a MisoModel one input per channel,

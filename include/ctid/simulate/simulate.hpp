@@ -64,6 +64,11 @@ struct Simulation {
 /// other rest. Reports of a fit use it so that their plotted fit is the one the estimator reported.
 InitialCondition fit_initial_condition(const AnyModel& model, const Diagnostics& diagnostics);
 
+/// The initial condition for comparing a model with a record it was not fitted on (a held-out part of a record does
+/// not start at rest): Estimated — the state that fits the record best, as MATLAB's compare — for linear and grey-box
+/// models, Measured (the record's own history) for NARX and NDE models, Rest for FSF models (simulated from rest only).
+InitialCondition validation_initial_condition(const AnyModel& model);
+
 /// Simulate `model` driven by the inputs of `data` (its outputs are read only for the Measured and
 /// Estimated initial conditions). Throws InvalidArgument when the data do not match the model (input
 /// count, sampling period, no outputs where the initial condition needs them, an x0 of the wrong size).
