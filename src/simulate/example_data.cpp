@@ -11,6 +11,7 @@
 #include "ctid/core/check.hpp"
 #include "ctid/core/names.hpp"
 #include "ctid/data/input_design.hpp"
+#include "ctid/model/greybox.hpp"
 #include "ctid/model/modal.hpp"
 #include "ctid/model/nde.hpp"
 #include "ctid/model/state_space.hpp"
@@ -216,13 +217,76 @@ ExampleData mimo() {
                    Eigen::VectorXd(y.col(1) + white_noise(N, 0.01, 44))})};
 }
 
+// docs/methods/greybox.md's mass on a spring with viscous and Coulomb-like friction, the model file
+// examples/data/spring_greybox.json: dq/dt = v, dv/dt = (force - k q - c v - fc tanh(v/0.05))/m with the truth
+// k = 2.5, c = 0.3, fc = 0.2, m = 1. The force steps every second to a level in [-3, 3] (a deterministic sequence per
+// record), Ts = 0.01 s, 1500 samples, the position with white noise of standard deviation 0.005; records differ in
+// their force sequence, initial position and noise.
+ExampleData spring(const char* name, double phase, double q0, std::uint64_t noise_seed) {
+  GreyboxSpec s;
+  s.inputs = {"force"};
+  s.states = {"q", "v"};
+  s.outputs = {{"position", "q"}};
+  s.parameters = {{"k", 2.5}, {"c", 0.3}, {"fc", 0.2}, {"m", 1.0}};
+  s.equations = {"v", "(force - k*q - c*v - fc*tanh(v/0.05))/m"};
+  s.initial = {{}, {}};
+  const GreyboxModel truth(s);
+  const int N = 1500;
+  const double Ts = 0.01;
+  const Eigen::VectorXd t = time_grid(Ts, N);
+  Eigen::MatrixXd force(N, 1);
+  for (int k = 0; k < N; ++k) force(k, 0) = 3.0 * std::sin(phase + 2.399963 * (k / 100));  // golden-angle steps
+  const GreyboxSimulation sim = truth.simulate(force, t, Intersample::Zoh, Eigen::Vector2d(q0, 0.0), 1e-10);
+  CTID_REQUIRE(sim.ok(), "example_data: the spring record did not simulate: {}", sim.message);
+  return {name,
+          detail::format("The mass-spring with friction of docs/methods/greybox.md (examples/data/spring_greybox.json) "
+                         "with k = 2.5, c = 0.3, fc = 0.2, m = 1, q(0) = {}, v(0) = 0: force steps every 1 s, Ts = 0.01 s, "
+                         "1500 samples, position noise std 0.005",
+                         q0),
+          {"t", "force", "position"},
+          columns({t, force.col(0), Eigen::VectorXd(sim.y.col(0) + white_noise(N, 0.005, noise_seed))})};
+}
+
+// docs/methods/greybox.md's magnetic levitation (python/examples/greybox_levitation.py): a steel ball under an
+// electromagnet, dy/dt = v, dv/dt = g - k i^2/y^2 - c v with k = 1e-4, c = 2, g = 9.81 (unstable in open loop: pole
+// +44 1/s at a 1 cm gap), recorded under the PD loop i = 3.132092 + 600 (y - r) + 9 v around the reference
+// r = 0.01 + 0.0015 sin(2 pi 0.7 t) + 0.001 sin(2 pi 2.3 t) m; Ts = 1 ms, 3000 samples, the current (a continuous
+// signal: first-order hold) and the gap with white noise of 10 um. The open-loop plant is
+// examples/data/levitation_greybox.json.
+ExampleData levitation() {
+  GreyboxSpec s;
+  s.inputs = {"r"};
+  s.states = {"y", "v"};
+  s.outputs = {{"y", "y"}, {"i", "3.132092 + 600*(y - r) + 9*v"}};
+  s.parameters = {{"k", 1e-4}, {"c", 2.0}, {"g", 9.81}};
+  s.equations = {"v", "g - k*(3.132092 + 600*(y - r) + 9*v)^2/y^2 - c*v"};
+  s.initial = {{"0.01"}, {}};
+  const GreyboxModel loop(s);
+  const int N = 3000;
+  const Eigen::VectorXd t = time_grid(0.001, N);
+  const double pi = 3.141592653589793;
+  const Eigen::MatrixXd r = (0.01 + 0.0015 * (2 * pi * 0.7 * t.array()).sin() + 0.001 * (2 * pi * 2.3 * t.array()).sin()).matrix();
+  const GreyboxSimulation sim = loop.simulate(r, t, Intersample::Foh, Eigen::Vector2d(0.01, 0.0), 1e-11);
+  CTID_REQUIRE(sim.ok(), "example_data: the levitation record did not simulate: {}", sim.message);
+  return {"levitation",
+          "The magnetic levitation of docs/methods/greybox.md: dv/dt = g - k i^2/y^2 - c v with k = 1e-4, c = 2, g = 9.81, "
+          "under the PD loop i = 3.132092 + 600 (y - r) + 9 v, r two sines around 1 cm; Ts = 0.001 s, 3000 samples, the "
+          "current i (first-order hold) and the gap y (m) with noise std 1e-5",
+          {"t", "i", "y"},
+          columns({t, sim.y.col(1), Eigen::VectorXd(sim.y.col(0) + white_noise(N, 1e-5, 61))})};
+}
+
 struct Entry {
   const char* name;
   ExampleData (*make)();
 };
 constexpr Entry kEntries[] = {{"data", rao_garnier}, {"second", second_order}, {"miso", miso},   {"loop", closed_loop},
                               {"freq", frequency},   {"mimo", mimo},           {"circuit", circuit}, {"steps", steps},
-                              {"sines", sines},      {"free", free_response},  {"forced", forced}, {"bl", billings_li}};
+                              {"sines", sines},      {"free", free_response},  {"forced", forced}, {"bl", billings_li},
+                              {"spring", [] { return spring("spring", 0.0, 0.4, 51); }},
+                              {"spring-b", [] { return spring("spring-b", 1.0, -0.3, 52); }},
+                              {"spring-test", [] { return spring("spring-test", 2.0, 0.2, 53); }},
+                              {"levitation", levitation}};
 
 }  // namespace
 

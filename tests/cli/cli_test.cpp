@@ -1805,6 +1805,33 @@ TEST(Cli, ExampleDataWritesTheDocumentedRecords) {
   for (int i = 0; i < res.parameters.size(); ++i)
     EXPECT_NEAR(res.parameters.values(i), truth.at(res.parameters.names[i]), 4 * res.parameters.std(i))
         << res.parameters.names[i];
+  // The grey-box page's record and its shipped model file (examples/data/spring_greybox.json): the truth of the
+  // record's description, k = 2.5, c = 0.3, fc = 0.2, q(0) = 0.4, within 4 reported std (measured: within 1.7).
+  const std::string spring = test::temp_path("spring.csv"), spring_json = test::temp_path("spring_fit.json");
+  fs::remove(spring);
+  fs::remove(spring_json);
+  ASSERT_EQ(ctid_run("example-data spring " + spring).code, 0);
+  r = ctid_run("fit " + spring + " --time t --method greybox --model " + std::string(CTID_EXAMPLES_DATA_DIR) +
+               "/spring_greybox.json --json " + spring_json);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const ResultFile gb = read_result_file(spring_json);
+  const std::map<std::string, double> gb_truth{{"k", 2.5}, {"c", 0.3}, {"fc", 0.2}, {"q(0)", 0.4}};
+  for (const auto& [name, value] : gb_truth)
+    EXPECT_NEAR(gb.result.parameters.value(name), value, 4 * gb.result.parameters.std[gb.result.parameters.index(name)])
+        << name;
+  // The unstable levitation under its PD loop and the open-loop plant file (multiple shooting, chosen automatically):
+  // k = 1e-4 and c = 2 within 4 reported std (measured: 0.3 and 0.6).
+  const std::string lev = test::temp_path("levitation.csv"), lev_json = test::temp_path("levitation_fit.json");
+  fs::remove(lev);
+  fs::remove(lev_json);
+  ASSERT_EQ(ctid_run("example-data levitation " + lev).code, 0);
+  r = ctid_run("fit " + lev + " --time t --intersample foh --method greybox --model " +
+               std::string(CTID_EXAMPLES_DATA_DIR) + "/levitation_greybox.json --json " + lev_json);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const ResultFile lf = read_result_file(lev_json);
+  for (const auto& [name, value] : std::map<std::string, double>{{"k", 1e-4}, {"c", 2.0}})
+    EXPECT_NEAR(lf.result.parameters.value(name), value, 4 * lf.result.parameters.std[lf.result.parameters.index(name)])
+        << name;
   // Nothing the user has is overwritten, and a wrong name is one line naming the closest.
   r = ctid_run("example-data second " + csv);
   EXPECT_EQ(r.code, 2);
