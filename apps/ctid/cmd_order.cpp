@@ -54,7 +54,8 @@ int run(const OrderArgs& a) {
   std::printf("rank  nb nf nk        YIC       RT2         AIC         BIC    fit %%  SRIVC\n");
   int i = 0;
   for (const auto& k : c)
-    std::printf("%4d  %2d %2d %2d %10.3f %9.4f %11.1f %11.1f %8s  %s\n", ++i, k.orders.nb, k.orders.nf, k.orders.nk, k.yic,
+    // Significant digits, not fixed decimals: a diverged structure's RT2 of -1e135 stays one column wide.
+    std::printf("%4d  %2d %2d %2d %10.4g %9.4g %11.6g %11.6g %8s  %s\n", ++i, k.orders.nb, k.orders.nf, k.orders.nk, k.yic,
                 k.rt2, k.aic, k.bic, fit_percent_text(k.fit_percent).c_str(), k.termination.c_str());
   if (!a.json.empty()) {
     write_text_file(a.json, order_selection_to_json(c, o.rank_by, interrupt_requested()));

@@ -56,6 +56,8 @@ int run(const ReportArgs& a) {
   o.method = file.method.empty() ? model_type_name(file.result.model) : file.method;
   o.title = a.title.empty() ? "ctid report: " + a.result : a.title;
   o.data_source = a.paths.front();
+  o.command_line = g_command_line;
+  o.preprocessing = g_preprocessing;
   for (std::size_t e = 1; e < ds.size(); ++e) {
     // Further records start as ReportOptions::more_records says (a fitted x0 belongs to the first record).
     const bool narx = std::holds_alternative<NarxModel>(file.result.model);

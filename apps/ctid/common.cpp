@@ -124,20 +124,44 @@ IdData DataArgs::load(bool need_output, TrendInfo* removed_trend, std::pair<int,
           if (same(o, in)) throw UsageError(detail::format("'{}' is selected both as an input and as the output", o));
     if (!need_output) spec.outputs = {spec.inputs.front()};  // placeholder output for loading only
     IdData d = tab ? iddata_from_table(*tab, spec) : load_iddata(path, spec);
-    if (rows) *rows = {1, d.size()};
+    const int n_rows = d.size();
+    std::pair<int, int> used{1, n_rows};
     if (!samples.empty()) {
       const auto [begin, end] = row_range(samples_option, samples, d.size());
       d = d.slice(begin, end);
-      if (rows) *rows = {begin + 1, end};
+      used = {begin + 1, end};
     }
+    if (rows) *rows = used;
     if (d.uniform_time_deviation() > 1e-9)
       std::fprintf(stderr, "note: %s: the sample times are within %.2g Ts of a uniform grid (threshold %g Ts): read as "
                    "uniform, Ts = %.10g s\n", path.c_str(), d.uniform_time_deviation(), IdData::kUniformTimeTolerance,
                    d.ts());
+    const bool first = g_preprocessing.empty();
+    if (first)
+      g_preprocessing = path + ": " +
+                        (samples.empty() ? "all " + std::to_string(n_rows) + " rows"
+                                         : detail::format("rows {}..{} of {}", used.first, used.second, n_rows)) +
+                        (detrend == "none" ? "; no detrending" : "");
     if (detrend == "none") return d;
     TrendInfo removed;
     IdData out = d.detrend(detrend == "mean" ? Detrend::Mean : Detrend::Linear, &removed);
     if (removed_trend) *removed_trend = removed;
+    if (first) {
+      std::string what;
+      char value[64];
+      for (int j = 0; j < d.nu() + d.ny(); ++j) {
+        const bool in = j < d.nu();
+        const int k = in ? j : j - d.nu();
+        if (detrend == "mean")
+          std::snprintf(value, sizeof value, "%.6g", in ? removed.u_offset(k) : removed.y_offset(k));
+        else
+          std::snprintf(value, sizeof value, "%.6g + %.6g (t - %.6g)", in ? removed.u_offset(k) : removed.y_offset(k),
+                        in ? removed.u_slope(k) : removed.y_slope(k), removed.t_ref);
+        what += detail::format("{}{} {} {}", j > 0 ? ", " : "", in ? "input" : "output",
+                               channel_name(in ? d.input_names() : d.output_names(), k), value);
+      }
+      g_preprocessing += detail::format("; {} removed ({})", detrend == "mean" ? "means" : "linear trends", what);
+    }
     if (announce_means && detrend == "mean") {
       std::string means;
       char value[32];

@@ -31,6 +31,11 @@ struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The command line as typed (main) and what DataArgs::load did to the first record it loaded (its rows and
+/// detrending, with the removed means): the report's "command" and "preprocessing".
+extern std::string g_command_line;
+extern std::string g_preprocessing;
+
 /// Options that select an experiment from a data file.
 struct DataArgs {
   std::string path;
@@ -160,6 +165,8 @@ void write_report(const std::string& path, const IdData& d, const Result<M>& r, 
   if (path.empty()) return;
   ReportOptions o;
   o.more_records_initial = more_records_initial;
+  o.command_line = g_command_line;
+  o.preprocessing = g_preprocessing;
   o.method = method;
   o.title = "ctid " + method + " fit";
   o.data_source = source;

@@ -11,6 +11,7 @@
 
 namespace ctid::cli {
 std::function<int()> g_run;
+std::string g_command_line, g_preprocessing;
 
 namespace {
 volatile std::sig_atomic_t g_sigint = 0;
@@ -67,6 +68,11 @@ int main(int argc, char** argv) {
   setup_report(*app.add_subcommand("report", "Self-contained HTML report of a result file on a record"));
   setup_demo(*app.add_subcommand("demo", "Identify a bundled real data set and print the model"));
   setup_example_data(*app.add_subcommand("example-data", "Write a simulated example record the README and docs use"));
+  g_command_line = "ctid";
+  for (int i = 1; i < argc; ++i) {
+    const std::string s = argv[i];
+    g_command_line += " " + (s.find_first_of(" \t'\"") == std::string::npos ? s : "'" + s + "'");
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

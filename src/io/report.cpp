@@ -5,6 +5,7 @@
 #include "ctid/io/report.hpp"
 
 #include <algorithm>
+#include <ctime>
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -12,6 +13,7 @@
 
 #include "ctid/core/check.hpp"
 #include "ctid/estimate/gfrf.hpp"
+#include "ctid/io/json.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/simulate/simulate.hpp"
 #include "ctid/validate/metrics.hpp"
@@ -157,7 +159,7 @@ h1 { font-size: 1.5em; } h2 { font-size: 1.15em; margin-top: 1.8em; border-botto
 table { border-collapse: collapse; margin: 0.5em 0; font-size: 0.9em; }
 td, th { border: 1px solid #ccc; padding: 2px 8px; text-align: left; font-variant-numeric: tabular-nums; }
 .plot { margin: 0.8em 0; } .plot .title { font-weight: 600; font-size: 0.95em; }
-.warn { color: #a40; } #ctid-selfcheck { color: #888; font-size: 0.8em; }
+.warn { color: #a40; } #ctid-selfcheck { display: none; }
 code { background: #f4f4f4; padding: 1px 4px; }
 )css";
   static constexpr const char* kJs = R"js(
@@ -284,6 +286,13 @@ void overview(Page& page, const IdData& d, const Result<M>& r, const ReportOptio
       {"fit (simulation)", r.fit.n_samples > 0 ? fmt(r.fit.fit_percent, 4) + " %" : std::string("not computed")},
       {"MSE / AIC / BIC", fmt(r.fit.mse, 4) + " / " + fmt(r.fit.aic, 5) + " / " + fmt(r.fit.bic, 5)},
       {"condition number", fmt(r.diagnostics.condition_number, 3)}};
+  if (!o.preprocessing.empty()) rows.push_back({"preprocessing", o.preprocessing});
+  if (!o.command_line.empty()) rows.push_back({"command", o.command_line});
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  char when[32] = "";
+  if (gmtime_r(&now, &utc)) std::strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S UTC", &utc);
+  rows.push_back({"made by", std::string("ctid ") + version() + ", " + when});
   page.table({"", ""}, rows);
   if (!o.settings.empty()) {
     std::vector<std::vector<std::string>> s;
@@ -362,8 +371,22 @@ void parameters(Page& page, const ParameterSet& p, const Eigen::VectorXd* err = 
     if (err) r.push_back(i < err->size() ? fmt((*err)(i), 4) : "-");
     rows.push_back(r);
   }
-  if (err) page.table({"parameter", "value", "std", "ERR %"}, rows);
-  else page.table({"parameter", "value", "std"}, rows);
+  // A parameter within two standard deviations of 0 is not significant: the data cannot tell it from 0 (at about 95 %),
+  // so the structure may have a term too many.
+  int insignificant = 0;
+  for (int i = 0; i < p.size(); ++i) {
+    const bool fixed = i < static_cast<int>(p.fixed.size()) && p.fixed[static_cast<size_t>(i)];
+    const bool known = !fixed && i < p.std.size() && std::isfinite(p.std(i));
+    const bool weak = known && std::abs(p.values(i)) < 2 * p.std(i);
+    insignificant += weak;
+    rows[static_cast<size_t>(i)].push_back(!known ? "-" : weak ? "no: |value| < 2 std" : "yes");
+  }
+  if (err) page.table({"parameter", "value", "std", "ERR %", "significant"}, rows);
+  else page.table({"parameter", "value", "std", "significant"}, rows);
+  if (insignificant > 0)
+    page.text("<span class=\"warn\">" + std::to_string(insignificant) + " parameter(s) lie within two standard deviations "
+              "of 0: the data cannot tell them from 0 (about 95 % confidence); a structure with fewer terms may do as "
+              "well (compare its BIC).</span>");
 }
 
 // Measured vs simulated output and the residual correlation tests.
@@ -390,13 +413,25 @@ void validation(Page& page, const IdData& d, const Eigen::VectorXd& yhat, const 
   for (int i = 0; i < d.nu(); ++i)
     tests.push_back({"Input-residual cross-correlation" + (d.nu() > 1 ? " (" + input_name(d, i) + ")" : std::string()),
                      input_residual_crosscorrelation(d.u().col(i), e, lags)});
-  for (const auto& [title, test] : tests) {
+  for (size_t t = 0; t < tests.size(); ++t) {
+    const auto& [title, test] = tests[t];
     const CorrelationTest* c = &test;
     const Eigen::VectorXd x = c->lags.cast<double>();
     const Eigen::VectorXd b = Eigen::VectorXd::Constant(x.size(), c->bound);
     page.plot({title + ": " + std::to_string(c->n_outside) + " lag(s) outside the 99 % bounds",
                "lag (samples)", "correlation", x, {{"r(k)", c->values}, {"+bound", b, true, true}, {"-bound", -b, true, true}}, false,
                true});
+    // What the result means, in one line (Ljung 1999, sec. 16.6).
+    const bool pass = c->passed();
+    const std::string meaning =
+        t == 0 ? (pass ? "Passed: the residuals look white — nothing predictable is left in them."
+                       : "Failed: the residuals are correlated — the model misses dynamics, or the noise is coloured "
+                         "(an output-error fit does not model the noise; its parameters can still be right).")
+               : (pass ? "Passed: the residuals do not depend on past inputs — no input-output dynamics is left "
+                         "unexplained."
+                       : "Failed: the residuals depend on the input — the model misses input-output dynamics (a higher "
+                         "order, another delay, a nonlinearity), or the data were taken in closed loop.");
+    page.text(pass ? meaning : "<span class=\"warn\">" + meaning + "</span>");
   }
 }
 
@@ -507,10 +542,41 @@ void step_at_input_level(Page& page, const AnyModel& m, const IdData& d, const E
 }
 
 
+// The poles of a transfer function as an engineer reads them: natural frequency and damping of each complex pair,
+// time constant of each real pole, and the zeros, DC gain and delay.
+void poles_and_gain(Page& page, const TransferFunction& g) {
+  page.section("Poles, zeros and gain");
+  std::vector<std::vector<std::string>> rows;
+  const Eigen::VectorXcd p = g.poles();
+  for (Eigen::Index i = 0; i < p.size(); ++i) {
+    const std::complex<double> s = p(i);
+    if (s.imag() < -1e-12 * std::abs(s)) continue;  // a pair is shown once, by its upper pole
+    const double wn = std::abs(s);
+    const bool real = std::abs(s.imag()) <= 1e-12 * std::max(wn, 1e-300);
+    const std::string where = s.real() > 0 ? "unstable" : s.real() == 0 ? "on the imaginary axis" : "stable";
+    if (real)
+      rows.push_back({fmt(s.real()), "real", s.real() != 0 ? fmt(1.0 / std::abs(s.real()), 4) + " s" : "-", "-", "-", where});
+    else
+      rows.push_back({fmt(s.real()) + " ± " + fmt(s.imag()) + "j", "complex pair", "-", fmt(wn, 4) + " rad/s (" +
+                      fmt(wn / (2 * std::numbers::pi), 4) + " Hz)", fmt(-s.real() / wn, 4), where});
+  }
+  page.table({"pole", "kind", "time constant", "natural frequency", "damping ratio", ""}, rows);
+  std::string zeros;
+  const Eigen::VectorXcd z = g.zeros();
+  for (Eigen::Index i = 0; i < z.size(); ++i)
+    zeros += (i ? ", " : "") + (std::abs(z(i).imag()) > 0 ? fmt(z(i).real()) + (z(i).imag() > 0 ? "+" : "-") +
+                                                                 fmt(std::abs(z(i).imag())) + "j"
+                                                           : fmt(z(i).real()));
+  page.table({"", ""}, {{"zeros", zeros.empty() ? "none" : zeros},
+                        {"DC gain G(0)", fmt(g.dc_gain(), 5)},
+                        {"delay", fmt(g.io_delay(), 4) + " s"}});
+}
+
 std::string report_of(const IdData& d, const Result<TransferFunction>& r, const ReportOptions& o) {
   require_siso(d);
   Page page;
   opening(page, d, r, o);
+  poles_and_gain(page, r.model);
   parameters(page, r.parameters);
   diagnostics(page, r.diagnostics);
   const Eigen::VectorXd w = frequency_grid(r.model.poles(), nyquist(d));

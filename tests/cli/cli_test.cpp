@@ -8,6 +8,7 @@
 #include <optional>
 #include <random>
 #include <set>
+#include <sstream>
 #include <sys/wait.h>
 
 #include <gtest/gtest.h>
@@ -329,7 +330,13 @@ TEST(Cli, SamplesAndValidateHoldOutPartOfARecord) {
   fs::remove(html);
   r = ctid_run("fit " + dryer + base + "--samples 1:500 --validate-samples 501: --report " + html);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(read_text_file(html).find("Record 2: validation, " + dryer + " rows 501..1000"), std::string::npos);
+  const std::string page = read_text_file(html);
+  EXPECT_NE(page.find("Record 2: validation, " + dryer + " rows 501..1000"), std::string::npos);
+  // The report says how the data were treated (the dryer's first 500 inputs average 4.994) and what made it.
+  EXPECT_NE(page.find("<td>preprocessing</td><td>" + dryer + ": rows 1..500 of 1000; means removed (input 1 4.994,"),
+            std::string::npos);
+  EXPECT_NE(page.find("<td>command</td><td>ctid fit " + dryer + base), std::string::npos);
+  EXPECT_NE(page.find("<td>made by</td><td>ctid " + std::string(version())), std::string::npos);
   // Bad ranges and flags: one line naming the option, the value and the record's size; exit 2.
   for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
            {"--samples 0:10", "--samples 0:10: '0' is not a row number from 1 to 1000 (the record has 1000 rows)"},
@@ -416,6 +423,15 @@ TEST(Cli, SrivcTfestWithDelayAndOrderSelection) {
   EXPECT_EQ(ord.at("candidates")[0].at("nk"), 14);
   EXPECT_EQ(ord.at("candidates")[0].at("usable"), true);
   EXPECT_EQ(ctid_run("order " + csv14 + " --time t --nf 2 --json " + oj).code, 2);  // exists, no --force
+  // Structures that diverge (on the `second` example record nb = 1, nf = 3 reaches RT2 = -5e266) keep the table's
+  // columns: every row is at most 100 characters (it was 300 with fixed decimals).
+  const std::string second = test::temp_path("second_order.csv");
+  fs::remove(second);
+  ASSERT_EQ(ctid_run("example-data second " + second).code, 0);
+  const CliRun wide = ctid_run("order " + second + " --time t --input u --output y --nb 1:3 --nf 1:4 --nk 0");
+  ASSERT_EQ(wide.code, 0) << wide.err;
+  std::istringstream rows(wide.out);
+  for (std::string row; std::getline(rows, row);) EXPECT_LE(row.size(), 100u) << row;
   EXPECT_EQ(ctid_run("order " + csv + " --time t --nf 3:1").code, 2);
   EXPECT_EQ(ctid_run("order " + csv + " --time t --nf x").code, 2);
   const CliRun bad = ctid_run("fit " + csv + " --time t --method srivc --delay --set delay_min=2 --set delay_max=1");

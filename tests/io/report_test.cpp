@@ -42,6 +42,36 @@ TEST(Report, TransferFunctionReportHasEverySection) {
   EXPECT_TRUE(report_has_plot_library());
 }
 
+TEST(Report, SaysWhatTheNumbersMean) {
+  // Issue 17, "a report worth sending": the poles as an engineer reads them, parameters within 2 std of 0 flagged,
+  // one plain-language line under each residual test, the preprocessing, the command and the version.
+  // The record (test::second_order_record) is 4/(s^2 + 0.8 s + 4) at 20 dB: wn = 2 rad/s, zeta = 0.2, DC gain 1.
+  const IdData d = plant();
+  auto r = srivc(d, {.nb = 1, .nf = 2});
+  ReportOptions o{.method = "srivc"};
+  o.preprocessing = "rows 1..500 of 1000; means removed";
+  o.command_line = "ctid fit x.csv --method srivc";
+  std::string html = html_report(d, r, o);
+  for (const char* s : {"<h2>Poles, zeros and gain</h2>", "complex pair", "DC gain G(0)", "<td>preprocessing</td><td>rows "
+                        "1..500 of 1000; means removed</td>", "<td>command</td><td>ctid fit x.csv --method srivc</td>",
+                        "<td>made by</td><td>ctid "})
+    EXPECT_NE(html.find(s), std::string::npos) << s;
+  const Eigen::VectorXcd p = r.model.poles();
+  const double wn = std::abs(p(0)), zeta = -p(0).real() / wn;
+  EXPECT_NEAR(wn, 2.0, 0.05);   // the estimate of the truth's 2 rad/s
+  EXPECT_NEAR(zeta, 0.2, 0.02);
+  char cell[64];
+  std::snprintf(cell, sizeof cell, "<td>%.4g</td>", zeta);
+  EXPECT_NE(html.find(cell), std::string::npos) << cell;
+  EXPECT_EQ(count(html, "Passed: ") + count(html, "Failed: "), 2);  // one line under each of the two tests
+  EXPECT_EQ(html.find("no: |value| &lt; 2 std"), std::string::npos);  // every parameter of the true structure is significant
+  // A parameter made insignificant (its std raised above half its value) is flagged, with a note.
+  r.parameters.std(0) = 0.6 * std::abs(r.parameters.values(0));
+  html = html_report(d, r, o);
+  EXPECT_EQ(count(html, "no: |value| &lt; 2 std"), 1);
+  EXPECT_NE(html.find("1 parameter(s) lie within two standard deviations of 0"), std::string::npos);
+}
+
 TEST(Report, MultiInputReportHasAChannelPerInput) {
   // Two inputs through (s + 3)/(s^2 + 2 s + 5) and 2/(s + 1), noise-free, MISO SRIVC: the report shows both
   // inputs, a cross-correlation test per input, and one Bode/step/impulse series per channel.
