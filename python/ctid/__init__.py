@@ -20,7 +20,7 @@ from ._ctid import (  # noqa: F401  (re-exported)
     NonlinearCorrelationTests, PhysicalModel, ResultFile, Simulation, StateSpace, TransferFunction, add_noise_snr, fit_percent, frequency_grid,
     example_data, example_data_names, generator_fitted_to_input, html_report, kia_product_candidates,
     input_residual_crosscorrelation, load, magnitude_band, mode_uncertainty, frequency_response_std, methods, settings, diagnostics, narx_candidates, narx_noise_candidates,
-    nonlinear_correlation_tests, one_sided_dft, piecewise_constant_windows, prbs, read_narx_json, read_nde_json,
+    nonlinear_correlation_tests, one_sided_dft, piecewise_constant_windows, prbs, random_binary, multisine, steps, white_noise, read_narx_json, read_nde_json,
     greybox_initial_state, read_result, residual_autocorrelation, response_horizon, time_grid, write_result,
 )
 
@@ -132,6 +132,75 @@ def _from_pandas(cls, frame, inputs, outputs, ts=None, time=None, intersample=No
 
 IdData.from_arrays = classmethod(_from_arrays)
 IdData.from_pandas = classmethod(_from_pandas)
+
+
+def _iddata_getitem(self, key):
+    """d[a:b]: the samples a..b-1 as an IdData (step 1; negative indices count from the end), IdData.slice with Python's
+    rules. d[k]: sample k as (t, u, y) with u and y arrays of the channels."""
+    if isinstance(key, (int, _np.integer)):
+        n = len(self)
+        k = int(key) + n if key < 0 else int(key)
+        if not 0 <= k < n:
+            raise IndexError(f"IdData index {key} is outside the {n} samples")
+        return float(self.times[k]), self.u[k, :].copy(), self.y[k, :].copy()
+    if not isinstance(key, slice):
+        raise TypeError(f"IdData indices are sample numbers or slices, e.g. d[100:500] (got {type(key).__name__})")
+    begin, end, step = key.indices(len(self))
+    if step != 1:
+        raise InvalidArgument(f"IdData[{key.start}:{key.stop}:{key.step}]: only consecutive samples (step 1); "
+                              "resample the signals and build a new IdData for another rate")
+    return self.slice(begin, max(begin, end))
+
+
+def _iddata_to_pandas(self):
+    """A pandas DataFrame with a column t (s) and one column per input and output, named as the channels."""
+    import pandas as pd
+    cols = {"t": self.times}
+    for i, n in enumerate(self.input_names):
+        cols[n] = self.u[:, i]
+    for j, n in enumerate(self.output_names):
+        cols[n if n not in cols else f"{n} (output)"] = self.y[:, j]
+    return pd.DataFrame(cols)
+
+
+def _iddata_repr(self):
+    sampling = f"Ts={self.ts:g} s" if self.is_uniform else "irregular times"
+    t = self.times
+    return (f"IdData({len(self)} samples, {sampling}, {t[-1] - t[0]:g} s; inputs {list(self.input_names)}, "
+            f"outputs {list(self.output_names)})")
+
+
+IdData.__getitem__ = _iddata_getitem
+IdData.to_pandas = _iddata_to_pandas
+IdData.__repr__ = _iddata_repr
+
+
+def _tf_to_scipy(self):
+    """This transfer function as scipy.signal.TransferFunction (continuous time). A delay has no place in that
+    class: a model with one is refused (scipy would silently drop it)."""
+    import scipy.signal
+    if self.delay != 0:
+        raise InvalidArgument(f"TransferFunction.to_scipy: the model has a delay of {self.delay:g} s, which "
+                              "scipy.signal.TransferFunction cannot hold; use a Pade approximation or keep the delay apart")
+    return scipy.signal.TransferFunction(_np.asarray(self.num), _np.asarray(self.den))
+
+
+def _tf_from_scipy(cls, system, delay=0.0):
+    """A TransferFunction from a continuous-time scipy.signal LTI object (TransferFunction, ZerosPolesGain or
+    StateSpace; single input and output); delay in seconds."""
+    import scipy.signal
+    if getattr(system, "dt", None) not in (None,):
+        raise InvalidArgument(f"TransferFunction.from_scipy: the system is discrete-time (dt = {system.dt}); ctid's "
+                              "models are continuous-time")
+    tf = system.to_tf() if hasattr(system, "to_tf") else scipy.signal.TransferFunction(system)
+    num = _np.atleast_2d(tf.num)
+    if num.shape[0] != 1:
+        raise InvalidArgument(f"TransferFunction.from_scipy: {num.shape[0]} outputs; give a single-output system")
+    return cls(_np.trim_zeros(num[0], "f") if _np.any(num[0]) else [0.0], _np.asarray(tf.den, dtype=float), delay)
+
+
+TransferFunction.to_scipy = _tf_to_scipy
+TransferFunction.from_scipy = classmethod(_tf_from_scipy)
 
 
 def _report(result):

@@ -173,6 +173,16 @@ void bind_core(py::module_& m) {
           return prbs(n, {.register_length = register_length, .clock_period = clock_period, .initial_state = initial_state});
         }, py::arg("n"), py::arg("register_length") = 10, py::arg("clock_period") = 1, py::arg("initial_state") = 1,
         "PRBS of +-1 (initial_state: the non-zero register seed).");
+  m.def("random_binary", &random_binary, py::arg("n"), py::arg("seed"), py::arg("clock_period") = 1,
+        py::arg("amplitude") = 1.0,
+        "Random binary signal: independent +-amplitude values (equal probability), each held clock_period samples.");
+  m.def("multisine", &multisine, py::arg("t"), py::arg("frequencies"), py::arg("amplitudes"),
+        py::arg("phases") = std::vector<double>{},
+        "Sum of sinusoids at the times t: sum a_i sin(w_i t + phi_i), frequencies in rad/s; phases empty: Schroeder "
+        "phases (low crest factor).");
+  m.def("steps", &steps, py::arg("t"), py::arg("step_times"), py::arg("levels"),
+        "Piecewise-constant signal at the times t: levels[i] from step_times[i] on (0 before the first).");
+  m.def("white_noise", &white_noise, py::arg("n"), py::arg("stddev"), py::arg("seed"), "White Gaussian noise.");
   m.def("add_noise_snr", &add_noise_snr, py::arg("x"), py::arg("snr_db"), py::arg("seed"),
         "x plus white Gaussian noise at the given signal-to-noise ratio (dB, power of x - mean).");
   m.def("fit_percent", &fit_percent, py::arg("y"), py::arg("yhat"), "100 (1 - ||y - yhat|| / ||y - mean(y)||).");

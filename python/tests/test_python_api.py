@@ -1,0 +1,62 @@
+"""Python as Python users expect (issue 17): input generators, IdData slicing / to_pandas / repr, scipy.signal
+conversion of transfer functions."""
+import numpy as np
+import pytest
+import scipy.signal
+
+import ctid
+
+
+def test_input_generators():
+    # random_binary: +-amplitude held clock_period samples; the same seed gives the same signal.
+    u = ctid.random_binary(1000, seed=4, clock_period=5, amplitude=2.0)
+    assert u.shape == (1000,) and set(np.unique(u)) == {-2.0, 2.0}
+    assert np.all(u.reshape(-1, 5) == u.reshape(-1, 5)[:, :1])
+    assert np.array_equal(u, ctid.random_binary(1000, seed=4, clock_period=5, amplitude=2.0))
+    # multisine with given phases is the sum it names, to rounding.
+    t = ctid.time_grid(0.01, 500)
+    m = ctid.multisine(t, [1.0, 3.0], [0.5, 2.0], [0.1, -0.7])
+    assert np.max(np.abs(m - (0.5 * np.sin(t + 0.1) + 2.0 * np.sin(3 * t - 0.7)))) < 1e-12
+    # steps: 0 before the first step time, then each level from its time on.
+    s = ctid.steps(t, [1.0, 2.5], [3.0, -1.0])
+    assert s[t < 1.0].max() == 0 and np.all(s[(t >= 1.0) & (t < 2.5)] == 3.0) and np.all(s[t >= 2.5] == -1.0)
+    n = ctid.white_noise(20000, stddev=0.5, seed=1)
+    assert abs(n.std() - 0.5) < 0.01  # 20000 samples: the std of the estimate is 0.5/sqrt(40000) = 0.0025
+
+
+def test_iddata_slicing_pandas_and_repr():
+    d = ctid.IdData.from_arrays(np.arange(100.0), np.arange(100.0) ** 2, ts=0.1, input_names=["volt"],
+                                output_names=["temp"])
+    part = d[10:20]
+    assert len(part) == 10 and part.u[0, 0] == 10.0 and abs(part.times[0] - 1.0) < 1e-12
+    assert d[-5:].u[0, 0] == 95.0 and len(d[:3]) == 3
+    with pytest.raises(Exception, match="step 1"):
+        d[::2]
+    t3, u3, y3 = d[3]
+    assert abs(t3 - 0.3) < 1e-12 and u3[0] == 3.0 and y3[0] == 9.0 and d[-1][2][0] == 99.0 ** 2
+    with pytest.raises(IndexError):
+        d[100]
+    with pytest.raises(TypeError, match="slices"):
+        d["a"]
+    f = d.to_pandas()
+    assert list(f.columns) == ["t", "volt", "temp"] and f["temp"].iloc[7] == 49.0 and abs(f["t"].iloc[7] - 0.7) < 1e-12
+    back = ctid.IdData.from_pandas(f, inputs=["volt"], outputs=["temp"], time="t")
+    assert np.array_equal(back.y, d.y)
+    assert repr(d) == "IdData(100 samples, Ts=0.1 s, 9.9 s; inputs ['volt'], outputs ['temp'])"
+
+
+def test_transfer_function_to_and_from_scipy():
+    g = ctid.TransferFunction([1.0, 3.0], [1.0, 1.2, 4.0])
+    sg = g.to_scipy()
+    assert isinstance(sg, scipy.signal.TransferFunction) and sg.dt is None
+    t = np.linspace(0, 10, 201)
+    _, y = scipy.signal.step(sg, T=t)
+    assert np.max(np.abs(y - ctid.step_response(g, t))) < 1e-6  # scipy's lsim vs ctid's exact step
+    back = ctid.TransferFunction.from_scipy(scipy.signal.ZerosPolesGain([-3.0], [-0.6 + 1.908j, -0.6 - 1.908j], 1.0),
+                                            delay=0.2)
+    assert np.allclose(back.num, [1.0, 3.0]) and np.allclose(back.den, [1.0, 1.2, 0.36 + 1.908 ** 2])
+    assert back.delay == 0.2
+    with pytest.raises(Exception, match="delay of 0.2 s"):
+        back.to_scipy()
+    with pytest.raises(Exception, match="discrete-time"):
+        ctid.TransferFunction.from_scipy(scipy.signal.TransferFunction([1.0], [1.0, -0.5], dt=0.1))
