@@ -228,6 +228,49 @@ for _cls in (_ctid.TransferFunctionResult, _ctid.MisoResult, _ctid.ModalResult, 
     _cls.report = _report
 
 
+def _parameters_repr(p):
+    rows = [f"{'parameter':<16}{'value':>14}{'std':>12}"]
+    for i, name in enumerate(p.names):
+        sd = "fixed" if p.fixed and p.fixed[i] else f"{p.std[i]:.4g}" if len(p.std) else "-"
+        rows.append(f"{name:<16}{p.values[i]:>14.6g}{sd:>12}")
+    return "\n".join(rows)
+
+
+def _fit_repr(f):
+    return (f"FitReport(fit {_ctid.fit_percent_text(f.fit_percent)} %, nrmse {f.nrmse:.4g}, mse {f.mse:.4g}, "
+            f"aic {f.aic:.6g}, bic {f.bic:.6g}, {f.n_samples} samples)")
+
+
+def _summary_repr(s):
+    return (f"Summary({s.termination}, {s.iterations} iteration(s), {s.seconds:.3g} s"
+            + (f": {s.message}" if s.message else "") + ")")
+
+
+def _diagnostics_repr(g):
+    lines = [f"Diagnostics(condition number {g.condition_number:.3g})"]
+    lines += [f"  {k} = {v:.6g}" for k, v in g.scalars.items()]
+    lines += [f"  {k} = [{', '.join(f'{x:.4g}' for x in v[:8])}{', ...' if len(v) > 8 else ''}]"
+              for k, v in g.vectors.items()]
+    lines += [f"  chosen: {c}" for c in g.choices] + [f"  warning: {w}" for w in g.warnings]
+    return "\n".join(lines)
+
+
+def _html_pre(self):
+    """Notebooks: the repr in a monospaced block (escaped)."""
+    import html
+    return "<pre>" + html.escape(repr(self)) + "</pre>"
+
+
+_ctid.ParameterSet.__repr__ = _parameters_repr
+_ctid.FitReport.__repr__ = _fit_repr
+_ctid.Summary.__repr__ = _summary_repr
+_ctid.Diagnostics.__repr__ = _diagnostics_repr
+for _cls in (IdData, _ctid.ParameterSet, _ctid.FitReport, _ctid.Summary, _ctid.Diagnostics, TransferFunction,
+             StateSpace, MisoModel, FsfModel, NarxModel, NdeModel, GreyboxModel, _ctid.TransferFunctionResult,
+             _ctid.MisoResult, _ctid.ModalResult, _ctid.FsfResult, _ctid.NarxResult, _ctid.NdeResult, _ctid.GreyboxResult):
+    _cls._repr_html_ = _html_pre
+
+
 # ---- responses of the models that have no closed form in C++ ----
 
 def _miso_columns(method):

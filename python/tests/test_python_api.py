@@ -60,3 +60,17 @@ def test_transfer_function_to_and_from_scipy():
         back.to_scipy()
     with pytest.raises(Exception, match="discrete-time"):
         ctid.TransferFunction.from_scipy(scipy.signal.TransferFunction([1.0], [1.0, -0.5], dt=0.1))
+
+
+def test_every_result_part_has_a_readable_repr_and_html():
+    e = ctid.example_data("second")
+    d = ctid.IdData.from_arrays(e.values[:, 1], e.values[:, 2], ts=0.05)
+    r = ctid.srivc(d, nb=2, nf=2)
+    assert repr(r.parameters).splitlines()[0].split() == ["parameter", "value", "std"]
+    assert len(repr(r.parameters).splitlines()) == 1 + len(r.parameters.names)
+    assert repr(r.fit).startswith(f"FitReport(fit {r.fit.fit_percent:.2f} %")
+    assert repr(r.summary).startswith("Summary(converged, ")
+    assert repr(r.diagnostics).startswith("Diagnostics(condition number ")
+    for obj in (d, r, r.parameters, r.fit, r.summary, r.diagnostics, r.model):
+        assert "object at 0x" not in repr(obj), type(obj).__name__
+        assert obj._repr_html_().startswith("<pre>") and "&lt;" not in obj._repr_html_()[:5]
