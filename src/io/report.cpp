@@ -442,36 +442,55 @@ void validations(Page& page, const IdData& d, const Eigen::MatrixXd& yhat, const
 
 // Bode magnitude and (unwrapped) phase of one or more responses hs = {(label, H(jw))} on the grid w; the
 // 95 % magnitude band (lo_mag, hi_mag) goes with a single response.
+// The phase of h in degrees, unwrapped along the grid (no jumps of 360).
+Eigen::VectorXd unwrapped_phase_deg(const Eigen::VectorXcd& h) {
+  Eigen::VectorXd ph(h.size());
+  double prev = 0, offset = 0;
+  for (Eigen::Index i = 0; i < h.size(); ++i) {
+    const double a = std::arg(h(i)) * 180 / std::numbers::pi;
+    if (i > 0) {
+      while (a + offset - prev > 180) offset -= 360;
+      while (a + offset - prev < -180) offset += 360;
+    }
+    ph(i) = prev = a + offset;
+  }
+  return ph;
+}
+
+// 95 % bands (2.5 and 97.5 % curves) of one response, each a (lower, upper) pair.
+struct Bands {
+  const MagnitudeBand* magnitude = nullptr;  ///< of |G(jw)|
+  const MagnitudeBand* phase = nullptr;      ///< of the unwrapped phase, degrees
+};
+
 void bode(Page& page, const Eigen::VectorXd& w, const std::vector<std::pair<std::string, Eigen::VectorXcd>>& hs,
-          const Eigen::VectorXd* lo_mag = nullptr, const Eigen::VectorXd* hi_mag = nullptr) {
+          const Bands& bands = {}) {
   page.section("Frequency response");
   std::vector<Series> ms, ps;
   for (const auto& [label, h] : hs) {
-    Eigen::VectorXd mag(w.size()), ph(w.size());
-    double prev = 0, offset = 0;
-    for (Eigen::Index i = 0; i < w.size(); ++i) {
-      mag(i) = 20 * std::log10(std::abs(h(i)));
-      double a = std::arg(h(i)) * 180 / std::numbers::pi;
-      if (i > 0) {  // unwrap
-        while (a + offset - prev > 180) offset -= 360;
-        while (a + offset - prev < -180) offset += 360;
-      }
-      ph(i) = prev = a + offset;
-    }
-    ms.push_back({"|" + label + "|", mag});
-    ps.push_back({hs.size() > 1 ? label : "phase", ph});
+    ms.push_back({"|" + label + "|", (20 * h.cwiseAbs().array().log10()).matrix()});
+    ps.push_back({hs.size() > 1 ? label : "phase", unwrapped_phase_deg(h)});
   }
-  if (lo_mag && hi_mag) {
-    ms.push_back({"2.5 %", (20 * lo_mag->array().log10()).matrix(), false, true});
-    ms.push_back({"97.5 %", (20 * hi_mag->array().log10()).matrix(), false, true});
+  const MagnitudeBand* m = bands.magnitude && !bands.magnitude->empty() ? bands.magnitude : nullptr;
+  const MagnitudeBand* p = bands.phase && !bands.phase->empty() ? bands.phase : nullptr;
+  if (m) {
+    ms.push_back({"2.5 %", (20 * m->lower.array().log10()).matrix(), false, true});
+    ms.push_back({"97.5 %", (20 * m->upper.array().log10()).matrix(), false, true});
   }
-  page.plot({"Bode magnitude" + std::string(lo_mag ? " with the 95 % band from the parameter covariance" : ""),
+  if (p) {
+    ps.push_back({"2.5 %", p->lower, false, true});
+    ps.push_back({"97.5 %", p->upper, false, true});
+  }
+  page.plot({"Bode magnitude" + std::string(m ? " with the 95 % band from the parameter covariance" : ""),
              "frequency (rad/s)", "dB", w, ms, true});
-  page.plot({"Bode phase", "frequency (rad/s)", "deg", w, ps, true});
+  page.plot({"Bode phase" + std::string(p ? " with the 95 % band from the parameter covariance" : ""),
+             "frequency (rad/s)", "deg", w, ps, true});
 }
 
-// Step and impulse responses of a linear model (one curve per input, labelled) over `horizon` seconds.
-void time_responses(Page& page, const AnyModel& model, const std::vector<std::string>& labels, double horizon) {
+// Step and impulse responses of a linear model (one curve per input, labelled) over `horizon` seconds; with `tf`, the
+// 95 % band of the step response from its parameter covariance (response_band).
+void time_responses(Page& page, const AnyModel& model, const std::vector<std::string>& labels, double horizon,
+                    const Result<TransferFunction>* tf = nullptr) {
   page.section("Step and impulse responses");
   const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(400, 0.0, horizon);
   const Eigen::MatrixXd s = model_step_response(model, t), g = model_impulse_response(model, t);
@@ -480,7 +499,14 @@ void time_responses(Page& page, const AnyModel& model, const std::vector<std::st
     step.push_back({s.cols() > 1 ? labels[static_cast<size_t>(i)] : "step", s.col(i)});
     impulse.push_back({s.cols() > 1 ? labels[static_cast<size_t>(i)] : "impulse", g.col(i)});
   }
-  page.plot({"Step response", "time (s)", "y", t, step});
+  const MagnitudeBand band =
+      tf ? response_band(*tf, [&](const TransferFunction& m) { return step_response(m, t); }) : MagnitudeBand{};
+  if (!band.empty()) {
+    step.push_back({"2.5 %", band.lower, false, true});
+    step.push_back({"97.5 %", band.upper, false, true});
+  }
+  page.plot({band.empty() ? "Step response" : "Step response with the 95 % band from the parameter covariance",
+             "time (s)", "y", t, step});
   page.plot({"Impulse response", "time (s)", "y", t, impulse});
 }
 
@@ -581,10 +607,19 @@ std::string report_of(const IdData& d, const Result<TransferFunction>& r, const 
   diagnostics(page, r.diagnostics);
   const Eigen::VectorXd w = frequency_grid(r.model.poles(), nyquist(d));
   const Eigen::VectorXcd h = r.model.frequency_response(w);
-  // 95 % band of |G| from 200 draws of the parameter covariance (seeded: the report is reproducible).
-  const MagnitudeBand band = magnitude_band(r, w);
-  bode(page, w, {{"G(jw)", h}}, band.empty() ? nullptr : &band.lower, band.empty() ? nullptr : &band.upper);
-  time_responses(page, r.model, {"G"}, response_horizon({r.model}, d.duration()));
+  // 95 % bands of |G|, its phase and the step response from 200 draws of the parameter covariance (seeded: the
+  // report is reproducible).
+  const MagnitudeBand mag = magnitude_band(r, w);
+  // Each drawn phase is unwrapped from the estimate's branch at the first frequency (a draw starting at -179 deg
+  // against the estimate's +179 deg is the same curve, not one 360 deg away).
+  const Eigen::VectorXd phase0 = unwrapped_phase_deg(h);
+  const MagnitudeBand phase = response_band(r, [&](const TransferFunction& g) {
+    Eigen::VectorXd ph = unwrapped_phase_deg(g.frequency_response(w));
+    if (ph.size() > 0) ph.array() += 360.0 * std::round((phase0(0) - ph(0)) / 360.0);
+    return ph;
+  });
+  bode(page, w, {{"G(jw)", h}}, {&mag, &phase});
+  time_responses(page, r.model, {"G"}, response_horizon({r.model}, d.duration()), &r);
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }
 

@@ -74,6 +74,15 @@ MagnitudeBand magnitude_band(const Result<TransferFunction>& r, const Eigen::Vec
                              unsigned seed) {
   CTID_REQUIRE(level > 0 && level < 1, "magnitude_band: level must be in (0, 1) (got {})", level);
   CTID_REQUIRE(draws >= 10, "magnitude_band: need at least 10 draws (got {})", draws);
+  return response_band(r, [&](const TransferFunction& g) { return Eigen::VectorXd(g.frequency_response(w).cwiseAbs()); },
+                       level, draws, seed);
+}
+
+MagnitudeBand response_band(const Result<TransferFunction>& r,
+                            const std::function<Eigen::VectorXd(const TransferFunction&)>& response, double level,
+                            int draws, unsigned seed) {
+  CTID_REQUIRE(level > 0 && level < 1, "response_band: level must be in (0, 1) (got {})", level);
+  CTID_REQUIRE(draws >= 10, "response_band: need at least 10 draws (got {})", draws);
   const ParameterSet& p = r.parameters;
   const int P = p.size();
   MagnitudeBand band;
@@ -86,19 +95,23 @@ MagnitudeBand magnitude_band(const Result<TransferFunction>& r, const Eigen::Vec
   const Eigen::MatrixXd L = es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
   std::mt19937 rng(seed);
   std::normal_distribution<double> n01;
-  Eigen::MatrixXd mags(draws, w.size());
+  const Eigen::Index n = response(r.model).size();
+  Eigen::MatrixXd mags(draws, n);
   Eigen::VectorXd z(P);
   for (int k = 0; k < draws; ++k) {
     for (auto& v : z) v = n01(rng);
-    mags.row(k) = with_coefficients(r.model, map, p.values + L * z).frequency_response(w).cwiseAbs().transpose();
+    const Eigen::VectorXd v = response(with_coefficients(r.model, map, p.values + L * z));
+    CTID_REQUIRE(v.size() == n, "response_band: the response has {} points for a drawn model, {} for the estimate",
+                 v.size(), n);
+    mags.row(k) = v.transpose();
   }
   const double tail = 0.5 * (1.0 - level);
   const auto lo_i = static_cast<size_t>(std::floor(tail * draws));
   const auto hi_i = std::min(static_cast<size_t>(draws) - 1, static_cast<size_t>(std::ceil((1.0 - tail) * draws)) - 1);
-  band.lower.resize(w.size());
-  band.upper.resize(w.size());
+  band.lower.resize(n);
+  band.upper.resize(n);
   std::vector<double> c(static_cast<size_t>(draws));
-  for (Eigen::Index j = 0; j < w.size(); ++j) {
+  for (Eigen::Index j = 0; j < n; ++j) {
     for (int k = 0; k < draws; ++k) c[static_cast<size_t>(k)] = mags(k, j);
     std::sort(c.begin(), c.end());
     band.lower(j) = c[lo_i];

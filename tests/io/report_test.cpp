@@ -29,7 +29,8 @@ TEST(Report, TransferFunctionReportHasEverySection) {
   const std::string html = html_report(d, r, {.method = "srivc", .settings = {{"max_iterations", "50"}}});
   for (const char* s : {"<h2>Summary</h2>", "<h2>Method settings</h2>", "<h2>Data</h2>", "Measured and simulated",
                         "<h2>Residual tests</h2>", "<h2>Parameters</h2>", "<h2>Frequency response</h2>",
-                        "95 % band", "Step response", "Impulse response", "max_iterations"})
+                        "95 % band", "Step response", "Impulse response", "max_iterations",
+                        "Bode phase with the 95 % band", "Step response with the 95 % band"})
     EXPECT_NE(html.find(s), std::string::npos) << s;
   // 9 plots: input, output, compare, 2 correlations, Bode magnitude and phase, step, impulse.
   EXPECT_EQ(count(html, "class=\"plot\""), 9);

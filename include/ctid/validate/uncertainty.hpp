@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <functional>
 #include <vector>
 
 #include "ctid/core/types.hpp"
@@ -51,6 +52,11 @@ struct MagnitudeBand {
 /// coefficient of its model (e.g. physical parameters). Throws InvalidArgument for level outside (0, 1) or draws < 10.
 MagnitudeBand magnitude_band(const Result<TransferFunction>& r, const Eigen::VectorXd& w, double level = 0.95,
                              int draws = 200, unsigned seed = 1);
+/// The same band for any real response of the model — `response(g)`, one value per point (e.g. the step response at
+/// given times, or the unwrapped phase): pointwise central `level` band over the drawn transfer functions.
+MagnitudeBand response_band(const Result<TransferFunction>& r,
+                            const std::function<Eigen::VectorXd(const TransferFunction&)>& response, double level = 0.95,
+                            int draws = 200, unsigned seed = 1);
 
 // State-space results (ssest): what a parameter is, and the uncertainty of poles and frequency responses.
 
