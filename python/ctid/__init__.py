@@ -203,18 +203,22 @@ TransferFunction.to_scipy = _tf_to_scipy
 TransferFunction.from_scipy = classmethod(_tf_from_scipy)
 
 
+def _parameters_repr(p):
+    rows = [f"{'parameter':<16}{'value':>14}{'std':>12}"]
+    for i, name in enumerate(p.names):
+        sd = "fixed" if p.fixed and p.fixed[i] else f"{p.std[i]:.4g}" if len(p.std) else "-"
+        rows.append(f"{name:<16}{p.values[i]:>14.6g}{sd:>12}")
+    return "\n".join(rows)
+
+
 def _report(result):
     """Brief text report of a result (what repr() shows)."""
     s = result.summary
     lines = [f"{type(result.model).__name__}: {result.model!r}",
              f"termination: {s.termination}" + (f" ({s.message})" if s.message else "")
              + f", {s.iterations} iteration(s), {s.seconds:.3g} s, usable: {result.usable()}"]
-    p = result.parameters
-    if len(p):
-        lines.append(f"{'parameter':<16}{'value':>14}{'std':>12}")
-        for i, name in enumerate(p.names):
-            sd = "fixed" if p.fixed and p.fixed[i] else f"{p.std[i]:.4g}" if len(p.std) else "-"
-            lines.append(f"{name:<16}{p.values[i]:>14.6g}{sd:>12}")
+    if len(result.parameters):
+        lines.append(_parameters_repr(result.parameters))
     f = result.fit
     lines.append(f"fit: {_ctid.fit_percent_text(f.fit_percent)} %  (mse {f.mse:.4g}, aic {f.aic:.4g}, "
                  f"{f.n_samples} samples)")
@@ -226,14 +230,6 @@ for _cls in (_ctid.TransferFunctionResult, _ctid.MisoResult, _ctid.ModalResult, 
              _ctid.NdeResult, _ctid.GreyboxResult):
     _cls.__repr__ = _report
     _cls.report = _report
-
-
-def _parameters_repr(p):
-    rows = [f"{'parameter':<16}{'value':>14}{'std':>12}"]
-    for i, name in enumerate(p.names):
-        sd = "fixed" if p.fixed and p.fixed[i] else f"{p.std[i]:.4g}" if len(p.std) else "-"
-        rows.append(f"{name:<16}{p.values[i]:>14.6g}{sd:>12}")
-    return "\n".join(rows)
 
 
 def _fit_repr(f):
