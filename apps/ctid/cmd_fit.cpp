@@ -94,20 +94,11 @@ void reject_flags_that_do_not_apply(const FitArgs& a) {
 
 
 
-// A linear model through the origin cannot follow an offset: after a fit by a linear method of data that keep a
-// large one (--detrend none), a warning naming the channel, its mean and how many standard deviations that is.
+// After a fit by a linear method of data that keep their offsets (--detrend none): warn_offsets.
 void warn_offsets(const FitArgs& a, const IdData& d) {
   static const std::set<std::string> linear = {"srivc", "tfest", "oe", "lssvf", "ivsvf", "rls-svf", "subspace", "ssest"};
   if (a.data.detrend != "none" || !linear.count(a.method)) return;
-  auto check = [](const Eigen::VectorXd& x, const std::string& name) {
-    const double m = x.mean(), sd = std::sqrt((x.array() - m).square().mean());
-    if (std::abs(m) > 0.5 * sd && sd > 0)
-      std::fprintf(stderr, "warning: %s has a mean of %.4g, %.2g times its standard deviation: a linear model "
-                   "through the origin cannot fit that offset; add --detrend mean (or linear)\n", name.c_str(), m,
-                   std::abs(m) / sd);
-  };
-  for (int j = 0; j < d.nu(); ++j) check(d.u().col(j), "input " + channel_name(d.input_names(), j));
-  for (int j = 0; j < d.ny(); ++j) check(d.y().col(j), "output " + channel_name(d.output_names(), j));
+  cli::warn_offsets(d);
 }
 
 // The model simulated on the held-out record (validation_initial_condition: for a linear model the initial state that
@@ -470,6 +461,23 @@ int fit_experiments(const FitArgs& a, const std::vector<IdData>& ds,
 // one per input.
 int run_miso(const FitArgs& a, const std::vector<IdData>& ds) {
   const int nu = ds.front().nu();
+  if (a.method == "srivc-auto") {
+    if (ds.size() > 1) throw UsageError("srivc-auto fits one record; several records: --method srivc with --nb/--nf");
+    if (a.delay) throw UsageError("--delay: srivc-auto searches the delays itself");
+    SrivcAutoOptions o;
+    apply_sets("srivc_auto", a.sets, o);
+    const Result<MisoModel> r = call_library([&] { return srivc_auto_miso(ds.front(), o); });
+    std::printf("srivc-auto chose, per input:");
+    for (int i = 0; i < nu; ++i) {
+      const TransferFunction& g = r.model.channels[static_cast<size_t>(i)];
+      char delay[48] = "";
+      if (g.io_delay() > 0) std::snprintf(delay, sizeof delay, ", delay %.3g s", g.io_delay());
+      std::printf("%s %s nb = %d, nf = %d%s", i ? ";" : "", channel_name(ds.front().input_names(), i).c_str(),
+                  g.num().degree() + 1, g.den().degree(), delay);
+    }
+    std::printf(" (each input alone, then each channel on the output less the others; the least BIC)\n");
+    return finish(r, "srivc_auto", ds.front(), a, settings_of(o));
+  }
   auto per_input = [&](const std::vector<int>& v, const char* flag, int i) {
     if (v.size() != 1 && static_cast<int>(v.size()) != nu)
       throw UsageError(detail::format("{} has {} values for {} inputs (give one value, or one per input)", flag, v.size(), nu));

@@ -454,4 +454,16 @@ void print_result(const Result<FsfModel>& r, const std::string& method, const Id
   print_notes(r.summary, r.diagnostics);
 }
 
+void warn_offsets(const IdData& d) {
+  auto check = [](const Eigen::VectorXd& x, const std::string& name) {
+    const double m = x.mean(), sd = std::sqrt((x.array() - m).square().mean());
+    if (std::abs(m) > 0.5 * sd && sd > 0)
+      std::fprintf(stderr, "warning: %s has a mean of %.4g, %.2g times its standard deviation: a linear model "
+                   "through the origin cannot fit that offset; add --detrend mean (or linear)\n", name.c_str(), m,
+                   std::abs(m) / sd);
+  };
+  for (int j = 0; j < d.nu(); ++j) check(d.u().col(j), "input " + channel_name(d.input_names(), j));
+  for (int j = 0; j < d.ny(); ++j) check(d.y().col(j), "output " + channel_name(d.output_names(), j));
+}
+
 }  // namespace ctid::cli

@@ -209,6 +209,10 @@ void setup_poles(CLI::App& app);
 void setup_response(CLI::App& app);
 void setup_simulate(CLI::App& app);
 void setup_validate(CLI::App& app);
+/// A linear model through the origin cannot follow an offset: for each channel of d whose mean is above half its
+/// standard deviation, a warning on stderr naming it, its mean and the ratio, and suggesting --detrend mean.
+void warn_offsets(const IdData& d);
+void setup_compare(CLI::App& app);
 /// The name of channel j (0-based) of a record: its name, or its 1-based position when it has none.
 std::string channel_name(const std::vector<std::string>& names, int j);
 

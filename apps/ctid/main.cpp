@@ -1,4 +1,4 @@
-// ctid — command-line tool. Subcommands: fit, simulate, validate, order, poles, response, gfrf, report, demo, example-data (DESIGN.md §8).
+// ctid — command-line tool. Subcommands: fit, simulate, validate, order, poles, response, gfrf, report, compare, demo, example-data (DESIGN.md §8).
 // Exit codes: 0 ok, 1 estimate not usable, 2 usage, 3 input file error; one line on stderr.
 #include <atomic>
 #include <chrono>
@@ -66,6 +66,7 @@ int main(int argc, char** argv) {
   setup_response(*app.add_subcommand("response", "Nonparametric step, impulse or frequency response (modal functions)"));
   setup_gfrf(*app.add_subcommand("gfrf", "Generalised frequency response functions of a NARX or NDE model file"));
   setup_report(*app.add_subcommand("report", "Self-contained HTML report of a result file on a record"));
+  setup_compare(*app.add_subcommand("compare", "Several models on one record side by side (fits, simulations, Bode, step)"));
   setup_demo(*app.add_subcommand("demo", "Identify a bundled real data set and print the model"));
   setup_example_data(*app.add_subcommand("example-data", "Write a simulated example record the README and docs use"));
   g_command_line = "ctid";

@@ -59,6 +59,7 @@
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/simulate/simulate.hpp"
 #include "ctid/validate/crlb.hpp"
+#include "ctid/validate/compare.hpp"
 #include "ctid/validate/metrics.hpp"
 #include "ctid/validate/residuals.hpp"
 #include "ctid/validate/uncertainty.hpp"

@@ -44,6 +44,6 @@ def test_html_report_from_python(plant, tmp_path):
     path = tmp_path / "r.html"
     ctid.html_report(d, r, str(path), method="srivc", settings={"nb": "1", "nf": "2"})
     text = path.read_text()
-    assert "Residual tests" in text and "srivc" in text and text.count('class="plot"') == 9
+    assert "Residual tests" in text and "srivc" in text and text.count('class="plot"') == 10
     with pytest.raises(ctid.FileError):
         ctid.html_report(d, r, str(tmp_path / "missing" / "r.html"))

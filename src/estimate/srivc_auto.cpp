@@ -4,10 +4,13 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <vector>
 
 #include "ctid/core/check.hpp"
 #include "ctid/core/progress.hpp"
+#include "ctid/simulate/lsim.hpp"
 #include "estimate/tf_common.hpp"
 
 namespace ctid {
@@ -84,6 +87,109 @@ done:
   }
   best.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return best;
+}
+
+namespace {
+// A MISO fit's BIC (+inf when it has none) and whether it is usable: usable() and no channel pole beyond ten times
+// the Nyquist frequency.
+struct Scored {
+  Result<MisoModel> r;
+  bool usable = false;
+  double bic = INFINITY;
+};
+
+Scored score(Result<MisoModel> r, const IdData& d) {
+  Scored s;
+  s.usable = r.usable();
+  for (const TransferFunction& g : r.model.channels) s.usable = s.usable && !tf_detail::pole_beyond_bandwidth(g, d);
+  s.bic = r.fit.n_samples > 0 && std::isfinite(r.fit.bic) ? r.fit.bic : INFINITY;
+  s.r = std::move(r);
+  return s;
+}
+
+bool better(const Scored& a, const Scored& b) { return (a.usable && !b.usable) || (a.usable == b.usable && a.bic < b.bic); }
+
+std::string structure_text(const TfOrders& o, double delay) {
+  char b[96];
+  std::snprintf(b, sizeof b, "nb = %d, nf = %d, delay %.4g s", o.nb, o.nf, delay);
+  return b;
+}
+}  // namespace
+
+Result<MisoModel> srivc_auto_miso(const IdData& data, const SrivcAutoOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  options.validate();
+  CTID_REQUIRE(data.ny() == 1, "srivc_auto_miso: needs one output (the data have {}); several outputs: ssest", data.ny());
+  const int nu = data.nu();
+  const auto name = [&](int i) {
+    const auto& n = data.input_names();
+    return i < static_cast<int>(n.size()) && !n[static_cast<size_t>(i)].empty() ? n[static_cast<size_t>(i)]
+                                                                                 : "u" + std::to_string(i + 1);
+  };
+  // Channel i's record: its input, and the output less the other channels' simulated contributions (none yet: the
+  // whole output, the other inputs acting as noise).
+  auto channel_record = [&](int i, const MisoModel* others) {
+    IdData di = data.select({i}, {0});
+    if (!others) return di;
+    Eigen::VectorXd y = data.y().col(0);
+    for (int j = 0; j < nu; ++j)
+      if (j != i) y -= lsim(others->channels[static_cast<size_t>(j)], data, j);
+    IdData out = data.is_uniform() ? IdData(di.u(), y, data.ts(), data.t0()) : IdData(di.u(), y, data.times());
+    out.set_intersample(data.intersample(i));
+    return out;
+  };
+  SrivcMisoOptions mo;
+  mo.max_iterations = std::max(options.srivc.max_iterations, 1);
+  mo.tolerance = options.srivc.tolerance;
+  std::vector<std::string> choices;
+  std::vector<TfOrders> orders(static_cast<size_t>(nu));
+  std::vector<double> delays(static_cast<size_t>(nu), 0.0);
+  Scored best;
+  bool have = false;
+  int siso = 0, sweeps = 0;
+  // Sweep 0: each input alone; then each channel on the output less the others (backfitting), until the structures
+  // repeat (at most 3 sweeps after the first).
+  for (; sweeps <= 3; ++sweeps) {
+    std::vector<TfOrders> o(static_cast<size_t>(nu));
+    std::vector<double> d(static_cast<size_t>(nu), 0.0);
+    for (int i = 0; i < nu; ++i) {
+      if (!report_progress("srivc_auto_miso", ++siso, NAN)) goto done;
+      const Result<TransferFunction> ri = srivc_auto(channel_record(i, have ? &best.r.model : nullptr), options);
+      o[static_cast<size_t>(i)] = {ri.model.num().degree() + 1, ri.model.den().degree(), 0};
+      d[static_cast<size_t>(i)] = ri.model.io_delay();
+    }
+    bool same = have;
+    for (int i = 0; i < nu && same; ++i)
+      same = o[static_cast<size_t>(i)].nb == orders[static_cast<size_t>(i)].nb &&
+             o[static_cast<size_t>(i)].nf == orders[static_cast<size_t>(i)].nf &&
+             std::abs(d[static_cast<size_t>(i)] - delays[static_cast<size_t>(i)]) <= 0.5 * (data.is_uniform() ? data.ts() : 0.0);
+    if (same) break;
+    SrivcMisoOptions m = mo;
+    m.delays = d;
+    Scored s = score(srivc_miso(data, o, m), data);
+    std::string text;
+    for (int i = 0; i < nu; ++i)
+      text += (i ? "; " : "") + name(i) + ": " + structure_text(o[static_cast<size_t>(i)], d[static_cast<size_t>(i)]);
+    const bool take = !have || better(s, best);
+    choices.push_back((sweeps == 0 ? "each input alone: " : "each channel on the output less the others: ") + text +
+                      (s.usable ? "" : " (not usable)") + (take ? "" : " — BIC not lower, the previous kept"));
+    if (!take) break;
+    best = std::move(s);
+    orders = o;
+    delays = d;
+    have = true;
+  }
+done:
+  CTID_REQUIRE(have, "srivc_auto_miso: interrupted before a fit");
+  Result<MisoModel> r = std::move(best.r);
+  for (auto& c : choices) r.diagnostics.choices.push_back(std::move(c));
+  if (!best.usable && r.summary.succeeded()) {
+    r.summary.termination = Termination::Unidentifiable;
+    r.summary.message = "srivc_auto_miso: no structure gave a usable fit (a channel pole beyond ten times the Nyquist "
+                        "frequency, or failed); choose the orders with srivc_miso";
+  }
+  r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
 }
 
 }  // namespace ctid

@@ -16,6 +16,7 @@
 #include "ctid/io/json.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/simulate/simulate.hpp"
+#include "ctid/validate/compare.hpp"
 #include "ctid/validate/metrics.hpp"
 #include "ctid/validate/residuals.hpp"
 #include "ctid/validate/uncertainty.hpp"
@@ -80,7 +81,8 @@ struct Series {
   std::string label;
   Eigen::VectorXd y;
   bool dashed = false;
-  bool light = false;  // a band edge
+  bool light = false;    // a band edge
+  bool neutral = false;  // the measured signal among models (dark grey: the models keep their colours across plots)
 };
 
 struct Plot {
@@ -89,6 +91,18 @@ struct Plot {
   std::vector<Series> series;
   bool logx = false;
   bool bars = false;
+};
+
+// Points drawn as markers on equal footing with the origin and the axes through it (a pole-zero map).
+struct PointSet {
+  std::string label;
+  Eigen::VectorXd x, y;
+  char marker = 'x';   // 'x' cross, 'o' circle, '.' dot
+  bool light = false;  // a cloud (drawn first, pale)
+};
+struct Scatter {
+  std::string title, xlabel, ylabel;
+  std::vector<PointSet> sets;
 };
 
 struct Heatmap {
@@ -123,7 +137,21 @@ class Page {
     for (size_t i = 0; i < p.series.size(); ++i)
       s << (i ? "," : "") << "{\"label\":" << json_string(p.series[i].label) << ",\"dashed\":"
         << (p.series[i].dashed ? "true" : "false") << ",\"light\":" << (p.series[i].light ? "true" : "false")
+        << ",\"neutral\":" << (p.series[i].neutral ? "true" : "false")
         << ",\"y\":" << json_array(p.series[i].y) << "}";
+    s << "]}";
+    specs_.push_back(s.str());
+  }
+  void scatter(const Scatter& p) {
+    const std::string id = "plot" + std::to_string(n_++);
+    body_ << "<div class=\"plot\" id=\"" << id << "\"></div>\n";
+    std::ostringstream s;
+    s << "{\"id\":\"" << id << "\",\"kind\":\"scatter\",\"title\":" << json_string(p.title)
+      << ",\"xlabel\":" << json_string(p.xlabel) << ",\"ylabel\":" << json_string(p.ylabel) << ",\"sets\":[";
+    for (size_t i = 0; i < p.sets.size(); ++i)
+      s << (i ? "," : "") << "{\"label\":" << json_string(p.sets[i].label) << ",\"marker\":\"" << p.sets[i].marker
+        << "\",\"light\":" << (p.sets[i].light ? "true" : "false") << ",\"x\":" << json_array(p.sets[i].x)
+        << ",\"y\":" << json_array(p.sets[i].y) << "}";
     s << "]}";
     specs_.push_back(s.str());
   }
@@ -159,7 +187,7 @@ h1 { font-size: 1.5em; } h2 { font-size: 1.15em; margin-top: 1.8em; border-botto
 table { border-collapse: collapse; margin: 0.5em 0; font-size: 0.9em; }
 td, th { border: 1px solid #ccc; padding: 2px 8px; text-align: left; font-variant-numeric: tabular-nums; }
 .plot { margin: 0.8em 0; } .plot .title { font-weight: 600; font-size: 0.95em; }
-.warn { color: #a40; } #ctid-selfcheck { display: none; }
+.warn { color: #a40; } #ctid-selfcheck { display: none; } .legend { font-size: 0.85em; margin-top: 0.3em; }
 code { background: #f4f4f4; padding: 1px 4px; }
 )css";
   static constexpr const char* kJs = R"js(
@@ -177,7 +205,7 @@ code { background: #f4f4f4; padding: 1px 4px; }
     const data = [p.x].concat(p.series.map(s => s.y));
     let c = 0;
     const series = [{ label: p.xlabel }].concat(p.series.map(function (s) {
-      const col = s.light ? '#9ab' : colors[(c++) % colors.length];
+      const col = s.light ? '#9ab' : s.neutral ? '#444' : colors[(c++) % colors.length];
       const o = { label: s.label, stroke: col, width: s.light ? 1 : 1.5, points: { show: false } };
       if (s.dashed || s.light) o.dash = [6, 4];
       if (p.bars && !s.dashed) { o.paths = uPlot.paths.bars({ size: [0.3, 6] }); o.fill = col; }
@@ -216,9 +244,61 @@ code { background: #f4f4f4; padding: 1px 4px; }
     }
     g.fillStyle = '#222'; g.fillText(hi.toPrecision(3), m + W + 38, 12); g.fillText(lo.toPrecision(3), m + W + 38, H - 2);
   }
+  function nice(x) {
+    const e = Math.pow(10, Math.floor(Math.log10(x))), f = x / e;
+    return (f < 1.5 ? 1 : f < 3 ? 2 : f < 7 ? 5 : 10) * e;
+  }
+  function scatter(el, p) {
+    title(el, p);
+    const W = Math.min(640, Math.max(400, el.clientWidth || 640)), H = 380, L = 64, R = 12, T = 10, B = 42;
+    const cv = document.createElement('canvas'); cv.width = W; cv.height = H; el.appendChild(cv);
+    const g = cv.getContext('2d');
+    let x0 = 0, x1 = 0, ym = 0;  // the origin is always shown; the vertical range is symmetric (conjugate pairs)
+    p.sets.forEach(s => s.x.forEach((v, i) => {
+      if (v === null || s.y[i] === null) return;
+      x0 = Math.min(x0, v); x1 = Math.max(x1, v); ym = Math.max(ym, Math.abs(s.y[i]));
+    }));
+    let dx = x1 - x0, dy = 2 * ym;
+    if (!(dx > 0)) dx = dy > 0 ? dy : 1;
+    if (!(dy > 0)) dy = dx;
+    x0 -= 0.08 * dx; x1 += 0.08 * dx; const y0 = -0.54 * dy, y1 = 0.54 * dy;
+    const px = v => L + (v - x0) / (x1 - x0) * (W - L - R), py = v => T + (y1 - v) / (y1 - y0) * (H - T - B);
+    g.strokeStyle = '#888'; g.strokeRect(L, T, W - L - R, H - T - B);
+    g.fillStyle = '#222'; g.font = '11px sans-serif'; g.textAlign = 'center';
+    const sx = nice((x1 - x0) / 5), sy = nice((y1 - y0) / 5);
+    for (let v = Math.ceil(x0 / sx) * sx; v <= x1; v += sx) g.fillText(+v.toPrecision(3), px(v), H - B + 14);
+    g.textAlign = 'right';
+    for (let v = Math.ceil(y0 / sy) * sy; v <= y1; v += sy) g.fillText(+v.toPrecision(3), L - 4, py(v) + 4);
+    g.textAlign = 'center'; g.fillText(p.xlabel, L + (W - L - R) / 2, H - 6);
+    g.save(); g.translate(12, T + (H - T - B) / 2); g.rotate(-Math.PI / 2); g.fillText(p.ylabel, 0, 0); g.restore();
+    g.strokeStyle = '#bbb'; g.setLineDash([4, 3]); g.beginPath();
+    g.moveTo(px(0), T); g.lineTo(px(0), H - B); g.moveTo(L, py(0)); g.lineTo(W - R, py(0)); g.stroke(); g.setLineDash([]);
+    const legend = document.createElement('div'); legend.className = 'legend';
+    const pale = ['rgba(31,119,180,0.3)', 'rgba(214,39,40,0.3)'];
+    let c = 0, l = 0;
+    p.sets.forEach(function (s) {
+      const col = s.light ? pale[(l++) % pale.length] : colors[(c++) % colors.length];
+      g.strokeStyle = col; g.fillStyle = col; g.lineWidth = s.light ? 1 : 2;
+      s.x.forEach(function (v, i) {
+        if (v === null || s.y[i] === null) return;
+        const X = px(v), Y = py(s.y[i]), r = s.light ? 2 : 5;
+        g.beginPath();
+        if (s.marker === 'x') { g.moveTo(X - r, Y - r); g.lineTo(X + r, Y + r); g.moveTo(X - r, Y + r); g.lineTo(X + r, Y - r); g.stroke(); }
+        else if (s.marker === 'o') { g.arc(X, Y, r, 0, 2 * Math.PI); g.stroke(); }
+        else { g.arc(X, Y, r, 0, 2 * Math.PI); g.fill(); }
+      });
+      const item = document.createElement('span');
+      item.textContent = (s.marker === 'x' ? '\u00d7 ' : s.marker === 'o' ? '\u25cb ' : '\u2022 ') + s.label;
+      item.style.color = s.light ? col.replace('0.3)', '0.8)') : col; item.style.marginRight = '1.5em';
+      legend.appendChild(item);
+    });
+    g.lineWidth = 1;
+    el.appendChild(legend);
+  }
+  const kinds = { line: line, heatmap: heatmap, scatter: scatter };
   specs.forEach(function (p) {
     const el = document.getElementById(p.id);
-    try { (p.kind === 'heatmap' ? heatmap : line)(el, p); } catch (e) { errors++; console.error(e); }
+    try { kinds[p.kind](el, p); } catch (e) { errors++; console.error(e); }
   });
   function check() {
     let drawn = 0;
@@ -272,6 +352,20 @@ std::string output_name(const IdData& d, int j) {
              : (d.ny() > 1 ? "y" + std::to_string(j + 1) : "y");
 }
 
+void data_section(Page& page, const IdData& d, const ReportOptions& o);
+
+// The rows every report's summary ends with: the preprocessing and command line (when given), the ctid version and
+// the UTC time the report was made.
+void provenance(std::vector<std::vector<std::string>>& rows, const ReportOptions& o) {
+  if (!o.preprocessing.empty()) rows.push_back({"preprocessing", o.preprocessing});
+  if (!o.command_line.empty()) rows.push_back({"command", o.command_line});
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  char when[32] = "";
+  if (gmtime_r(&now, &utc)) std::strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S UTC", &utc);
+  rows.push_back({"made by", std::string("ctid ") + version() + ", " + when});
+}
+
 template <class M>
 void overview(Page& page, const IdData& d, const Result<M>& r, const ReportOptions& o, const std::string& model_text) {
   page.section("Summary");
@@ -286,13 +380,7 @@ void overview(Page& page, const IdData& d, const Result<M>& r, const ReportOptio
       {"fit (simulation)", r.fit.n_samples > 0 ? fmt(r.fit.fit_percent, 4) + " %" : std::string("not computed")},
       {"MSE / AIC / BIC", fmt(r.fit.mse, 4) + " / " + fmt(r.fit.aic, 5) + " / " + fmt(r.fit.bic, 5)},
       {"condition number", fmt(r.diagnostics.condition_number, 3)}};
-  if (!o.preprocessing.empty()) rows.push_back({"preprocessing", o.preprocessing});
-  if (!o.command_line.empty()) rows.push_back({"command", o.command_line});
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  char when[32] = "";
-  if (gmtime_r(&now, &utc)) std::strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S UTC", &utc);
-  rows.push_back({"made by", std::string("ctid ") + version() + ", " + when});
+  provenance(rows, o);
   page.table({"", ""}, rows);
   if (!o.settings.empty()) {
     std::vector<std::vector<std::string>> s;
@@ -308,6 +396,11 @@ void overview(Page& page, const IdData& d, const Result<M>& r, const ReportOptio
     page.section("Warnings");
     for (const auto& w : r.diagnostics.warnings) page.text("<span class=\"warn\">" + escape(w) + "</span>");
   }
+  data_section(page, d, o);
+}
+
+// The record: its source, size, sampling and channels, and plots of its inputs and outputs.
+void data_section(Page& page, const IdData& d, const ReportOptions& o) {
   page.section("Data");
   const double dur = d.duration();
   std::string inputs;
@@ -598,11 +691,69 @@ void poles_and_gain(Page& page, const TransferFunction& g) {
                         {"delay", fmt(g.io_delay(), 4) + " s"}});
 }
 
+// The real and imaginary parts of v as a point set.
+PointSet points(const std::string& label, const Eigen::VectorXcd& v, char marker, bool light = false) {
+  return {label, v.real(), v.imag(), marker, light};
+}
+
+// Pole-zero map of a transfer-function fit with the poles and zeros of 200 models drawn from its parameter covariance
+// (drawn_models, seeded) as a cloud: where the cloud is wide the data pin that pole or zero down poorly. The map shows
+// the dynamics: it reaches 5 times the largest pole magnitude (the zeros' when there is no pole); estimated zeros
+// beyond it are listed under the map, and the drawn points beyond it counted.
+void pole_zero_map(Page& page, const Result<TransferFunction>& r) {
+  const Eigen::VectorXcd p = r.model.poles(), z = r.model.zeros();
+  double reach = 0;
+  for (const auto& v : {p, z})
+    if (reach == 0)
+      for (Eigen::Index i = 0; i < v.size(); ++i) reach = std::max(reach, 5 * std::abs(v(i)));
+  auto inside = [&](std::complex<double> x) { return std::isfinite(std::abs(x)) && std::abs(x) <= std::max(reach, 1e-300); };
+  auto kept = [&](const Eigen::VectorXcd& v, int* left_out) {
+    std::vector<std::complex<double>> o;
+    for (Eigen::Index i = 0; i < v.size(); ++i)
+      if (inside(v(i))) o.push_back(v(i));
+      else if (left_out) ++*left_out;
+    return o;
+  };
+  auto vec = [](const std::vector<std::complex<double>>& v) {
+    return Eigen::Map<const Eigen::VectorXcd>(v.data(), static_cast<Eigen::Index>(v.size())).eval();
+  };
+  const std::vector<TransferFunction> draws = drawn_models(r);
+  std::vector<std::complex<double>> dp, dz;
+  int left_out = 0;
+  for (const TransferFunction& g : draws) {
+    for (const auto& x : kept(g.poles(), &left_out)) dp.push_back(x);
+    for (const auto& x : kept(g.zeros(), &left_out)) dz.push_back(x);
+  }
+  std::vector<PointSet> sets;
+  if (!draws.empty()) {
+    sets.push_back(points("poles of " + std::to_string(draws.size()) + " models drawn from the covariance", vec(dp), '.', true));
+    if (!dz.empty()) sets.push_back(points("their zeros", vec(dz), '.', true));
+  }
+  sets.push_back(points("poles", p, 'x'));
+  const std::vector<std::complex<double>> zi = kept(z, nullptr);
+  if (!zi.empty()) sets.push_back(points("zeros", vec(zi), 'o'));
+  page.scatter({draws.empty() ? "Pole-zero map" : "Pole-zero map with the spread of the parameter covariance",
+                "real part (1/s)", "imaginary part (rad/s)", sets});
+  std::string note;
+  if (!draws.empty())
+    note = "The pale clouds show where the poles and zeros of equally likely models lie (drawn from the parameter "
+           "covariance): a wide cloud is a pole or zero the data pin down poorly; a zero cloud over a pole cloud "
+           "suggests they cancel and the order may be too high.";
+  std::string far;
+  for (Eigen::Index i = 0; i < z.size(); ++i)
+    if (!inside(z(i)) && z(i).imag() >= 0)
+      far += (far.empty() ? "" : ", ") + fmt(z(i).real(), 4) + (z(i).imag() > 0 ? " ± " + fmt(z(i).imag(), 4) + "j" : "");
+  if (!far.empty()) note += " Zero(s) beyond the map (5 times the largest pole): " + far + ".";
+  if (left_out) note += " " + std::to_string(left_out) + " drawn point(s) beyond the map are not shown.";
+  if (!note.empty()) page.text(note);
+}
+
 std::string report_of(const IdData& d, const Result<TransferFunction>& r, const ReportOptions& o) {
   require_siso(d);
   Page page;
   opening(page, d, r, o);
   poles_and_gain(page, r.model);
+  pole_zero_map(page, r);
   parameters(page, r.parameters);
   diagnostics(page, r.diagnostics);
   const Eigen::VectorXd w = frequency_grid(r.model.poles(), nyquist(d));
@@ -814,7 +965,175 @@ std::string report_of(const IdData& d, const Result<GreyboxModel>& r, const Repo
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }
 
+// The one-line meaning of a residual test result (Ljung 1999, sec. 16.6), for the table of a comparison.
+std::string test_cell(const CorrelationTest& c) {
+  if (c.lags.size() == 0) return "-";
+  return c.passed() ? "passed" : std::to_string(c.n_outside) + " lag(s) outside";
+}
+
 }  // namespace
+
+std::string html_comparison_report(const IdData& d, const std::vector<ModelComparison>& cs, const ReportOptions& o) {
+  CTID_REQUIRE(!cs.empty(), "html_comparison_report: no model to compare");
+  for (const ModelComparison& c : cs)
+    CTID_REQUIRE(c.simulation.y.rows() == d.size() && c.simulation.y.cols() == d.ny() &&
+                     static_cast<int>(c.fits.size()) == d.ny(),
+                 "html_comparison_report: model {} was not compared on this record (compare_models)", c.name);
+  Page page;
+  size_t best = 0;
+  for (size_t k = 1; k < cs.size(); ++k)
+    if (cs[k].mean_fit() > cs[best].mean_fit()) best = k;
+  page.section("Summary");
+  std::vector<std::vector<std::string>> rows = {
+      {"models", std::to_string(cs.size())},
+      {"best fit", cs[best].name + " (" + fmt(cs[best].mean_fit(), 4) + " %" + (d.ny() > 1 ? ", mean over the outputs)" : ")")}};
+  provenance(rows, o);
+  page.table({"", ""}, rows);
+
+  page.section("Models");
+  std::vector<std::string> header = {"model", "type", "coefficients", "initial condition"};
+  for (int j = 0; j < d.ny(); ++j) header.push_back(d.ny() > 1 ? "fit % (" + output_name(d, j) + ")" : "fit %");
+  header.insert(header.end(), {"NRMSE", "AIC"});
+  std::vector<std::vector<std::string>> table;
+  for (const ModelComparison& c : cs) {
+    std::vector<std::string> r = {c.name, model_type_name(c.model), std::to_string(model_coefficient_count(c.model)),
+                                  to_string(c.initial)};
+    double nrmse = 0, aic = 0;
+    for (const FitReport& f : c.fits) {
+      r.push_back(std::isfinite(f.fit_percent) ? fmt(f.fit_percent, 4) : "diverges");
+      nrmse += f.nrmse / static_cast<double>(c.fits.size());
+      aic += f.aic;
+    }
+    r.push_back(fmt(nrmse, 4));
+    r.push_back(fmt(aic, 5));
+    table.push_back(r);
+  }
+  page.table(header, table);
+  page.text("Each model is simulated from its initial condition on the record (estimated: the state that fits the "
+            "record's first samples best, as MATLAB's compare; measured: the record's own past outputs) and scored on "
+            "the whole record. AIC counts each model's coefficients" + std::string(d.ny() > 1 ? ", summed over the outputs" : "") +
+            ": lower is better for the same data.");
+  for (const ModelComparison& c : cs) {
+    page.text("<code>" + escape(c.name) + "</code>: " + escape(describe(c.model, 4)));
+    if (!c.simulation.ok()) page.text("<span class=\"warn\">" + escape(c.name + ": " + c.simulation.problem) + "</span>");
+  }
+  data_section(page, d, o);
+
+  const auto k = keep(d.size(), o.max_points);
+  for (int j = 0; j < d.ny(); ++j) {
+    const std::string of = d.ny() > 1 ? " (" + output_name(d, j) + ")" : "";
+    page.section("Measured and simulated output" + of);
+    std::vector<Series> series = {{"measured", pick(d.y().col(j), k), false, false, true}};
+    for (const ModelComparison& c : cs)
+      series.push_back({c.name + " (" + (std::isfinite(c.fits[static_cast<size_t>(j)].fit_percent)
+                                             ? fmt(c.fits[static_cast<size_t>(j)].fit_percent, 4) + " %"
+                                             : std::string("diverges")) + ")",
+                        pick(c.simulation.y.col(j), k)});
+    page.plot({"Output" + of + ": measured and each model's simulation", "time (s)", "y", pick(d.times(), k), series});
+  }
+
+  page.section("Residual tests");
+  std::vector<std::string> th = {"model"};
+  if (d.ny() > 1) th.push_back("output");
+  th.push_back("whiteness");
+  for (int i = 0; i < d.nu(); ++i) th.push_back("independence of " + input_name(d, i));
+  std::vector<std::vector<std::string>> tests;
+  for (const ModelComparison& c : cs)
+    for (int j = 0; j < d.ny(); ++j) {
+      std::vector<std::string> r = {c.name};
+      if (d.ny() > 1) r.push_back(output_name(d, j));
+      r.push_back(test_cell(c.whiteness[static_cast<size_t>(j)]));
+      const auto& ind = c.independence[static_cast<size_t>(j)];
+      for (int i = 0; i < d.nu(); ++i) r.push_back(i < static_cast<int>(ind.size()) ? test_cell(ind[static_cast<size_t>(i)]) : "-");
+      tests.push_back(r);
+    }
+  page.table(th, tests);
+  page.text("Whiteness fails: the residuals are correlated — the model misses dynamics, or the noise is coloured (an "
+            "output-error model does not model the noise). Independence fails: the residuals depend on that input — "
+            "the model misses input-output dynamics (order, delay, a nonlinearity), or the data are closed-loop. "
+            "99 % bounds, lags up to " + std::to_string(std::min(o.max_lag, d.size() / 4)) + ".");
+
+  // Responses of the models (one output: model_frequency_response and the step responses are of the first output).
+  if (d.ny() != 1) {
+    page.text("The frequency and step responses are compared for single-output records only.");
+    return page.render(o.title.empty() ? "ctid compare" : o.title);
+  }
+  std::vector<const ModelComparison*> linear;
+  std::vector<std::complex<double>> all_poles;
+  for (const ModelComparison& c : cs) {
+    if (!is_linear(c.model)) continue;
+    try {
+      (void)model_frequency_response(c.model, Eigen::VectorXd::Ones(1));
+    } catch (const InvalidArgument& e) {  // a windowed FSF model
+      page.text(escape(c.name + ": no frequency or step response (" + e.what() + ")"));
+      continue;
+    }
+    linear.push_back(&c);
+    const Eigen::VectorXcd p = model_poles(c.model);
+    all_poles.insert(all_poles.end(), p.data(), p.data() + p.size());
+  }
+  const Eigen::VectorXcd poles = Eigen::Map<const Eigen::VectorXcd>(all_poles.data(), static_cast<Eigen::Index>(all_poles.size()));
+  if (!linear.empty()) {
+    const Eigen::VectorXd w = frequency_grid(poles, nyquist(d));
+    for (int i = 0; i < d.nu(); ++i) {
+      const std::string from = d.nu() > 1 ? " from " + input_name(d, i) : "";
+      std::vector<Series> mag, ph;
+      for (const ModelComparison* c : linear) {
+        const Eigen::VectorXcd h = model_frequency_response(c->model, w).col(i);
+        mag.push_back({c->name, (20 * h.cwiseAbs().array().log10()).matrix()});
+        ph.push_back({c->name, unwrapped_phase_deg(h)});
+      }
+      page.section("Frequency response" + from);
+      page.plot({"Bode magnitude" + from + " (up to the record's Nyquist frequency)", "frequency (rad/s)", "dB", w, mag, true});
+      page.plot({"Bode phase" + from, "frequency (rad/s)", "deg", w, ph, true});
+    }
+  }
+  // Step responses: unit steps when every model is linear; otherwise every model's response to a step of each input's
+  // RMS level (a nonlinear model's step response depends on the amplitude). A NARX model steps on its sampling grid.
+  const bool all_linear = linear.size() == cs.size();
+  double horizon = poles_response_horizon(poles, d.duration());
+  Eigen::VectorXd t;
+  if (d.is_uniform()) {
+    const Eigen::Index n = std::min<Eigen::Index>(static_cast<Eigen::Index>(std::ceil(horizon / d.ts())), 20000);
+    t = Eigen::VectorXd::LinSpaced(n + 1, 0.0, static_cast<double>(n)) * d.ts();
+  } else {
+    t = Eigen::VectorXd::LinSpaced(400, 0.0, horizon);
+  }
+  const auto kt = keep(t.size(), o.max_points);
+  for (int i = 0; i < d.nu(); ++i) {
+    const Eigen::VectorXd u = d.u().col(i);
+    const double level = all_linear ? 1.0 : std::sqrt(u.squaredNorm() / std::max<Eigen::Index>(1, u.size()));
+    std::vector<Series> steps;
+    std::vector<std::string> failed;
+    for (const ModelComparison& c : cs) {
+      if (is_linear(c.model) && std::find(linear.begin(), linear.end(), &c) == linear.end()) continue;
+      const Eigen::VectorXcd p = model_poles(c.model);
+      if ((p.real().array() > 0).any()) {  // its growth would flatten every other curve
+        if (i == 0) failed.push_back(c.name + ": not drawn, it is unstable (its step response grows without bound)");
+        continue;
+      }
+      try {
+        steps.push_back({c.name, pick(model_step_response(c.model, t, level).col(i), kt)});
+      } catch (const InvalidArgument& e) {
+        failed.push_back(c.name + ": " + e.what());
+      }
+    }
+    const std::string from = d.nu() > 1 ? " of " + input_name(d, i) : "";
+    page.section("Step response" + from);
+    if (!steps.empty())
+      page.plot({all_linear ? "Unit step response" + from
+                            : "Response to a step" + from + " of the input's RMS level (" + fmt(level, 3) + ")",
+                 "time (s)", "y", pick(t, kt), steps});
+    for (const auto& f : failed) page.text("<span class=\"warn\">" + escape(f) + "</span>");
+  }
+  if (!linear.empty()) {
+    page.section("Poles");
+    std::vector<PointSet> sets;
+    for (const ModelComparison* c : linear) sets.push_back(points(c->name, model_poles(c->model), 'x'));
+    page.scatter({"Poles of the linear models", "real part (1/s)", "imaginary part (rad/s)", sets});
+  }
+  return page.render(o.title.empty() ? "ctid compare" : o.title);
+}
 
 std::string html_report(const IdData& data, const Result<AnyModel>& result, const ReportOptions& options) {
   return std::visit(

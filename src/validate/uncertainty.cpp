@@ -78,29 +78,41 @@ MagnitudeBand magnitude_band(const Result<TransferFunction>& r, const Eigen::Vec
                        level, draws, seed);
 }
 
-MagnitudeBand response_band(const Result<TransferFunction>& r,
-                            const std::function<Eigen::VectorXd(const TransferFunction&)>& response, double level,
-                            int draws, unsigned seed) {
-  CTID_REQUIRE(level > 0 && level < 1, "response_band: level must be in (0, 1) (got {})", level);
-  CTID_REQUIRE(draws >= 10, "response_band: need at least 10 draws (got {})", draws);
+std::vector<TransferFunction> drawn_models(const Result<TransferFunction>& r, int draws, unsigned seed) {
+  CTID_REQUIRE(draws >= 10, "drawn_models: need at least 10 draws (got {})", draws);
   const ParameterSet& p = r.parameters;
   const int P = p.size();
-  MagnitudeBand band;
-  if (P == 0 || p.covariance.rows() != P || p.covariance.cols() != P || !p.covariance.allFinite()) return band;
+  std::vector<TransferFunction> out;
+  if (P == 0 || p.covariance.rows() != P || p.covariance.cols() != P || !p.covariance.allFinite()) return out;
   const std::vector<TfCoefficient> map = tf_coefficients(r.model, p);
-  if (std::none_of(map.begin(), map.end(), [](const TfCoefficient& c) { return c.poly != 0; })) return band;
+  if (std::none_of(map.begin(), map.end(), [](const TfCoefficient& c) { return c.poly != 0; })) return out;
   // Draws theta + L z with L L^T = covariance (eigen-decomposition: semi-definite covariances of fixed parameters
   // are fine).
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (p.covariance + p.covariance.transpose()));
   const Eigen::MatrixXd L = es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
   std::mt19937 rng(seed);
   std::normal_distribution<double> n01;
-  const Eigen::Index n = response(r.model).size();
-  Eigen::MatrixXd mags(draws, n);
   Eigen::VectorXd z(P);
+  out.reserve(static_cast<size_t>(draws));
   for (int k = 0; k < draws; ++k) {
     for (auto& v : z) v = n01(rng);
-    const Eigen::VectorXd v = response(with_coefficients(r.model, map, p.values + L * z));
+    out.push_back(with_coefficients(r.model, map, p.values + L * z));
+  }
+  return out;
+}
+
+MagnitudeBand response_band(const Result<TransferFunction>& r,
+                            const std::function<Eigen::VectorXd(const TransferFunction&)>& response, double level,
+                            int draws, unsigned seed) {
+  CTID_REQUIRE(level > 0 && level < 1, "response_band: level must be in (0, 1) (got {})", level);
+  CTID_REQUIRE(draws >= 10, "response_band: need at least 10 draws (got {})", draws);
+  MagnitudeBand band;
+  const std::vector<TransferFunction> models = drawn_models(r, draws, seed);
+  if (models.empty()) return band;
+  const Eigen::Index n = response(r.model).size();
+  Eigen::MatrixXd mags(draws, n);
+  for (int k = 0; k < draws; ++k) {
+    const Eigen::VectorXd v = response(models[static_cast<size_t>(k)]);
     CTID_REQUIRE(v.size() == n, "response_band: the response has {} points for a drawn model, {} for the estimate",
                  v.size(), n);
     mags.row(k) = v.transpose();

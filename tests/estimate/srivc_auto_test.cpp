@@ -9,6 +9,7 @@
 #include "ctid/estimate/srivc_auto.hpp"
 #include "ctid/io/csv.hpp"
 #include "ctid/io/load.hpp"
+#include "ctid/simulate/example_data.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/simulate/simulate.hpp"
 #include "ctid/validate/metrics.hpp"
@@ -87,4 +88,30 @@ TEST(SrivcAuto, BadDataAndOptionsAreNamed) {
   SrivcAutoOptions o;
   o.nf_max = 0;
   EXPECT_THROW((void)srivc_auto(record(0.0, 1), o), InvalidOptions);
+}
+
+TEST(SrivcAuto, SeveralInputsGetTheirOwnStructureAndDelay) {
+  // `ctid example-data miso`: 5/(s^2 + 2 s + 5) e^{-0.15 s} u1 + 2/(s^2 + 3 s + 2) e^{-0.25 s} u2 at 20 dB, Ts = 0.05 s;
+  // its first 1500 samples. Each input alone (the other's response as noise) gives neither structure right (measured:
+  // nf = 3 without delay for u1); backfitting on the output less the other channel must find nb = 1, nf = 2 for both
+  // and the delays within half a sample period, the poles within 5 % (the 20 dB noise leaves about 1 %).
+  const ExampleData ex = example_data("miso");  // columns t, u1, u2, y
+  ASSERT_EQ(ex.columns.size(), 4u);
+  const IdData d = IdData(Eigen::MatrixXd(ex.values.middleCols(1, 2)), Eigen::MatrixXd(ex.values.col(3)), 0.05)
+                       .slice(0, 1500)
+                       .detrend(Detrend::Mean);
+  const Result<MisoModel> r = srivc_auto_miso(d);
+  ASSERT_TRUE(r.usable()) << r.why_not_usable();
+  const double delay[2] = {0.15, 0.25}, wn2[2] = {5.0, 2.0}, two_zeta_wn[2] = {2.0, 3.0};
+  for (int i = 0; i < 2; ++i) {
+    const TransferFunction& g = r.model.channels[static_cast<size_t>(i)];
+    EXPECT_EQ(g.num().degree(), 0) << "input " << i + 1;
+    ASSERT_EQ(g.den().degree(), 2) << "input " << i + 1;
+    EXPECT_NEAR(g.io_delay(), delay[i], 0.025) << "input " << i + 1;
+    const double c0 = g.den()(0.0), c1 = (g.den()(1.0) - g.den()(-1.0)) / 2;  // a2 (constant) and a1 (linear)
+    EXPECT_NEAR(c0, wn2[i], 0.05 * wn2[i]) << "input " << i + 1;
+    EXPECT_NEAR(c1, two_zeta_wn[i], 0.05 * two_zeta_wn[i]) << "input " << i + 1;
+  }
+  EXPECT_GE(r.diagnostics.choices.size(), 2u);  // each input alone, then at least one backfitting round
+  EXPECT_THROW(srivc_auto_miso(IdData(d.u(), Eigen::MatrixXd::Zero(d.size(), 2), 0.05)), InvalidArgument);
 }

@@ -32,8 +32,8 @@ TEST(Report, TransferFunctionReportHasEverySection) {
                         "95 % band", "Step response", "Impulse response", "max_iterations",
                         "Bode phase with the 95 % band", "Step response with the 95 % band"})
     EXPECT_NE(html.find(s), std::string::npos) << s;
-  // 9 plots: input, output, compare, 2 correlations, Bode magnitude and phase, step, impulse.
-  EXPECT_EQ(count(html, "class=\"plot\""), 9);
+  // 10 plots: input, output, compare, 2 correlations, pole-zero map, Bode magnitude and phase, step, impulse.
+  EXPECT_EQ(count(html, "class=\"plot\""), 10);
   EXPECT_EQ(count(html, "\"kind\":\"line\""), 9);
   char fit[32];
   std::snprintf(fit, sizeof fit, "fit %.4g %%", r.fit.fit_percent);
@@ -65,12 +65,41 @@ TEST(Report, SaysWhatTheNumbersMean) {
   std::snprintf(cell, sizeof cell, "<td>%.4g</td>", zeta);
   EXPECT_NE(html.find(cell), std::string::npos) << cell;
   EXPECT_EQ(count(html, "Passed: ") + count(html, "Failed: "), 2);  // one line under each of the two tests
+  // The pole-zero map, with the cloud of 200 drawn models' poles (2 each: 400 points) next to the estimate's 2.
+  EXPECT_NE(html.find("Pole-zero map with the spread of the parameter covariance"), std::string::npos);
+  EXPECT_NE(html.find("\"label\":\"poles of 200 models drawn from the covariance\",\"marker\":\".\",\"light\":true"),
+            std::string::npos);
   EXPECT_EQ(html.find("no: |value| &lt; 2 std"), std::string::npos);  // every parameter of the true structure is significant
   // A parameter made insignificant (its std raised above half its value) is flagged, with a note.
   r.parameters.std(0) = 0.6 * std::abs(r.parameters.values(0));
   html = html_report(d, r, o);
   EXPECT_EQ(count(html, "no: |value| &lt; 2 std"), 1);
   EXPECT_NE(html.find("1 parameter(s) lie within two standard deviations of 0"), std::string::npos);
+}
+
+TEST(Report, ComparisonPutsModelsSideBySide) {
+  // ctid compare's report: the SRIVC fit of the record's structure against a first-order model and a diverging one.
+  const IdData d = plant();
+  const auto r = srivc(d, {.nb = 1, .nf = 2});
+  const TransferFunction first(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 1.0}});
+  const TransferFunction unstable(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, -20.0}});
+  const auto cs = compare_models(d, {{"srivc <2>", r.model}, {"first", first}, {"unstable", unstable}});
+  ReportOptions o;
+  o.command_line = "ctid compare a.json b.json c.json x.csv";
+  const std::string html = html_comparison_report(d, cs, o);
+  for (const char* s : {"<title>ctid compare</title>", "<h2>Models</h2>", "<td>srivc &lt;2&gt;</td>", "<td>diverges</td>",
+                        "<h2>Residual tests</h2>", "Unit step response", "Poles of the linear models",
+                        "<td>command</td><td>ctid compare a.json b.json c.json x.csv</td>"})
+    EXPECT_NE(html.find(s), std::string::npos) << s;
+  char best[96];
+  std::snprintf(best, sizeof best, "<td>best fit</td><td>srivc &lt;2&gt; (%.4g %%)</td>", cs[0].fits[0].fit_percent);
+  EXPECT_NE(html.find(best), std::string::npos) << best;
+  // Plots: input, output, overlay, Bode magnitude and phase, step, poles; every model in the overlay.
+  EXPECT_EQ(count(html, "<div class=\"plot"), 7);
+  EXPECT_EQ(count(html, "\"label\":\"unstable"), 4);  // overlay, Bode magnitude and phase, poles; not the step
+  EXPECT_NE(html.find("unstable: not drawn, it is unstable"), std::string::npos);
+  EXPECT_THROW(html_comparison_report(d, {}, o), InvalidArgument);
+  EXPECT_THROW(html_comparison_report(d.slice(0, 100), cs, o), InvalidArgument);
 }
 
 TEST(Report, MultiInputReportHasAChannelPerInput) {
@@ -143,7 +172,7 @@ TEST(Report, DiagnosticsSectionShowsMethodNumbers) {
   const std::string hm = html_report(sines, m, {.method = "modal"});
   EXPECT_NE(hm.find("Modal functions (El-Shafey)"), std::string::npos);
   EXPECT_NE(hm.find("condition_by_order"), std::string::npos);
-  EXPECT_EQ(count(hm, "class=\"plot\""), 10);  // the 9 of a transfer-function report + the condition plot
+  EXPECT_EQ(count(hm, "class=\"plot\""), 11);  // the 10 of a transfer-function report + the condition plot
 }
 
 TEST(Report, TextIsEscapedAndScriptsCannotBeInjected) {

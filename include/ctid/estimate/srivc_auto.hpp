@@ -1,4 +1,5 @@
-// ctid — srivc_auto: a transfer function without hand-picked orders (issue 17; the default of `ctid fit`).
+// ctid — srivc_auto: a transfer function without hand-picked orders (issue 17; the default of `ctid fit`), and
+// srivc_auto_miso, the same for several inputs.
 //
 // What an expert does first with a new single-input record: SRIVC (Young & Jakeman 1980; estimate/srivc.hpp) for
 // every structure nf = 1..nf_max, nb = 1..nf (strictly proper), each once without an input delay and, with
@@ -12,6 +13,7 @@
 #include "ctid/data/iddata.hpp"
 #include "ctid/estimate/options.hpp"
 #include "ctid/estimate/srivc.hpp"
+#include "ctid/model/miso.hpp"
 #include "ctid/model/transfer_function.hpp"
 
 namespace ctid {
@@ -39,5 +41,17 @@ const OptionTable<SrivcAutoOptions>& option_table<SrivcAutoOptions>();
 /// (not usable, its own reason). Throws InvalidArgument for data that are not single-input single-output or too
 /// short, InvalidOptions for bad options.
 Result<TransferFunction> srivc_auto(const IdData& data, const SrivcAutoOptions& options = {});
+
+/// The same for several inputs (MISO; one output): y = sum_i B_i(s)/A_i(s) e^{-s tau_i} u_i, by backfitting the
+/// structures as srivc_miso backfits the parameters (Garnier, Gilson, Young & Huselstein 2007). First each
+/// input alone (srivc_auto on that input and the whole output; the other inputs act as noise, which the instruments
+/// tolerate when the inputs are not correlated) gives every channel's structure and delay tau_i, and srivc_miso fits
+/// all channels together (separate denominators, the delays as SrivcMisoOptions::delays). Then, repeatedly, srivc_auto
+/// on each channel's input and the output less the other channels' simulated contributions chooses that channel's
+/// structure and delay again; the new joint fit is kept while its BIC is lower (the usable fit first), until the
+/// structures repeat (at most 3 rounds). diagnostics.choices says what each round chose. One input: srivc_auto as a
+/// one-channel MisoModel. Throws InvalidArgument for data with other than one output or too short, InvalidOptions
+/// for bad options.
+Result<MisoModel> srivc_auto_miso(const IdData& data, const SrivcAutoOptions& options = {});
 
 }  // namespace ctid

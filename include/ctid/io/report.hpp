@@ -21,6 +21,7 @@
 #include "ctid/model/nde.hpp"
 #include "ctid/model/transfer_function.hpp"
 #include "ctid/simulate/simulate.hpp"
+#include "ctid/validate/compare.hpp"
 
 namespace ctid {
 
@@ -59,6 +60,17 @@ template <class M>
 std::string html_report(const IdData& data, const Result<M>& result, const ReportOptions& options) {
   return html_report(data, to_any(result), options);
 }
+
+/// Several models on one record side by side (ctid compare): a table of each model's type, coefficient count, initial
+/// condition, fit (%) per output, NRMSE and AIC; the record; the measured output with every model's simulation
+/// overlaid; each model's residual tests; and, for a single-output record, the Bode magnitude and phase of the linear
+/// models (up to the record's Nyquist frequency), the step responses (unit steps when every model is linear,
+/// otherwise steps of each input's RMS level for all) and the poles of the linear models. `comparisons` from
+/// compare_models (validate/compare.hpp) on `data`; of `options` the title (default "ctid compare"), data source,
+/// preprocessing, command line and max_points are used. Throws InvalidArgument when comparisons is empty or was not
+/// computed on data.
+std::string html_comparison_report(const IdData& data, const std::vector<ModelComparison>& comparisons,
+                                   const ReportOptions& options);
 
 /// Whether the plotting library was found at build time (scripts/install-deps.sh fetches it); without it
 /// a report still holds every table and says that its plots are missing.

@@ -52,6 +52,11 @@ struct MagnitudeBand {
 /// coefficient of its model (e.g. physical parameters). Throws InvalidArgument for level outside (0, 1) or draws < 10.
 MagnitudeBand magnitude_band(const Result<TransferFunction>& r, const Eigen::VectorXd& w, double level = 0.95,
                              int draws = 200, unsigned seed = 1);
+/// `draws` transfer functions whose estimated coefficients are drawn from N(values, covariance) of r (fixed parameters
+/// and non-coefficients held; a seeded generator, so the draws are reproducible): the models behind the bands below and
+/// the report's pole-zero cloud. Empty when r has no finite covariance of its parameters' size or none of its
+/// parameters is a coefficient of its model. Throws InvalidArgument for draws < 10.
+std::vector<TransferFunction> drawn_models(const Result<TransferFunction>& r, int draws = 200, unsigned seed = 1);
 /// The same band for any real response of the model — `response(g)`, one value per point (e.g. the step response at
 /// given times, or the unwrapped phase): pointwise central `level` band over the drawn transfer functions.
 MagnitudeBand response_band(const Result<TransferFunction>& r,
