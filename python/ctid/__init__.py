@@ -19,7 +19,8 @@ from ._ctid import (  # noqa: F401  (re-exported)
     InvalidOptions, MisoModel, ModalModel, ModalWindow, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm,
     NonlinearCorrelationTests, PhysicalModel, ResultFile, Simulation, StateSpace, TransferFunction, add_noise_snr, fit_percent, frequency_grid,
     example_data, example_data_names, generator_fitted_to_input, html_report, kia_product_candidates,
-    input_residual_crosscorrelation, load, magnitude_band, mode_uncertainty, frequency_response_std, methods, settings, diagnostics, narx_candidates, narx_noise_candidates,
+    input_residual_crosscorrelation, load, magnitude_band, response_band, drawn_models, compare_models,
+    html_comparison_report, ModelComparison, mode_uncertainty, frequency_response_std, methods, settings, diagnostics, narx_candidates, narx_noise_candidates,
     nonlinear_correlation_tests, one_sided_dft, piecewise_constant_windows, prbs, random_binary, multisine, steps, white_noise, read_narx_json, read_nde_json,
     greybox_initial_state, read_result, residual_autocorrelation, response_horizon, time_grid, write_result,
 )
@@ -334,8 +335,11 @@ def srivc_auto(data, **options):
     """A transfer function without hand-picked orders: SRIVC for every nf = 1..nf_max (default 3), nb = 1..nf, each
     with and without a delay search, the usable fit of least BIC (options: SrivcAutoOptions; ctid.settings("srivc_auto")
     lists them). The structures tried are in result.diagnostics.vectors["structure_nb"], "structure_nf",
-    "structure_delay" and "structure_bic". The means are not removed: use data.detrend() first."""
-    return _ctid.srivc_auto(data, _options(_ctid.SrivcAutoOptions, "srivc_auto", options))
+    "structure_delay" and "structure_bic". The means are not removed: use data.detrend() first. Data with several
+    inputs: srivc_auto_miso (each channel's structure and delay, backfitted; a MisoResult; the steps in
+    result.diagnostics.choices)."""
+    o = _options(_ctid.SrivcAutoOptions, "srivc_auto", options)
+    return _ctid.srivc_auto_miso(data, o) if data.nu > 1 else _ctid.srivc_auto(data, o)
 
 
 def oe(data, nb, nf, nk=0, **options):
@@ -665,3 +669,52 @@ def simulate(model, data, initial="rest", x0=None, initial_samples=0):
         import warnings
         warnings.warn(s.problem, RuntimeWarning, stacklevel=2)
     return s.y[:, 0] if s.y.shape[1] == 1 else s.y
+
+
+def compare(data, models, initial=None, max_lag=25, report=None, title=""):
+    """Several models on one record side by side — the library's compare_models (``ctid compare`` uses it).
+
+    models: a dict {name: model}, or a list of models, results, result-file paths or (name, model) pairs (unnamed
+    ones are called by their file path or "model 1", "model 2", ..). Each is simulated on ``data`` from ``initial``
+    ("rest", "measured", "estimated"; None = each model's validation condition: estimated for linear and grey-box
+    models, measured for NARX/NDE, rest for FSF) and scored: fits (one FitReport per output), whiteness and
+    independence (residual tests, ``max_lag`` lags). A model that diverges is kept, with ``simulation.problem``.
+    report: a path to write the side-by-side HTML report to (fits, overlaid simulations, Bode, step, poles).
+    Returns the list of ModelComparison, in the given order."""
+    items = list(models.items()) if isinstance(models, dict) else list(models)
+    named = []
+    for k, m in enumerate(items):
+        name = None
+        if isinstance(m, tuple) and len(m) == 2 and isinstance(m[0], str):
+            name, m = m
+        if isinstance(m, str):
+            name, m = name or m, _ctid.read_result(m).result
+        named.append((name or "model %d" % (k + 1), getattr(m, "model", m)))
+    out = _ctid.compare_models(data, named, initial or "", int(max_lag))
+    if report is not None:
+        _ctid.html_comparison_report(data, out, str(report), title)
+    return out
+
+
+# Python functions of the registered methods whose name differs from the method's.
+_METHOD_FUNCTIONS = {"physical": ["fit_physical_step", "fit_physical_frequency", "fit_physical_raw"],
+                     "modal": ["modal_fit", "modal_estimate"], "poles": ["free_response_poles", "compare_poles"]}
+
+
+def _document_options():
+    """Appends to each method function's docstring its keyword options with kind, unit, range and default — read from
+    the library's option table (the same names and defaults as ``ctid fit --method M --help`` and ``--set``)."""
+    for method in methods():
+        for name in _METHOD_FUNCTIONS.get(method, [method]):
+            f = globals().get(name)
+            if not callable(f) or getattr(f, "__module__", None) != __name__:
+                continue
+            lines = ["", "", f"Keyword options (ctid.settings({method!r}); the CLI's --set NAME=VALUE):"]
+            for s in settings(method):
+                unit = f" {s['unit']}" if s["unit"] else ""
+                rng = f", {s['range']}" if s["range"] else ""
+                lines.append(f"    {s['name']} = {s['default'] or '(none)'}{unit} -- {s['doc']} ({s['kind']}{rng})")
+            f.__doc__ = (f.__doc__ or "").rstrip() + "\n".join(lines) + "\n"
+
+
+_document_options()

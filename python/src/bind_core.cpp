@@ -221,6 +221,19 @@ void bind_core(py::module_& m) {
       },
       py::arg("result"), py::arg("w"), py::arg("level") = 0.95, py::arg("draws") = 200, py::arg("seed") = 1,
       "(lower, upper) of |G(jw)| over draws from the parameter covariance, or None when the result has none.");
+  m.def(
+      "response_band",
+      [](const Result<TransferFunction>& r, const std::function<Eigen::VectorXd(const TransferFunction&)>& response,
+         double level, int draws, unsigned seed) {
+        const MagnitudeBand b = response_band(r, response, level, draws, seed);
+        return b.empty() ? py::object(py::none()) : py::object(py::make_tuple(b.lower, b.upper));
+      },
+      py::arg("result"), py::arg("response"), py::arg("level") = 0.95, py::arg("draws") = 200, py::arg("seed") = 1,
+      "(lower, upper): the pointwise central band of response(g) (a real array, one value per point) over the "
+      "transfer functions drawn from the parameter covariance (drawn_models), or None when the result has none.");
+  m.def("drawn_models", &drawn_models, py::arg("result"), py::arg("draws") = 200, py::arg("seed") = 1,
+        "Transfer functions whose coefficients are drawn from N(values, covariance) of a result (seeded; empty "
+        "without a usable covariance): the models behind the report's bands and pole-zero cloud.");
 }
 
 }  // namespace ctid::python

@@ -155,6 +155,12 @@ void bind_linear(py::module_& m) {
       [](const IdData& d, const SrivcAutoOptions& o) { return interruptible([&] { return srivc_auto(d, o); }); },
       py::arg("data"), py::arg("options") = SrivcAutoOptions{},
       "SRIVC over nf = 1..nf_max, nb = 1..nf, each with and without a delay search; the least BIC.");
+  m.def(
+      "srivc_auto_miso",
+      [](const IdData& d, const SrivcAutoOptions& o) { return interruptible([&] { return srivc_auto_miso(d, o); }); },
+      py::arg("data"), py::arg("options") = SrivcAutoOptions{},
+      "srivc_auto for several inputs: each channel's structure and delay by srivc_auto, backfitted on the output "
+      "less the other channels, the joint srivc_miso fit of least BIC.");
   // Several experiments (a list of IdData) of one system: one parameter set.
   def_experiments_estimator<SrivcOptions>(m, "srivc", &srivc);
   def_experiments_estimator<LssvfOptions>(m, "lssvf", &lssvf);

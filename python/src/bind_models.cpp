@@ -91,6 +91,49 @@ void bind_models(py::module_& m) {
       py::arg("model"), py::arg("data"), py::arg("initial") = "rest", py::arg("x0") = Eigen::VectorXd(),
       py::arg("initial_samples") = 0,
       "Simulate any model on a record (simulate/simulate.hpp): initial 'rest', 'measured' or 'estimated'.");
+  py::class_<ModelComparison>(m, "ModelComparison",
+                              "One model scored on a record (compare_models): name, model, initial (the initial "
+                              "condition it was simulated from), simulation, fits (a FitReport per output), whiteness "
+                              "(a CorrelationTest per output; no lags where the residuals are not finite) and "
+                              "independence (per output, one CorrelationTest per input).")
+      .def_readonly("name", &ModelComparison::name)
+      .def_property_readonly("model", [](const ModelComparison& c) { return c.model; })
+      .def_property_readonly("initial", [](const ModelComparison& c) { return std::string(to_string(c.initial)); })
+      .def_readonly("simulation", &ModelComparison::simulation)
+      .def_readonly("fits", &ModelComparison::fits)
+      .def_readonly("whiteness", &ModelComparison::whiteness)
+      .def_readonly("independence", &ModelComparison::independence)
+      .def("mean_fit", &ModelComparison::mean_fit, "Mean fit (%) over the outputs (-inf where a simulation diverges).")
+      .def("__repr__", [](const ModelComparison& c) {
+        char fit[32];
+        std::snprintf(fit, sizeof fit, "%.2f", c.mean_fit());
+        return "<ModelComparison " + c.name + ": " + model_type_name(c.model) + ", fit " + fit + " %, initial " +
+               to_string(c.initial) + ">";
+      });
+  m.def(
+      "compare_models",
+      [](const IdData& d, const std::vector<std::pair<std::string, AnyModel>>& models, const std::string& initial,
+         int max_lag) {
+        std::optional<InitialCondition> ic;
+        if (!initial.empty()) ic = initial_condition_from_string(initial);
+        py::gil_scoped_release release;
+        return compare_models(d, models, ic, max_lag);
+      },
+      py::arg("data"), py::arg("models"), py::arg("initial") = "", py::arg("max_lag") = 25,
+      "Score several models [(name, model), ..] on one record (validate/compare.hpp): each simulated from initial "
+      "('rest', 'measured', 'estimated'; '' = each model's validation condition), its fit per output and residual "
+      "tests. A diverging model is recorded (its simulation.problem), not an error.");
+  m.def(
+      "html_comparison_report",
+      [](const IdData& d, const std::vector<ModelComparison>& cs, const std::string& path, const std::string& title,
+         const std::string& data_source) {
+        ReportOptions o;
+        o.title = title;
+        o.data_source = data_source;
+        write_text_file(path, html_comparison_report(d, cs, o));
+      },
+      py::arg("data"), py::arg("comparisons"), py::arg("path"), py::arg("title") = "", py::arg("data_source") = "",
+      "Write the side-by-side HTML report (ctid compare --report) of compare_models' result on the same record.");
   m.def("model_type_name", &model_type_name, py::arg("model"), "The model's JSON type name.");
   m.def("model_step_response", &model_step_response, py::arg("model"), py::arg("t"), py::arg("amplitude") = 1.0,
         "Response from rest to the step amplitude * 1(t) at the times t (s) of any model, one column per input.");

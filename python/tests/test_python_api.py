@@ -74,3 +74,36 @@ def test_every_result_part_has_a_readable_repr_and_html():
     for obj in (d, r, r.parameters, r.fit, r.summary, r.diagnostics, r.model):
         assert "object at 0x" not in repr(obj), type(obj).__name__
         assert obj._repr_html_().startswith("<pre>") and "&lt;" not in obj._repr_html_()[:5]
+
+
+def test_compare_scores_models_side_by_side(tmp_path):
+    # 4/(s^2 + 0.8 s + 4), noise-free, from sample 500 of a run from rest: the truth from its estimated initial state
+    # fits to 100 % (within 1e-2 %); the first-order model's fit is what simulate(..., "estimated") + fit_percent give.
+    truth = ctid.TransferFunction([4.0], [1.0, 0.8, 4.0])
+    first = ctid.TransferFunction([1.0], [1.0, 1.0])
+    u = ctid.random_binary(2000, seed=2, clock_period=3)
+    t = ctid.time_grid(0.02, 2000)
+    d = ctid.IdData.from_arrays(u, scipy.signal.lsim((truth.num, truth.den), u, t, interp=False)[1], ts=0.02)[500:]
+    path = tmp_path / "cmp.html"
+    cs = ctid.compare(d, {"truth": truth, "first": first}, report=path)
+    assert [c.name for c in cs] == ["truth", "first"] and cs[0].initial == "estimated"
+    assert cs[0].fits[0].fit_percent > 99.99
+    expected = ctid.fit_percent(d.y[:, 0], ctid.simulate(first, d, initial="estimated"))
+    assert abs(cs[1].fits[0].fit_percent - expected) < 1e-9
+    assert "<h2>Models</h2>" in path.read_text() and "ModelComparison truth" in repr(cs[0])
+    two = ctid.MisoModel()
+    two.channels = [truth, truth]
+    with pytest.raises(ctid.InvalidArgument, match="has 2 input"):
+        ctid.compare(d, [two])
+
+
+def test_docstrings_list_every_option_with_its_default():
+    # Each registered method's Python function lists its settings with the option table's defaults (help(ctid.srivc)).
+    doc = ctid.srivc.__doc__
+    for s in ctid.settings("srivc"):
+        assert f"    {s['name']} = {s['default'] or '(none)'}" in doc, s["name"]
+    assert "max_iterations = 50" in doc
+    assert "T = " in ctid.fsf.__doc__ and "shifts" in ctid.modal_fit.__doc__
+    undocumented = [m for m in ctid.methods() if all("Keyword options (ctid.settings(%r)" % m not in (getattr(
+        ctid, f, None).__doc__ or "") for f in ctid._METHOD_FUNCTIONS.get(m, [m]) if hasattr(ctid, f))]
+    assert undocumented == []
