@@ -1,6 +1,6 @@
 # Thin wrapper around CMake (DESIGN.md §2).
 #   make demo   install dependencies, build the library and the command-line tool only (unity build,
-#               CTID_UNITY_BUILD: about 4 min 40 s on 2 cores), run `ctid demo` on the bundled data
+#               CTID_UNITY_BUILD: about 4 min 40 s on 2 cores, README.md), run `ctid demo` on the bundled data
 #   make test   install dependencies, build, run every test (ctest), then the sanitizer build's tests
 #               (AddressSanitizer + UBSan, Debug with -O1 and line tables only (-g1: file:line in every report,
 #               40 % less compile time than -g): assertions on; the long Monte Carlo tests, ctest label

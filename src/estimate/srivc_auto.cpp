@@ -178,9 +178,16 @@ Result<MisoModel> srivc_auto_miso(const IdData& data, const SrivcAutoOptions& op
     orders = o;
     delays = d;
     have = true;
+    if (nu == 1) break;  // nothing to take away from the output: the next round would repeat this one
   }
 done:
-  CTID_REQUIRE(have, "srivc_auto_miso: interrupted before a fit");
+  if (!have) {  // interrupted during the first round: no joint fit to return
+    Result<MisoModel> r;
+    r.summary.termination = Termination::Interrupted;
+    r.summary.message = "srivc_auto_miso: interrupted before the first joint fit";
+    r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return r;
+  }
   Result<MisoModel> r = std::move(best.r);
   for (auto& c : choices) r.diagnostics.choices.push_back(std::move(c));
   if (!best.usable && r.summary.succeeded()) {
