@@ -71,19 +71,12 @@ int run(const CompareArgs& a) {
   for (int j = 0; j < d.ny(); ++j)
     std::printf("  %9s", d.ny() > 1 ? ("fit% " + channel_name(d.output_names(), j)).c_str() : "fit %");
   std::printf("  %9s  %10s  %s\n", "NRMSE", "AIC", "residual tests");
-  std::size_t best = 0;
-  for (std::size_t k = 0; k < cs.size(); ++k) {
-    const ModelComparison& c = cs[k];
-    if (c.mean_fit() > cs[best].mean_fit()) best = k;
-    double nrmse = 0, aic = 0;
-    for (const FitReport& f : c.fits) {
-      nrmse += f.nrmse / static_cast<double>(c.fits.size());
-      aic += f.aic;
-    }
+  for (const ModelComparison& c : cs) {
     std::printf("%-*s  %-17s  %-9s", static_cast<int>(width), c.name.c_str(), model_type_name(c.model), to_string(c.initial));
     for (const FitReport& f : c.fits) std::printf("  %9s", fit_text(f).c_str());
-    std::printf("  %9.4g  %10.5g  %s\n", nrmse, aic, tests_text(c).c_str());
+    std::printf("  %9.4g  %10.5g  %s\n", c.mean_nrmse(), c.total_aic(), tests_text(c).c_str());
   }
+  const std::size_t best = best_comparison(cs);
   std::printf("best: %s (%s %%%s)\n", cs[best].name.c_str(), two_decimals(cs[best].mean_fit()).c_str(),
               d.ny() > 1 ? ", mean over the outputs" : "");
   if (!a.json.empty()) {

@@ -105,9 +105,10 @@ def bode(model, w=None, data=None, confidence=True, ax=None):
             mag = np.maximum(np.abs(h) - band, 1e-300), np.abs(h) + band
         elif isinstance(m, TransferFunction) and hasattr(model, "parameters"):
             mag = magnitude_band(model, w)  # 2.5-97.5 % of 200 seeded draws
-            # each drawn phase on the estimate's branch at the first frequency (as the report)
-            phase = response_band(model, lambda g: (lambda p: p + 360.0 * np.round((ph[0] - p[0]) / 360.0))(
-                np.degrees(np.unwrap(np.angle(g.freqresp(w))))))
+            def drawn_phase(g):  # on the estimate's branch at the first frequency, as the report's band
+                p = np.degrees(np.unwrap(np.angle(g.freqresp(w))))
+                return p + 360.0 * np.round((ph[0] - p[0]) / 360.0)
+            phase = response_band(model, drawn_phase)
         if mag is not None:
             axes[0].fill_between(w, 20 * np.log10(mag[0]), 20 * np.log10(mag[1]), alpha=0.25, lw=0,
                                  label="95 % band")

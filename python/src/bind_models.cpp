@@ -104,6 +104,8 @@ void bind_models(py::module_& m) {
       .def_readonly("whiteness", &ModelComparison::whiteness)
       .def_readonly("independence", &ModelComparison::independence)
       .def("mean_fit", &ModelComparison::mean_fit, "Mean fit (%) over the outputs (-inf where a simulation diverges).")
+      .def("mean_nrmse", &ModelComparison::mean_nrmse, "Mean NRMSE over the outputs.")
+      .def("total_aic", &ModelComparison::total_aic, "AIC summed over the outputs.")
       .def("__repr__", [](const ModelComparison& c) {
         char fit[32];
         std::snprintf(fit, sizeof fit, "%.2f", c.mean_fit());

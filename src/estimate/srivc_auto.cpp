@@ -126,14 +126,13 @@ Result<MisoModel> srivc_auto_miso(const IdData& data, const SrivcAutoOptions& op
     return i < static_cast<int>(n.size()) && !n[static_cast<size_t>(i)].empty() ? n[static_cast<size_t>(i)]
                                                                                  : "u" + std::to_string(i + 1);
   };
-  // Channel i's record: its input, and the output less the other channels' simulated contributions (none yet: the
-  // whole output, the other inputs acting as noise).
-  auto channel_record = [&](int i, const MisoModel* others) {
+  // Channel i's record: its input, and the output less the other channels' simulated contributions (`parts`, one
+  // column per channel, simulated once per round; none in the first round: the whole output, the other inputs
+  // acting as noise).
+  auto channel_record = [&](int i, const Eigen::MatrixXd* parts) {
     IdData di = data.select({i}, {0});
-    if (!others) return di;
-    Eigen::VectorXd y = data.y().col(0);
-    for (int j = 0; j < nu; ++j)
-      if (j != i) y -= lsim(others->channels[static_cast<size_t>(j)], data, j);
+    if (!parts) return di;
+    const Eigen::VectorXd y = data.y().col(0) - parts->rowwise().sum() + parts->col(i);
     IdData out = data.is_uniform() ? IdData(di.u(), y, data.ts(), data.t0()) : IdData(di.u(), y, data.times());
     out.set_intersample(data.intersample(i));
     return out;
@@ -152,9 +151,12 @@ Result<MisoModel> srivc_auto_miso(const IdData& data, const SrivcAutoOptions& op
   for (; sweeps <= 3; ++sweeps) {
     std::vector<TfOrders> o(static_cast<size_t>(nu));
     std::vector<double> d(static_cast<size_t>(nu), 0.0);
+    Eigen::MatrixXd parts(data.size(), nu);
+    if (have)
+      for (int j = 0; j < nu; ++j) parts.col(j) = lsim(best.r.model.channels[static_cast<size_t>(j)], data, j);
     for (int i = 0; i < nu; ++i) {
       if (!report_progress("srivc_auto_miso", ++siso, NAN)) goto done;
-      const Result<TransferFunction> ri = srivc_auto(channel_record(i, have ? &best.r.model : nullptr), options);
+      const Result<TransferFunction> ri = srivc_auto(channel_record(i, have ? &parts : nullptr), options);
       o[static_cast<size_t>(i)] = {ri.model.num().degree() + 1, ri.model.den().degree(), 0};
       d[static_cast<size_t>(i)] = ri.model.io_delay();
     }

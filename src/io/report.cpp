@@ -980,9 +980,7 @@ std::string html_comparison_report(const IdData& d, const std::vector<ModelCompa
                      static_cast<int>(c.fits.size()) == d.ny(),
                  "html_comparison_report: model {} was not compared on this record (compare_models)", c.name);
   Page page;
-  size_t best = 0;
-  for (size_t k = 1; k < cs.size(); ++k)
-    if (cs[k].mean_fit() > cs[best].mean_fit()) best = k;
+  const size_t best = best_comparison(cs);
   page.section("Summary");
   std::vector<std::vector<std::string>> rows = {
       {"models", std::to_string(cs.size())},
@@ -998,14 +996,9 @@ std::string html_comparison_report(const IdData& d, const std::vector<ModelCompa
   for (const ModelComparison& c : cs) {
     std::vector<std::string> r = {c.name, model_type_name(c.model), std::to_string(model_coefficient_count(c.model)),
                                   to_string(c.initial)};
-    double nrmse = 0, aic = 0;
-    for (const FitReport& f : c.fits) {
-      r.push_back(std::isfinite(f.fit_percent) ? fmt(f.fit_percent, 4) : "diverges");
-      nrmse += f.nrmse / static_cast<double>(c.fits.size());
-      aic += f.aic;
-    }
-    r.push_back(fmt(nrmse, 4));
-    r.push_back(fmt(aic, 5));
+    for (const FitReport& f : c.fits) r.push_back(std::isfinite(f.fit_percent) ? fmt(f.fit_percent, 4) : "diverges");
+    r.push_back(fmt(c.mean_nrmse(), 4));
+    r.push_back(fmt(c.total_aic(), 5));
     table.push_back(r);
   }
   page.table(header, table);

@@ -18,6 +18,25 @@ double ModelComparison::mean_fit() const {
   return s / static_cast<double>(fits.size());
 }
 
+double ModelComparison::mean_nrmse() const {
+  double s = 0;
+  for (const FitReport& f : fits) s += f.nrmse;
+  return fits.empty() ? std::numeric_limits<double>::quiet_NaN() : s / static_cast<double>(fits.size());
+}
+
+double ModelComparison::total_aic() const {
+  double s = 0;
+  for (const FitReport& f : fits) s += f.aic;
+  return s;
+}
+
+std::size_t best_comparison(const std::vector<ModelComparison>& comparisons) {
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < comparisons.size(); ++k)
+    if (comparisons[k].mean_fit() > comparisons[best].mean_fit()) best = k;
+  return best;
+}
+
 std::vector<ModelComparison> compare_models(const IdData& data,
                                             const std::vector<std::pair<std::string, AnyModel>>& models,
                                             std::optional<InitialCondition> initial, int max_lag) {

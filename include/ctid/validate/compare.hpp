@@ -32,7 +32,13 @@ struct ModelComparison {
   std::vector<std::vector<CorrelationTest>> independence;  ///< [output][input]
   /// Mean fit over the outputs (the ranking of ctid compare).
   double mean_fit() const;
+  /// Mean NRMSE over the outputs, and the AIC summed over them.
+  double mean_nrmse() const;
+  double total_aic() const;
 };
+
+/// The index of the comparison with the highest mean_fit (the first of equals); 0 for an empty list.
+std::size_t best_comparison(const std::vector<ModelComparison>& comparisons);
 
 /// Every model of `models` (name, model) simulated on `data` and scored, in the given order. `initial` (set) is used
 /// for every model; unset, each model's validation_initial_condition. The residual tests use lags up to
