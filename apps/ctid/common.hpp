@@ -115,7 +115,10 @@ inline std::string settings_hint(const std::string& method) {
 /// `method` and the closest valid setting. Ranges are checked by the estimator (validate()).
 template <class... O>
 void apply_sets(const std::string& method, const std::vector<std::string>& sets, O&... o) {
-  for (const auto& [key, value] : parse_sets(sets)) {
+  for (const auto& kv : parse_sets(sets)) {
+    // Named references, not a structured binding: clang before 16 cannot capture a binding in the lambda below.
+    const std::string& key = kv.first;
+    const std::string& value = kv.second;
     bool done = false;
     try {
       (
