@@ -36,7 +36,7 @@ namespace {
 using cd = std::complex<double>;
 
 // Evaluate the scaled model at s' = j w / w0: parameters [a'(n), b'(nb)], delay T (unscaled).
-struct Scaled {
+struct ScaledModel {
   int n, nb;
   Eigen::VectorXd ws;  // scaled frequencies
   Eigen::VectorXd w;   // unscaled (for the delay)
@@ -68,7 +68,7 @@ Result<TransferFunction> tf_from_frequency(const FrequencyData& data, const TfOr
                "fits a state-space model to an FRF matrix)", data.inputs(), data.outputs());
   const Eigen::VectorXcd& G = data.response();
   const double w0 = std::exp(data.w().array().log().mean());
-  Scaled sc{n, nb, data.w() / w0, data.w()};
+  ScaledModel sc{n, nb, data.w() / w0, data.w()};
   // G with the fixed/initial delay removed for the linear SK stage.
   Eigen::VectorXcd Gd(K);
   for (int k = 0; k < K; ++k) Gd(k) = G(k) * std::exp(cd(0, data.w()(k) * opt.delay));

@@ -306,15 +306,15 @@ void check_siso(const IdData& data, const char* who) {
 }
 
 // Several records concatenated (each checked: one input, one output, uniform at the first record's Ts).
-struct Records {
+struct NarxRecords {
   Eigen::VectorXd y, u;
   std::vector<Eigen::Index> starts;
   double ts = 1.0;
 };
 
-Records concatenate(const std::vector<IdData>& data, const char* who) {
+NarxRecords concatenate(const std::vector<IdData>& data, const char* who) {
   CTID_REQUIRE(!data.empty(), "{}: no records", who);
-  Records r;
+  NarxRecords r;
   r.ts = data.front().is_uniform() ? data.front().ts() : 0.0;
   Eigen::Index n = 0;
   for (size_t i = 0; i < data.size(); ++i) {
@@ -343,7 +343,7 @@ Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& cand, c
 
 Result<NarxModel> frols(const std::vector<IdData>& data, const std::vector<NarxTerm>& cand, const FrolsOptions& o) {
   o.validate();
-  const Records r = concatenate(data, "frols");
+  const NarxRecords r = concatenate(data, "frols");
   CTID_REQUIRE(!cand.empty(), "frols: no candidate terms");
   for (const auto& t : cand) CTID_REQUIRE(!t.has_noise(), "frols: candidate {} is a noise term (use narmax)", t.name());
   const Eigen::VectorXd e = Eigen::VectorXd::Zero(r.y.size());
@@ -413,7 +413,7 @@ Result<NarxModel> narmax(const IdData& data, const std::vector<NarxTerm>& proces
 Result<NarxModel> narmax(const std::vector<IdData>& data, const std::vector<NarxTerm>& process, const NarmaxOptions& o) {
   const auto t_start = std::chrono::steady_clock::now();
   o.validate();
-  const Records rec = concatenate(data, "narmax");
+  const NarxRecords rec = concatenate(data, "narmax");
   for (const auto& t : process) CTID_REQUIRE(!t.has_noise(), "narmax: process candidate {} is a noise term", t.name());
   const Eigen::VectorXd& y = rec.y;
   const Eigen::VectorXd& u = rec.u;

@@ -20,13 +20,6 @@ inline int samples_of(double seconds, double Ts, const std::string& what) {
   return static_cast<int>(std::lround(r));
 }
 
-inline double condition_2(const Eigen::MatrixXd& M) {
-  if (M.size() == 0) return 0.0;
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(M);
-  const Eigen::VectorXd s = svd.singularValues();
-  return s(s.size() - 1) > 0 ? s(0) / s(s.size() - 1) : std::numeric_limits<double>::infinity();
-}
-
 // D f = Omega f with Omega = [[0, Omega'], [-Omega', 0]], Omega' = diag(w, 2w, .., m w) (ES 3.25, missing
 // in the OCR), and f(0) = f(T_o) = [0 .. 0, 1 .. 1].
 struct FourierFunctions {

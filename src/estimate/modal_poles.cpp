@@ -95,7 +95,7 @@ PoleEstimate free_response_poles(const Eigen::VectorXd& y, double Ts, const Free
   }
   PoleEstimate r;
   const Eigen::MatrixXd ZZ = Z * Z.transpose();
-  r.condition = condition_2(ZZ);
+  r.condition = internal::condition_number(ZZ);
   r.lambda = ZZ.transpose().colPivHouseholderQr().solve(Z * Y.transpose()).transpose();  // Y Z^T (Z Z^T)^{-1}
   r.all_poles = Eigen::EigenSolver<Eigen::MatrixXd>(r.lambda, false).eigenvalues();
   r.augmented = newton_characteristic_polynomial(r.lambda);
@@ -124,7 +124,7 @@ PoleEstimate prony(const Eigen::VectorXd& y, double Ts, const PronyOptions& o) {
     b(e) = -y(o.start + m * o.spacing);
   }
   PoleEstimate r;
-  r.condition = condition_2(R.transpose() * R);
+  r.condition = internal::condition_number(R.transpose() * R);
   const Eigen::VectorXd pk = R.colPivHouseholderQr().solve(b);
   Eigen::VectorXd c(n + 1);
   c << 1.0, pk;

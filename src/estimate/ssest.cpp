@@ -73,7 +73,7 @@ constexpr int kBatch = 128;  // samples gathered before one rank-k update of J^T
 constexpr double kInitialDamping = 1e-6;  // Levenberg-Marquardt's first damping (see search())
 
 // One record as the search sees it: inputs and outputs divided by the channel scales.
-struct Record {
+struct ScaledRecord {
   Eigen::MatrixXd u, y;
   Eigen::VectorXd t;
   bool uniform = true;
@@ -81,10 +81,10 @@ struct Record {
   std::vector<Intersample> intersample;  // of each input
 };
 
-std::vector<Record> records_of(const std::vector<IdData>& ds, const Eigen::VectorXd& su, const Eigen::VectorXd& sy) {
-  std::vector<Record> out;
+std::vector<ScaledRecord> records_of(const std::vector<IdData>& ds, const Eigen::VectorXd& su, const Eigen::VectorXd& sy) {
+  std::vector<ScaledRecord> out;
   for (const IdData& d : ds) {
-    Record r;
+    ScaledRecord r;
     r.u = d.u() * su.cwiseInverse().asDiagonal();
     r.y = d.y() * sy.cwiseInverse().asDiagonal();
     r.t = d.times();
@@ -172,7 +172,7 @@ Step step_of(const Point& m, const std::vector<Point>& dirs, double h, const std
 // predictor x_{k+1} = Phi x_k + Gamma_u u_k + GK e_k (predict() in simulate/lsim.hpp), and the sensitivities follow
 // dX_{k+1} = PhiK dX_k + F_k - GK (dC x_k + dD u_k), F_k the forcing by [u; e] (the recursion of the prediction
 // error's own sensitivity -(C dX_k + dC x_k + dD u_k)).
-bool evaluate(const Point& m0, const std::vector<Point>* dirs0, const std::vector<Record>& recs, const Eigen::VectorXd& sw,
+bool evaluate(const Point& m0, const std::vector<Point>* dirs0, const std::vector<ScaledRecord>& recs, const Eigen::VectorXd& sw,
               double& cost, Eigen::MatrixXd* JtJ, Eigen::VectorXd* Jtr, std::vector<Eigen::MatrixXd>* yhat = nullptr) {
   const Eigen::Index nx = m0.A.rows(), nu = m0.B.cols(), ny = m0.C.rows(), nk = m0.K.size() ? ny : 0;
   const bool sens = dirs0 && JtJ && Jtr;
@@ -200,7 +200,7 @@ bool evaluate(const Point& m0, const std::vector<Point>* dirs0, const std::vecto
       F(nx * P, kBatch), G(ny * P, kBatch), CD(ny, P * kBatch), Jb(kBatch * ny, P), Delta(nx, P);
   Eigen::VectorXd x(nx), xn(nx), yk(ny);
   for (size_t e = 0; e < recs.size(); ++e) {
-    const Record& rec = recs[e];
+    const ScaledRecord& rec = recs[e];
     const Eigen::Index N = rec.u.rows();
     std::vector<Intersample> is = rec.intersample;
     is.resize(static_cast<size_t>(nu + nk), Intersample::Zoh);  // the innovation is held
@@ -297,7 +297,7 @@ bool evaluate(const Point& m0, const std::vector<Point>* dirs0, const std::vecto
 }
 
 // Per-output residual variances of a model (scaled units), pooled over the records.
-Eigen::VectorXd residual_variances(const Point& m, const std::vector<Record>& recs) {
+Eigen::VectorXd residual_variances(const Point& m, const std::vector<ScaledRecord>& recs) {
   std::vector<Eigen::MatrixXd> yh;
   double cost = 0.0;
   const Eigen::VectorXd ones = Eigen::VectorXd::Ones(m.C.rows());
@@ -321,7 +321,7 @@ struct Search {
 
 // The model in state coordinates of unit covariance along its trajectory over the records (x = L z, L L^T the
 // states' second moment): every state of a comparable size, so the search's coordinates are well conditioned.
-Point whitened(const Point& m, const std::vector<Record>& recs) {
+Point whitened(const Point& m, const std::vector<ScaledRecord>& recs) {
   const Eigen::Index nx = m.A.rows(), nu = m.B.cols();
   Eigen::MatrixXd Sx = Eigen::MatrixXd::Zero(nx, nx);
   Eigen::Index n = 0;
@@ -344,7 +344,7 @@ Point whitened(const Point& m, const std::vector<Record>& recs) {
 // the search repeated once (weighted output error = ML for independent Gaussian output noise). `damping` is the
 // Levenberg-Marquardt damping to start with, and receives the one reached (a warm-up hands it to the next stage).
 Search search_records(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& held,
-                      const std::vector<Record>& recs, const SsestOptions& o, bool free_coordinates, double& damping) {
+                      const std::vector<ScaledRecord>& recs, const SsestOptions& o, bool free_coordinates, double& damping) {
   Search s;
   // enforce_stability keeps a stable start stable (an unstable start is searched freely: it may be an unstable plant).
   const bool check_stability = o.enforce_stability && stable(unpack(L, theta).A, o.integrators);
@@ -393,11 +393,11 @@ Search search_records(const Layout& L, Eigen::VectorXd theta, const std::vector<
 }
 
 // The warm-up's data: the records' beginnings, n samples in all (each record its share).
-std::vector<Record> beginnings(const std::vector<Record>& recs, Eigen::Index total, Eigen::Index n_all) {
-  std::vector<Record> out;
-  for (const Record& r : recs) {
+std::vector<ScaledRecord> beginnings(const std::vector<ScaledRecord>& recs, Eigen::Index total, Eigen::Index n_all) {
+  std::vector<ScaledRecord> out;
+  for (const ScaledRecord& r : recs) {
     const Eigen::Index n = std::max<Eigen::Index>(2, r.u.rows() * n_all / total);
-    out.push_back(Record{r.u.topRows(n), r.y.topRows(n), r.t.head(n), r.uniform, r.h, r.intersample});
+    out.push_back(ScaledRecord{r.u.topRows(n), r.y.topRows(n), r.t.head(n), r.uniform, r.h, r.intersample});
   }
   return out;
 }
@@ -409,10 +409,10 @@ std::vector<Record> beginnings(const std::vector<Record>& recs, Eigen::Index tot
 // records at the end, then finish in a few iterations. A warm-up's model is kept only when its cost on the full
 // records is below that of the model it started from, so it can make the search faster, never start it from a worse
 // point (a beginning too short to determine the slow modes gives a model that is rejected).
-Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& held, const std::vector<Record>& recs,
+Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& held, const std::vector<ScaledRecord>& recs,
               const SsestOptions& o, bool free_coordinates, int* warm_iterations) {
   Eigen::Index total = 0;
-  for (const Record& r : recs) total += r.u.rows();
+  for (const ScaledRecord& r : recs) total += r.u.rows();
   *warm_iterations = 0;
   Eigen::VectorXd sw;  // the full records' weights, from the start's residuals
   double current = INFINITY;
@@ -508,7 +508,7 @@ void deliver(Result<StateSpace>& res, const std::vector<IdData>& ds, Point fin, 
         d.x0[static_cast<size_t>(e)](i) = 1.0;
         cdirs.push_back(std::move(d));
       }
-  const std::vector<Record> raw = records_of(ds, Eigen::VectorXd::Ones(nu), Eigen::VectorXd::Ones(ny));
+  const std::vector<ScaledRecord> raw = records_of(ds, Eigen::VectorXd::Ones(nu), Eigen::VectorXd::Ones(ny));
   const Eigen::VectorXd var = noise_variance ? *noise_variance : residual_variances(fin, raw);
   Eigen::MatrixXd JtJ;
   Eigen::VectorXd Jtr;
@@ -562,7 +562,7 @@ Result<StateSpace> fit_from(const std::vector<IdData>& ds, Point start, bool use
   const int E = static_cast<int>(ds.size());
   const Layout L{nx, nu, ny, E, o.estimate_k ? ny : 0};
   const Eigen::VectorXd su = ss_detail::channel_scales(ds, false), sy = ss_detail::channel_scales(ds, true);
-  const std::vector<Record> recs = records_of(ds, su, sy);
+  const std::vector<ScaledRecord> recs = records_of(ds, su, sy);
   if (!o.estimate_k) start.K.resize(0, 0);
   else if (start.K.size() == 0) start.K = Eigen::MatrixXd::Zero(nx, ny);  // the output-error predictor
 

@@ -50,7 +50,7 @@ void SubspaceOptions::validate() const { option_table<SubspaceOptions>().check(*
 
 namespace {
 
-constexpr int kBatch = 256;  // rows gathered before one rank-k update of a Gram matrix
+constexpr int kGramBatch = 256;  // rows gathered before one rank-k update of a Gram matrix
 
 // Pseudo-inverse of a symmetric positive semi-definite matrix (eigenvalues below rel * largest dropped), and the
 // same for its inverse square root.
@@ -67,10 +67,10 @@ Eigen::MatrixXd spd_pinv(const Eigen::MatrixXd& G, double power, double rel = 1e
 // Streams rows into a Gram matrix G = sum z z^T.
 class Gram {
  public:
-  explicit Gram(int m) : G_(Eigen::MatrixXd::Zero(m, m)), Z_(kBatch, m) {}
+  explicit Gram(int m) : G_(Eigen::MatrixXd::Zero(m, m)), Z_(kGramBatch, m) {}
   void set(int j, double v) { Z_(fill_, j) = v; }
   void commit() {
-    if (++fill_ == kBatch) flush();
+    if (++fill_ == kGramBatch) flush();
   }
   const Eigen::MatrixXd& done() {
     flush();
@@ -87,16 +87,16 @@ class Gram {
   int fill_ = 0;
 };
 
-struct Scaled {
+struct ChannelScales {
   Eigen::VectorXd su, sy;  // standard deviations of the inputs and outputs (1 where constant)
 };
 
-Scaled scales(const IdData& d) {
+ChannelScales scales(const IdData& d) {
   return {ss_detail::channel_scales({&d, 1}, false), ss_detail::channel_scales({&d, 1}, true)};
 }
 
 // Gram matrix of z = [U_f; U_p; Y_f] of the lambda route (block row k of U_f: lambda^{r-1-k} u; U_p: lambda^{r+j} u).
-Eigen::MatrixXd lambda_gram(const IdData& d, const Scaled& s, int r, double tau) {
+Eigen::MatrixXd lambda_gram(const IdData& d, const ChannelScales& s, int r, double tau) {
   const int nu = d.nu(), ny = d.ny(), ns = nu + ny;
   std::vector<Intersample> is;
   for (int i = 0; i < nu; ++i) is.push_back(d.intersample(i));
@@ -130,7 +130,7 @@ Eigen::MatrixXd lambda_gram(const IdData& d, const Scaled& s, int r, double tau)
 }
 
 // Gram matrix of z = [U_f; U_p; Y_p; Y_f] on the samples (block row k of U_f: u(t + k); of U_p: u(t - r + k)).
-Eigen::MatrixXd discrete_gram(const IdData& d, const Scaled& s, int r) {
+Eigen::MatrixXd discrete_gram(const IdData& d, const ChannelScales& s, int r) {
   const int nu = d.nu(), ny = d.ny();
   Gram g(2 * r * (nu + ny));
   for (int t = r; t + r <= d.size(); ++t) {
@@ -194,7 +194,7 @@ struct Estimate {
   std::string refusal;  // non-empty: no continuous-time model (discrete route: no real logarithm)
 };
 
-Estimate estimate_at(const IdData& d, const Scaled& s, const SubspaceOptions& o, int r, double tau) {
+Estimate estimate_at(const IdData& d, const ChannelScales& s, const SubspaceOptions& o, int r, double tau) {
   const int nu = d.nu(), ny = d.ny();
   const bool lambda = o.route == SubspaceRoute::Lambda;
   const Range range = lambda ? moesp(lambda_gram(d, s, r, tau), r * nu, r * nu, r * ny)
@@ -230,7 +230,7 @@ Estimate estimate_at(const IdData& d, const Scaled& s, const SubspaceOptions& o,
   return e;
 }
 
-ss_detail::Fits fits_of(const StateSpace& m, const IdData& d, const Scaled& s, const Eigen::VectorXd& x0,
+ss_detail::Fits fits_of(const StateSpace& m, const IdData& d, const ChannelScales& s, const Eigen::VectorXd& x0,
                         int n_parameters) {
   LsimOptions lo;
   lo.x0 = x0;
@@ -314,7 +314,7 @@ Result<StateSpace> subspace(const IdData& data, const SubspaceOptions& options) 
                "subspace: nx = {} needs (horizon - 1) * outputs >= nx (horizon {}, {} outputs)", options.nx, r, ny);
 
   Result<StateSpace> res;
-  const Scaled scale = scales(data);  // every output and input to unit standard deviation
+  const ChannelScales scale = scales(data);  // every output and input to unit standard deviation
   // The free parameters of a minimal realisation (A, B, C, D up to a change of basis) and the initial state.
   auto n_free = [&](int nx) {
     return nx * (nu + ny) + (options.estimate_d ? ny * nu : 0) + (options.estimate_initial_state ? nx : 0);

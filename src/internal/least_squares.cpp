@@ -25,6 +25,13 @@ double scaled_condition(const Eigen::MatrixXd& M) {
   return smin > 0 ? sv(0) / smin : std::numeric_limits<double>::infinity();
 }
 
+double condition_number(const Eigen::MatrixXd& M) {
+  if (M.size() == 0) return 0.0;
+  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(M).singularValues();
+  const double smin = sv(sv.size() - 1);
+  return smin > 0 ? sv(0) / smin : std::numeric_limits<double>::infinity();
+}
+
 StreamingLeastSquares::StreamingLeastSquares(int p, int block)
     : p_(p), buf_(Eigen::MatrixXd::Zero(p + 1 + block, p + 1)), fill_(p + 1), qr_(p + 1 + block, p + 1) {
   CTID_ASSERT(p >= 1 && block >= 1);

@@ -126,6 +126,9 @@ class InstrumentalVariables {
 /// 2-norm condition number of a square matrix after scaling its columns to unit norm.
 double scaled_condition(const Eigen::MatrixXd& M);
 
+/// 2-norm condition number sigma_max / sigma_min of M as it is (infinite when singular, 0 when empty).
+double condition_number(const Eigen::MatrixXd& M);
+
 /// The covariance sigma2 M^{-1} of estimated parameters from their information matrix M (J^T J of a search,
 /// sum zeta zeta^T of instrumental variables); an empty matrix (unknown, see ParameterSet::set_covariance)
 /// when M is empty or sigma2 is not finite.

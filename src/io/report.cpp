@@ -603,7 +603,7 @@ void time_responses(Page& page, const AnyModel& model, const std::vector<std::st
   page.plot({"Impulse response", "time (s)", "y", t, impulse});
 }
 
-double nyquist(const IdData& d) { return d.is_uniform() ? std::numbers::pi / d.ts() : 0.0; }
+double nyquist_or_zero(const IdData& d) { return d.is_uniform() ? std::numbers::pi / d.ts() : 0.0; }
 
 // The model simulated on the record with the report's initial condition (Estimated takes the initial state a
 // fit estimated, its diagnostics "x0", where the result has one); a diverging simulation is drawn up to
@@ -756,7 +756,7 @@ std::string report_of(const IdData& d, const Result<TransferFunction>& r, const 
   pole_zero_map(page, r);
   parameters(page, r.parameters);
   diagnostics(page, r.diagnostics);
-  const Eigen::VectorXd w = frequency_grid(r.model.poles(), nyquist(d));
+  const Eigen::VectorXd w = frequency_grid(r.model.poles(), nyquist_or_zero(d));
   const Eigen::VectorXcd h = r.model.frequency_response(w);
   // 95 % bands of |G|, its phase and the step response from 200 draws of the parameter covariance (seeded: the
   // report is reproducible).
@@ -816,7 +816,7 @@ std::string report_of(const IdData& d, const Result<StateSpace>& r, const Report
   parameters(page, r.parameters);
   diagnostics(page, r.diagnostics);
   // The Bode magnitude matrix: one plot per input, one curve per output.
-  const Eigen::VectorXd w = frequency_grid(m.poles(), nyquist(d));
+  const Eigen::VectorXd w = frequency_grid(m.poles(), nyquist_or_zero(d));
   const std::vector<Eigen::MatrixXcd> G = frequency_response(m, w);
   page.section("Frequency response (magnitude of every channel)");
   for (int i = 0; i < m.nu(); ++i) {
@@ -848,7 +848,7 @@ std::string report_of(const IdData& d, const Result<MisoModel>& r, const ReportO
   diagnostics(page, r.diagnostics);
   std::vector<std::string> labels;
   for (int i = 0; i < r.model.nu(); ++i) labels.push_back("G" + std::to_string(i + 1) + " (" + input_name(d, i) + ")");
-  const Eigen::VectorXd w = frequency_grid(model_poles(r.model), nyquist(d));
+  const Eigen::VectorXd w = frequency_grid(model_poles(r.model), nyquist_or_zero(d));
   const Eigen::MatrixXcd h = model_frequency_response(r.model, w);
   std::vector<std::pair<std::string, Eigen::VectorXcd>> hs;
   for (int i = 0; i < r.model.nu(); ++i) hs.push_back({labels[static_cast<size_t>(i)], h.col(i)});
@@ -939,7 +939,7 @@ std::string report_of(const IdData& d, const Result<NdeModel>& r, const ReportOp
   const Eigen::VectorXd* err = r.diagnostics.has(diagnostic::err) ? &r.diagnostics.get(diagnostic::err) : nullptr;
   parameters(page, r.parameters, err && err->size() == r.parameters.size() ? err : nullptr);
   diagnostics(page, r.diagnostics);
-  const Eigen::VectorXd w = frequency_grid(m.a().roots(), nyquist(d));
+  const Eigen::VectorXd w = frequency_grid(m.a().roots(), nyquist_or_zero(d));
   Eigen::VectorXcd h(w.size());
   for (Eigen::Index i = 0; i < w.size(); ++i) h(i) = m.h1(std::complex<double>(0, w(i)));
   bode(page, w, {{"H_1(jw)", h}});
@@ -1067,7 +1067,7 @@ std::string html_comparison_report(const IdData& d, const std::vector<ModelCompa
   }
   const Eigen::VectorXcd poles = Eigen::Map<const Eigen::VectorXcd>(all_poles.data(), static_cast<Eigen::Index>(all_poles.size()));
   if (!linear.empty()) {
-    const Eigen::VectorXd w = frequency_grid(poles, nyquist(d));
+    const Eigen::VectorXd w = frequency_grid(poles, nyquist_or_zero(d));
     for (int i = 0; i < d.nu(); ++i) {
       const std::string from = d.nu() > 1 ? " from " + input_name(d, i) : "";
       std::vector<Series> mag, ph;

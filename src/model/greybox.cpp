@@ -254,9 +254,9 @@ Eigen::VectorXd checked_start(const GreyboxModel& m, const Eigen::MatrixXd& u, c
 }
 
 // The expressions' variables z = [x, u, theta, t] at one instant (theta loaded once).
-class Point {
+class Variables {
  public:
-  Point(const GreyboxModel& g, int nz) : z_(static_cast<size_t>(nz)), n_(g.nx()), m_(g.nu()) {
+  Variables(const GreyboxModel& g, int nz) : z_(static_cast<size_t>(nz)), n_(g.nx()), m_(g.nu()) {
     for (int j = 0; j < g.np(); ++j) z_[static_cast<size_t>(n_ + m_ + j)] = g.spec().parameters[j].value;
   }
   const double* at(double t, const double* x, const double* u) {
@@ -504,7 +504,7 @@ namespace {
 // Integrates [x; S] (S: the sensitivities to the quantities q_to_z, n x q column by column after x; q = 0: the states
 // alone) from a0 with the switching surfaces' events: Dormand-Prince 5(4), or CVODES's BDF, or (Auto) Dormand-Prince
 // and, where it needs more than its step budget (a stiff model), BDF. reset() is called before each attempt.
-internal::OdeOutcome integrate(Switching& sw, Point& z, int n, int nz, const std::vector<int>& q_to_z,
+internal::OdeOutcome integrate(Switching& sw, Variables& z, int n, int nz, const std::vector<int>& q_to_z,
                                const Eigen::VectorXd& a0, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
                                Intersample intersample, double rtol, GreyboxIntegrator integrator,
                                const internal::OdeSample& sample, const std::function<void()>& reset,
@@ -569,7 +569,7 @@ GreyboxSimulation GreyboxModel::simulate(const Eigen::MatrixXd& u, const Eigen::
   const Eigen::VectorXd start = checked_start(*this, u, t, x0, intersample);
   const Compiled& c = *c_;
   const int n = nx();
-  Point z(*this, c.nz);
+  Variables z(*this, c.nz);
   Switching sw(c.f, c.surfaces, c.surface_of, n, c.nz);
   GreyboxSimulation out;
   const internal::OdeOutcome o = integrate(
@@ -604,7 +604,7 @@ GreyboxSensitivities GreyboxModel::sensitivities(const Eigen::MatrixXd& u, const
   // Column j of S is the derivative with respect to z[q_to_z[j]] (a parameter) or an initial state (-1).
   std::vector<int> q_to_z(static_cast<size_t>(q), -1);
   for (int j = 0; j < nf; ++j) q_to_z[static_cast<size_t>(j)] = n + m + free[static_cast<size_t>(j)];
-  Point z(*this, c.nz);
+  Variables z(*this, c.nz);
   Switching sw(c.f, c.surfaces, c.surface_of, n, c.nz);
   std::vector<double> g(static_cast<size_t>(c.nz));
   // The derivative along column j of S of the output whose gradient g holds: dh/dx . S_j + dh/dz[q_to_z[j]].

@@ -6,17 +6,12 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "ctid/core/check.hpp"
+#include "internal/least_squares.hpp"
 
 namespace ctid {
 
 namespace {
 bool all_finite(const Eigen::MatrixXd& M) { return M.allFinite(); }
-
-double condition_2(const Eigen::MatrixXd& M) {
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(M);
-  const Eigen::VectorXd s = svd.singularValues();
-  return s(s.size() - 1) > 0 ? s(0) / s(s.size() - 1) : std::numeric_limits<double>::infinity();
-}
 }  // namespace
 
 InputGenerator::InputGenerator(Eigen::MatrixXd A, Eigen::VectorXd c, Eigen::VectorXd x0)
@@ -105,7 +100,7 @@ ModalParameters modal_parameters(const StateSpace& sys, const Eigen::VectorXd& s
   r.psi.resize(n, n);
   const Eigen::RowVectorXd c = sys.C().row(0);
   for (int i = 0; i < n; ++i) r.psi.row(i) = c * Eigen::MatrixXd(-sys.A() * shifts(i)).exp();
-  r.condition = condition_2(r.psi);
+  r.condition = internal::condition_number(r.psi);
   CTID_REQUIRE(r.condition < 1e13, "modal_parameters: psi is singular (condition {}): the model is unobservable or the "
                "shifts make two modes indistinguishable; move the shifts", r.condition);
   const Eigen::PartialPivLU<Eigen::MatrixXd> lu(r.psi.transpose());
@@ -143,7 +138,7 @@ ShiftChoice choose_modal_shifts(const TransferFunction& prior, double Ts, double
     Eigen::RowVectorXd row = cr;
     for (int i = 0; i < n; ++i) psi.row(i) = row = row * E;
     c.spacings(k - 1) = d;
-    c.conditions(k - 1) = condition_2(psi);
+    c.conditions(k - 1) = internal::condition_number(psi);
     if (std::isfinite(c.conditions(k - 1)) && (best < 0 || c.conditions(k - 1) < c.conditions(best))) best = k - 1;
   }
   CTID_REQUIRE(best >= 0, "choose_modal_shifts: psi is singular for every spacing up to {} s", max_shift / n);
