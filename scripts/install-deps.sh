@@ -8,7 +8,8 @@ packages=(
   build-essential cmake pkg-config
   libeigen3-dev nlohmann-json3-dev libcli11-dev libmatio-dev libsundials-dev libomp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-pandas
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-pandas python3-scipy
+  python3-dask python3-distributed
   python3-pip python3-setuptools python3-wheel python3-venv
   clang libclang-rt-14-dev
   chromium

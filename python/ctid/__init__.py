@@ -718,3 +718,5 @@ def _document_options():
 
 
 _document_options()
+
+from . import batch  # noqa: E402,F401  (ctid.batch.fit_many; imports Dask only when called)

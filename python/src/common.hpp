@@ -141,5 +141,6 @@ void bind_nonlinear(py::module_& m);
 void bind_modal(py::module_& m);
 void bind_physical(py::module_& m);
 void bind_models(py::module_& m);
+void bind_pickle(py::module_& m);
 
 }  // namespace ctid::python

@@ -28,4 +28,5 @@ PYBIND11_MODULE(_ctid, m) {
   ctid::python::bind_modal(m);
   ctid::python::bind_physical(m);
   ctid::python::bind_models(m);
+  ctid::python::bind_pickle(m);  // last: pickling of the classes above
 }

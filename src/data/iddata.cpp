@@ -65,6 +65,14 @@ IdData IdData::from_times(Eigen::MatrixXd u, Eigen::MatrixXd y, Eigen::VectorXd 
   return IdData(std::move(u), std::move(y), std::move(t));
 }
 
+void IdData::set_uniform_time_deviation(double deviation) {
+  CTID_REQUIRE(uniform_, "IdData: irregular data have no uniform time deviation");
+  CTID_REQUIRE(deviation >= 0 && deviation <= kUniformTimeTolerance,
+               "IdData: the uniform time deviation must be in [0, {}] sampling periods (got {})", kUniformTimeTolerance,
+               deviation);
+  uniform_deviation_ = deviation;
+}
+
 void IdData::check_and_init() {
   CTID_REQUIRE(y_.cols() >= 1, "IdData: at least one output channel is needed (y has {} columns)", y_.cols());
   CTID_REQUIRE(y_.rows() >= 1, "IdData: at least one sample is needed (y has {} rows)", y_.rows());

@@ -154,7 +154,9 @@ void write_model_json(const std::string& path, const LinearModel& m) {
 
 namespace {
 json fsf_json(const FsfModel& f) {
-  return {{"type", "fsf"}, {"delta", f.delta()}, {"N", f.N()}, {"n", f.n()}, {"shift", f.shift()}, {"theta", vec(f.theta())}};
+  json j = {{"type", "fsf"}, {"delta", f.delta()}, {"N", f.N()}, {"n", f.n()}, {"shift", f.shift()}, {"theta", vec(f.theta())}};
+  if (f.covariance().size() > 0) j["covariance"] = mat(f.covariance());
+  return j;
 }
 
 template <class Terms>
@@ -164,8 +166,8 @@ json terms_json(const Terms& terms, const Eigen::VectorXd& c) {
   return t;
 }
 json narx_json(const NarxModel& m) { return {{"type", "narx"}, {"ts", m.ts()}, {"terms", terms_json(m.terms(), m.coefficients())}}; }
-json nde_json(const NdeModel& m0) {
-  const NdeModel m = m0.coefficient("y") != 0.0 ? m0.normalized() : m0;
+json nde_json(const NdeModel& m0, bool exact) {
+  const NdeModel m = !exact && m0.coefficient("y") != 0.0 ? m0.normalized() : m0;
   return {{"type", "nde"}, {"terms", terms_json(m.terms(), m.coefficients())}};
 }
 
@@ -362,10 +364,10 @@ GreyboxModel read_greybox_json(const std::string& path) { return parse_greybox_j
 std::string greybox_to_json(const GreyboxModel& model, int indent) { return greybox_json(model).dump(indent); }
 
 namespace {
-json any_model_json(const AnyModel& m) {
+json any_model_json(const AnyModel& m, bool exact = false) {
   if (const auto* f = std::get_if<FsfModel>(&m)) return fsf_json(*f);
   if (const auto* n = std::get_if<NarxModel>(&m)) return narx_json(*n);
-  if (const auto* e = std::get_if<NdeModel>(&m)) return nde_json(*e);
+  if (const auto* e = std::get_if<NdeModel>(&m)) return nde_json(*e, exact);
   if (const auto* g = std::get_if<GreyboxModel>(&m)) return greybox_json(*g);
   if (const auto* t = std::get_if<TransferFunction>(&m)) return model_json(*t);
   if (const auto* i = std::get_if<MisoModel>(&m)) return model_json(*i);
@@ -380,7 +382,8 @@ FsfModel fsf_from(const json& m, const Reader& rd) {
   try {
     return FsfModel(delta.get<double>(), rd.count(rd.member(m, "N", "the model"), "N"),
                     rd.count(rd.member(m, "n", "the model"), "n"), rd.vector(rd.member(m, "theta", "the model"), "theta"),
-                    Eigen::MatrixXd(), shift.get<double>());
+                    m.contains("covariance") ? rd.matrix(m.at("covariance"), "covariance") : Eigen::MatrixXd(),
+                    shift.get<double>());
   } catch (const InvalidArgument& e) {
     rd.fail(std::string("invalid FSF model: ") + e.what());
   }
@@ -403,6 +406,10 @@ AnyModel any_model_from(const json& root, const Reader& rd) {
 }
 }  // namespace
 NdeModel read_nde_json(const std::string& path) { return parse_nde_json(read_text_file(path), path); }
+
+std::string any_model_to_json(const AnyModel& model, bool exact, int indent) {
+  return any_model_json(model, exact).dump(indent);
+}
 
 namespace {
 std::string result_json(const Result<AnyModel>& r, const std::string& method, int indent) {

@@ -382,3 +382,25 @@ TEST(Json, EveryModelTypeRoundTripsThroughOneResultReader) {
                 .find("x.json: model type \"arx\" is not one ctid knows (transfer_function, miso, state_space, fsf"),
             std::string::npos);
 }
+
+// The exact model text Python's pickle uses (issue 18): doubles that have no short decimal form read back bit for
+// bit, an NDE keeps its coefficients (the file form normalises y's to +1), an FSF model its covariance.
+TEST(Json, TheExactModelTextReadsBackBitForBit) {
+  const double awkward[] = {0.1 + 0.2, 1.0 / 3.0, 1e-300, 3.141592653589793, -2.0 / 7.0};
+  const NdeModel nde({NdeTerm::parse("Dy"), NdeTerm::parse("y"), NdeTerm::parse("u")},
+                     Eigen::VectorXd{{awkward[0], 3.0, awkward[1]}});
+  const NdeModel nde_back = std::get<NdeModel>(parse_result_file(any_model_to_json(nde, true)).result.model);
+  EXPECT_EQ(nde_back.coefficients(), nde.coefficients());  // exact equality: every bit
+  EXPECT_EQ(std::get<NdeModel>(parse_result_file(any_model_to_json(nde)).result.model).coefficient("y"), 1.0);
+  const TransferFunction g(Eigen::VectorXd{{awkward[2], awkward[3]}}, Eigen::VectorXd{{1.0, awkward[4], awkward[1]}},
+                           awkward[0]);
+  const auto g_back = std::get<TransferFunction>(parse_result_file(any_model_to_json(g, true, -1)).result.model);
+  EXPECT_EQ(g_back.num().coefficients(), g.num().coefficients());
+  EXPECT_EQ(g_back.den().coefficients(), g.den().coefficients());
+  EXPECT_EQ(g_back.io_delay(), g.io_delay());
+  const Eigen::MatrixXd cov = Eigen::Vector3d(awkward[0], awkward[1], awkward[3]).asDiagonal();
+  const FsfModel fsf(0.1, 20, 3, Eigen::VectorXd{{1.0, awkward[1], -0.1}}, cov);
+  const auto fsf_back = std::get<FsfModel>(parse_result_file(any_model_to_json(fsf, true)).result.model);
+  EXPECT_EQ(fsf_back.covariance(), cov);
+  EXPECT_EQ(fsf_back.theta(), fsf.theta());
+}

@@ -45,6 +45,9 @@ class IdData {
   /// Largest distance, in units of Ts, of a time given to from_times from the uniform grid the data were read as
   /// (0 for data built uniform or kept irregular). The CLI notes a value above 1e-9.
   double uniform_time_deviation() const { return uniform_deviation_; }
+  /// Restores uniform_time_deviation() on a record rebuilt from its ts() and t0() (Python's pickle). Throws
+  /// InvalidArgument for irregular data or a value outside [0, kUniformTimeTolerance].
+  void set_uniform_time_deviation(double deviation);
   /// from_times's threshold: times within 1e-3 Ts of a uniform grid are uniform samples (e.g. a dSPACE log's
   /// relative clock jitter of 2.4e-5 Ts); the model error of that time shift is of order 1e-3 of one sample's change.
   static constexpr double kUniformTimeTolerance = 1e-3;

@@ -59,7 +59,7 @@ std::string table_to_json(const std::string& type, const std::vector<std::pair<s
                           const std::vector<std::string>& names, const Eigen::MatrixXd& values, int indent = 2);
 /// Any result ctid writes, or a bare model object: Result<AnyModel> in the envelope above, model "type"
 /// one of model_type_name()'s — the one writer and reader of result files. Model forms besides the linear ones:
-/// FSF {"type": "fsf", "delta", "N", "n", "shift", "theta": [...]} (real parameterisation); NARX/NARMAX
+/// FSF {"type": "fsf", "delta", "N", "n", "shift", "theta": [...], "covariance": [[...]] when known} (real parameterisation); NARX/NARMAX
 /// {"type": "narx", "ts": s, "terms": [{"name": "y(k-1)*u(k-2)", "value": c}, ...]}; NDE {"type": "nde", "terms":
 /// [{"name": "D^2y", "value": 1e-4}, ...]}, written normalised so that the coefficient of y is +1 when the model
 /// has a y term (DESIGN.md §8); grey-box models as parse_greybox_json reads them. write_result_json writes atomically (temporary file, then rename); throws FileError.
@@ -74,6 +74,11 @@ template <class M>
 void write_result_json(const std::string& path, const Result<M>& result, const std::string& method) {
   write_result_json(path, to_any(result), method);
 }
+/// A bare model of any type as result_to_json writes its "model" member (read back by parse_result_file). exact:
+/// every coefficient as it is — an NDE is otherwise normalised so that y's coefficient is +1 — so that the text reads
+/// back to the same model bit for bit (finite doubles are written with the shortest digits that round-trip; Python's
+/// pickle and copy use this form).
+std::string any_model_to_json(const AnyModel& model, bool exact = false, int indent = 2);
 /// A file read back: the result (a bare model gets its term coefficients as parameters, without
 /// uncertainty, and no fit), the method that wrote it ("" for a bare model) and whether it was bare.
 struct ResultFile {
