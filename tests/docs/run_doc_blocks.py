@@ -3,7 +3,7 @@
 
 Each ```sh block runs with bash -e -o pipefail in a scratch folder per Markdown file (the blocks of one file in
 order, so a later block may use what an earlier one wrote), where `ctid` is the built command-line tool on PATH,
-`build/ctid` is the same tool (the README's spelling), `examples/` is the source tree's, and `../shared` is the
+`build/ctid` is the same tool (the README's spelling) and `build/python` the Python package beside it, `examples/` is the source tree's, and `../shared` is the
 shared data folder when it exists (a block that names ../shared is skipped, saying so, when it does not).
 A block preceded by the line `<!-- doc-test: skip: REASON -->` is not run; REASON is printed and must not be empty.
 Every command must exit 0. Usage: run_doc_blocks.py SOURCE_DIR CTID_BINARY [SHARED_DIR] [--only FILE.md ...]
@@ -66,6 +66,8 @@ def main(argv):
             work = root / str(rel).replace("/", "_").replace(".md", "")
             (work / "build").mkdir(parents=True)
             (work / "build" / "ctid").symlink_to(ctid)
+            if (ctid.parent / "python").is_dir():  # the Python package beside the tool: PYTHONPATH=build/python
+                (work / "build" / "python").symlink_to(ctid.parent / "python")
             (work / "examples").symlink_to(src / "examples")
             for line, text, reason in blocks(md):
                 where = f"{rel}:{line}"
