@@ -151,13 +151,21 @@ void bind_pickle(py::module_& m) {
             return f;
           }));
 
+  // Each model type with its result type.
   pickle_model<TransferFunction>(m, "TransferFunction");
+  pickle_result<TransferFunction>(m, "TransferFunctionResult");
   pickle_model<MisoModel>(m, "MisoModel");
+  pickle_result<MisoModel>(m, "MisoResult");
   pickle_model<StateSpace>(m, "StateSpace");
+  pickle_result<StateSpace>(m, "StateSpaceResult");
   pickle_model<FsfModel>(m, "FsfModel");
+  pickle_result<FsfModel>(m, "FsfResult");
   pickle_model<NarxModel>(m, "NarxModel");
+  pickle_result<NarxModel>(m, "NarxResult");
   pickle_model<NdeModel>(m, "NdeModel");
+  pickle_result<NdeModel>(m, "NdeResult");
   pickle_model<GreyboxModel>(m, "GreyboxModel");
+  pickle_result<GreyboxModel>(m, "GreyboxResult");
   declared<ModalModel>(m, "ModalModel")
       .def(py::pickle([](const ModalModel& x) { return py::make_tuple(x.shifts(), x.P(), x.Q()); },
                       [](const py::tuple& t) {
@@ -165,14 +173,6 @@ void bind_pickle(py::module_& m) {
                         return ModalModel(t[0].cast<Eigen::VectorXd>(), t[1].cast<Eigen::MatrixXd>(),
                                           t[2].cast<Eigen::MatrixXd>());
                       }));
-
-  pickle_result<TransferFunction>(m, "TransferFunctionResult");
-  pickle_result<MisoModel>(m, "MisoResult");
-  pickle_result<StateSpace>(m, "StateSpaceResult");
-  pickle_result<FsfModel>(m, "FsfResult");
-  pickle_result<NarxModel>(m, "NarxResult");
-  pickle_result<NdeModel>(m, "NdeResult");
-  pickle_result<GreyboxModel>(m, "GreyboxResult");
   pickle_result<ModalModel>(m, "ModalResult");
 }
 
