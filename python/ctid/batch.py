@@ -1,11 +1,10 @@
-"""ctid.batch — one identification method over many records, on Dask (issue 18).
+"""ctid.batch — one identification method over many records, on threads or a Dask cluster (issue 18).
 
 ``fit_many(records, method="srivc", client=None, **options)`` fits every record with the single-record function
 ``ctid.<method>`` and the same keyword arguments (``fit_many(paths, method="srivc", nb=1, nf=1)`` is
-``ctid.srivc(data, nb=1, nf=1)`` per record) and returns a pandas DataFrame, one row per record. It runs on a
-``dask.distributed`` client: the one given (a cluster of several machines unchanged), or with ``client=None`` a
-local in-process cluster of threads (the fits release the GIL, so threads use every core without copying the
-records). A record that cannot be read or fitted, or whose fit is not usable, is a row with its error; a task lost
+``ctid.srivc(data, nb=1, nf=1)`` per record) and returns a pandas DataFrame, one row per record. It runs on the
+``dask.distributed`` client given (a cluster of several machines unchanged), or with ``client=None`` on a pool of
+threads in this process (the fits release the GIL, so threads use every core without copying the records). A record that cannot be read or fitted, or whose fit is not usable, is a row with its error; a task lost
 with its worker is run again by Dask (``retries``) and every record gives exactly one row. With ``out=`` the rows
 are also written to a CSV or JSON-lines file as they arrive, so that ``resume=True`` continues an interrupted batch
 with only the records not yet written.
@@ -17,16 +16,12 @@ import os as _os
 import sys as _sys
 import time as _time
 
-import numpy as _np
-
 #: The columns every row has, in this order; then, per parameter NAME of the model, NAME and NAME_std.
 COLUMNS = ["id", "method", "model", "orders", "fit_percent", "termination", "usable", "seconds", "error"]
-#: Settings of fit_many that read a record from a file: ctid.load's arguments (column names or 1-based numbers).
-FILE_OPTIONS = ("inputs", "outputs", "time", "ts", "intersample")
 
 
 def _orders(model):
-    """The structure of a fitted model in the estimators' terms (nb, nf, delay; nx; terms)."""
+    """The structure of a fitted linear model in the estimators' terms (nb, nf, delay; nx); '' for the others."""
     import ctid
     if isinstance(model, ctid.TransferFunction):
         s = f"nb={len(model.num)} nf={len(model.den) - 1}"
@@ -171,13 +166,13 @@ def _show(done, total, errors, final=False):
 def fit_many(records, method="srivc", client=None, *, out=None, resume=False, progress=True, retries=2, jobs=None,
              chunk=None,
              inputs=None, outputs=None, time=None, ts=None, intersample=None, **options):
-    """Fit every record with ``ctid.<method>(record, **options)`` on Dask; a pandas DataFrame, one row per record.
+    """Fit every record with ``ctid.<method>(record, **options)``; a pandas DataFrame, one row per record.
 
     records: file paths (read by ctid.load with inputs=, outputs= and time=/ts=/intersample=), IdData objects (id =
     position) or (id, IdData) pairs. method: the name of a single-record estimator of ctid ("srivc", "srivc_auto",
     "oe", "tfest", "ssest", "fsf", "greybox", ...); options: its keyword arguments, as for one record.
     client: a dask.distributed.Client (its cluster runs the fits: records and options are sent to the workers, the
-    library is not); None: a local cluster of ``jobs`` threads (default: every core) in this process.
+    library is not); None: a pool of ``jobs`` threads (default: every core) in this process.
     out: a .csv or .jsonl file the rows are written to as they arrive; resume=True continues a batch that stopped
     (the records whose id is in `out` are not fitted again; without resume an existing file is an error, never
     overwritten). progress: True prints a line on stderr, a callable gets (done, total) after each row.
@@ -201,9 +196,8 @@ def fit_many(records, method="srivc", client=None, *, out=None, resume=False, pr
     file_options = {k: v for k, v in dict(inputs=inputs, outputs=outputs, time=time, ts=ts,
                                           intersample=intersample).items() if v is not None}
     writer = _Writer(out, resume) if out is not None else None
-    have = {str(r["id"]) for r in writer.rows} if writer else set()
-    todo = [(rid, rec) for rid, rec in pairs if rid not in have]
-    rows = {str(r["id"]): r for r in writer.rows} if writer else {}
+    rows = {str(r["id"]): r for r in writer.rows} if writer else {}  # those of an earlier run (resume)
+    todo = [(rid, rec) for rid, rec in pairs if rid not in rows]
 
     errors = sum(1 for r in rows.values() if r.get("error"))
     # The local default is a pool of threads in this process (the standard library's executor: the fits release

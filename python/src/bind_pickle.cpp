@@ -50,7 +50,6 @@ void pickle_result(py::module_& m, const char* name) {
       }));
 }
 
-
 }  // namespace
 
 void bind_pickle(py::module_& m) {

@@ -20,9 +20,7 @@ double scaled_condition(const Eigen::MatrixXd& M) {
     const double nj = S.col(j).norm();
     if (nj > 0) S.col(j) /= nj;
   }
-  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(S).singularValues();
-  const double smin = sv(sv.size() - 1);
-  return smin > 0 ? sv(0) / smin : std::numeric_limits<double>::infinity();
+  return condition_number(S);
 }
 
 double condition_number(const Eigen::MatrixXd& M) {
