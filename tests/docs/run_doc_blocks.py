@@ -81,6 +81,11 @@ def main(argv):
                     print(f"skip {where}: needs ../shared (not present)")
                     skipped += 1
                     continue
+                if "build/python" in text and not (ctid.parent / "python").is_dir():
+                    print(f"skip {where}: needs the Python package, not built beside {ctid} (the sanitizer "
+                          "build has none; the Release build runs this block)")
+                    skipped += 1
+                    continue
                 t0 = time.monotonic()
                 p = subprocess.run(["bash", "-e", "-o", "pipefail", "-c", text], cwd=work, env=env,
                                    capture_output=True, text=True, timeout=600)
