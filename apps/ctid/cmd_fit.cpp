@@ -129,6 +129,11 @@ void print_validation(const AnyModel& m, const std::pair<std::string, IdData>& v
 template <class M>
 int finish(const Result<M>& r, const std::string& method, const IdData& d, const FitArgs& a, const Settings& settings,
            std::vector<std::pair<std::string, IdData>> more_records = {}) {
+  if (BatchOutcome* b = batch_outcome()) {  // ctid batch: the row is written by the batch
+    b->result = to_any(r);
+    b->method = method;
+    return r.usable() ? kOk : kNotUsable;
+  }
   print_result(r, method, d);
   warn_offsets(a, d);
   if (a.validation) {
@@ -186,7 +191,8 @@ int run_srivc_auto(const FitArgs& a, const IdData& d) {
   const TransferFunction& m = r.model;
   char delay[64] = "";
   if (m.io_delay() > 0) std::snprintf(delay, sizeof delay, " and an input delay of %.3g s", m.io_delay());
-  std::printf("srivc-auto chose SRIVC with nb = %d, nf = %d%s: the least BIC of %d structures (nf = 1..%d, nb = 1..nf%s)\n",
+  if (!batch_outcome())
+    std::printf("srivc-auto chose SRIVC with nb = %d, nf = %d%s: the least BIC of %d structures (nf = 1..%d, nb = 1..nf%s)\n",
               m.num().degree() + 1, m.den().degree(), delay, static_cast<int>(nb.size()), o.nf_max,
               o.try_delay ? ", each with and without a delay" : "");
   return finish(r, "srivc_auto", d, a, settings_of(o));
@@ -467,15 +473,16 @@ int run_miso(const FitArgs& a, const std::vector<IdData>& ds) {
     SrivcAutoOptions o;
     apply_sets("srivc_auto", a.sets, o);
     const Result<MisoModel> r = call_library([&] { return srivc_auto_miso(ds.front(), o); });
-    std::printf("srivc-auto chose, per input:");
-    for (int i = 0; i < nu; ++i) {
+    if (!batch_outcome()) std::printf("srivc-auto chose, per input:");
+    for (int i = 0; i < nu && !batch_outcome(); ++i) {
       const TransferFunction& g = r.model.channels[static_cast<size_t>(i)];
       char delay[48] = "";
       if (g.io_delay() > 0) std::snprintf(delay, sizeof delay, ", delay %.3g s", g.io_delay());
       std::printf("%s %s nb = %d, nf = %d%s", i ? ";" : "", channel_name(ds.front().input_names(), i).c_str(),
                   g.num().degree() + 1, g.den().degree(), delay);
     }
-    std::printf(" (each input alone, then each channel on the output less the others; the least BIC)\n");
+    if (!batch_outcome())
+      std::printf(" (each input alone, then each channel on the output less the others; the least BIC)\n");
     return finish(r, "srivc_auto", ds.front(), a, settings_of(o));
   }
   auto per_input = [&](const std::vector<int>& v, const char* flag, int i) {
@@ -811,6 +818,41 @@ void setup_fit(CLI::App& app) {
   app.callback([a, &app] {
     resolve_fit_args(*a, app);
     g_run = [a] { return run(*a); };
+  });
+}
+
+void setup_batch(CLI::App& app) {
+  auto a = add_fit_options(app);
+  auto job = std::make_shared<BatchJob>();
+  app.get_option("DATA")->description(
+      "Records: files or glob patterns (a quoted pattern is expanded by ctid, for more files than a command line "
+      "holds); each record is fitted alone, with the options below, and is one row of --out");
+  app.add_option("--out", job->out,
+                 "Rows file, .csv or .jsonl: one row per record (id, method, model, orders, fit_percent, termination, "
+                 "usable, seconds, error, then NAME and NAME_std per parameter: the columns of Python's "
+                 "ctid.batch.fit_many), written as the fits finish")
+      ->required();
+  app.add_option("--jobs", job->jobs, "Threads fitting records at once (default: one per core)")->check(CLI::Range(1, 4096));
+  app.add_flag("--resume", job->resume, "Continue an interrupted batch: fit only the records whose id is not in --out");
+  app.callback([a, job, &app] {
+    resolve_fit_args(*a, app);
+    job->patterns = a->paths;
+    job->method = a->method;
+    job->force = a->force;
+    g_run = [a, job] {
+      for (const char* f : {"json", "report", "validate", "validate-samples", "responses", "frequency", "period"})
+        if (a->given.count(f))
+          throw UsageError("--" + std::string(f) + " is an option of ctid fit on one record, not of ctid batch (one "
+                           "row per record in --out)");
+      reject_flags_that_do_not_apply(*a);  // once, before any record
+      job->fit_one = [a](const std::string& path) {
+        FitArgs b = *a;
+        b.paths = {path};
+        b.data.path = path;
+        return run(std::move(b));
+      };
+      return run_batch(*job);
+    };
   });
 }
 

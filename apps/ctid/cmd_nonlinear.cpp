@@ -13,6 +13,7 @@ extern std::function<int()> g_run;
 
 namespace {
 void print_narx(const Result<NarxModel>& r) {
+  if (batch_outcome()) return;
   std::printf("selected terms (in order of selection) with their error reduction ratio:\n");
   const Eigen::VectorXd& err = r.diagnostics.get(diagnostic::err);
   for (int i = 0; i < r.parameters.size(); ++i)
@@ -27,7 +28,8 @@ void print_narx(const Result<NarxModel>& r) {
 Result<NarxModel> run_narx(const std::vector<IdData>& ds, const NarxOptions& o) {
   try {
     o.validate();
-    std::printf("candidates: %zu (degree %d, ylag %d, ulag %d)\n",
+    if (!batch_outcome())
+      std::printf("candidates: %zu (degree %d, ylag %d, ulag %d)\n",
                 narx_candidates(o.degree, o.ylag, o.ulag, o.constant, o.umin).size(), o.degree, o.ylag, o.ulag);
     return narx(ds, o);
   } catch (const InvalidArgument& e) {
@@ -44,6 +46,11 @@ int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, co
   if (method == "narx") {
     apply_sets("narx", set_list, no);
     const Result<NarxModel> r = run_narx(ds, no);
+    if (BatchOutcome* b = batch_outcome()) {
+      b->result = to_any(r);
+      b->method = "narx";
+      return r.usable() ? kOk : kNotUsable;
+    }
     print_narx(r);
     if (!json.empty()) {
       write_result_json(json, r, "narx");
@@ -73,6 +80,11 @@ int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, co
     run = kia(ds, narx, ko);
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
+  }
+  if (BatchOutcome* b = batch_outcome()) {
+    b->result = to_any(run.result());
+    b->method = ko.refine ? "kia+oe" : "kia";
+    return run.result().usable() ? kOk : kNotUsable;
   }
   const Result<NdeModel>& k = run.reconstructed;
   for (const auto& c : k.diagnostics.choices) std::printf("chosen: %s\n", c.c_str());

@@ -91,7 +91,8 @@ IdData DataArgs::load(bool need_output, TrendInfo* removed_trend, std::pair<int,
       }
       if (time_col.empty())
         throw UsageError("give the time axis: --time COLUMN or --ts SECONDS (no column is named t or time)");
-      std::fprintf(stderr, "note: column '%s' is the time axis (no --time or --ts given)\n", time_col.c_str());
+      if (!batch_outcome())
+        std::fprintf(stderr, "note: column '%s' is the time axis (no --time or --ts given)\n", time_col.c_str());
     }
     spec.time = time_col;
     if (inputs.empty() || (need_output && outputs.empty())) {
@@ -132,11 +133,11 @@ IdData DataArgs::load(bool need_output, TrendInfo* removed_trend, std::pair<int,
       used = {begin + 1, end};
     }
     if (rows) *rows = used;
-    if (d.uniform_time_deviation() > 1e-9)
+    if (d.uniform_time_deviation() > 1e-9 && !batch_outcome())
       std::fprintf(stderr, "note: %s: the sample times are within %.2g Ts of a uniform grid (threshold %g Ts): read as "
                    "uniform, Ts = %.10g s\n", path.c_str(), d.uniform_time_deviation(), IdData::kUniformTimeTolerance,
                    d.ts());
-    const bool first = g_preprocessing.empty();
+    const bool first = g_preprocessing.empty() && !batch_outcome();  // (batch threads: no report, no shared text)
     if (first)
       g_preprocessing = path + ": " +
                         (samples.empty() ? "all " + std::to_string(n_rows) + " rows"
@@ -161,7 +162,7 @@ IdData DataArgs::load(bool need_output, TrendInfo* removed_trend, std::pair<int,
                              channel_name(in ? d.input_names() : d.output_names(), k), value);
     }
     if (first) g_preprocessing += detail::format("; {} removed ({})", detrend == "mean" ? "means" : "linear trends", what);
-    if (announce_means && detrend == "mean")
+    if (announce_means && detrend == "mean" && !batch_outcome())
       std::fprintf(stderr, "note: the means were removed (%s); --detrend none keeps them\n", what.c_str());
     return out;
   } catch (const FileError& e) {

@@ -1,7 +1,9 @@
 // ctid command line — shared pieces: exit codes, data loading options, output files.
 #pragma once
 
+#include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -223,5 +225,27 @@ void setup_demo(CLI::App& app);
 void setup_example_data(CLI::App& app);
 void setup_order(CLI::App& app);
 void setup_report(CLI::App& app);
+
+/// ctid batch fits records on worker threads. While a fit runs there, batch_outcome() points at its slot: the
+/// fit's result goes into it and nothing is printed (the commands test it before printing); elsewhere it is null.
+struct BatchOutcome {
+  std::optional<Result<AnyModel>> result;
+  std::string method;
+};
+BatchOutcome*& batch_outcome();
+
+/// One ctid batch run (cmd_batch.cpp): the records matched by `patterns`, each fitted by `fit_one` (ctid fit's
+/// options, one record; it fills batch_outcome() or throws), on `jobs` threads; one row per record written to `out`
+/// (.csv or .jsonl, the columns of Python's ctid.batch.fit_many) as it arrives. `resume` fits only the records whose
+/// id is not yet in `out`. Exit code: 0 when every record gave a usable fit, 1 otherwise (the rows say why).
+struct BatchJob {
+  std::vector<std::string> patterns;
+  std::string method, out;
+  int jobs = 0;  ///< 0: one per core
+  bool resume = false, force = false;
+  std::function<int(const std::string& path)> fit_one;
+};
+int run_batch(const BatchJob& job);
+void setup_batch(CLI::App& app);
 
 }  // namespace ctid::cli

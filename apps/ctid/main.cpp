@@ -59,6 +59,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("ctid ") + ctid::version());
   app.require_subcommand(1);
   setup_fit(*app.add_subcommand("fit", "Estimate a continuous-time model from input/output data"));
+  setup_batch(*app.add_subcommand("batch", "Fit each of many records with one method (threads); one row per record in a CSV or JSON-lines file"));
   setup_simulate(*app.add_subcommand("simulate", "Simulate a model file on the inputs of a data file"));
   setup_validate(*app.add_subcommand("validate", "Compare a model with measured data (fit, residual tests)"));
   setup_order(*app.add_subcommand("order", "Rank model structures [nb nf nk] by YIC, RT2, AIC or BIC (SRIVC fits)"));
