@@ -8,6 +8,10 @@ threads in this process (the fits release the GIL, so threads use every core wit
 with its worker is run again by Dask (``retries``) and every record gives exactly one row. With ``out=`` the rows
 are also written to a CSV or JSON-lines file as they arrive, so that ``resume=True`` continues an interrupted batch
 with only the records not yet written.
+
+``monte_carlo(model, u, ts, runs=, snr_db=/noise_std=, seed=, methods=, **options)`` runs a Monte Carlo study of
+estimators on the same executors: only the model, the input and the seeds travel, each worker draws its runs' noise
+from their seeds, and the summary gives bias, std and std over the Cramer-Rao bound per method and parameter.
 """
 import csv as _csv
 import json as _json
@@ -111,11 +115,11 @@ class _Writer:
         self.path = _os.fspath(path)
         self.jsonl = self.path.endswith((".jsonl", ".json", ".ndjson"))
         if not self.jsonl and not self.path.endswith(".csv"):
-            raise ValueError(f"fit_many: out must end in .csv or .jsonl (got '{self.path}')")
+            raise ValueError(f"ctid.batch: out must end in .csv or .jsonl (got '{self.path}')")
         self.rows = []
         if _os.path.exists(self.path):
             if not resume:
-                raise FileExistsError(f"fit_many: {self.path} exists; resume=True continues it (only the records "
+                raise FileExistsError(f"ctid.batch: {self.path} exists; resume=True continues it (only the rows "
                                       f"not in it are fitted), or remove it")
             self.rows = self._read()
         self.columns = list(COLUMNS)
@@ -158,9 +162,61 @@ class _Writer:
                 _csv.DictWriter(f, fieldnames=self.columns, restval="").writerow(row)
 
 
-def _show(done, total, errors, final=False):
-    _sys.stderr.write(f"\rfit_many: {done}/{total} records, {errors} with an error" + ("\n" if final else ""))
+def _show(label, done, total, errors, final=False):
+    _sys.stderr.write(f"\r{label}: {done}/{total} done, {errors} with an error" + ("\n" if final else ""))
     _sys.stderr.flush()
+
+
+def _threads(client, jobs):
+    """Threads the work runs on: `jobs` (default every core) locally, the cluster's worker threads on Dask."""
+    if client is None:
+        return jobs or _os.cpu_count() or 1
+    return max(1, sum(client.nthreads().values()))
+
+
+def _chunk_size(n, threads):
+    """Items per task: enough tasks for 8 per thread, at most 32 items each (a Dask task costs about a millisecond
+    of scheduling, as much as a fit of a few thousand samples, while the load should stay balanced)."""
+    return max(1, min(32, -(-n // (8 * threads))))
+
+
+def _execute(func, tasks, client, jobs, retries, rows, writer, progress, done, total, label):
+    """Runs func(*args) for every args of `tasks` (each returns a list of rows) on a thread pool (client None) or
+    the Dask client; every row goes into `rows` (by id), the writer and the progress display as its task ends."""
+    import concurrent.futures as cf
+
+    errors = sum(1 for r in rows.values() if r.get("error"))
+    # The local default is a pool of threads in this process (the standard library's executor: the fits release
+    # the GIL, and nothing is copied); a Dask client gets the same tasks as futures with retries.
+    pool = cf.ThreadPoolExecutor(max_workers=_threads(None, jobs)) if client is None else None
+    try:
+        if pool:
+            futures = [pool.submit(func, *args) for args in tasks]
+            as_completed = cf.as_completed
+        else:
+            from distributed import as_completed
+            stamp = _time.time_ns()
+            futures = [client.submit(func, *args, retries=retries, key=f"ctid-{label}-{stamp}-{i}", pure=False)
+                       for i, args in enumerate(tasks)]
+        last = 0.0
+        for fut in as_completed(futures):
+            task_rows = fut.result()
+            if not pool:
+                fut.release()
+            for row in task_rows:
+                rows[str(row["id"])] = row
+                if writer:
+                    writer.add(row)
+                done += 1
+                errors += bool(row["error"])
+                if callable(progress):
+                    progress(done, total)
+            if progress is True and (_time.monotonic() - last > 0.5 or done == total):
+                last = _time.monotonic()
+                _show(label, done, total, errors, final=done == total)
+    finally:
+        if pool:
+            pool.shutdown(cancel_futures=True)
 
 
 def fit_many(records, method="srivc", client=None, *, out=None, resume=False, progress=True, retries=2, jobs=None,
@@ -185,7 +241,6 @@ def fit_many(records, method="srivc", client=None, *, out=None, resume=False, pr
     order of `records`.
     """
     import pandas as pd
-    import concurrent.futures as cf
     import ctid
 
     if not isinstance(method, str) or not callable(getattr(ctid, method, None)) or method.startswith("_"):
@@ -199,45 +254,156 @@ def fit_many(records, method="srivc", client=None, *, out=None, resume=False, pr
     rows = {str(r["id"]): r for r in writer.rows} if writer else {}  # those of an earlier run (resume)
     todo = [(rid, rec) for rid, rec in pairs if rid not in rows]
 
-    errors = sum(1 for r in rows.values() if r.get("error"))
-    # The local default is a pool of threads in this process (the standard library's executor: the fits release
-    # the GIL, and nothing is copied); a Dask client gets the same tasks as futures with retries.
-    pool = cf.ThreadPoolExecutor(max_workers=jobs or _os.cpu_count() or 1) if client is None else None
-    try:
-        threads = pool._max_workers if pool else max(1, sum(client.nthreads().values()))
-        size = chunk or max(1, min(32, -(-len(todo) // (8 * threads))))
-        chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
-        if pool:
-            futures = [pool.submit(fit_chunk, c, method, options, file_options) for c in chunks]
-            as_completed = cf.as_completed
-        else:
-            from distributed import as_completed
-            stamp = _time.time_ns()
-            futures = [client.submit(fit_chunk, c, method, options, file_options, retries=retries,
-                                     key=f"ctid-fit-{stamp}-{i}", pure=False) for i, c in enumerate(chunks)]
-        done = len(pairs) - len(todo)
-        last = 0.0
-        for fut in as_completed(futures):
-            chunk_rows = fut.result()
-            if not pool:
-                fut.release()
-            for row in chunk_rows:
-                rows[str(row["id"])] = row
-                if writer:
-                    writer.add(row)
-                done += 1
-                errors += bool(row["error"])
-                if callable(progress):
-                    progress(done, len(pairs))
-            if progress is True and (_time.monotonic() - last > 0.5 or done == len(pairs)):
-                last = _time.monotonic()
-                _show(done, len(pairs), errors, final=done == len(pairs))
-    finally:
-        if pool:
-            pool.shutdown(cancel_futures=True)
+    size = chunk or _chunk_size(len(todo), _threads(client, jobs))
+    chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
+    _execute(fit_chunk, [(c, method, options, file_options) for c in chunks], client, jobs, retries, rows, writer,
+             progress, len(pairs) - len(todo), len(pairs), "fit_many")
     frame = pd.DataFrame([rows[rid] for rid, _ in pairs if rid in rows])
     for c in COLUMNS:
         if c not in frame:
             frame[c] = pd.Series(dtype=object)
     rest = [c for c in frame.columns if c not in COLUMNS]
     return frame[COLUMNS + rest].reset_index(drop=True)
+
+
+def _truth(model):
+    """The true parameters of a transfer function in the estimators' names: a1..an (denominator after its leading
+    1), b0.. (numerator, highest power first), delay."""
+    import ctid
+    if not isinstance(model, ctid.TransferFunction):
+        return {}
+    truth = {f"a{i}": float(c) for i, c in enumerate(model.den) if i > 0}
+    truth.update({f"b{j}": float(c) for j, c in enumerate(model.num)})
+    if model.delay:
+        truth["delay"] = float(model.delay)
+    return truth
+
+
+def _experiment(model, u, ts, t, intersample):
+    """The noise-free record of the design: the model simulated exactly from rest on the input."""
+    import numpy as np
+    import ctid
+    u = np.asarray(u, dtype=float)
+    times = np.asarray(t, dtype=float) if t is not None else ctid.time_grid(ts, u.shape[0])
+    x = model.simulate(u, times, intersample)
+    if t is None:
+        return ctid.IdData.from_arrays(u, x, ts=ts, intersample=intersample)
+    return ctid.IdData.from_arrays(u, x, t=times, intersample=intersample)
+
+
+def monte_carlo_chunk(model, u, ts, t, intersample, runs, snr_db, noise_std, method, options):
+    """The rows of some runs of a Monte Carlo (run, seed pairs): the model's noise-free response computed once, the
+    noise of each run drawn from its seed (ctid.add_noise_snr or ctid.white_noise, the same numbers on any machine),
+    the record fitted by ctid.<method>(record, **options)."""
+    import numpy as np
+    import ctid
+    clean = _experiment(model, u, ts, t, intersample)
+    x = np.asarray(clean.y)[:, 0]
+    rows = []
+    for run, seed in runs:
+        t0 = _time.perf_counter()
+        rid = f"{method}/{run}"
+        try:
+            y = ctid.add_noise_snr(x, snr_db, seed) if snr_db is not None else x + ctid.white_noise(x.size, noise_std, seed)
+            if t is None:
+                record = ctid.IdData.from_arrays(clean.u, y, ts=ts, intersample=intersample)
+            else:
+                record = ctid.IdData.from_arrays(clean.u, y, t=clean.t, intersample=intersample)
+            row = _row(rid, method, getattr(ctid, method)(record, **options))
+        except Exception as e:  # noqa: BLE001 -- every failure becomes the row's error
+            row = _row(rid, method, error=f"{type(e).__name__}: {e}", seconds=_time.perf_counter() - t0)
+        row["run"], row["seed"] = run, seed
+        rows.append(row)
+    return rows
+
+
+class MonteCarlo(tuple):
+    """monte_carlo's answer: ``runs`` (one row per method and run: the estimates, their standard deviations, the
+    fit's termination and usability) and ``summary`` (one row per method and parameter)."""
+    __slots__ = ()
+
+    def __new__(cls, runs, summary):
+        return super().__new__(cls, (runs, summary))
+
+    runs = property(lambda self: self[0])
+    summary = property(lambda self: self[1])
+
+
+def monte_carlo(model, u, ts=None, *, t=None, intersample="zoh", runs=100, snr_db=None, noise_std=None, seed=1000,
+                methods="srivc", client=None, jobs=None, retries=2, chunk=None, progress=True, out=None,
+                resume=False, **options):
+    """A Monte Carlo study of estimators on a simulated experiment, on threads or a Dask cluster.
+
+    model: the true system (a ctid model with .simulate, e.g. a TransferFunction). u: the input design (an array,
+    e.g. ctid.prbs(...)), sampled every ts seconds or at the times t; intersample: "zoh" or "foh". Noise: white and
+    Gaussian on the output, snr_db (variance = variance of the noise-free output / 10^(snr_db/10), as
+    ctid.add_noise_snr) or noise_std; run k uses the seed seed + k, so every run is reproduced wherever it ran (the
+    accuracy report's set-ups use seed=1000). methods: an estimator name, a list of names, or a dict name ->
+    options; options (e.g. nb=2, nf=4) go to every method. client/jobs/retries/chunk/progress/out/resume: as
+    fit_many (out holds the runs; resume continues an interrupted study).
+
+    Returns MonteCarlo(runs, summary): `runs` has fit_many's columns plus run and seed; `summary` one row per method
+    and parameter: true, mean, bias, std (over the usable runs), crlb_std (the Cramer-Rao bound, ctid.crlb, for a
+    transfer function fitted with its own orders; NaN otherwise), std_over_crlb, bias_over_std, usable, runs.
+    """
+    import numpy as np
+    import pandas as pd
+    import ctid
+
+    if (snr_db is None) == (noise_std is None):
+        raise ValueError("monte_carlo: give the noise level as snr_db or as noise_std (one of them)")
+    if noise_std is not None and not (np.isfinite(noise_std) and noise_std > 0):
+        raise ValueError(f"monte_carlo: noise_std must be finite and > 0 (got {noise_std!r})")
+    if not (isinstance(runs, int) and runs >= 1):
+        raise ValueError(f"monte_carlo: runs must be a whole number >= 1 (got {runs!r})")
+    if not (isinstance(seed, int) and seed >= 0):
+        raise ValueError(f"monte_carlo: seed must be a whole number >= 0 (got {seed!r})")
+    if (ts is None) == (t is None):
+        raise ValueError("monte_carlo: give the sampling as ts (seconds) or as the sample times t (one of them)")
+    per_method = {methods: {}} if isinstance(methods, str) else \
+        dict(methods) if isinstance(methods, dict) else {m: {} for m in methods}
+    for m in per_method:
+        if not isinstance(m, str) or not callable(getattr(ctid, m, None)) or m.startswith("_"):
+            raise ValueError(f"monte_carlo: '{m}' is not an estimator of ctid (ctid.methods() lists them)")
+    clean = _experiment(model, u, ts, t, intersample)  # checks the design here, before any task is sent
+    x = np.asarray(clean.y)[:, 0]
+    sigma2 = noise_std ** 2 if noise_std is not None else float(np.mean((x - x.mean()) ** 2)) / 10 ** (snr_db / 10)
+
+    writer = _Writer(out, resume) if out is not None else None
+    rows = {str(r["id"]): r for r in writer.rows} if writer else {}
+    threads = _threads(client, jobs)
+    tasks, total = [], 0
+    for m, own in per_method.items():
+        opts = {**options, **own}
+        todo = [(k, seed + k) for k in range(runs) if f"{m}/{k}" not in rows]
+        total += runs
+        size = chunk or _chunk_size(len(todo), threads)
+        tasks += [(model, np.asarray(u, dtype=float), ts, t, intersample, todo[i:i + size], snr_db, noise_std, m, opts)
+                  for i in range(0, len(todo), size)]
+    _execute(monte_carlo_chunk, tasks, client, jobs, retries, rows, writer, progress, len(rows), total,
+             "monte_carlo")
+
+    order = [f"{m}/{k}" for m in per_method for k in range(runs)]
+    frame = pd.DataFrame([rows[i] for i in order if i in rows])
+    rest = [c for c in frame.columns if c not in COLUMNS + ["run", "seed"]]
+    frame = frame[COLUMNS + ["run", "seed"] + rest].reset_index(drop=True)
+
+    truth = _truth(model)
+    summary = []
+    for m, own in per_method.items():
+        sub = frame[(frame["method"] == m) & (frame["usable"].astype(bool))]
+        bound = None
+        names = [c for c in rest if not c.endswith("_std") and c in sub and sub[c].notna().any()]
+        if isinstance(model, ctid.TransferFunction) and names == [n for n in truth if n != "delay"]:
+            bound = np.sqrt(np.diag(ctid.crlb(model, len(model.num), clean, sigma2)))
+        for i, name in enumerate(names):
+            v = sub[name].astype(float).to_numpy()
+            true = truth.get(name, np.nan)
+            mean = float(v.mean()) if v.size else np.nan
+            std = float(v.std(ddof=1)) if v.size > 1 else np.nan
+            crlb_std = float(bound[i]) if bound is not None else np.nan
+            summary.append({"method": m, "parameter": name, "true": true, "mean": mean, "bias": mean - true,
+                            "std": std, "crlb_std": crlb_std, "std_over_crlb": std / crlb_std,
+                            "bias_over_std": abs(mean - true) / std, "usable": int(v.size),
+                            "runs": int((frame["method"] == m).sum())})
+    return MonteCarlo(frame, pd.DataFrame(summary))

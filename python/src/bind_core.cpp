@@ -6,9 +6,29 @@
 namespace ctid::python {
 
 namespace {
-Eigen::VectorXd lsim_tf(const TransferFunction& g, const Eigen::VectorXd& u, const Eigen::VectorXd& t,
-                        const std::string& intersample) {
-  return lsim(g, u, t, intersample_from_string(intersample));
+// TransferFunction.simulate: u and t read in place (float64 arrays are not copied), the output written into a new
+// numpy array or into `out` (a float64 array of len(u), reused by the caller), with the GIL released.
+py::array_t<double> lsim_tf(const TransferFunction& g, const Eigen::Ref<const Eigen::VectorXd>& u,
+                            const Eigen::Ref<const Eigen::VectorXd>& t, const std::string& intersample,
+                            const py::object& out) {
+  using Out = py::array_t<double, py::array::c_style>;
+  const Intersample is = intersample_from_string(intersample);
+  const auto refuse = [&](const std::string& got) {
+    throw InvalidArgument(detail::format("simulate: out must be a writable, contiguous 1-D float64 numpy array of {} "
+                                         "entries (got {})", u.size(), got));
+  };
+  if (!out.is_none() && !py::isinstance<Out>(out)) refuse(py::str(py::type::of(out)).cast<std::string>() +
+                                                          (py::isinstance<py::array>(out) ? " of dtype " +
+                                                           py::str(out.attr("dtype")).cast<std::string>() : ""));
+  Out y = out.is_none() ? Out(u.size()) : py::reinterpret_borrow<Out>(out);
+  if (y.ndim() != 1 || y.shape(0) != u.size() || !y.writeable())
+    refuse(detail::format("{} entries in {} dimension(s){}", y.size(), y.ndim(), y.writeable() ? "" : ", read-only"));
+  Eigen::Map<Eigen::VectorXd> ym(y.mutable_data(), u.size());
+  {
+    py::gil_scoped_release release;
+    lsim_into(g, u, t, is, ym);
+  }
+  return y;
 }
 }  // namespace
 
@@ -151,7 +171,9 @@ void bind_core(py::module_& m) {
       .def("impulse", [](const TransferFunction& g, const Eigen::VectorXd& t) { return impulse_response(g, t); },
            py::arg("t"))
       .def("simulate", &lsim_tf, py::arg("u"), py::arg("t"), py::arg("intersample") = "zoh",
-           "Exact simulation from rest of the input u at the times t.")
+           py::arg("out") = py::none(),
+           "Exact simulation from rest of the input u at the times t (float64 arrays are read in place); out: a "
+           "float64 array of len(u) to write the output into (returned), e.g. reused over many simulations.")
       .def("__call__", &TransferFunction::operator(), py::arg("s"))
       .def("__repr__", [](const TransferFunction& g) { return g.to_string(6); });
   bind_result<TransferFunction>(m, "TransferFunctionResult");

@@ -58,6 +58,10 @@ void bind_linear(py::module_& m) {
         },
         py::arg("data"), py::arg("initial") = std::nullopt, py::arg("options") = SsestOptions{},
         "MIMO continuous-time state space by output error (records: a list of IdData; initial: a starting model).");
+  m.def("crlb", &crlb, py::arg("truth"), py::arg("nb"), py::arg("data"), py::arg("noise_variance"),
+        py::arg("with_delay") = false,
+        "Cramer-Rao bound of a transfer function's [a1..an, b0..b(nb-1)] (and the delay last with with_delay) for "
+        "output-error identification with white output noise of this variance, on the record's input and times.");
   m.def("ssest_crlb", &ssest_crlb, py::arg("truth"), py::arg("data"), py::arg("noise_variance"),
         py::arg("options") = SsestOptions{},
         "Cramer-Rao bound of ssest's parameters and modes at a true model (records at rest, white output noise).");

@@ -459,3 +459,26 @@ def test_innovation_gain_predictor_and_prediction_error_ssest():
     assert abs(r.diagnostics.vectors["output_noise_variance"][0] / sigma ** 2 - 1) < 0.08
     with pytest.raises(ctid.InvalidArgument, match="K must be 2x1"):
         ctid.StateSpace(A, B, C, np.zeros((1, 1)), K=np.ones((2, 2)))
+
+
+def test_simulate_reads_in_place_and_writes_into_out():
+    """TransferFunction.simulate (issue 18): the output equals the library's lsim (through a fresh array or `out`,
+    which is returned and reused: the same numbers bit for bit), and matches SciPy's exact ZOH discretisation of the
+    state space (scipy.signal.cont2discrete + dlsim) to 1e-12 of the output's range; a wrong `out` is named."""
+    import numpy as np
+    import scipy.signal as ss
+    g = ctid.TransferFunction([1.0, 3.0], [1.0, 1.2, 4.0])
+    n = 5000
+    u = np.random.default_rng(4).standard_normal(n)
+    t = ctid.time_grid(0.01, n)
+    y = g.simulate(u, t)
+    out = np.full(n, np.nan)
+    assert g.simulate(u, t, out=out) is out and np.array_equal(out, y)
+    A, B, C, D = ss.tf2ss([1.0, 3.0], [1.0, 1.2, 4.0])
+    Ad, Bd, Cd, Dd, _ = ss.cont2discrete((A, B, C, D), 0.01, method="zoh")
+    _, ys, _ = ss.dlsim((Ad, Bd, Cd, Dd, 0.01), u)
+    assert np.max(np.abs(y - ys[:, 0])) < 1e-12 * np.ptp(y)
+    with pytest.raises(ctid.InvalidArgument, match="float64 numpy array of 5000 entries \\(got 4999 entries"):
+        g.simulate(u, t, out=np.empty(n - 1))
+    with pytest.raises(ctid.InvalidArgument, match="of dtype float32"):
+        g.simulate(u, t, out=np.empty(n, dtype=np.float32))

@@ -59,21 +59,32 @@ double shortest_duration(const Records& ds) {
   return s;
 }
 
+// Buffers of the residual evaluations, kept over the iterations so that none allocates what grows with the records.
+struct OeWorkspace {
+  std::vector<SensitivityWorkspace> sens;  // per record
+  Eigen::VectorXd sim;                     // one record's simulated output
+  Eigen::MatrixXd s, S;                    // one record's sensitivities; all records' stacked
+};
+
 // The output-error residuals y - G u of every record after its transient (each simulated from rest), stacked, and
-// (J != nullptr) their sensitivities to the parameters.
+// (with_sensitivities) their sensitivities to the parameters in ws.S.
 bool stacked_residuals(const TransferFunction& g, const Records& ds, double transient, int nb, bool with_delay,
-                       Eigen::VectorXd& r, Eigen::MatrixXd* S) {
+                       Eigen::VectorXd& r, bool with_sensitivities, OeWorkspace& ws) {
   Eigen::Index total = 0;
   for (const IdData& d : ds) total += d.size() - first_after(d, transient);
-  r.resize(total);
+  if (r.size() != total) r.resize(total);
+  ws.sens.resize(ds.size());
   Eigen::Index at = 0;
-  for (const IdData& d : ds) {
+  for (std::size_t e = 0; e < ds.size(); ++e) {
+    const IdData& d = ds[e];
     const Eigen::Index f = first_after(d, transient), m = d.size() - f;
-    r.segment(at, m) = (d.y().col(0) - lsim(g, d, 0)).tail(m);
-    if (S) {
-      const Eigen::MatrixXd s = output_sensitivities(g, nb, d, with_delay);
-      if (S->rows() != total) S->resize(total, s.cols());
-      S->middleRows(at, m) = s.bottomRows(m);
+    if (ws.sim.size() != d.size()) ws.sim.resize(d.size());
+    lsim_into(g, d, 0, ws.sim);
+    r.segment(at, m) = d.y().col(0).tail(m) - ws.sim.tail(m);
+    if (with_sensitivities) {
+      output_sensitivities_into(g, nb, d, with_delay, ws.sens[e], ws.s);
+      if (ws.S.rows() != total || ws.S.cols() != ws.s.cols()) ws.S.resize(total, ws.s.cols());
+      ws.S.middleRows(at, m) = ws.s.bottomRows(m);
     }
     at += m;
   }
@@ -134,13 +145,14 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
     c(0) = 1.0;
     return Polynomial(c);
   };
+  OeWorkspace ws;
   auto evaluate = [&](const Eigen::VectorXd& x, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
     const TransferFunction g = model_of(x.head(p));
-    Eigen::MatrixXd S;
-    if (!stacked_residuals(g, ds, opt.transient_time, o.nb, opt.estimate_delay, r, J ? &S : nullptr)) return false;
+    if (!stacked_residuals(g, ds, opt.transient_time, o.nb, opt.estimate_delay, r, J != nullptr, ws)) return false;
     if (J) {
-      J->setZero(r.size(), q);
-      for (int j = 0; j < p; ++j) J->col(j) = -S.col(free[j]);
+      if (J->rows() != r.size() || J->cols() != q) J->resize(r.size(), q);
+      if (q > p) J->rightCols(q - p).setZero();
+      for (int j = 0; j < p; ++j) J->col(j) = -ws.S.col(free[j]);
     }
     if (ni == 0) return true;
     const Polynomial& F = g.den();
@@ -223,8 +235,9 @@ TransferFunction starting_model(const TransferFunction& s, const Records& ds, do
   if (s.is_stable()) return s;
   const TransferFunction st = tf_detail::stabilized(s);
   Eigen::VectorXd r_raw, r_stab;
-  const bool raw_ok = stacked_residuals(s, ds, transient, 1, false, r_raw, nullptr);
-  stacked_residuals(st, ds, transient, 1, false, r_stab, nullptr);
+  OeWorkspace ws;
+  const bool raw_ok = stacked_residuals(s, ds, transient, 1, false, r_raw, false, ws);
+  stacked_residuals(st, ds, transient, 1, false, r_stab, false, ws);
   return raw_ok && r_raw.squaredNorm() < r_stab.squaredNorm() ? s : st;
 }
 

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "ctid/core/check.hpp"
 #include "ctid/core/progress.hpp"
@@ -113,6 +114,13 @@ void set_termination(Result<M>& r, bool rank_deficient, bool converged, double t
 
 namespace srivc_detail {
 
+// The filtered signals of one record's IV step, kept from one iteration to the next so that no iteration
+// allocates (or page-faults) buffers that grow with the record.
+struct IvWorkspace {
+  Eigen::MatrixXd yf, xf, tmp;
+  std::vector<Eigen::MatrixXd> uf, uz;  // per input channel
+};
+
 // One record of an IV step (several records: several experiments, each filtered from rest).
 struct IvRecord {
   const Eigen::VectorXd* y;
@@ -120,21 +128,119 @@ struct IvRecord {
   const std::vector<IvChannel>* ch;
   Eigen::Index first = 0;                   // rows before it (the record's transient) are left out
   const ClosedLoopInstruments* cl = nullptr;  // closed loop: instruments from this record's reference
+  IvWorkspace* ws = nullptr;                  // its buffers (null: fresh ones each step)
+  double h = 0;                               // > 0: uniformly sampled at this interval (the streaming pass)
 };
+
+// A filter bank of derivative_recursion with S states (a compile-time size: the per-sample loops unroll).
+template <int S>
+struct Bank {
+  double P[S * S], G0[S], G1[S], C[(2 * S + 1) * S], D[2 * S + 1], x[S] = {}, row[2 * S + 1];
+  int m;
+  explicit Bank(const DerivativeRecursion& r) : m(static_cast<int>(r.C.rows())) {
+    CTID_ASSERT(r.Phi.rows() == S && m <= 2 * S + 1);
+    for (int i = 0; i < S; ++i) {
+      for (int l = 0; l < S; ++l) P[i * S + l] = r.Phi(i, l);
+      G0[i] = r.G0(i);
+      G1[i] = r.G1(i);
+    }
+    for (int j = 0; j < m; ++j) {
+      for (int i = 0; i < S; ++i) C[j * S + i] = r.C(j, i);
+      D[j] = r.D(j);
+    }
+  }
+  const double* at(double v) {
+    for (int j = 0; j < m; ++j) {
+      double acc = D[j] * v;
+      for (int i = 0; i < S; ++i) acc += C[j * S + i] * x[i];
+      row[j] = acc;
+    }
+    return row;
+  }
+  void advance(double v, double v_next) {
+    double xn[S];
+    const double dv = v_next - v;
+    for (int i = 0; i < S; ++i) {
+      double acc = G0[i] * v + G1[i] * dv;
+      for (int l = 0; l < S; ++l) acc += P[i * S + l] * x[l];
+      xn[i] = acc;
+    }
+    for (int i = 0; i < S; ++i) x[i] = xn[i];
+  }
+};
+
+// The rows of an open-loop, single-input, delay-free IV step on uniform samples, made and added sample by sample:
+// the banks 1/A of y (FOH) and of u, and B/A^2 of u (the instruments) advance together, so that the step reads y
+// and u once and writes nothing that grows with the record (the same recursions as filtered_derivatives).
+template <int n>
+void iv_stream_n(internal::InstrumentalVariables& iv, const Polynomial& A, const Eigen::VectorXd& y, const IvChannel& c,
+                 int p, const Eigen::VectorXd& theta, Eigen::Index first, double h) {
+  const TransferFunction F(Polynomial{1.0}, A);
+  const Eigen::VectorXd b = theta.segment(n, c.nb);
+  const bool aux = b.cwiseAbs().maxCoeff() > 0;
+  Bank<n> yb(derivative_recursion(F, n, h, Intersample::Foh)), ub(derivative_recursion(F, c.nb - 1, h, c.intersample));
+  std::optional<Bank<2 * n>> xb;
+  if (aux) xb.emplace(derivative_recursion(TransferFunction(Polynomial(b), A * A), n - 1, h, c.intersample));
+  std::vector<double> phi(p), zeta(p, 0.0);
+  const int m = c.nb - 1;
+  const Eigen::Index N = y.size();
+  for (Eigen::Index k = 0; k < N; ++k) {
+    const double* yr = yb.at(y(k));
+    const double* ur = ub.at(c.u(k));
+    const double* xr = aux ? xb->at(c.u(k)) : nullptr;
+    if (k >= first) {
+      for (int i = 1; i <= n; ++i) {
+        phi[i - 1] = -yr[n - i];
+        zeta[i - 1] = aux ? -xr[n - i] : 0.0;
+      }
+      for (int j = 0; j <= m; ++j) phi[n + j] = zeta[n + j] = ur[m - j];
+      iv.add(zeta.data(), phi.data(), yr[n], 1.0);
+    }
+    if (k + 1 == N) break;
+    yb.advance(y(k), y(k + 1));
+    ub.advance(c.u(k), c.u(k + 1));
+    if (aux) xb->advance(c.u(k), c.u(k + 1));
+  }
+}
+
+// iv_stream_n for the model order n (1..8); false for another order (the caller uses the matrices).
+bool iv_stream(internal::InstrumentalVariables& iv, const Polynomial& A, const Eigen::VectorXd& y, const IvChannel& c,
+               int n, int p, const Eigen::VectorXd& theta, Eigen::Index first, double h) {
+  switch (n) {
+    case 1: iv_stream_n<1>(iv, A, y, c, p, theta, first, h); return true;
+    case 2: iv_stream_n<2>(iv, A, y, c, p, theta, first, h); return true;
+    case 3: iv_stream_n<3>(iv, A, y, c, p, theta, first, h); return true;
+    case 4: iv_stream_n<4>(iv, A, y, c, p, theta, first, h); return true;
+    case 5: iv_stream_n<5>(iv, A, y, c, p, theta, first, h); return true;
+    case 6: iv_stream_n<6>(iv, A, y, c, p, theta, first, h); return true;
+    case 7: iv_stream_n<7>(iv, A, y, c, p, theta, first, h); return true;
+    case 8: iv_stream_n<8>(iv, A, y, c, p, theta, first, h); return true;
+    default: return false;
+  }
+}
 
 // Adds one record's rows of an SRIVC instrumental-variable step to iv (see iv_step).
 void iv_accumulate(internal::InstrumentalVariables& iv, const Polynomial& A, const Eigen::VectorXd& y, const Eigen::VectorXd& t,
                    const std::vector<IvChannel>& ch, int n, int p, const Eigen::VectorXd& theta,
-                   const ClosedLoopInstruments* cl, Eigen::Index first) {
+                   const ClosedLoopInstruments* cl, Eigen::Index first, IvWorkspace& ws, double h) {
   const TransferFunction F(Polynomial{1.0}, A);
-  const Eigen::MatrixXd yf = filtered_derivatives(F, n, y, t, Intersample::Foh);
-  Eigen::MatrixXd xf = Eigen::MatrixXd::Zero(t.size(), n);
-  std::vector<Eigen::MatrixXd> uf, uz;  // regressors and instruments of the input part
+  if (h > 0 && !cl && ch.size() == 1 && ch.front().delay == 0.0 && n >= 1 && n <= 8 &&
+      iv_stream(iv, A, y, ch.front(), n, p, theta, first, h))
+    return;
+  filtered_derivatives_into(F, n, y, t, Intersample::Foh, 0.0, ws.yf);
+  const Eigen::MatrixXd& yf = ws.yf;
+  Eigen::MatrixXd& xf = ws.xf;
+  xf.setZero(t.size(), n);
+  std::vector<Eigen::MatrixXd>& uf = ws.uf;  // regressors and instruments of the input part
+  std::vector<Eigen::MatrixXd>& uz = ws.uz;
+  uf.resize(ch.size());
+  if (cl) uz.resize(ch.size());
   int off = n;
-  for (const auto& c : ch) {
+  for (std::size_t ci = 0; ci < ch.size(); ++ci) {
+    const IvChannel& c = ch[ci];
     const Eigen::VectorXd b = theta.segment(off, c.nb);
     off += c.nb;
-    uf.push_back(filtered_derivatives(F, c.nb - 1, c.u, t, c.intersample, c.delay));
+    filtered_derivatives_into(F, c.nb - 1, c.u, t, c.intersample, c.delay, uf[ci]);
     if (cl) {
       // Noise-free loop: u^ = S r (or C S r), x^ = B/A u^, S = A Dc / (A Dc + B Nc); prefiltered by 1/A.
       const Polynomial& Nc = cl->controller.num();
@@ -143,10 +249,11 @@ void iv_accumulate(internal::InstrumentalVariables& iv, const Polynomial& A, con
       const Polynomial Pcl = stabilized(TransferFunction(Polynomial{1.0}, A * Dc + B * Nc)).den();
       const Polynomial Su = cl->at_plant_input ? A * Dc : A * Nc;  // u^ = Su / Pcl r
       const Polynomial Sx = cl->at_plant_input ? B * Dc : B * Nc;  // x^ = Sx / Pcl r
-      uz.push_back(filtered_derivatives(TransferFunction(Su, Pcl * A), c.nb - 1, cl->r, t, cl->intersample));
-      xf = filtered_derivatives(TransferFunction(Sx, Pcl * A), n - 1, cl->r, t, cl->intersample);
+      filtered_derivatives_into(TransferFunction(Su, Pcl * A), c.nb - 1, cl->r, t, cl->intersample, 0.0, uz[ci]);
+      filtered_derivatives_into(TransferFunction(Sx, Pcl * A), n - 1, cl->r, t, cl->intersample, 0.0, xf);
     } else if (b.cwiseAbs().maxCoeff() > 0) {
-      xf += filtered_derivatives(TransferFunction(Polynomial(b), A * A), n - 1, c.u, t, c.intersample, c.delay);
+      filtered_derivatives_into(TransferFunction(Polynomial(b), A * A), n - 1, c.u, t, c.intersample, c.delay, ws.tmp);
+      xf += ws.tmp;
     }
   }
   std::vector<double> phi(p), zeta(p);
@@ -180,7 +287,10 @@ SrivcRun iv_step(const std::vector<IvRecord>& records, int n, const Eigen::Vecto
   den.tail(n) = theta.head(n);
   const Polynomial A = stabilized(TransferFunction(Polynomial{1.0}, Polynomial(den))).den();
   internal::InstrumentalVariables iv(p, /*with_rss=*/false);
-  for (const auto& rec : records) iv_accumulate(iv, A, *rec.y, *rec.t, *rec.ch, n, p, theta, rec.cl, rec.first);
+  for (const auto& rec : records) {
+    IvWorkspace fresh;
+    iv_accumulate(iv, A, *rec.y, *rec.t, *rec.ch, n, p, theta, rec.cl, rec.first, rec.ws ? *rec.ws : fresh, rec.h);
+  }
   SrivcRun run;
   run.sol = iv.solve();
   run.zz = iv.zz();
@@ -209,8 +319,11 @@ SrivcRun srivc_fixed_delay(const Records& ds, const TfOrders& o, double delay, E
     ys.push_back(d.y().col(0));
     chs.push_back({{d.u().col(0), d.intersample(0), delay, o.nb}});
   }
+  std::vector<srivc_detail::IvWorkspace> ws(ds.size());
   std::vector<srivc_detail::IvRecord> recs;
-  for (std::size_t e = 0; e < ds.size(); ++e) recs.push_back({&ys[e], &ts[e], &chs[e], first_after(ds[e], opt.transient_time)});
+  for (std::size_t e = 0; e < ds.size(); ++e)
+    recs.push_back({&ys[e], &ts[e], &chs[e], first_after(ds[e], opt.transient_time), nullptr, &ws[e],
+                    ds[e].is_uniform() ? ds[e].ts() : 0.0});
   SrivcRun run;
   run.theta = theta;
   for (int it = 1; it <= max_iterations; ++it) {

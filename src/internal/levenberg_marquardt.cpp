@@ -139,8 +139,9 @@ LmResult lm_residuals(const Evaluate& evaluate, Eigen::VectorXd x, const Eigen::
     if (!evaluate(xv, r, A ? &J : nullptr) || !r.allFinite() || (A && !finite(J))) return false;
     cost = 0.5 * r.squaredNorm();
     if (A) {
-      *A = Normal(J.transpose()) * J;
-      *g = J.transpose() * r;
+      if constexpr (std::is_same_v<Jacobian, Sparse>) *A = Normal(J.transpose()) * J;
+      else A->noalias() = J.transpose() * J;  // no transposed copy of J (N x p) per evaluation
+      g->noalias() = J.transpose() * r;
     }
     return true;
   };

@@ -192,8 +192,18 @@ void check_v4(const std::string& path, const std::vector<unsigned char>& b) {
 }
 
 void check_mat_structure(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  std::ifstream f(path, std::ios::binary | std::ios::ate);
+  const std::streamoff size = f.tellg();
+  std::vector<unsigned char> bytes;
+  if (size >= 0) {  // one read of the whole file (byte by byte through a stream iterator was 1 ms per 240 kB)
+    bytes.resize(static_cast<std::size_t>(size));
+    f.seekg(0);
+    f.read(reinterpret_cast<char*>(bytes.data()), size);
+    bytes.resize(static_cast<std::size_t>(f.gcount()));
+  } else {  // not seekable (a pipe): as it comes
+    f.clear();
+    bytes.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+  }
   const bool header = bytes.size() >= 128;
   const bool le = header && bytes[126] == 'I' && bytes[127] == 'M', be = header && bytes[126] == 'M' && bytes[127] == 'I';
   if (!le && !be) return check_v4(path, bytes);

@@ -64,14 +64,14 @@ class DiscretizationCache {
 
 // Sample times: explicit, or t0 + k h without materialising them.
 struct TimeAxis {
-  const Eigen::VectorXd* t = nullptr;
+  const double* t = nullptr;
   double t0 = 0, h = 0;
   Eigen::Index n = 0;
-  double operator()(Eigen::Index k) const { return t ? (*t)(k) : t0 + double(k) * h; }
+  double operator()(Eigen::Index k) const { return t ? t[k] : t0 + double(k) * h; }
   Eigen::Index size() const { return n; }
 };
 
-bool is_uniform(const Eigen::VectorXd& t, double* h) {
+bool is_uniform(const Eigen::Ref<const Eigen::VectorXd>& t, double* h) {
   if (t.size() < 2) { *h = 1.0; return true; }
   *h = (t(t.size() - 1) - t(0)) / double(t.size() - 1);
   for (Eigen::Index k = 1; k < t.size(); ++k)
@@ -243,15 +243,29 @@ void lsim_core(const StateSpace& sys, const Eigen::Ref<const Eigen::MatrixXd>& u
 TimeAxis axis_of(const IdData& d) { return TimeAxis{nullptr, d.t0(), d.ts(), d.size()}; }
 }  // namespace
 
-Eigen::MatrixXd lsim(const StateSpace& sys, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
-                     const std::vector<Intersample>& intersample, const LsimOptions& o) {
+namespace {
+// The checked time axis of explicit sample times (uniform: their common interval in h).
+TimeAxis explicit_axis(const Eigen::Ref<const Eigen::VectorXd>& t, bool* uniform, double* h) {
   for (Eigen::Index k = 1; k < t.size(); ++k)
     CTID_REQUIRE(t(k) > t(k - 1), "lsim: sample times must be strictly increasing (t[{}] = {} after {})", k, t(k), t(k - 1));
+  *uniform = is_uniform(t, h);
+  return TimeAxis{t.data(), 0.0, 0.0, t.size()};
+}
+}  // namespace
+
+void lsim_into(const StateSpace& sys, const Eigen::Ref<const Eigen::MatrixXd>& u, const Eigen::VectorXd& t,
+               const std::vector<Intersample>& intersample, const LsimOptions& o, Eigen::MatrixXd& y) {
+  bool uniform = false;
   double h = 0;
-  const bool uniform = is_uniform(t, &h);
-  const TimeAxis axis{&t, 0.0, 0.0, t.size()};
-  Eigen::MatrixXd y(t.size(), sys.ny());
+  const TimeAxis axis = explicit_axis(t, &uniform, &h);
+  if (y.rows() != t.size() || y.cols() != sys.ny()) y.resize(t.size(), sys.ny());
   lsim_core(sys, u, axis, uniform, h, intersample, o, y);
+}
+
+Eigen::MatrixXd lsim(const StateSpace& sys, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
+                     const std::vector<Intersample>& intersample, const LsimOptions& o) {
+  Eigen::MatrixXd y;
+  lsim_into(sys, u, t, intersample, o, y);
   return y;
 }
 
@@ -296,20 +310,39 @@ Eigen::MatrixXd predict(const StateSpace& sys, const IdData& data, const LsimOpt
   return y;
 }
 
-Eigen::VectorXd lsim(const TransferFunction& tf, const Eigen::VectorXd& u, const Eigen::VectorXd& t, Intersample is) {
+void lsim_into(const TransferFunction& tf, const Eigen::Ref<const Eigen::VectorXd>& u,
+               const Eigen::Ref<const Eigen::VectorXd>& t, Intersample is, Eigen::Ref<Eigen::VectorXd> y) {
+  CTID_REQUIRE(y.size() == u.size(), "lsim: the output has room for {} samples but the input has {}", y.size(), u.size());
+  bool uniform = false;
+  double h = 0;
+  const TimeAxis axis = explicit_axis(t, &uniform, &h);
   LsimOptions o;
   o.input_delay = tf.io_delay();
-  return lsim(tf.to_state_space(), Eigen::MatrixXd(u), t, std::vector<Intersample>{is}, o).col(0);
+  const Eigen::Map<const Eigen::MatrixXd> um(u.data(), u.size(), 1);
+  Eigen::Map<Eigen::MatrixXd> ym(y.data(), y.size(), 1);
+  lsim_core(tf.to_state_space(), um, axis, uniform, h, {is}, o, ym);
+}
+
+Eigen::VectorXd lsim(const TransferFunction& tf, const Eigen::VectorXd& u, const Eigen::VectorXd& t, Intersample is) {
+  Eigen::VectorXd y(u.size());
+  lsim_into(tf, u, t, is, y);
+  return y;
 }
 
 Eigen::VectorXd lsim(const TransferFunction& tf, const IdData& data, int input) {
+  Eigen::VectorXd y(data.size());
+  lsim_into(tf, data, input, y);
+  return y;
+}
+
+void lsim_into(const TransferFunction& tf, const IdData& data, int input, Eigen::Ref<Eigen::VectorXd> y) {
   CTID_REQUIRE(input >= 0 && input < data.nu(), "lsim: input index {} out of range (data has {} inputs)", input, data.nu());
-  if (!data.is_uniform()) return lsim(tf, Eigen::VectorXd(data.u().col(input)), data.times(), data.intersample(input));
+  CTID_REQUIRE(y.size() == data.size(), "lsim: the output has room for {} samples but the record has {}", y.size(), data.size());
+  if (!data.is_uniform()) return lsim_into(tf, data.u().col(input), data.times(), data.intersample(input), y);
   LsimOptions o;
   o.input_delay = tf.io_delay();
-  Eigen::VectorXd y(data.size());
-  lsim_core(tf.to_state_space(), data.u().col(input), axis_of(data), true, data.ts(), {data.intersample(input)}, o, y);
-  return y;
+  Eigen::Map<Eigen::MatrixXd> ym(y.data(), y.size(), 1);
+  lsim_core(tf.to_state_space(), data.u().col(input), axis_of(data), true, data.ts(), {data.intersample(input)}, o, ym);
 }
 
 Eigen::VectorXd lsim(const MisoModel& m, const IdData& data) {

@@ -43,6 +43,11 @@ struct LsimOptions {
 /// intersample behaviour of each input. Throws InvalidArgument for size mismatches.
 Eigen::MatrixXd lsim(const StateSpace& sys, const Eigen::MatrixXd& u, const Eigen::VectorXd& t,
                      const std::vector<Intersample>& intersample, const LsimOptions& options = {});
+/// The same into y, a caller's buffer: resized to N x ny only when its shape differs, so that a workspace reused over
+/// the iterations of a fit is written in place (no allocation, no page faults); u is read in place (any column-major
+/// block or map of N x nu).
+void lsim_into(const StateSpace& sys, const Eigen::Ref<const Eigen::MatrixXd>& u, const Eigen::VectorXd& t,
+               const std::vector<Intersample>& intersample, const LsimOptions& options, Eigen::MatrixXd& y);
 /// Same on an experiment: uses its inputs, times and intersample behaviour.
 Eigen::MatrixXd lsim(const StateSpace& sys, const IdData& data, const LsimOptions& options = {});
 /// One-step-ahead predictions (N x ny) of a model with an innovation gain (issue 16): the innovation form
@@ -53,9 +58,15 @@ Eigen::MatrixXd lsim(const StateSpace& sys, const IdData& data, const LsimOption
 Eigen::MatrixXd predict(const StateSpace& sys, const IdData& data, const LsimOptions& options = {});
 /// Simulate a SISO transfer function (with its delay) driven by input column `input`.
 Eigen::VectorXd lsim(const TransferFunction& tf, const IdData& data, int input = 0);
+/// The same into y (data.size() entries), e.g. a buffer reused over the iterations of a fit.
+void lsim_into(const TransferFunction& tf, const IdData& data, int input, Eigen::Ref<Eigen::VectorXd> y);
 /// Simulate a SISO transfer function on (u, t) with the given intersample behaviour.
 Eigen::VectorXd lsim(const TransferFunction& tf, const Eigen::VectorXd& u, const Eigen::VectorXd& t,
                      Intersample intersample = Intersample::Zoh);
+/// The same into y (u.size() entries, e.g. a numpy array's memory), u and t read in place; nothing is allocated
+/// that grows with the record.
+void lsim_into(const TransferFunction& tf, const Eigen::Ref<const Eigen::VectorXd>& u,
+               const Eigen::Ref<const Eigen::VectorXd>& t, Intersample intersample, Eigen::Ref<Eigen::VectorXd> y);
 
 /// Simulate a MISO model: the sum of its channels, channel i driven by input column i.
 /// Throws InvalidArgument when the data do not have one input per channel.

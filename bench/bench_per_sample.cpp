@@ -1,0 +1,98 @@
+// Time and memory per sample of SRIVC, OE, FROLS and lsim from N = 1e4 to 1e7 (issue 18, "one core"): the time per
+// sample should not grow with N (no allocation whose page faults grow with the record, no temporaries that fall out
+// of cache); the peak memory of one fit above the record itself, in bytes per sample, shows the O(N) constant.
+// Run: build/bench/bench_per_sample [N_MAX=10000000]
+//
+// Problems: SRIVC and OE fit the Rao-Garnier system (-6400 s + 1600)/(s^4 + 5 s^3 + 408 s^2 + 416 s + 1600) (nb = 2,
+// nf = 4) to a PRBS response at Ts = 10 ms with 10 dB output noise; lsim simulates it (ZOH); FROLS selects 5 terms
+// of the 15 degree-2 candidates of lags 1..2 (constant included) for a NARX record of the same length. Each fit is
+// repeated until 2 s have passed (at least twice); the least time is kept. "minor faults" are the page faults of one
+// fit (getrusage), "peak" the process's resident high-water mark during one fit (reset through
+// /proc/self/clear_refs before it) less the resident size before it.
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <string>
+
+#include "ctid/ctid.hpp"
+
+namespace {
+const ctid::TransferFunction kRao(Eigen::VectorXd{{-6400.0, 1600.0}}, Eigen::VectorXd{{1.0, 5.0, 408.0, 416.0, 1600.0}});
+
+long status_kb(const char* key) {
+  std::ifstream f("/proc/self/status");
+  for (std::string line; std::getline(f, line);)
+    if (line.rfind(key, 0) == 0) return std::atol(line.c_str() + std::string(key).size() + 1);
+  return -1;
+}
+
+struct Measure {
+  double seconds, faults, peak_mb;
+  int iterations;
+};
+
+Measure measure(const std::function<int()>& fit) {
+  double best = 1e300, faults = 0, peak = 0;
+  int iterations = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (int rep = 0; rep < 2 || std::chrono::steady_clock::now() - start < std::chrono::seconds(2); ++rep) {
+    std::ofstream("/proc/self/clear_refs") << "5";  // VmHWM := VmRSS
+    const long rss0 = status_kb("VmRSS:");
+    rusage r0{}, r1{};
+    getrusage(RUSAGE_SELF, &r0);
+    const auto t0 = std::chrono::steady_clock::now();
+    const int it = fit();
+    const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    getrusage(RUSAGE_SELF, &r1);
+    if (dt < best) {
+      best = dt;
+      faults = static_cast<double>(r1.ru_minflt - r0.ru_minflt);
+      peak = (status_kb("VmHWM:") - rss0) / 1024.0;
+      iterations = it;
+    }
+  }
+  return {best, faults, peak, iterations};
+}
+
+ctid::IdData narx_record(int N) {
+  const Eigen::VectorXd u = ctid::white_noise(N, 1.0, 1), e = ctid::white_noise(N, 0.05, 2);
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(N);
+  for (int k = 2; k < N; ++k)
+    y(k) = 0.5 * y(k - 1) - 0.2 * y(k - 2) + 0.3 * u(k - 1) + 0.2 * u(k - 2) + 0.1 * y(k - 1) * u(k - 1) -
+           0.05 * y(k - 2) * y(k - 2) + e(k);
+  return ctid::IdData(u, y, 1.0);
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  const long n_max = argc > 1 ? std::atol(argv[1]) : 10000000;
+  std::printf("| method | N | iterations | ms per fit | ns per sample | ns per sample and iteration | minor faults per fit | "
+              "peak MB above the record | bytes per sample |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  for (long N = 10000; N <= n_max; N *= 10) {
+    const int n = static_cast<int>(N);
+    const Eigen::VectorXd u = ctid::prbs(n, {.register_length = 16, .clock_period = 7});
+    const Eigen::VectorXd t = ctid::time_grid(0.01, n);
+    const ctid::IdData d(u, ctid::add_noise_snr(ctid::lsim(kRao, u, t), 10.0, 1), 0.01);
+    const ctid::IdData nd = narx_record(n);
+    const auto cand = ctid::narx_candidates(2, 2, 2);
+    const std::pair<const char*, std::function<int()>> cases[] = {
+        {"srivc", [&] { return ctid::srivc(d, {2, 4, 0}).summary.iterations; }},
+        {"oe", [&] { return ctid::oe(d, {2, 4, 0}).summary.iterations; }},
+        {"frols", [&] { return ctid::frols(nd, cand, {.max_terms = 5}).summary.iterations; }},
+        {"lsim", [&] { return static_cast<int>(ctid::lsim(kRao, u, t).size() > 0); }},
+    };
+    for (const auto& [name, fit] : cases) {
+      const Measure m = measure(fit);
+      std::printf("| %s | %.0e | %d | %.1f | %.1f | %.1f | %.0f | %.1f | %.1f |\n", name, static_cast<double>(N), m.iterations,
+                  1e3 * m.seconds, 1e9 * m.seconds / N, 1e9 * m.seconds / N / std::max(1, m.iterations), m.faults,
+                  m.peak_mb, m.peak_mb * 1048576.0 / N);
+      std::fflush(stdout);
+    }
+  }
+}
