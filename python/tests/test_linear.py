@@ -478,6 +478,14 @@ def test_simulate_reads_in_place_and_writes_into_out():
     Ad, Bd, Cd, Dd, _ = ss.cont2discrete((A, B, C, D), 0.01, method="zoh")
     _, ys, _ = ss.dlsim((Ad, Bd, Cd, Dd, 0.01), u)
     assert np.max(np.abs(y - ys[:, 0])) < 1e-12 * np.ptp(y)
+    # Order 8 (a Butterworth low-pass of 10 rad/s, simulated through its modal form): the same to 1e-9 of the range
+    # (measured 3.5e-11; SciPy's lfilter of the discretised transfer function is off by 6.5e-7, bench/simulate_vs_scipy.py).
+    poles = 10.0 * np.exp(1j * np.pi * (2 * np.arange(1, 9) + 7) / 16)
+    den = np.real(np.poly(poles))
+    y8 = ctid.TransferFunction([den[-1]], den).simulate(u, t)
+    A, B, C, D = ss.tf2ss([den[-1]], den)
+    _, y8s, _ = ss.dlsim(ss.cont2discrete((A, B, C, D), 0.01, method="zoh"), u)
+    assert np.max(np.abs(y8 - y8s[:, 0])) < 1e-9 * np.ptp(y8)
     with pytest.raises(ctid.InvalidArgument, match="float64 numpy array of 5000 entries \\(got 4999 entries"):
         g.simulate(u, t, out=np.empty(n - 1))
     with pytest.raises(ctid.InvalidArgument, match="of dtype float32"):

@@ -152,8 +152,13 @@ Result<MisoModel> srivc_auto_miso(const IdData& data, const SrivcAutoOptions& op
     std::vector<TfOrders> o(static_cast<size_t>(nu));
     std::vector<double> d(static_cast<size_t>(nu), 0.0);
     Eigen::MatrixXd parts(data.size(), nu);
-    if (have)
+    if (have) {
       for (int j = 0; j < nu; ++j) parts.col(j) = lsim(best.r.model.channels[static_cast<size_t>(j)], data, j);
+      if (!parts.allFinite()) {  // a channel of the model kept diverges: nothing sound to take from the output
+        choices.push_back("backfitting stopped: a channel of the model kept diverges on the record");
+        break;
+      }
+    }
     for (int i = 0; i < nu; ++i) {
       if (!report_progress("srivc_auto_miso", ++siso, NAN)) goto done;
       const Result<TransferFunction> ri = srivc_auto(channel_record(i, have ? &parts : nullptr), options);
