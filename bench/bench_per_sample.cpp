@@ -1,10 +1,11 @@
 // Time and memory per sample of SRIVC, OE, FROLS and lsim from N = 1e4 to 1e7 (issue 18, "one core"): the time per
 // sample should not grow with N (no allocation whose page faults grow with the record, no temporaries that fall out
 // of cache); the peak memory of one fit above the record itself, in bytes per sample, shows the O(N) constant.
-// Run: build/bench/bench_per_sample [N_MAX=10000000]
+// Run: build/bench/bench_per_sample [N_MAX=10000000] [METHODS=srivc,oe,frols,lsim,lsim-new]
 //
 // Problems: SRIVC and OE fit the Rao-Garnier system (-6400 s + 1600)/(s^4 + 5 s^3 + 408 s^2 + 416 s + 1600) (nb = 2,
-// nf = 4) to a PRBS response at Ts = 10 ms with 10 dB output noise; lsim simulates it (ZOH); FROLS selects 5 terms
+// nf = 4) to a PRBS response at Ts = 10 ms with 10 dB output noise; lsim simulates it (ZOH) into a buffer reused from
+// run to run (lsim_into), lsim-new into a new vector each time (its pages faulted anew above glibc's mmap threshold); FROLS selects 5 terms
 // of the 15 degree-2 candidates of lags 1..2 (constant included) for a NARX record of the same length. Each fit is
 // repeated until 2 s have passed (at least twice); the least time is kept. "minor faults" are the page faults of one
 // fit (getrusage), "peak" the process's resident high-water mark during one fit (reset through
@@ -71,6 +72,7 @@ ctid::IdData narx_record(int N) {
 
 int main(int argc, char** argv) {
   const long n_max = argc > 1 ? std::atol(argv[1]) : 10000000;
+  const std::string only = argc > 2 ? "," + std::string(argv[2]) + "," : "";
   std::printf("| method | N | iterations | ms per fit | ns per sample | ns per sample and iteration | minor faults per fit | "
               "peak MB above the record | bytes per sample |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
@@ -81,13 +83,19 @@ int main(int argc, char** argv) {
     const ctid::IdData d(u, ctid::add_noise_snr(ctid::lsim(kRao, u, t), 10.0, 1), 0.01);
     const ctid::IdData nd = narx_record(n);
     const auto cand = ctid::narx_candidates(2, 2, 2);
+    Eigen::VectorXd ybuf(n);
     const std::pair<const char*, std::function<int()>> cases[] = {
         {"srivc", [&] { return ctid::srivc(d, {2, 4, 0}).summary.iterations; }},
         {"oe", [&] { return ctid::oe(d, {2, 4, 0}).summary.iterations; }},
         {"frols", [&] { return ctid::frols(nd, cand, {.max_terms = 5}).summary.iterations; }},
-        {"lsim", [&] { return static_cast<int>(ctid::lsim(kRao, u, t).size() > 0); }},
+        {"lsim", [&] {
+           ctid::lsim_into(kRao, u, t, ctid::Intersample::Zoh, ybuf);
+           return 1;
+         }},
+        {"lsim-new", [&] { return static_cast<int>(ctid::lsim(kRao, u, t).size() > 0); }},
     };
     for (const auto& [name, fit] : cases) {
+      if (!only.empty() && only.find("," + std::string(name) + ",") == std::string::npos) continue;
       const Measure m = measure(fit);
       std::printf("| %s | %.0e | %d | %.1f | %.1f | %.1f | %.0f | %.1f | %.1f |\n", name, static_cast<double>(N), m.iterations,
                   1e3 * m.seconds, 1e9 * m.seconds / N, 1e9 * m.seconds / N / std::max(1, m.iterations), m.faults,
