@@ -7,20 +7,13 @@
 #include <benchmark/benchmark.h>
 
 #include "ctid/ctid.hpp"
+#include "narx_record.hpp"
 
 namespace {
-ctid::IdData narx_record(int N) {
-  const Eigen::VectorXd u = ctid::white_noise(N, 1.0, 1), e = ctid::white_noise(N, 0.05, 2);
-  Eigen::VectorXd y = Eigen::VectorXd::Zero(N);
-  for (int k = 2; k < N; ++k)
-    y(k) = 0.5 * y(k - 1) - 0.2 * y(k - 2) + 0.3 * u(k - 1) + 0.2 * u(k - 2) + 0.1 * y(k - 1) * u(k - 1) -
-           0.05 * y(k - 2) * y(k - 2) + e(k);
-  return ctid::IdData(u, y, 1.0);
-}
 
 void run(benchmark::State& state, ctid::InformationCriterion c) {
   const int N = static_cast<int>(state.range(0));
-  const ctid::IdData d = narx_record(N);
+  const ctid::IdData d = bench::narx_record(N);
   const auto cand = ctid::narx_candidates(2, 16, 16);
   for (auto _ : state) {
     auto r = ctid::frols(d, cand, {.max_terms = 20, .criterion = c});

@@ -21,6 +21,7 @@
 #include <string>
 
 #include "ctid/ctid.hpp"
+#include "narx_record.hpp"
 
 namespace {
 const ctid::TransferFunction kRao(Eigen::VectorXd{{-6400.0, 1600.0}}, Eigen::VectorXd{{1.0, 5.0, 408.0, 416.0, 1600.0}});
@@ -60,14 +61,6 @@ Measure measure(const std::function<int()>& fit) {
   return {best, faults, peak, iterations};
 }
 
-ctid::IdData narx_record(int N) {
-  const Eigen::VectorXd u = ctid::white_noise(N, 1.0, 1), e = ctid::white_noise(N, 0.05, 2);
-  Eigen::VectorXd y = Eigen::VectorXd::Zero(N);
-  for (int k = 2; k < N; ++k)
-    y(k) = 0.5 * y(k - 1) - 0.2 * y(k - 2) + 0.3 * u(k - 1) + 0.2 * u(k - 2) + 0.1 * y(k - 1) * u(k - 1) -
-           0.05 * y(k - 2) * y(k - 2) + e(k);
-  return ctid::IdData(u, y, 1.0);
-}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -81,7 +74,7 @@ int main(int argc, char** argv) {
     const Eigen::VectorXd u = ctid::prbs(n, {.register_length = 16, .clock_period = 7});
     const Eigen::VectorXd t = ctid::time_grid(0.01, n);
     const ctid::IdData d(u, ctid::add_noise_snr(ctid::lsim(kRao, u, t), 10.0, 1), 0.01);
-    const ctid::IdData nd = narx_record(n);
+    const ctid::IdData nd = bench::narx_record(n);
     const auto cand = ctid::narx_candidates(2, 2, 2);
     Eigen::VectorXd ybuf(n);
     const std::pair<const char*, std::function<int()>> cases[] = {

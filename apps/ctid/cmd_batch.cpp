@@ -6,8 +6,8 @@
 
 #include <algorithm>
 #include <atomic>
-#include <charconv>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <csignal>
 #include <cstdio>
@@ -37,17 +37,6 @@ const std::vector<std::string> kColumns = {"id", "method", "model", "orders", "f
 // Columns holding text (the others are numbers, or True/False for usable).
 bool is_text_column(const std::string& c) {
   return c == "id" || c == "method" || c == "model" || c == "orders" || c == "termination" || c == "error";
-}
-
-// A number as Python's str(float) writes it: the shortest text that reads back to the same double; nan as nan.
-std::string number_text(double v) {
-  if (std::isnan(v)) return "nan";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  char buf[32];
-  const auto res = std::to_chars(buf, buf + sizeof buf, v);
-  std::string s(buf, res.ptr);
-  if (s.find_first_of(".en") == std::string::npos) s += ".0";  // 2 -> 2.0, as Python
-  return s;
 }
 
 // A row: column name -> text as written in the CSV (numbers in number_text, usable as True/False).
@@ -83,20 +72,20 @@ std::string one_line(std::string s) {
 Row row_of(const std::string& id, const std::string& method, const BatchOutcome* outcome, const std::string& error,
            double seconds) {
   Row row = {{"id", id},           {"method", method},  {"model", ""},         {"orders", ""},
-             {"fit_percent", "nan"}, {"termination", ""}, {"usable", "False"}, {"seconds", number_text(seconds)},
+             {"fit_percent", "nan"}, {"termination", ""}, {"usable", "False"}, {"seconds", detail::round_trip(seconds)},
              {"error", one_line(error)}};
   if (!outcome || !outcome->result) return row;
   const Result<AnyModel>& r = *outcome->result;
   row["model"] = model_type_name(r.model);
   row["orders"] = orders_text(r.model);
-  row["fit_percent"] = number_text(r.fit.fit_percent);
+  row["fit_percent"] = detail::round_trip(r.fit.fit_percent);
   row["termination"] = to_string(r.summary.termination);
   row["usable"] = r.usable() ? "True" : "False";
-  row["seconds"] = number_text(r.summary.seconds);
+  row["seconds"] = detail::round_trip(r.summary.seconds);
   row["error"] = one_line(r.why_not_usable());
   for (int i = 0; i < r.parameters.size(); ++i) {
-    row[r.parameters.names[static_cast<size_t>(i)]] = number_text(r.parameters.values(i));
-    row[r.parameters.names[static_cast<size_t>(i)] + "_std"] = number_text(r.parameters.std(i));
+    row[r.parameters.names[static_cast<size_t>(i)]] = detail::round_trip(r.parameters.values(i));
+    row[r.parameters.names[static_cast<size_t>(i)] + "_std"] = detail::round_trip(r.parameters.std(i));
   }
   return row;
 }
@@ -192,19 +181,18 @@ class RowWriter {
     return s;
   }
   static std::string json_line(const Row& row) {
+    // A number cell as JSON: NaN (no fit) as null, as Python's writer does.
+    const auto number = [](const std::string& v) -> nlohmann::ordered_json {
+      const double x = std::strtod(v.c_str(), nullptr);
+      return std::isnan(x) ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(x);
+    };
     nlohmann::ordered_json j;
     for (const auto& c : kColumns) {
       const std::string& v = row.at(c);
-      if (is_text_column(c)) j[c] = v;
-      else if (c == "usable") j[c] = v == "True";
-      else if (v == "nan") j[c] = nullptr;
-      else j[c] = std::stod(v);
+      j[c] = is_text_column(c) ? nlohmann::ordered_json(v) : c == "usable" ? nlohmann::ordered_json(v == "True") : number(v);
     }
     for (const auto& [k, v] : row)
-      if (std::find(kColumns.begin(), kColumns.end(), k) == kColumns.end()) {
-        if (v == "nan") j[k] = nullptr;
-        else j[k] = std::stod(v);
-      }
+      if (std::find(kColumns.begin(), kColumns.end(), k) == kColumns.end()) j[k] = number(v);
     return j.dump();
   }
   // The rows of an earlier run (--resume): their ids are skipped, their cells kept for a rewrite.
@@ -222,7 +210,7 @@ class RowWriter {
           for (const auto& [k, v] : j.items())
             r[k] = v.is_string() ? v.get<std::string>()
                    : v.is_boolean() ? (v.get<bool>() ? "True" : "False")
-                   : v.is_number() ? number_text(v.get<double>())
+                   : v.is_number() ? detail::round_trip(v.get<double>())
                                    : "nan";
           ids_.insert(j.at("id").get<std::string>());
           rows_.push_back(std::move(r));

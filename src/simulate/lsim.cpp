@@ -178,7 +178,7 @@ bool modal_blocks(const StateSpace& sys, double h, bool foh, const std::vector<d
   if (lam.real().maxCoeff() > 0) return false;
   const Eigen::MatrixXcd V = es.eigenvectors();
   const Eigen::Index n2 = n + (n % 2);
-  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(n2, n2), M = Eigen::MatrixXd::Zero(n2, n2);
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(n, n), M = Eigen::MatrixXd::Zero(n2, n2);  // M's padding block: zero
   std::vector<Eigen::Index> reals;
   Eigen::Index j = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -186,9 +186,9 @@ bool modal_blocks(const StateSpace& sys, double h, bool foh, const std::vector<d
     if (l.imag() == 0.0) {
       reals.push_back(i);
     } else if (l.imag() > 0) {
-      if (j + 1 >= n2) return false;
-      T.block(0, j, n, 1) = V.col(i).real();
-      T.block(0, j + 1, n, 1) = V.col(i).imag();
+      if (j + 1 >= n) return false;
+      T.col(j) = V.col(i).real();
+      T.col(j + 1) = V.col(i).imag();
       M(j, j) = M(j + 1, j + 1) = l.real();
       M(j, j + 1) = l.imag();
       M(j + 1, j) = -l.imag();
@@ -196,22 +196,21 @@ bool modal_blocks(const StateSpace& sys, double h, bool foh, const std::vector<d
     }
   }
   for (Eigen::Index i : reals) {
-    if (j >= n2) return false;
-    T.block(0, j, n, 1) = V.col(i).real();
+    if (j >= n) return false;
+    T.col(j) = V.col(i).real();
     M(j, j) = lam(i).real();
     ++j;
   }
   if (j != n) return false;
-  if (n2 > n) T(n, n) = 1.0;  // the padding state: z = 0 for ever (no input, no output)
-  const Eigen::MatrixXd Tn = T.topLeftCorner(n, n);
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Tn);
+  // (An odd n's padding state has no column in T and a zero block in M: z = 0 for ever, no input, no output.)
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(T);
   const Eigen::VectorXd sv = svd.singularValues();
   if (!(sv(n - 1) > 0) || sv(0) / sv(n - 1) > 1e5) return false;
-  if ((Ab * Tn - Tn * M.topLeftCorner(n, n)).norm() > 1e-12 * Ab.norm() * Tn.norm()) return false;
-  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(Tn);
+  if ((Ab * T - T * M.topLeftCorner(n, n)).norm() > 1e-12 * Ab.norm() * T.norm()) return false;
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(T);
   Eigen::MatrixXd Bm = Eigen::MatrixXd::Zero(n2, 1), Cm = Eigen::MatrixXd::Zero(sys.ny(), n2);
   Bm.topRows(n) = lu.solve(dbal.cwiseInverse().asDiagonal() * sys.B());
-  Cm.leftCols(n) = sys.C() * dbal.asDiagonal() * Tn;
+  Cm.leftCols(n) = sys.C() * dbal.asDiagonal() * T;
   Eigen::VectorXd z0 = Eigen::VectorXd::Zero(n2);
   z0.head(n) = lu.solve(dbal.cwiseInverse().cwiseProduct(Eigen::Map<const Eigen::VectorXd>(x0.data(), n)));
   const Discretization dz = discretize(M, Bm, h);
@@ -221,8 +220,8 @@ bool modal_blocks(const StateSpace& sys, double h, bool foh, const std::vector<d
     for (int r = 0; r < 2; ++r)
       for (int c = 0; c < 2; ++c) mb.phi[static_cast<std::size_t>(4 * b + 2 * r + c)] = dz.Phi(2 * b + r, 2 * b + c);
   mb.g0.assign(dz.Gamma0.data(), dz.Gamma0.data() + n2);
-  mb.g1.assign(n2, 0.0);
   if (foh) mb.g1.assign(dz.Gamma1.data(), dz.Gamma1.data() + n2);
+  else mb.g1.assign(n2, 0.0);
   mb.c.resize(static_cast<std::size_t>(Cm.size()));
   for (Eigen::Index r = 0; r < Cm.rows(); ++r)
     for (Eigen::Index i = 0; i < n2; ++i) mb.c[static_cast<std::size_t>(r * n2 + i)] = Cm(r, i);
