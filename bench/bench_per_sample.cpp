@@ -1,15 +1,16 @@
 // Time and memory per sample of SRIVC, OE, FROLS and lsim from N = 1e4 to 1e7 (issue 18, "one core"): the time per
 // sample should not grow with N (no allocation whose page faults grow with the record, no temporaries that fall out
 // of cache); the peak memory of one fit above the record itself, in bytes per sample, shows the O(N) constant.
-// Run: build/bench/bench_per_sample [N_MAX=10000000] [METHODS=srivc,oe,frols,lsim,lsim-new]
+// Run: build/bench/bench_per_sample [N_MAX=10000000] [METHODS=srivc,oe,oe-start,frols,lsim,lsim-new]
 //
 // Problems: SRIVC and OE fit the Rao-Garnier system (-6400 s + 1600)/(s^4 + 5 s^3 + 408 s^2 + 416 s + 1600) (nb = 2,
-// nf = 4) to a PRBS response at Ts = 10 ms with 10 dB output noise; lsim simulates it (ZOH) into a buffer reused from
-// run to run (lsim_into), lsim-new into a new vector each time (its pages faulted anew above glibc's mmap threshold); FROLS selects 5 terms
-// of the 15 degree-2 candidates of lags 1..2 (constant included) for a NARX record of the same length. Each fit is
-// repeated until 2 s have passed (at least twice); the least time is kept. "minor faults" are the page faults of one
-// fit (getrusage), "peak" the process's resident high-water mark during one fit (reset through
-// /proc/self/clear_refs before it) less the resident size before it.
+// nf = 4) to a PRBS response at Ts = 10 ms with 10 dB output noise (oe-start: from a given start, the system with each
+// coefficient 5 % off, so without the LSSVF and SRIVC start-up fits); lsim simulates it (ZOH) into a buffer reused
+// from run to run (lsim_into), lsim-new into a new vector each time (its pages faulted anew above glibc's mmap
+// threshold); FROLS selects 5 terms of the 15 degree-2 candidates of lags 1..2 (constant included) for a NARX record
+// of the same length. Each fit is repeated until 2 s have passed (at least twice); the least time is kept. "minor
+// faults" are the page faults of one fit (getrusage), "peak" the process's resident high-water mark during one fit
+// (reset through /proc/self/clear_refs before it) less the resident size before it.
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -25,6 +26,8 @@
 
 namespace {
 const ctid::TransferFunction kRao(Eigen::VectorXd{{-6400.0, 1600.0}}, Eigen::VectorXd{{1.0, 5.0, 408.0, 416.0, 1600.0}});
+const ctid::TransferFunction kStart(Eigen::VectorXd{{-6400.0 * 1.05, 1600.0 * 0.95}},
+                                    Eigen::VectorXd{{1.0, 5.0 * 1.05, 408.0 * 0.95, 416.0 * 1.05, 1600.0 * 0.95}});
 
 long status_kb(const char* key) {
   std::ifstream f("/proc/self/status");
@@ -33,14 +36,26 @@ long status_kb(const char* key) {
   return -1;
 }
 
-struct Measure {
-  double seconds, faults, peak_mb;
-  int iterations;
+// What one run did: its iterations and its passes over the record (SRIVC, FROLS: one per iteration; OE: every cost
+// evaluation of its search, rejected steps included, and how many of them also made the Jacobian).
+struct Work {
+  int iterations = 1, passes = 1, jacobians = 0;
 };
 
-Measure measure(const std::function<int()>& fit) {
+struct Measure {
+  double seconds, faults, peak_mb;
+  Work work;
+};
+
+Work iterations(int it) { return {it, it, 0}; }
+Work oe_work(const ctid::Result<ctid::TransferFunction>& r) {
+  return {r.summary.iterations, static_cast<int>(r.diagnostics.get(ctid::diagnostic::evaluations)),
+          static_cast<int>(r.diagnostics.get(ctid::diagnostic::jacobian_evaluations))};
+}
+
+Measure measure(const std::function<Work()>& fit) {
   double best = 1e300, faults = 0, peak = 0;
-  int iterations = 0;
+  Work work;
   const auto start = std::chrono::steady_clock::now();
   for (int rep = 0; rep < 2 || std::chrono::steady_clock::now() - start < std::chrono::seconds(2); ++rep) {
     std::ofstream("/proc/self/clear_refs") << "5";  // VmHWM := VmRSS
@@ -48,17 +63,17 @@ Measure measure(const std::function<int()>& fit) {
     rusage r0{}, r1{};
     getrusage(RUSAGE_SELF, &r0);
     const auto t0 = std::chrono::steady_clock::now();
-    const int it = fit();
+    const Work w = fit();
     const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     getrusage(RUSAGE_SELF, &r1);
     if (dt < best) {
       best = dt;
       faults = static_cast<double>(r1.ru_minflt - r0.ru_minflt);
       peak = (status_kb("VmHWM:") - rss0) / 1024.0;
-      iterations = it;
+      work = w;
     }
   }
-  return {best, faults, peak, iterations};
+  return {best, faults, peak, work};
 }
 
 }  // namespace
@@ -66,9 +81,9 @@ Measure measure(const std::function<int()>& fit) {
 int main(int argc, char** argv) {
   const long n_max = argc > 1 ? std::atol(argv[1]) : 10000000;
   const std::string only = argc > 2 ? "," + std::string(argv[2]) + "," : "";
-  std::printf("| method | N | iterations | ms per fit | ns per sample | ns per sample and iteration | minor faults per fit | "
+  std::printf("| method | N | iterations | passes (with the Jacobian) | ms per fit | ns per sample | ns per sample and pass | minor faults per fit | "
               "peak MB above the record | bytes per sample |\n");
-  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (long N = 10000; N <= n_max; N *= 10) {
     const int n = static_cast<int>(N);
     const Eigen::VectorXd u = ctid::prbs(n, {.register_length = 16, .clock_period = 7});
@@ -77,22 +92,27 @@ int main(int argc, char** argv) {
     const ctid::IdData nd = bench::narx_record(n);
     const auto cand = ctid::narx_candidates(2, 2, 2);
     Eigen::VectorXd ybuf(n);
-    const std::pair<const char*, std::function<int()>> cases[] = {
-        {"srivc", [&] { return ctid::srivc(d, {2, 4, 0}).summary.iterations; }},
-        {"oe", [&] { return ctid::oe(d, {2, 4, 0}).summary.iterations; }},
-        {"frols", [&] { return ctid::frols(nd, cand, {.max_terms = 5}).summary.iterations; }},
+    const std::pair<const char*, std::function<Work()>> cases[] = {
+        {"srivc", [&] { return iterations(ctid::srivc(d, {2, 4, 0}).summary.iterations); }},
+        {"oe", [&] { return oe_work(ctid::oe(d, {2, 4, 0})); }},
+        {"oe-start", [&] {  // from a given start 5 % off: the search alone, without the LSSVF and SRIVC start
+           return oe_work(ctid::oe(d, {2, 4, 0}, {.initial = kStart}));
+         }},
+        {"frols", [&] { return iterations(ctid::frols(nd, cand, {.max_terms = 5}).summary.iterations); }},
         {"lsim", [&] {
            ctid::lsim_into(kRao, u, t, ctid::Intersample::Zoh, ybuf);
-           return 1;
+           return Work{};
          }},
-        {"lsim-new", [&] { return static_cast<int>(ctid::lsim(kRao, u, t).size() > 0); }},
+        {"lsim-new", [&] { return iterations(static_cast<int>(ctid::lsim(kRao, u, t).size() > 0)); }},
     };
     for (const auto& [name, fit] : cases) {
       if (!only.empty() && only.find("," + std::string(name) + ",") == std::string::npos) continue;
       const Measure m = measure(fit);
-      std::printf("| %s | %.0e | %d | %.1f | %.1f | %.1f | %.0f | %.1f | %.1f |\n", name, static_cast<double>(N), m.iterations,
-                  1e3 * m.seconds, 1e9 * m.seconds / N, 1e9 * m.seconds / N / std::max(1, m.iterations), m.faults,
-                  m.peak_mb, m.peak_mb * 1048576.0 / N);
+      const std::string passes = std::to_string(m.work.passes) +
+                                 (m.work.jacobians ? " (" + std::to_string(m.work.jacobians) + ")" : "");
+      std::printf("| %s | %.0e | %d | %s | %.1f | %.1f | %.1f | %.0f | %.1f | %.1f |\n", name, static_cast<double>(N),
+                  m.work.iterations, passes.c_str(), 1e3 * m.seconds, 1e9 * m.seconds / N,
+                  1e9 * m.seconds / N / std::max(1, m.work.passes), m.faults, m.peak_mb, m.peak_mb * 1048576.0 / N);
       std::fflush(stdout);
     }
   }

@@ -21,6 +21,8 @@ const std::vector<DiagnosticInfo>& diagnostic_catalogue() {
       info(diagnostic::tau),
       info(diagnostic::cost),
       info(diagnostic::cost_history),
+      info(diagnostic::evaluations),
+      info(diagnostic::jacobian_evaluations),
       info(diagnostic::err),
       info(diagnostic::delay_grid),
       info(diagnostic::delay_grid_mse),

@@ -226,7 +226,8 @@ void require_io_data(const IdData& d, const char* who, int nu, int ny) {
                "{}: needs {} input(s) and {} output(s) (the data have {} and {}); select channels first", who,
                nu < 0 ? std::string("any number of") : std::to_string(nu), ny < 0 ? std::string("any number of") : std::to_string(ny),
                d.nu(), d.ny());
-  auto constant = [](const Eigen::VectorXd& v) { return v.size() > 0 && v.maxCoeff() == v.minCoeff(); };
+  // (the column read in place)
+  auto constant = [](const Eigen::Ref<const Eigen::VectorXd>& v) { return v.size() > 0 && v.maxCoeff() == v.minCoeff(); };
   for (int i = 0; i < d.nu(); ++i)
     CTID_REQUIRE(!constant(d.u().col(i)),
                  "{}: input '{}' is constant ({}) over the whole record: it excites nothing (a step response needs samples "

@@ -16,6 +16,7 @@
 #include "ctid/core/check.hpp"
 #include "ctid/core/progress.hpp"
 #include "ctid/validate/metrics.hpp"
+#include "data/record_refs.hpp"
 
 namespace ctid {
 
@@ -41,11 +42,12 @@ void FrolsOptions::validate() const { option_table<FrolsOptions>().check(*this);
 namespace {
 // Candidate columns for rows [k0, k0 + rows) into the columns of B.
 // The three signals a candidate can refer to (e: residuals of the previous NARMAX iteration).
+// (Read in place: a record's own columns, or the concatenation of several; e empty when no candidate has a noise factor.)
 struct Signals {
-  const Eigen::VectorXd& y;
-  const Eigen::VectorXd& u;
-  const Eigen::VectorXd& e;
-  const Eigen::VectorXd& of(NarxSignal s) const { return s == NarxSignal::Output ? y : s == NarxSignal::Input ? u : e; }
+  Eigen::Ref<const Eigen::VectorXd> y, u, e;
+  const Eigen::Ref<const Eigen::VectorXd>& of(NarxSignal s) const {
+    return s == NarxSignal::Output ? y : s == NarxSignal::Input ? u : e;
+  }
 };
 
 void candidate_block(const std::vector<NarxTerm>& cand, const Signals& sig, Eigen::Index k0, Eigen::Index rows,
@@ -155,8 +157,8 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
   const auto t_start = std::chrono::steady_clock::now();
   int L = 0;
   for (const auto& t : cand) L = std::max(L, t.max_lag());
-  const Eigen::VectorXd& y = sig.y;
-  const Eigen::VectorXd& u = sig.u;
+  const auto& y = sig.y;
+  const auto& u = sig.u;
   const Eigen::Index N = y.size(), Ne = N - L;
   const int M = static_cast<int>(cand.size());
   for (size_t r = 0; r < starts.size() && starts.size() > 1; ++r) {  // one record: the row count below says it
@@ -184,6 +186,7 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
   Eigen::MatrixXd W(Ne, K);  // orthogonal columns of the selected terms
   std::vector<bool> used(M, false);
   Eigen::VectorXd crit(K);
+  Eigen::VectorXd p(Ne);     // the column of the term being selected, then its orthogonal part
   double err_sum = 0;
   bool interrupted = false;
   for (int s = 0; s < K; ++s) {
@@ -209,7 +212,6 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
     }
     if (best < 0) break;
     // w_s = p_best - sum_r (c_r,best / ww_r) w_r, then c_s,m = p_m^T w_s for every candidate.
-    Eigen::VectorXd p(Ne);
     for (Eigen::Index r0 = 0; r0 < Ne; r0 += BR) {
       const Eigen::Index rows = std::min(BR, Ne - r0);
       Eigen::MatrixXd one(rows, 1);
@@ -305,14 +307,25 @@ void check_siso(const IdData& data, const char* who) {
   CTID_REQUIRE(data.is_uniform(), "{}: needs uniformly sampled data", who);
 }
 
-// Several records concatenated (each checked: one input, one output, uniform at the first record's Ts).
+// Several records concatenated (each checked: one input, one output, uniform at the first record's Ts); one record
+// is read in place (y and u stay empty, one() says so).
 struct NarxRecords {
   Eigen::VectorXd y, u;
   std::vector<Eigen::Index> starts;
   double ts = 1.0;
+  const IdData* single = nullptr;
+  // (if, not ?: — the conditional operator would make a temporary VectorXd of the column and refer to it)
+  Eigen::Ref<const Eigen::VectorXd> output() const {
+    if (single) return single->y().col(0);
+    return y;
+  }
+  Eigen::Ref<const Eigen::VectorXd> input() const {
+    if (single) return single->u().col(0);
+    return u;
+  }
 };
 
-NarxRecords concatenate(const std::vector<IdData>& data, const char* who) {
+NarxRecords concatenate(const internal::RecordRefs& data, const char* who) {
   CTID_REQUIRE(!data.empty(), "{}: no records", who);
   NarxRecords r;
   r.ts = data.front().is_uniform() ? data.front().ts() : 0.0;
@@ -323,6 +336,11 @@ NarxRecords concatenate(const std::vector<IdData>& data, const char* who) {
                  "{}: record {} is sampled at {} s, record 1 at {} s; a NARX model has one sampling period", who, i + 1,
                  data[i].ts(), r.ts);
     n += data[i].size();
+  }
+  if (data.size() == 1) {
+    r.single = &data.front();
+    r.starts = {0};
+    return r;
   }
   r.y.resize(n);
   r.u.resize(n);
@@ -335,19 +353,23 @@ NarxRecords concatenate(const std::vector<IdData>& data, const char* who) {
   }
   return r;
 }
-}  // namespace
 
-Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& cand, const FrolsOptions& o) {
-  return frols(std::vector<IdData>{data}, cand, o);
-}
-
-Result<NarxModel> frols(const std::vector<IdData>& data, const std::vector<NarxTerm>& cand, const FrolsOptions& o) {
+Result<NarxModel> frols_records(const internal::RecordRefs& data, const std::vector<NarxTerm>& cand,
+                                const FrolsOptions& o) {
   o.validate();
   const NarxRecords r = concatenate(data, "frols");
   CTID_REQUIRE(!cand.empty(), "frols: no candidate terms");
   for (const auto& t : cand) CTID_REQUIRE(!t.has_noise(), "frols: candidate {} is a noise term (use narmax)", t.name());
-  const Eigen::VectorXd e = Eigen::VectorXd::Zero(r.y.size());
-  return frols_signals({r.y, r.u, e}, r.starts, r.ts, cand, o);
+  return frols_signals({r.output(), r.input(), Eigen::VectorXd()}, r.starts, r.ts, cand, o);  // (no e: no noise term)
+}
+}  // namespace
+
+Result<NarxModel> frols(const IdData& data, const std::vector<NarxTerm>& cand, const FrolsOptions& o) {
+  return frols_records(data, cand, o);
+}
+
+Result<NarxModel> frols(const std::vector<IdData>& data, const std::vector<NarxTerm>& cand, const FrolsOptions& o) {
+  return frols_records(data, cand, o);
 }
 
 
@@ -388,17 +410,6 @@ void NarxOptions::validate() const {
   narmax.validate();
 }
 
-Result<NarxModel> narx(const IdData& data, const NarxOptions& o) { return narx(std::vector<IdData>{data}, o); }
-
-Result<NarxModel> narx(const std::vector<IdData>& data, const NarxOptions& o) {
-  o.validate();
-  const std::vector<NarxTerm> candidates = narx_candidates(o.degree, o.ylag, o.ulag, o.constant, o.umin);
-  if (o.noise_terms == 0) return frols(data, candidates, o.narmax.frols);
-  NarmaxOptions n = o.narmax;
-  n.noise_candidates = narx_noise_candidates(o.noise_terms, 2, 2);
-  return narmax(data, candidates, n);
-}
-
 void NarmaxOptions::validate() const {
   frols.validate();
   option_table<NarmaxOptions>().check(*this);
@@ -406,19 +417,16 @@ void NarmaxOptions::validate() const {
     CTID_REQUIRE_OPTION(t.has_noise(), "narmax: noise candidate {} has no e(k-i) factor", t.name());
 }
 
-Result<NarxModel> narmax(const IdData& data, const std::vector<NarxTerm>& process, const NarmaxOptions& o) {
-  return narmax(std::vector<IdData>{data}, process, o);
-}
-
-Result<NarxModel> narmax(const std::vector<IdData>& data, const std::vector<NarxTerm>& process, const NarmaxOptions& o) {
+namespace {
+Result<NarxModel> narmax_records(const internal::RecordRefs& data, const std::vector<NarxTerm>& process,
+                                 const NarmaxOptions& o) {
   const auto t_start = std::chrono::steady_clock::now();
   o.validate();
   const NarxRecords rec = concatenate(data, "narmax");
   for (const auto& t : process) CTID_REQUIRE(!t.has_noise(), "narmax: process candidate {} is a noise term", t.name());
-  const Eigen::VectorXd& y = rec.y;
-  const Eigen::VectorXd& u = rec.u;
+  const Eigen::Ref<const Eigen::VectorXd> y = rec.output(), u = rec.input();
   // Iteration 0: NARX; then residual-driven selection over process and noise candidates (extended LS).
-  Result<NarxModel> r = frols(data, process, o.frols);
+  Result<NarxModel> r = frols_records(data, process, o.frols);
   std::vector<NarxTerm> all = process;
   all.insert(all.end(), o.noise_candidates.begin(), o.noise_candidates.end());
   FrolsOptions fo = o.frols;
@@ -482,5 +490,27 @@ Result<NarxModel> narmax(const std::vector<IdData>& data, const std::vector<Narx
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return r;
 }
+
+Result<NarxModel> narx_records(const internal::RecordRefs& data, const NarxOptions& o) {
+  o.validate();
+  const std::vector<NarxTerm> candidates = narx_candidates(o.degree, o.ylag, o.ulag, o.constant, o.umin);
+  if (o.noise_terms == 0) return frols_records(data, candidates, o.narmax.frols);
+  NarmaxOptions n = o.narmax;
+  n.noise_candidates = narx_noise_candidates(o.noise_terms, 2, 2);
+  return narmax_records(data, candidates, n);
+}
+}  // namespace
+
+Result<NarxModel> narmax(const IdData& data, const std::vector<NarxTerm>& process, const NarmaxOptions& o) {
+  return narmax_records(data, process, o);
+}
+
+Result<NarxModel> narmax(const std::vector<IdData>& data, const std::vector<NarxTerm>& process, const NarmaxOptions& o) {
+  return narmax_records(data, process, o);
+}
+
+Result<NarxModel> narx(const IdData& data, const NarxOptions& o) { return narx_records(data, o); }
+
+Result<NarxModel> narx(const std::vector<IdData>& data, const NarxOptions& o) { return narx_records(data, o); }
 
 }  // namespace ctid

@@ -1,10 +1,13 @@
-// Output error and tfest — see include/ctid/estimate/oe.hpp.
+// Output error and tfest — see include/ctid/estimate/oe.hpp. The criterion and its Gauss-Newton / Levenberg-Marquardt
+// search on exact output sensitivities: Ljung (1999) §7.3 and §10.2; the sensitivities are filtered derivatives of the
+// input through 1/A and B/A^2, the filters of Young & Jakeman (1980) that SRIVC uses.
 #include "ctid/estimate/oe.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "ctid/core/check.hpp"
 #include "ctid/estimate/lssvf.hpp"
@@ -16,6 +19,7 @@
 #include "estimate/tf_common.hpp"
 #include "internal/least_squares.hpp"
 #include "internal/levenberg_marquardt.hpp"
+#include "signal/filter_bank.hpp"
 
 namespace ctid {
 
@@ -91,6 +95,69 @@ bool stacked_residuals(const TransferFunction& g, const Records& ds, double tran
   return r.allFinite();
 }
 
+// The normal equations of OE on a uniformly sampled single-input record from rest, without delay, made sample by
+// sample (LmNormalEvaluate's form: cost = 1/2 ||r||^2, A = J^T J, g = J^T r, added to what they hold): the banks 1/A
+// of u (its derivatives give the b-sensitivities and, combined by b, the simulated output) and B/A^2 of u (the
+// a-sensitivities) advance together — the recursions of output_sensitivities_into and lsim, so the Jacobian is the
+// same, but a pass reads u and y and writes nothing that grows with the record. theta = [a1..an, b0..b(nb-1)];
+// `free` are the columns of the Jacobian (indices into theta); A null: the cost alone.
+template <int n>
+void oe_stream_n(const Eigen::VectorXd& theta, int nb, const IdData& d, Eigen::Index first, const std::vector<int>& free,
+                 double& cost, Eigen::MatrixXd* A, Eigen::VectorXd* g) {
+  Eigen::VectorXd den(n + 1);
+  den(0) = 1.0;
+  den.tail(n) = theta.head(n);
+  const Polynomial F(den);
+  const Eigen::VectorXd b = theta.segment(n, nb);
+  const double h = d.ts();
+  const Intersample is = d.intersample(0);
+  signal_detail::Bank<n> ub(derivative_recursion(TransferFunction(Polynomial{1.0}, F), nb - 1, h, is));
+  std::optional<signal_detail::Bank<2 * n>> xb;  // none when B = 0 (the a-sensitivities vanish)
+  if (A && b.cwiseAbs().maxCoeff() > 0)
+    xb.emplace(derivative_recursion(TransferFunction(Polynomial(b), F * F), n - 1, h, is));
+  const int p = static_cast<int>(free.size());
+  std::vector<double> psi(static_cast<std::size_t>(p));
+  const auto u = d.u().col(0);
+  const auto y = d.y().col(0);
+  const Eigen::Index N = d.size();
+  double c = 0.0;
+  for (Eigen::Index k = 0; k < N; ++k) {
+    const double* ur = ub.at(u(k));
+    const double* xr = xb ? xb->at(u(k)) : nullptr;
+    if (k >= first) {
+      double yhat = 0.0;
+      for (int j = 0; j < nb; ++j) yhat += b(j) * ur[nb - 1 - j];
+      const double r = y(k) - yhat;
+      c += r * r;
+      if (A) {
+        // the sensitivity of the simulated output to theta_i: -s^{n-1-i} B/A^2 u (a), s^{nb-1-j}/A u (b); J = -S
+        for (int jj = 0; jj < p; ++jj) {
+          const int i = free[static_cast<std::size_t>(jj)];
+          psi[static_cast<std::size_t>(jj)] = i < n ? (xr ? -xr[n - 1 - i] : 0.0) : ur[nb - 1 - (i - n)];
+        }
+        for (int jj = 0; jj < p; ++jj) {
+          const double s = psi[static_cast<std::size_t>(jj)];
+          (*g)(jj) -= s * r;
+          for (int ll = jj; ll < p; ++ll) (*A)(jj, ll) += s * psi[static_cast<std::size_t>(ll)];
+        }
+      }
+    }
+    if (k + 1 == N) break;
+    ub.advance(u(k), u(k + 1));
+    if (xb) xb->advance(u(k), u(k + 1));
+  }
+  cost += 0.5 * c;
+}
+
+// Whether refine can stream its normal equations (oe_stream_n): every record uniformly sampled with one input, no
+// delay, no initial states, an order the banks are compiled for.
+bool streamable(const Records& ds, const TfOrders& o, bool delay, int initial_states) {
+  if (delay || initial_states > 0 || o.nf < 1 || o.nf > 8) return false;
+  for (const IdData& d : ds)
+    if (d.nu() != 1 || !d.is_uniform()) return false;
+  return true;
+}
+
 Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const TransferFunction& start, const OeOptions& opt,
                                 std::chrono::steady_clock::time_point t0) {
   std::vector<std::string> names = tf_parameter_names(o);
@@ -122,9 +189,13 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
     lo(j) = std::max(lo(j), c.lower(free[j]));
     hi(j) = std::min(hi(j), c.upper(free[j]));
   }
-  auto model_of = [&](const Eigen::VectorXd& x) {
+  auto full_of = [&](const Eigen::VectorXd& x) {
     Eigen::VectorXd f = full;
     for (int j = 0; j < p; ++j) f(free[j]) = x(j);
+    return f;
+  };
+  auto model_of = [&](const Eigen::VectorXd& x) {
+    const Eigen::VectorXd f = full_of(x);
     const double T = opt.estimate_delay ? f(nt) : fixed_delay;
     return tf_detail::tf_of(f.head(nt), o, std::max(0.0, T));
   };
@@ -138,8 +209,9 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
   const int E = static_cast<int>(ds.size());
   const int ni = opt.estimate_initial_state ? o.nf : 0;
   const int q = p + E * ni;
-  std::vector<Eigen::VectorXd> since_start;  // each record's times from its first sample
-  for (const IdData& d : ds) since_start.push_back(d.times().array() - d.times()(0));
+  std::vector<Eigen::VectorXd> since_start;  // each record's times from its first sample (for the free responses)
+  if (ni > 0)
+    for (const IdData& d : ds) since_start.push_back(d.times().array() - d.times()(0));
   auto power = [](int k) {  // s^k
     Eigen::VectorXd c = Eigen::VectorXd::Zero(k + 1);
     c(0) = 1.0;
@@ -185,7 +257,28 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
   v0.head(p) = x0;
   v_lo.head(p) = lo;
   v_hi.head(p) = hi;
-  internal::LmResult lm = internal::levenberg_marquardt(evaluate, v0, v_lo, v_hi, lmo);
+  internal::LmResult lm;
+  if (streamable(ds, o, opt.estimate_delay || fixed_delay != 0.0, ni)) {
+    std::vector<Eigen::Index> first;
+    for (const IdData& d : ds) first.push_back(first_after(d, opt.transient_time));
+    auto normal = [&](const Eigen::VectorXd& x, double& cost, Eigen::MatrixXd* A, Eigen::VectorXd* g) {
+      const Eigen::VectorXd theta = full_of(x).head(nt);
+      cost = 0.0;
+      if (A) {
+        A->setZero(p, p);
+        g->setZero(p);
+      }
+      for (std::size_t e = 0; e < ds.size(); ++e)
+        signal_detail::with_order(o.nf, [&]<int n>() { oe_stream_n<n>(theta, o.nb, ds[e], first[e], free, cost, A, g); });
+      if (A)
+        for (int j = 0; j < p; ++j)
+          for (int l = 0; l < j; ++l) (*A)(j, l) = (*A)(l, j);
+      return std::isfinite(cost) && (!A || (A->allFinite() && g->allFinite()));
+    };
+    lm = internal::levenberg_marquardt(internal::LmNormalEvaluate(normal), v0, v_lo, v_hi, lmo);
+  } else {
+    lm = internal::levenberg_marquardt(internal::LmEvaluate(evaluate), v0, v_lo, v_hi, lmo);
+  }
   Eigen::VectorXd free_response;  // the estimated free responses, stacked (empty: from rest)
   if (ni > 0 && std::isfinite(lm.cost)) {
     Eigen::VectorXd with, without;
@@ -219,6 +312,8 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
   r.diagnostics.condition_number = internal::gram_condition(lm.jtj);
   r.diagnostics.set(diagnostic::noise_variance, sigma2);
   r.diagnostics.set(diagnostic::delay, r.model.io_delay());
+  r.diagnostics.set(diagnostic::evaluations, lm.evaluations);
+  r.diagnostics.set(diagnostic::jacobian_evaluations, lm.jacobians);
   if (ds.size() > 1) r.diagnostics.set(diagnostic::experiments, static_cast<double>(ds.size()));
   internal::set_termination(
       r.summary, lm,
@@ -265,7 +360,7 @@ void check_record(const IdData& data, const TfOrders& o, const OeOptions& opt, c
                       opt.initial ? opt.initial->order() : 0, o.nf);
 }
 
-void check_common(const Records& ds, const TfOrders& o, const OeOptions& opt, const char* who) {
+void check_common(const internal::RecordRefs& ds, const TfOrders& o, const OeOptions& opt, const char* who) {
   o.validate(/*allow_biproper=*/true);
   opt.validate();
   CTID_REQUIRE(!ds.empty(), "{}: no records given", who);
@@ -302,13 +397,23 @@ OeOptions normalised(const OeOptions& o, const tf_detail::TfNormalisation& n, co
 
 // Runs `fit` (oe or tfest in the units of its record) on the normalised record and maps the result back.
 template <class F>
-Result<TransferFunction> in_normalised_units(const Records& data, const TfOrders& orders, const OeOptions& options, F&& fit) {
+Result<TransferFunction> in_normalised_units(const internal::RecordRefs& data, const TfOrders& orders, const OeOptions& options,
+                                             F&& fit) {
   const auto t0 = std::chrono::steady_clock::now();
   const tf_detail::TfNormalisation n = tf_detail::TfNormalisation::of(data);
   Records normalised_records;
   for (const IdData& d : data) normalised_records.push_back(n.data(d));
   Result<TransferFunction> r = fit(normalised_records, normalised(options, n, orders), t0);
   n.restore(r, orders);
+  // The held parameters exactly as given (the round trip through the normalised units can change their last bit).
+  if (!options.fixed.empty() && r.parameters.values.size() == static_cast<Eigen::Index>(r.parameters.names.size())) {
+    for (const auto& [name, v] : options.fixed)
+      for (std::size_t i = 0; i < r.parameters.names.size(); ++i)
+        if (r.parameters.names[i] == name) r.parameters.values(static_cast<Eigen::Index>(i)) = v;
+    const int nt = orders.nf + orders.nb;
+    const double delay = r.parameters.values.size() > nt ? r.parameters.values(nt) : r.model.io_delay();
+    if (r.model.den().coefficients().allFinite()) r.model = tf_detail::tf_of(r.parameters.values.head(nt), orders, delay);
+  }
   tf_detail::finish_tf_result(r, data.front());
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
@@ -357,7 +462,7 @@ Result<TransferFunction> tfest_in_units(const Records& data, const TfOrders& ord
 // With estimate_initial_state: each record's initial state in the fitted model's realisation, in the record's units —
 // the least-squares state of simulate(Estimated), which spans the same free responses as the fit's E_e(s)/A(s) and
 // so reproduces the fit's simulation.
-void set_initial_states(Result<TransferFunction>& r, const Records& data, const OeOptions& options) {
+void set_initial_states(Result<TransferFunction>& r, const internal::RecordRefs& data, const OeOptions& options) {
   if (!options.estimate_initial_state || !r.model.den().coefficients().allFinite()) return;
   SimulateOptions so;
   so.initial = InitialCondition::Estimated;
@@ -365,11 +470,9 @@ void set_initial_states(Result<TransferFunction>& r, const Records& data, const 
     r.diagnostics.set(diagnostic::x0, simulate(AnyModel(r.model), data[e], so).x0, static_cast<int>(e));
 }
 
-}  // namespace
-
 // oe and tfest estimate in normalised time and amplitude units (issue 13: the result does not depend on the
 // units of the record) and map the result back.
-Result<TransferFunction> oe(const std::vector<IdData>& data, const TfOrders& orders, const OeOptions& options) {
+Result<TransferFunction> oe_records(const internal::RecordRefs& data, const TfOrders& orders, const OeOptions& options) {
   check_common(data, orders, options, "oe");
   Result<TransferFunction> r = in_normalised_units(data, orders, options, [&](const Records& d, const OeOptions& o, auto t0) {
     return oe_in_units(d, orders, o, t0);
@@ -378,7 +481,8 @@ Result<TransferFunction> oe(const std::vector<IdData>& data, const TfOrders& ord
   return r;
 }
 
-Result<TransferFunction> tfest(const std::vector<IdData>& data, const TfOrders& orders, const OeOptions& options) {
+Result<TransferFunction> tfest_records(const internal::RecordRefs& data, const TfOrders& orders,
+                                       const OeOptions& options) {
   check_common(data, orders, options, "tfest");
   Result<TransferFunction> r = in_normalised_units(data, orders, options, [&](const Records& d, const OeOptions& o, auto t0) {
     return tfest_in_units(d, orders, o, t0);
@@ -387,12 +491,22 @@ Result<TransferFunction> tfest(const std::vector<IdData>& data, const TfOrders& 
   return r;
 }
 
+}  // namespace
+
+Result<TransferFunction> oe(const std::vector<IdData>& data, const TfOrders& orders, const OeOptions& options) {
+  return oe_records(data, orders, options);
+}
+
 Result<TransferFunction> oe(const IdData& data, const TfOrders& orders, const OeOptions& options) {
-  return oe(std::vector<IdData>{data}, orders, options);
+  return oe_records(data, orders, options);
+}
+
+Result<TransferFunction> tfest(const std::vector<IdData>& data, const TfOrders& orders, const OeOptions& options) {
+  return tfest_records(data, orders, options);
 }
 
 Result<TransferFunction> tfest(const IdData& data, const TfOrders& orders, const OeOptions& options) {
-  return tfest(std::vector<IdData>{data}, orders, options);
+  return tfest_records(data, orders, options);
 }
 
 }  // namespace ctid

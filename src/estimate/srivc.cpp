@@ -16,6 +16,7 @@
 #include "estimate/svf_common.hpp"
 #include "estimate/tf_common.hpp"
 #include "internal/least_squares.hpp"
+#include "signal/filter_bank.hpp"
 
 namespace ctid {
 
@@ -132,43 +133,6 @@ struct IvRecord {
   double h = 0;                               // > 0: uniformly sampled at this interval (the streaming pass)
 };
 
-// A filter bank of derivative_recursion with S states (a compile-time size: the per-sample loops unroll).
-template <int S>
-struct Bank {
-  double P[S * S], G0[S], G1[S], C[(2 * S + 1) * S], D[2 * S + 1], x[S] = {}, row[2 * S + 1];
-  int m;
-  explicit Bank(const DerivativeRecursion& r) : m(static_cast<int>(r.C.rows())) {
-    CTID_ASSERT(r.Phi.rows() == S && m <= 2 * S + 1);
-    for (int i = 0; i < S; ++i) {
-      for (int l = 0; l < S; ++l) P[i * S + l] = r.Phi(i, l);
-      G0[i] = r.G0(i);
-      G1[i] = r.G1(i);
-    }
-    for (int j = 0; j < m; ++j) {
-      for (int i = 0; i < S; ++i) C[j * S + i] = r.C(j, i);
-      D[j] = r.D(j);
-    }
-  }
-  const double* at(double v) {
-    for (int j = 0; j < m; ++j) {
-      double acc = D[j] * v;
-      for (int i = 0; i < S; ++i) acc += C[j * S + i] * x[i];
-      row[j] = acc;
-    }
-    return row;
-  }
-  void advance(double v, double v_next) {
-    double xn[S];
-    const double dv = v_next - v;
-    for (int i = 0; i < S; ++i) {
-      double acc = G0[i] * v + G1[i] * dv;
-      for (int l = 0; l < S; ++l) acc += P[i * S + l] * x[l];
-      xn[i] = acc;
-    }
-    for (int i = 0; i < S; ++i) x[i] = xn[i];
-  }
-};
-
 // The rows of an open-loop, single-input, delay-free IV step on uniform samples, made and added sample by sample:
 // the banks 1/A of y (FOH) and of u, and B/A^2 of u (the instruments) advance together, so that the step reads y
 // and u once and writes nothing that grows with the record (the same recursions as filtered_derivatives).
@@ -178,8 +142,8 @@ void iv_stream_n(internal::InstrumentalVariables& iv, const Polynomial& A, const
   const TransferFunction F(Polynomial{1.0}, A);
   const Eigen::VectorXd b = theta.segment(n, c.nb);
   const bool aux = b.cwiseAbs().maxCoeff() > 0;
-  Bank<n> yb(derivative_recursion(F, n, h, Intersample::Foh)), ub(derivative_recursion(F, c.nb - 1, h, c.intersample));
-  std::optional<Bank<2 * n>> xb;
+  signal_detail::Bank<n> yb(derivative_recursion(F, n, h, Intersample::Foh)), ub(derivative_recursion(F, c.nb - 1, h, c.intersample));
+  std::optional<signal_detail::Bank<2 * n>> xb;
   if (aux) xb.emplace(derivative_recursion(TransferFunction(Polynomial(b), A * A), n - 1, h, c.intersample));
   std::vector<double> phi(p), zeta(p, 0.0);
   const int m = c.nb - 1;
@@ -206,17 +170,7 @@ void iv_stream_n(internal::InstrumentalVariables& iv, const Polynomial& A, const
 // iv_stream_n for the model order n (1..8); false for another order (the caller uses the matrices).
 bool iv_stream(internal::InstrumentalVariables& iv, const Polynomial& A, const Eigen::VectorXd& y, const IvChannel& c,
                int n, int p, const Eigen::VectorXd& theta, Eigen::Index first, double h) {
-  switch (n) {
-    case 1: iv_stream_n<1>(iv, A, y, c, p, theta, first, h); return true;
-    case 2: iv_stream_n<2>(iv, A, y, c, p, theta, first, h); return true;
-    case 3: iv_stream_n<3>(iv, A, y, c, p, theta, first, h); return true;
-    case 4: iv_stream_n<4>(iv, A, y, c, p, theta, first, h); return true;
-    case 5: iv_stream_n<5>(iv, A, y, c, p, theta, first, h); return true;
-    case 6: iv_stream_n<6>(iv, A, y, c, p, theta, first, h); return true;
-    case 7: iv_stream_n<7>(iv, A, y, c, p, theta, first, h); return true;
-    case 8: iv_stream_n<8>(iv, A, y, c, p, theta, first, h); return true;
-    default: return false;
-  }
+  return signal_detail::with_order(n, [&]<int N>() { iv_stream_n<N>(iv, A, y, c, p, theta, first, h); });
 }
 
 // Adds one record's rows of an SRIVC instrumental-variable step to iv (see iv_step).
@@ -384,7 +338,7 @@ Eigen::VectorXd initial_theta(const Records& ds, const TfOrders& o, double delay
 
 namespace {
 // The checks of srivc()'s inputs, in the user's units (messages name seconds), for each record.
-void check_srivc_inputs(const Records& ds, const TfOrders& orders, const SrivcOptions& options) {
+void check_srivc_inputs(const internal::RecordRefs& ds, const TfOrders& orders, const SrivcOptions& options) {
   CTID_REQUIRE(!ds.empty(), "srivc: no records given");
   for (std::size_t e = 0; e < ds.size(); ++e) {
     const IdData& data = ds[e];
@@ -519,9 +473,9 @@ Result<TransferFunction> srivc_in_units(const Records& ds, const TfOrders& order
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }
-}  // namespace
 
-Result<TransferFunction> srivc(const std::vector<IdData>& data, const TfOrders& orders, const SrivcOptions& options) {
+Result<TransferFunction> srivc_records(const internal::RecordRefs& data, const TfOrders& orders,
+                                       const SrivcOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   orders.validate(/*allow_biproper=*/true);
   options.validate();
@@ -544,8 +498,14 @@ Result<TransferFunction> srivc(const std::vector<IdData>& data, const TfOrders& 
   return r;
 }
 
+}  // namespace
+
+Result<TransferFunction> srivc(const std::vector<IdData>& data, const TfOrders& orders, const SrivcOptions& options) {
+  return srivc_records(data, orders, options);
+}
+
 Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const SrivcOptions& options) {
-  return srivc(std::vector<IdData>{data}, orders, options);
+  return srivc_records(data, orders, options);
 }
 
 template <>

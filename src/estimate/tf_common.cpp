@@ -7,6 +7,7 @@
 #include <cmath>
 #include <complex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ctid/core/check.hpp"
@@ -110,21 +111,20 @@ bool warn_poles_beyond_bandwidth(Result<TransferFunction>& r, const IdData& d) {
   return false;
 }
 
-namespace {
 // Pooled over the records: RMS of u and y over all samples; w_c from the mean squared derivative of y over every
 // record's intervals and the RMS of y about its pooled mean.
-TfNormalisation normalisation_of(const std::vector<const IdData*>& ds) {
+TfNormalisation TfNormalisation::of(const internal::RecordRefs& ds) {
   TfNormalisation n;
   double u2 = 0, y2 = 0, ysum = 0, dy2 = 0;
   long long N = 0, intervals = 0;
-  for (const IdData* d : ds) {
-    const Eigen::VectorXd y = d->y().col(0), u = d->u().col(0);
+  for (const IdData& d : ds) {
+    const auto y = d.y().col(0), u = d.u().col(0);  // in place
     u2 += u.squaredNorm();
     y2 += y.squaredNorm();
     ysum += y.sum();
     N += y.size();
     for (Eigen::Index k = 1; k < y.size(); ++k) {
-      const double dv = (y(k) - y(k - 1)) / (d->time(static_cast<int>(k)) - d->time(static_cast<int>(k - 1)));
+      const double dv = (y(k) - y(k - 1)) / (d.time(static_cast<int>(k)) - d.time(static_cast<int>(k - 1)));
       dy2 += dv * dv;
       ++intervals;
     }
@@ -135,28 +135,19 @@ TfNormalisation normalisation_of(const std::vector<const IdData*>& ds) {
   if (N >= 3 && intervals > 0) {
     const double mean = ysum / double(N);
     double c2 = 0;
-    for (const IdData* d : ds) c2 += (d->y().col(0).array() - mean).matrix().squaredNorm();
+    for (const IdData& d : ds) c2 += (d.y().col(0).array() - mean).matrix().squaredNorm();
     const double wc = std::sqrt(dy2 / double(intervals)) / std::sqrt(c2 / double(N));
     if (wc > 0 && std::isfinite(wc)) n.c = 1.0 / wc;
   }
   return n;
 }
-}  // namespace
-
-TfNormalisation TfNormalisation::of(const IdData& d) { return normalisation_of({&d}); }
-
-TfNormalisation TfNormalisation::of(const std::vector<IdData>& ds) {
-  std::vector<const IdData*> p;
-  for (const IdData& d : ds) p.push_back(&d);
-  return normalisation_of(p);
-}
 
 IdData TfNormalisation::data(const IdData& d) const { return data(d, Eigen::RowVectorXd::Constant(d.nu(), su)); }
 
 IdData TfNormalisation::data(const IdData& d, const Eigen::RowVectorXd& input_scales) const {
-  const Eigen::MatrixXd u = d.u().array().rowwise() / input_scales.array();
-  IdData s = d.is_uniform() ? IdData(u, d.y() / sy, d.ts() / c, d.t0() / c)
-                            : IdData(u, d.y() / sy, Eigen::VectorXd(d.times() / c));
+  Eigen::MatrixXd u = d.u().array().rowwise() / input_scales.array();
+  IdData s = d.is_uniform() ? IdData(std::move(u), d.y() / sy, d.ts() / c, d.t0() / c)
+                            : IdData(std::move(u), d.y() / sy, Eigen::VectorXd(d.times() / c));
   for (int i = 0; i < d.nu(); ++i) s.set_intersample(i, d.intersample(i));
   s.set_input_names(d.input_names());
   s.set_output_names(d.output_names());
@@ -238,10 +229,11 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> pooled_outputs(const TransferFunctio
   for (const IdData& d : ds) {
     const Eigen::Index m = d.size() - first_after(d, transient);
     y.segment(at, m) = d.y().col(0).tail(m);
-    sim.segment(at, m) = lsim(g, d, 0).tail(m);
+    if (m == d.size()) lsim_into(g, d, 0, sim.segment(at, m));  // no transient left out: straight into place
+    else sim.segment(at, m) = lsim(g, d, 0).tail(m);
     at += m;
   }
-  return {y, sim};
+  return {std::move(y), std::move(sim)};
 }
 
 TransferFunction stabilized(const TransferFunction& tf) {

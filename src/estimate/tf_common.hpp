@@ -11,6 +11,7 @@
 #include "ctid/estimate/orders.hpp"
 #include "ctid/model/transfer_function.hpp"
 #include "ctid/validate/uncertainty.hpp"
+#include "data/record_refs.hpp"
 
 namespace ctid::tf_detail {
 
@@ -58,9 +59,8 @@ Result<TransferFunction> pre_estimate(const IdData& d, int nf = 0, bool equation
 /// normalised coefficients are of order one); su, sy are the RMS values of u and y.
 struct TfNormalisation {
   double c = 1.0, su = 1.0, sy = 1.0;
-  static TfNormalisation of(const IdData& d);
-  /// Pooled over several records of one system (one set of units for all).
-  static TfNormalisation of(const std::vector<IdData>& ds);
+  /// Of one record, or pooled over several records of one system (one set of units for all).
+  static TfNormalisation of(const internal::RecordRefs& ds);
   /// The normalised record (times / c, u / su, y / sy; names and intersample kept).
   IdData data(const IdData& d) const;
   /// The same with input i divided by input_scales(i) instead of su (MISO: each input by its own RMS).

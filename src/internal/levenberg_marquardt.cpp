@@ -54,10 +54,15 @@ Eigen::VectorXd diagonal(const Sparse& A) { return A.diagonal(); }
 // The search on the normal equations: normal(x, cost, A, g) sets cost = 1/2 ||r||^2 and, when A and g are not null,
 // A = J^T J and g = J^T r (Normal: dense or sparse).
 template <class Normal, class Evaluate>
-LmResult lm(const Evaluate& normal, Eigen::VectorXd x, const Eigen::VectorXd& lo, const Eigen::VectorXd& hi,
+LmResult lm(const Evaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& lo, const Eigen::VectorXd& hi,
             const LmOptions& o) {
   const Eigen::Index p = x.size();
   LmResult res;
+  auto normal = [&](const Eigen::VectorXd& xv, double& c, Normal* A, Eigen::VectorXd* g) {
+    ++res.evaluations;
+    if (A) ++res.jacobians;
+    return evaluate(xv, c, A, g);
+  };
   x = x.cwiseMax(lo).cwiseMin(hi);
   double cost = INFINITY;
   Normal A;

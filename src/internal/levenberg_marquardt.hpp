@@ -31,6 +31,8 @@ struct LmResult {
   double cost = 0.0;                // 1/2 ||r||^2 at x
   Eigen::MatrixXd jtj;              // J^T J at x
   int iterations = 0;
+  int evaluations = 0;              // residual evaluations, each a pass over the data ..
+  int jacobians = 0;                // .. of which with the Jacobian
   double lambda = 0.0;              // the damping at the end (a search continued in new coordinates starts there)
   bool converged = false;
   bool interrupted = false;         // the progress callback (core/progress.hpp) asked to stop

@@ -115,6 +115,35 @@ TEST(Lsim, GeneratedInputIsSimulatedExactly) {
 // MIMO responses of the two-mode 2x2 system (issue 16): the step response equals the exact simulation of a step input
 // (lsim, ZOH), tends to the DC gain -C A^-1 B + D, the impulse response equals each channel's transfer function's,
 // and the frequency-response matrix equals StateSpace::frequency_response channel by channel.
+TEST(Lsim, ModalStepOfOrdersFourToEightEqualsTheDenseStep) {
+  // Stable single-input models of order 4-8 on uniform samples take lsim's modal path (2 x 2 blocks, two samples per
+  // step); the same model with a second, zero input takes the dense path (one n x n step per sample). Both are exact
+  // discretisations, so they agree to rounding: 1e-10 of the output's range (ZOH and FOH, even and odd N, which
+  // end the two-sample step on either sample).
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> g;
+  for (int order : {4, 5, 7, 8}) {
+    Polynomial den{1.0};
+    for (int i = 0; i < order / 2; ++i) den = den * Polynomial{1.0, 0.2 + 0.3 * i, 4.0 + 9.0 * i};  // resonant pairs
+    if (order % 2) den = den * Polynomial{1.0, 1.5};
+    const TransferFunction tf(Polynomial{0.5, 2.0, den.coefficients()(order)}, den);
+    const StateSpace ss = tf.to_state_space();
+    const StateSpace two(ss.A(), (Eigen::MatrixXd(order, 2) << ss.B(), Eigen::VectorXd::Zero(order)).finished(), ss.C(),
+                         (Eigen::MatrixXd(1, 2) << ss.D(), 0.0).finished());
+    for (Eigen::Index N : {2001, 2000}) {
+      Eigen::MatrixXd u(N, 1), u2 = Eigen::MatrixXd::Zero(N, 2);
+      for (Eigen::Index k = 0; k < N; ++k) u(k, 0) = u2(k, 0) = g(rng);
+      const Eigen::VectorXd t = time_grid(0.01, static_cast<int>(N));
+      for (Intersample is : {Intersample::Zoh, Intersample::Foh}) {
+        const Eigen::MatrixXd modal = lsim(ss, u, t, {is});
+        const Eigen::MatrixXd dense = lsim(two, u2, t, {is, is});
+        const double range = dense.maxCoeff() - dense.minCoeff();
+        EXPECT_LT((modal - dense).cwiseAbs().maxCoeff(), 1e-10 * range) << "order " << order << ", N " << N;
+      }
+    }
+  }
+}
+
 TEST(Lsim, MimoStepImpulseAndFrequencyResponseMatrices) {
   const StateSpace m = ctid::test::ss::two_modes();
   const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(401, 0.0, 40.0);

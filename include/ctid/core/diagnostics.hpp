@@ -38,6 +38,10 @@ inline constexpr ScalarDiagnostic time_scale{"time_scale", "s",
                                              "time unit the estimation ran in (its results are converted back to seconds)"};
 inline constexpr ScalarDiagnostic tau{"tau", "s", "time constant of the state-variable filters 1/(1 + p tau)"};
 inline constexpr ScalarDiagnostic cost{"cost", "", "final value of the least-squares cost"};
+inline constexpr ScalarDiagnostic evaluations{"evaluations", "",
+                                             "cost evaluations of the search (each a simulation pass over the records)"};
+inline constexpr ScalarDiagnostic jacobian_evaluations{"jacobian_evaluations", "",
+                                                      "evaluations of the search that also computed the Jacobian"};
 inline constexpr VectorDiagnostic cost_history{"cost_history", "", "cost after each iteration of the search"};
 inline constexpr VectorDiagnostic err{"err", "%", "error reduction ratio of each selected term, in order of selection"};
 // SRIVC / output error.
