@@ -11,11 +11,11 @@ ctid: ctid.frols(record, ctid.narx_candidates(2, 16, 16), max_terms=20 [, criter
 Times: the least of 3 runs (1 run where a fit takes over 10 s). The selected terms of both are compared.
 """
 import argparse
-import time
 
 import numpy as np
 
 import ctid
+from timing import least_time
 
 
 def record(n):
@@ -39,20 +39,6 @@ def ctid_terms(names):
     return {tuple(sorted(n.split("*"))) if n not in ("1", "constant") else ("1",) for n in names}
 
 
-def timed(f, slow=10.0):
-    t = time.perf_counter()
-    out = f()
-    first = time.perf_counter() - t
-    if first > slow:
-        return first, out
-    times = [first]
-    for _ in range(2):
-        t = time.perf_counter()
-        out = f()
-        times.append(time.perf_counter() - t)
-    return min(times), out
-
-
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--sizes", default="1000,10000,100000")
@@ -72,7 +58,7 @@ def main():
         data = ctid.IdData.from_arrays(u, y, ts=1.0)
         for crit in ("20 terms", "AIC") if n in aic_sizes else ("20 terms",):
             opts = dict(max_terms=20) if crit == "20 terms" else dict(max_terms=20, criterion="aic")
-            t_c, r = timed(lambda: ctid.frols(data, cand, **opts))
+            t_c, r = least_time(lambda: ctid.frols(data, cand, **opts), 3, slow=10.0)
 
             def sid():
                 m = FROLS(order_selection=crit == "AIC", n_terms=None if crit == "AIC" else 20, n_info_values=20,
@@ -80,7 +66,7 @@ def main():
                           basis_function=Polynomial(degree=2))
                 m.fit(X=u.reshape(-1, 1), y=y.reshape(-1, 1))
                 return m
-            t_s, m = timed(sid)
+            t_s, m = least_time(sid, 3, slow=10.0)
             a_terms, b_terms = ctid_terms(r.parameters.names), sid_terms(m.final_model)
             same = "yes" if a_terms == b_terms else f"{len(a_terms & b_terms)} common"
             print(f"| {n} | {crit} | {1e3 * t_c:.1f} ms | {t_s:.2f} s | {t_s / t_c:.0f}x | "

@@ -10,22 +10,12 @@ for reference. Accuracy: the largest difference from an exact reference (SciPy's
 of the state space, run through dlsim) relative to the output's range.
 """
 import argparse
-import time
 
 import numpy as np
 import scipy.signal as ss
 
 import ctid
-
-
-def best(f, repeats=7):
-    out = None
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        out = f()
-        times.append(time.perf_counter() - t)
-    return min(times), out
+from timing import least_time
 
 
 def main():
@@ -45,14 +35,14 @@ def main():
         den = np.real(np.poly(poles))
         num = [den[-1]]
         g = ctid.TransferFunction(num, den)
-        t_ctid, y = best(lambda: g.simulate(u, t))
-        t_out, _ = best(lambda: g.simulate(u, t, out=buf))
+        t_ctid, y = least_time(lambda: g.simulate(u, t), 7)
+        t_out, _ = least_time(lambda: g.simulate(u, t, out=buf), 7)
         bd, ad, _ = ss.cont2discrete((num, den), h, method="zoh")
         bd = np.ravel(bd)
-        t_lf, y_lf = best(lambda: ss.lfilter(bd, ad, u))
+        t_lf, y_lf = least_time(lambda: ss.lfilter(bd, ad, u), 7)
         A, B, C, D = ss.tf2ss(num, den)
         sysd = ss.cont2discrete((A, B, C, D), h, method="zoh")
-        t_dl, (_, y_ref, _) = best(lambda: ss.dlsim(sysd, u), repeats=1)
+        t_dl, (_, y_ref, _) = least_time(lambda: ss.dlsim(sysd, u), 1)
         y_ref = y_ref[:, 0]
         scale = np.ptp(y_ref)
         err_c = np.max(np.abs(y - y_ref)) / scale
