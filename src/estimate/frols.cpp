@@ -308,7 +308,7 @@ void check_siso(const IdData& data, const char* who) {
 }
 
 // Several records concatenated (each checked: one input, one output, uniform at the first record's Ts); one record
-// is read in place (y and u stay empty, one() says so).
+// is read in place (y and u stay empty; `single` points to it).
 struct NarxRecords {
   Eigen::VectorXd y, u;
   std::vector<Eigen::Index> starts;

@@ -115,26 +115,32 @@ void oe_stream_n(const Eigen::VectorXd& theta, int nb, const IdData& d, Eigen::I
   std::optional<signal_detail::Bank<2 * n>> xb;  // none when B = 0 (the a-sensitivities vanish)
   if (A && b.cwiseAbs().maxCoeff() > 0)
     xb.emplace(derivative_recursion(TransferFunction(Polynomial(b), F * F), n - 1, h, is));
+  // Where each free column's sensitivity is read in the banks' rows (those arrays stay in place), with its sign.
   const int p = static_cast<int>(free.size());
-  std::vector<double> psi(static_cast<std::size_t>(p));
+  static constexpr double kZero = 0.0;
+  std::vector<const double*> src(static_cast<std::size_t>(p));
+  std::vector<double> sign(static_cast<std::size_t>(p)), psi(static_cast<std::size_t>(p));
+  for (int jj = 0; jj < p; ++jj) {
+    const int i = free[static_cast<std::size_t>(jj)];
+    const bool a = i < n;  // -s^{n-1-i} B/A^2 u (a_i), s^{nb-1-j}/A u (b_j); J = -S
+    src[static_cast<std::size_t>(jj)] = a ? (xb ? &xb->row[n - 1 - i] : &kZero) : &ub.row[nb - 1 - (i - n)];
+    sign[static_cast<std::size_t>(jj)] = a ? -1.0 : 1.0;
+  }
   const auto u = d.u().col(0);
   const auto y = d.y().col(0);
   const Eigen::Index N = d.size();
   double c = 0.0;
   for (Eigen::Index k = 0; k < N; ++k) {
     const double* ur = ub.at(u(k));
-    const double* xr = xb ? xb->at(u(k)) : nullptr;
+    if (xb) xb->at(u(k));
     if (k >= first) {
       double yhat = 0.0;
       for (int j = 0; j < nb; ++j) yhat += b(j) * ur[nb - 1 - j];
       const double r = y(k) - yhat;
       c += r * r;
       if (A) {
-        // the sensitivity of the simulated output to theta_i: -s^{n-1-i} B/A^2 u (a), s^{nb-1-j}/A u (b); J = -S
-        for (int jj = 0; jj < p; ++jj) {
-          const int i = free[static_cast<std::size_t>(jj)];
-          psi[static_cast<std::size_t>(jj)] = i < n ? (xr ? -xr[n - 1 - i] : 0.0) : ur[nb - 1 - (i - n)];
-        }
+        for (int jj = 0; jj < p; ++jj)
+          psi[static_cast<std::size_t>(jj)] = sign[static_cast<std::size_t>(jj)] * *src[static_cast<std::size_t>(jj)];
         for (int jj = 0; jj < p; ++jj) {
           const double s = psi[static_cast<std::size_t>(jj)];
           (*g)(jj) -= s * r;
@@ -407,9 +413,7 @@ Result<TransferFunction> in_normalised_units(const internal::RecordRefs& data, c
   n.restore(r, orders);
   // The held parameters exactly as given (the round trip through the normalised units can change their last bit).
   if (!options.fixed.empty() && r.parameters.values.size() == static_cast<Eigen::Index>(r.parameters.names.size())) {
-    for (const auto& [name, v] : options.fixed)
-      for (std::size_t i = 0; i < r.parameters.names.size(); ++i)
-        if (r.parameters.names[i] == name) r.parameters.values(static_cast<Eigen::Index>(i)) = v;
+    for (const auto& [name, v] : options.fixed) r.parameters.values(r.parameters.index(name)) = v;
     const int nt = orders.nf + orders.nb;
     const double delay = r.parameters.values.size() > nt ? r.parameters.values(nt) : r.model.io_delay();
     if (r.model.den().coefficients().allFinite()) r.model = tf_detail::tf_of(r.parameters.values.head(nt), orders, delay);

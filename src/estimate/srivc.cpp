@@ -142,7 +142,8 @@ void iv_stream_n(internal::InstrumentalVariables& iv, const Polynomial& A, const
   const TransferFunction F(Polynomial{1.0}, A);
   const Eigen::VectorXd b = theta.segment(n, c.nb);
   const bool aux = b.cwiseAbs().maxCoeff() > 0;
-  signal_detail::Bank<n> yb(derivative_recursion(F, n, h, Intersample::Foh)), ub(derivative_recursion(F, c.nb - 1, h, c.intersample));
+  signal_detail::Bank<n> yb(derivative_recursion(F, n, h, Intersample::Foh));
+  signal_detail::Bank<n> ub(derivative_recursion(F, c.nb - 1, h, c.intersample));
   std::optional<signal_detail::Bank<2 * n>> xb;
   if (aux) xb.emplace(derivative_recursion(TransferFunction(Polynomial(b), A * A), n - 1, h, c.intersample));
   std::vector<double> phi(p), zeta(p, 0.0);
