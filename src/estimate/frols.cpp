@@ -50,15 +50,10 @@ struct Signals {
   }
 };
 
-void candidate_block(const std::vector<NarxTerm>& cand, const Signals& sig, Eigen::Index k0, Eigen::Index rows,
-                     Eigen::MatrixXd& B) {
-  for (size_t m = 0; m < cand.size(); ++m) {
-    auto col = B.col(static_cast<Eigen::Index>(m)).head(rows);
-    col.setOnes();
-    for (const auto& f : cand[m].factors) {
-      col.array() *= sig.of(f.signal).segment(k0 - f.lag, rows).array();
-    }
-  }
+// The column of candidate t over signal indices k0 .. k0 + out.size() - 1.
+void candidate_column(const NarxTerm& t, const Signals& sig, Eigen::Index k0, Eigen::Ref<Eigen::VectorXd> out) {
+  out.setOnes();
+  for (const auto& f : t.factors) out.array() *= sig.of(f.signal).segment(k0 - f.lag, out.size()).array();
 }
 
 // Inner products of every candidate with a vector w, without forming the candidate columns: a candidate
@@ -66,7 +61,7 @@ void candidate_block(const std::vector<NarxTerm>& cand, const Signals& sig, Eige
 // (V+1) x (V+1) matrix Z = (X o (w o prefix))^T X holds all of them — a small matrix product per row block.
 class CandidateProducts {
  public:
-  CandidateProducts(const std::vector<NarxTerm>& cand) {
+  CandidateProducts(const std::vector<NarxTerm>& cand, Eigen::Index block) {
     auto var = [&](const NarxFactor& f) {
       for (size_t i = 0; i < vars_.size(); ++i)
         if (vars_[i] == f) return static_cast<int>(i) + 1;
@@ -85,28 +80,39 @@ class CandidateProducts {
       if (g == prefixes_.end()) prefixes_.push_back(prefix);
       items_.push_back(it);
     }
+    const Eigen::Index V = static_cast<Eigen::Index>(vars_.size()) + 1;
+    Z.assign(prefixes_.size(), Eigen::MatrixXd::Zero(V, V));
+    X.resize(block, V);
+    Vw.resize(block, V);
+    om.resize(block);
   }
 
-  // c_m = sum_k p_m(k) w(k) over rows k = L .. L + Ne - 1 (w indexed from 0); squared: sum_k p_m(k)^2 w(k).
-  Eigen::VectorXd dot(const Signals& sig, Eigen::Index L, const Eigen::VectorXd& w, Eigen::Index block,
-                      bool squared = false) const {
-    const Eigen::Index Ne = w.size(), V = static_cast<Eigen::Index>(vars_.size()) + 1;
-    std::vector<Eigen::MatrixXd> Z(prefixes_.size(), Eigen::MatrixXd::Zero(V, V));
-    Eigen::MatrixXd X(block, V), Vw(block, V);
-    Eigen::VectorXd om(block);
+  // c_m = sum_k p_m(k) w(k) over regression rows r = 0 .. Ne - 1 (signal index k = L + r), with w generated block by
+  // block: weights(r0, rows) returns w over rows r0 .. r0 + rows - 1 (valid until the next call). Squared: the sum of
+  // p_m(k)^2 w(k).
+  // (The block buffers are members, sized once per fit: a fresh buffer per pass would be mapped and faulted anew.)
+  template <class Weights>
+  Eigen::VectorXd dot(const Signals& sig, Eigen::Index L, Eigen::Index Ne, Weights&& weights, bool squared = false) {
+    const Eigen::Index V = X.cols(), block = X.rows();
+    for (auto& z : Z) z.setZero();
     for (Eigen::Index r0 = 0; r0 < Ne; r0 += block) {
       const Eigen::Index rows = std::min(block, Ne - r0);
+      const Eigen::Ref<const Eigen::VectorXd> w = weights(r0, rows);
       X.col(0).head(rows).setOnes();
       for (size_t i = 0; i < vars_.size(); ++i) {
         X.col(static_cast<Eigen::Index>(i) + 1).head(rows) = sig.of(vars_[i].signal).segment(L + r0 - vars_[i].lag, rows);
       }
       if (squared) X.topRows(rows) = X.topRows(rows).array().square().matrix();
       for (size_t g = 0; g < prefixes_.size(); ++g) {
-        om.head(rows) = w.segment(r0, rows);
+        om.head(rows) = w;
         for (int v : prefixes_[g]) om.head(rows).array() *= X.col(v).head(rows).array();
         Vw.topRows(rows) = om.head(rows).asDiagonal() * X.topRows(rows);
         // X^T diag(om) X is symmetric: the lower triangle is enough.
-        Z[g].triangularView<Eigen::Lower>() += Vw.topRows(rows).transpose() * X.topRows(rows);
+        // (Up to a dozen signals the products as dot products of columns are faster; beyond, a packed matrix product.)
+        if (V <= 12)
+          Z[g].triangularView<Eigen::Lower>() += Vw.topRows(rows).transpose().lazyProduct(X.topRows(rows));
+        else
+          Z[g].triangularView<Eigen::Lower>() += Vw.topRows(rows).transpose() * X.topRows(rows);
       }
     }
     Eigen::VectorXd c(static_cast<Eigen::Index>(items_.size()));
@@ -124,17 +130,39 @@ class CandidateProducts {
   std::vector<NarxFactor> vars_;
   std::vector<std::vector<int>> prefixes_;
   std::vector<Item> items_;
+  std::vector<Eigen::MatrixXd> Z;
+  Eigen::MatrixXd X, Vw;
+  Eigen::VectorXd om;
 };
 
-// Several records are concatenated; a regression row k (signal index) belongs to the record that starts at
-// the largest start <= k and is used only when all its lags stay inside that record (k - start >= L). The
-// mask over rows k = L .. N-1 is 1 for used rows and 0 for rows whose lags reach into the previous record.
-Eigen::VectorXd row_mask(const std::vector<Eigen::Index>& starts, Eigen::Index N, Eigen::Index L) {
-  Eigen::VectorXd mask = Eigen::VectorXd::Ones(std::max<Eigen::Index>(0, N - L));
-  for (Eigen::Index s : starts)
-    for (Eigen::Index k = std::max(s, L); k < std::min(s + L, N); ++k) mask(k - L) = 0.0;
-  return mask;
-}
+// Several records are concatenated; a regression row r (signal index k = L + r) belongs to the record that starts at
+// the largest start <= k and is used only when all its lags stay inside that record (k - start >= L). The rows whose
+// lags reach into the previous record are kept as ranges (no N-length mask): zero() clears them in a block of rows.
+class RowMask {
+ public:
+  RowMask(const std::vector<Eigen::Index>& starts, Eigen::Index N, Eigen::Index L) : rows_(std::max<Eigen::Index>(0, N - L)) {
+    for (Eigen::Index s : starts) {
+      const Eigen::Index a = std::max(s, L) - L, b = std::min(s + L, N) - L;
+      if (b > a) holes_.emplace_back(a, b);
+    }
+  }
+  Eigen::Index used() const {
+    Eigen::Index n = rows_;
+    for (const auto& [a, b] : holes_) n -= b - a;
+    return n;
+  }
+  // v holds rows r0 .. r0 + v.size() - 1.
+  void zero(Eigen::Ref<Eigen::VectorXd> v, Eigen::Index r0) const {
+    for (const auto& [a, b] : holes_) {
+      const Eigen::Index lo = std::max(a, r0), hi = std::min(b, r0 + v.size());
+      if (hi > lo) v.segment(lo - r0, hi - lo).setZero();
+    }
+  }
+
+ private:
+  Eigen::Index rows_;
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> holes_;
+};
 
 double criterion_value(InformationCriterion c, double mse, int n, int k) {
   switch (c) {
@@ -151,7 +179,7 @@ double criterion_value(InformationCriterion c, double mse, int n, int k) {
 namespace {
 // FROLS on given signals (e may be all zero when no candidate is a noise term): the records concatenated,
 // record r starting at starts[r] (starts[0] = 0); rows whose lags cross into the previous record are masked out
-// of every inner product (row_mask), so the regression is the stack of the records' own regressions.
+// of every inner product (RowMask), so the regression is the stack of the records' own regressions.
 Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Index>& starts, double Ts,
                                 const std::vector<NarxTerm>& cand, const FrolsOptions& o) {
   const auto t_start = std::chrono::steady_clock::now();
@@ -165,28 +193,43 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
     const Eigen::Index n = (r + 1 < starts.size() ? starts[r + 1] : N) - starts[r];
     CTID_REQUIRE(n > L, "frols: record {} has {} samples, not more than the largest lag {}", r + 1, n, L);
   }
-  const Eigen::VectorXd mask = row_mask(starts, N, L);
-  const Eigen::Index rows_used = static_cast<Eigen::Index>(mask.sum());
+  const RowMask mask(starts, N, L);
+  const Eigen::Index rows_used = mask.used();
   CTID_REQUIRE(rows_used > M, "frols: {} candidate terms but only {} usable rows ({} samples minus the largest lag {}{}); "
                "reduce the lags or the degree", M, rows_used, N, L, starts.size() > 1 ? " in each record" : "");
-  const Eigen::VectorXd yt = y.tail(Ne).cwiseProduct(mask);
-  const double yy = yt.squaredNorm();
-  CTID_REQUIRE(yy > 0, "frols: the output is identically zero");
   const int K = std::min(o.max_terms, M);
   const Eigen::Index BR = std::min<Eigen::Index>(o.block_rows, Ne);
 
-  // Pass 0: p_m^T y and p_m^T p_m.
-  const CandidateProducts products(cand);
-  const Eigen::VectorXd py = products.dot(sig, L, yt, BR);
-  const Eigen::VectorXd pp = products.dot(sig, L, mask, BR, true);
+  // Pass 0: p_m^T y, p_m^T p_m and y^T y over the used rows.
+  CandidateProducts products(cand, BR);
+  Eigen::VectorXd wb(BR);
+  double yy = 0;
+  const Eigen::VectorXd py = products.dot(sig, L, Ne, [&](Eigen::Index r0, Eigen::Index rows) {
+    auto w = wb.head(rows);
+    w = y.segment(L + r0, rows);
+    mask.zero(w, r0);
+    yy += w.squaredNorm();
+    return w;
+  });
+  CTID_REQUIRE(yy > 0, "frols: the output is identically zero");
+  const Eigen::VectorXd pp = products.dot(sig, L, Ne, [&](Eigen::Index r0, Eigen::Index rows) {
+    auto w = wb.head(rows);
+    w.setOnes();
+    mask.zero(w, r0);
+    return w;
+  }, true);
 
   std::vector<int> sel;
   std::vector<double> err, g, ww;
   Eigen::MatrixXd C(K, M);   // C(s, m) = p_m^T w_s
-  Eigen::MatrixXd W(Ne, K);  // orthogonal columns of the selected terms
+  // A(r, s) = c_r,sel(s) / ww_r: w_s = p_sel(s) - sum_{r<s} A(r, s) w_r (A unit upper triangular).
+  Eigen::MatrixXd A = Eigen::MatrixXd::Identity(K, K);
   std::vector<bool> used(M, false);
   Eigen::VectorXd crit(K);
-  Eigen::VectorXd p(Ne);     // the column of the term being selected, then its orthogonal part
+  // The orthogonal columns w_r of the selected terms are not stored (N x K): each pass regenerates them block by
+  // block from the candidate columns with the Gram-Schmidt coefficients already found, w_r = p_sel(r) - sum_{q<r}
+  // A(q, r) w_q (an (s + 1)-column block in the cache costs less than reading s stored N-columns from memory).
+  Eigen::MatrixXd Wb(BR, K);
   double err_sum = 0;
   bool interrupted = false;
   for (int s = 0; s < K; ++s) {
@@ -211,22 +254,25 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
       }
     }
     if (best < 0) break;
-    // w_s = p_best - sum_r (c_r,best / ww_r) w_r, then c_s,m = p_m^T w_s for every candidate.
-    for (Eigen::Index r0 = 0; r0 < Ne; r0 += BR) {
-      const Eigen::Index rows = std::min(BR, Ne - r0);
-      Eigen::MatrixXd one(rows, 1);
-      candidate_block({cand[best]}, sig, L + r0, rows, one);
-      p.segment(r0, rows) = one.col(0);
-    }
-    p.array() *= mask.array();
-    for (int r = 0; r < s; ++r) p -= (C(r, best) / ww[r]) * W.col(r);
-    W.col(s) = p;
-    const double w2 = p.squaredNorm();
-    C.row(s) = products.dot(sig, L, W.col(s), BR).transpose();
     used[best] = true;
     sel.push_back(best);
+    for (int q = 0; q < s; ++q) A(q, s) = C(q, best) / ww[q];
+    // One pass: w_s block by block, its norm and w_s^T y, and c_s,m = p_m^T w_s for every candidate.
+    double w2 = 0, wy = 0;
+    C.row(s) = products.dot(sig, L, Ne, [&](Eigen::Index r0, Eigen::Index rows) {
+      for (int r = 0; r <= s; ++r) {
+        auto w = Wb.col(r).head(rows);
+        candidate_column(cand[sel[r]], sig, L + r0, w);
+        mask.zero(w, r0);
+        w.noalias() -= Wb.topLeftCorner(rows, r) * A.col(r).head(r);
+      }
+      const auto w = Wb.col(s).head(rows);
+      w2 += w.squaredNorm();
+      wy += w.dot(y.segment(L + r0, rows));  // (w is zero on the masked rows)
+      return w;
+    }).transpose();
     ww.push_back(w2);
-    g.push_back(W.col(s).dot(yt) / w2);
+    g.push_back(wy / w2);
     err.push_back(g.back() * g.back() * w2 / yy);
     err_sum += err.back();
     const double mse_k = std::max(0.0, yy * (1 - err_sum)) / static_cast<double>(rows_used);
@@ -240,16 +286,14 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
     crit.head(k).minCoeff(&best);
     k = static_cast<int>(best) + 1;
   }
-  // theta from A theta = g, A unit upper triangular with A(r, s) = c_r,sel(s) / ww_r.
-  Eigen::MatrixXd A = Eigen::MatrixXd::Identity(k, k);
-  for (int s = 0; s < k; ++s)
-    for (int r = 0; r < s; ++r) A(r, s) = C(r, sel[s]) / ww[r];
+  // theta from A theta = g over the k terms kept.
   Eigen::VectorXd gv(k), winv(k);
   for (int s = 0; s < k; ++s) {
     gv(s) = g[s];
     winv(s) = 1.0 / ww[s];
   }
-  const auto Atri = A.triangularView<Eigen::UnitUpper>();
+  const Eigen::MatrixXd Ak = A.topLeftCorner(k, k);
+  const auto Atri = Ak.triangularView<Eigen::UnitUpper>();
   const Eigen::VectorXd theta = Atri.solve(gv);
   double esr = 1;
   for (int s = 0; s < k; ++s) esr -= err[s];
@@ -272,27 +316,32 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
     res.diagnostics.set(diagnostic::criterion, crit.head(static_cast<Eigen::Index>(sel.size())));
   res.diagnostics.set(diagnostic::esr, esr);
   res.diagnostics.set(diagnostic::candidates, M);
-  res.diagnostics.condition_number = Ainv.norm() * A.norm();
-  // The fit: each record's free run from its own first L measured outputs, pooled after those L samples.
+  res.diagnostics.condition_number = Ainv.norm() * Ak.norm();
+  // The fit: each record's free run from its own first L measured outputs, compared with the measured output after
+  // those L samples. The run is simulated a block at a time (the model's state is its last L outputs) and the sums
+  // of squares are accumulated, the deviations from the mean merged block by block (Chan, Golub & LeVeque 1983), so
+  // the fit needs no N-length buffer.
   const NarxModel process = res.model.process();
-  Eigen::VectorXd ypool(N - L * static_cast<Eigen::Index>(starts.size())), spool(ypool.size());
+  double sse = 0, sst = 0, mean = 0;
+  Eigen::Index n_fit = 0;
   bool escaped = false;
-  for (size_t r = 0, at = 0; r < starts.size(); ++r) {
-    const Eigen::Index n = (r + 1 < starts.size() ? starts[r + 1] : N) - starts[r];
-    bool esc = false;
-    const Eigen::VectorXd ys =
-        process.simulate(u.segment(starts[r], n), y.segment(starts[r], L), &esc);
-    escaped = escaped || esc;
-    ypool.segment(static_cast<Eigen::Index>(at), n - L) = y.segment(starts[r] + L, n - L);
-    spool.segment(static_cast<Eigen::Index>(at), n - L) = ys.tail(n - L);
-    at += static_cast<size_t>(n - L);
+  for (size_t r = 0; r < starts.size() && !escaped; ++r) {
+    const Eigen::Index end = r + 1 < starts.size() ? starts[r + 1] : N;
+    Eigen::VectorXd last = y.segment(starts[r], L);  // the run's last L outputs
+    for (Eigen::Index k0 = starts[r] + L; k0 < end && !escaped; k0 += BR) {
+      const Eigen::Index rows = std::min(BR, end - k0);
+      const Eigen::VectorXd run = process.simulate(u.segment(k0 - L, rows + L), last, &escaped);
+      last = run.tail(L);
+      const auto yb = y.segment(k0, rows);
+      sse += (yb - run.tail(rows)).squaredNorm();
+      const double mb = yb.mean(), delta = mb - mean, n = static_cast<double>(n_fit + rows);
+      sst += (yb.array() - mb).square().sum() + delta * delta * static_cast<double>(n_fit) * static_cast<double>(rows) / n;
+      mean += delta * static_cast<double>(rows) / n;
+      n_fit += rows;
+    }
   }
-  if (escaped) {
-    res.fit = fit_report_or_inf(ypool, Eigen::VectorXd::Constant(ypool.size(), NAN), k);
-    res.diagnostics.warnings.push_back("the free-run simulation of the selected model escapes (blows up)");
-  } else {
-    res.fit = fit_report_or_inf(ypool, spool, k);
-  }
+  if (escaped) res.diagnostics.warnings.push_back("the free-run simulation of the selected model escapes (blows up)");
+  res.fit = fit_report_from_sums(escaped ? std::numeric_limits<double>::infinity() : sse, sst, static_cast<int>(n_fit), k);
   res.summary.iterations = static_cast<int>(sel.size());
   if (interrupted) {
     res.summary.termination = Termination::Interrupted;
@@ -439,14 +488,13 @@ Result<NarxModel> narmax_records(const internal::RecordRefs& data, const std::ve
   Eigen::VectorXd e = Eigen::VectorXd::Zero(y.size());
   auto residuals = [&](const NarxModel& m) {
     const Eigen::Index L = m.max_lag(), Ne = y.size() - L;
-    Eigen::VectorXd next = Eigen::VectorXd::Zero(y.size());
-    Eigen::MatrixXd col(Ne, 1);
+    Eigen::VectorXd next = Eigen::VectorXd::Zero(y.size()), col(Ne);
     next.tail(Ne) = y.tail(Ne);
     for (size_t i = 0; i < m.terms().size(); ++i) {
-      candidate_block({m.terms()[i]}, {y, u, e}, L, Ne, col);
-      next.tail(Ne) -= m.coefficients()(static_cast<Eigen::Index>(i)) * col.col(0);
+      candidate_column(m.terms()[i], {y, u, e}, L, col);
+      next.tail(Ne) -= m.coefficients()(static_cast<Eigen::Index>(i)) * col;
     }
-    next.tail(Ne).array() *= row_mask(rec.starts, y.size(), L).array();  // a record's first L residuals are 0
+    RowMask(rec.starts, y.size(), L).zero(next.tail(Ne), 0);  // a record's first L residuals are 0
     return next;
   };
   for (; it < o.iterations && !o.noise_candidates.empty(); ++it) {

@@ -162,7 +162,7 @@ NarxModel NarxModel::process() const {
 
 namespace {
 // sum_m theta_m prod x_f(k - lag_f) with y and e given up to (and u including) sample k.
-double evaluate(const std::vector<NarxTerm>& terms, const Eigen::VectorXd& theta, const Eigen::VectorXd& u,
+double evaluate(const std::vector<NarxTerm>& terms, const Eigen::VectorXd& theta, const Eigen::Ref<const Eigen::VectorXd>& u,
                 const Eigen::VectorXd& y, const Eigen::VectorXd* e, Eigen::Index k) {
   double s = 0;
   for (size_t m = 0; m < terms.size(); ++m) {
@@ -177,7 +177,8 @@ double evaluate(const std::vector<NarxTerm>& terms, const Eigen::VectorXd& theta
 }
 }  // namespace
 
-Eigen::VectorXd NarxModel::simulate(const Eigen::VectorXd& u, const Eigen::VectorXd& y0, bool* escaped) const {
+Eigen::VectorXd NarxModel::simulate(const Eigen::Ref<const Eigen::VectorXd>& u, const Eigen::VectorXd& y0,
+                                    bool* escaped) const {
   const Eigen::Index N = u.size(), L = max_lag();
   CTID_REQUIRE(u.allFinite(), "NarxModel::simulate: the input has non-finite samples");
   CTID_REQUIRE(y0.size() == 0 || y0.size() >= std::min<Eigen::Index>(L, N),

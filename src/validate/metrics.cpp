@@ -9,7 +9,7 @@
 namespace ctid {
 
 namespace {
-void check_pair(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, const char* what) {
+void check_pair(const Eigen::Ref<const Eigen::VectorXd>& y, const Eigen::Ref<const Eigen::VectorXd>& yhat, const char* what) {
   CTID_REQUIRE(y.size() == yhat.size(), "{}: y has {} samples but the model output has {}", what, y.size(), yhat.size());
   CTID_REQUIRE(y.size() >= 2, "{}: need at least 2 samples (got {})", what, y.size());
 }
@@ -45,11 +45,9 @@ double aicc(double v, int N, int d) {
 double bic(double v, int N, int d) { return N * std::log(v) + d * std::log(double(N)); }
 
 namespace {
-// Two passes: the mean of y, then the sums of squares of y - mean and of y - yhat.
-FitReport fill(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, int d, double* sd_out) {
-  FitReport r;
-  r.n_samples = static_cast<int>(y.size());
-  r.n_parameters = d;
+// Two passes: the mean of y, then the sums of squares of y - yhat (*se) and of y - mean (*sd).
+void sums(const Eigen::Ref<const Eigen::VectorXd>& y, const Eigen::Ref<const Eigen::VectorXd>& yhat, double* se_out,
+          double* sd_out) {
   const double m = y.mean();
   double se = 0, sd = 0;
   for (Eigen::Index k = 0; k < y.size(); ++k) {
@@ -57,31 +55,43 @@ FitReport fill(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, int d, dou
     se += e * e;
     sd += c * c;
   }
+  *se_out = se;
   *sd_out = sd;
-  r.mse = se / double(y.size());
+}
+
+FitReport fill(double se, double sd, int n, int d) {
+  FitReport r;
+  r.n_samples = n;
+  r.n_parameters = d;
+  r.mse = se / double(n);
   r.nrmse = std::sqrt(se / sd);
   r.fit_percent = 100.0 * (1.0 - r.nrmse);
-  r.fpe = fpe(r.mse, r.n_samples, d);
-  r.aic = aic(r.mse, r.n_samples, d);
-  r.aicc = aicc(r.mse, r.n_samples, d);
-  r.bic = bic(r.mse, r.n_samples, d);
+  r.fpe = fpe(r.mse, n, d);
+  r.aic = aic(r.mse, n, d);
+  r.aicc = aicc(r.mse, n, d);
+  r.bic = bic(r.mse, n, d);
   return r;
 }
 }  // namespace
 
-FitReport fit_report(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, int d) {
+FitReport fit_report(const Eigen::Ref<const Eigen::VectorXd>& y, const Eigen::Ref<const Eigen::VectorXd>& yhat, int d) {
   check_pair(y, yhat, "fit_report");
-  double sd = 0;
-  FitReport r = fill(y, yhat, d, &sd);
+  double se = 0, sd = 0;
+  sums(y, yhat, &se, &sd);
   CTID_REQUIRE(sd > 0, "fit_report: the measured output is constant; the normalisation is zero");
-  return r;
+  return fill(se, sd, static_cast<int>(y.size()), d);
 }
 
-FitReport fit_report_or_inf(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, int d) {
+FitReport fit_report_or_inf(const Eigen::Ref<const Eigen::VectorXd>& y, const Eigen::Ref<const Eigen::VectorXd>& yhat, int d) {
   check_pair(y, yhat, "fit_report");
-  double sd = 0;
-  FitReport r = fill(y, yhat, d, &sd);
-  if (!(sd > 0) || !std::isfinite(r.mse)) {
+  double se = 0, sd = 0;
+  sums(y, yhat, &se, &sd);
+  return fit_report_from_sums(se, sd, static_cast<int>(y.size()), d);
+}
+
+FitReport fit_report_from_sums(double sse, double sst, int n_samples, int d) {
+  FitReport r = fill(sse, sst, n_samples, d);
+  if (!(sst > 0) || !std::isfinite(r.mse)) {
     r.fit_percent = -kInf;
     r.nrmse = r.mse = r.fpe = r.aic = r.aicc = r.bic = kInf;
   }

@@ -7,6 +7,7 @@
 #include "ctid/core/error.hpp"
 #include "ctid/data/input_design.hpp"
 #include "ctid/estimate/frols.hpp"
+#include "ctid/validate/metrics.hpp"
 #include "ctid/validate/residuals.hpp"
 #include "test_util.hpp"
 
@@ -243,4 +244,44 @@ TEST(Frols, SeveralRecordsAreOneStackedRegressionMoreAccurateThanEither) {
             std::string::npos);
   EXPECT_NE(test::error_of([&] { frols(std::vector<IdData>{a, record_from(100, 0.0, 6, 1.0, {1.0, 2.0}).slice(0, 2)}, terms, o); }).find("record 2 has 2 samples"),
             std::string::npos);
+}
+
+TEST(Frols, StreamedPassesDoNotDependOnTheBlockAndTheFitIsEachRecordsFreeRun) {
+  // FROLS regenerates the orthogonal columns and simulates the fit block by block (no N-length buffers). The block
+  // size must change nothing beyond round-off: selection, coefficients, ERR, and the fit, which must equal the
+  // pooled free runs of NarxModel::simulate from each record's own first L outputs (the independent reference,
+  // computed here with fit_report_or_inf over whole vectors). Block sizes 16 and 4096 against 10 000 rows: the
+  // 16-row blocks cross every record boundary and lag mask.
+  const auto cand = narx_candidates(2, 2, 2);
+  const IdData one = record(10000, 0.02, 4);
+  const std::vector<IdData> two = {record_from(3001, 0.02, 7, 1.0, {0, 0}), record_from(2003, 0.02, 8, 0.7, {1.0, -0.5})};
+  for (int records : {1, 2}) {
+    auto fit = [&](int block) {
+      const FrolsOptions o{.max_terms = 8, .block_rows = block};
+      return records == 1 ? frols(one, cand, o) : frols(two, cand, o);
+    };
+    const Result<NarxModel> a = fit(16), b = fit(4096);
+    ASSERT_EQ(a.parameters.names, b.parameters.names);
+    EXPECT_LT((a.parameters.values - b.parameters.values).cwiseAbs().maxCoeff(), 1e-12 * b.parameters.values.cwiseAbs().maxCoeff());
+    EXPECT_LT((a.diagnostics.get(diagnostic::err) - b.diagnostics.get(diagnostic::err)).cwiseAbs().maxCoeff(), 1e-10);
+    // The reference fit of b's model.
+    const NarxModel process = b.model.process();
+    const Eigen::Index L = 2;
+    Eigen::VectorXd ym, ys;
+    for (const IdData& d : records == 1 ? std::vector<IdData>{one} : two) {
+      const Eigen::VectorXd run = process.simulate(d.u().col(0), d.y().col(0).head(L));
+      const Eigen::Index n = d.size() - L, at = ym.size();
+      ym.conservativeResize(at + n);
+      ys.conservativeResize(at + n);
+      ym.tail(n) = d.y().col(0).tail(n);
+      ys.tail(n) = run.tail(n);
+    }
+    const FitReport ref = fit_report_or_inf(ym, ys, static_cast<int>(b.parameters.size()));
+    for (const Result<NarxModel>* r : {&a, &b}) {
+      EXPECT_EQ(r->fit.n_samples, ref.n_samples);
+      EXPECT_NEAR(r->fit.fit_percent, ref.fit_percent, 1e-9 * std::abs(ref.fit_percent)) << records << " records";
+      EXPECT_NEAR(r->fit.mse, ref.mse, 1e-10 * ref.mse);
+      EXPECT_NEAR(r->fit.aic, ref.aic, 1e-9 * std::abs(ref.aic));
+    }
+  }
 }

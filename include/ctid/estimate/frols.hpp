@@ -2,9 +2,12 @@
 // polynomial NARX structure detection (Billings & Li 1999, BL-D1 and BL 28-32 / SEEDS-SPEC BL-D6; the
 // algorithm of Billings, Chen & Korenberg 1989).
 //
-// Memory: the candidate matrix (N x M) is never stored. Candidate columns are generated in row blocks;
-// each step needs only the inner products of every candidate with the newest orthogonal vector, so the
-// workspace is O(block x M + N x terms + M x terms).
+// Memory: FROLS on one record stores nothing of the record's length N besides the record (several records are
+// concatenated once; NARMAX keeps its residual signal). Candidate columns are generated in row blocks;
+// each step needs only the inner products of every candidate with the newest orthogonal vector, which is
+// regenerated block by block from the selected terms' columns with the Gram-Schmidt coefficients already
+// found, and the fit's free run is simulated a block at a time. Workspace O(block x (variables + terms) +
+// M x terms); time per sample and term O(variables^2 + terms) (measured in docs/benchmarks.md).
 #pragma once
 
 #include <vector>

@@ -60,7 +60,9 @@ class NarxModel {
   /// Free-run simulation driven by u: y(k) for k >= max_lag from the model's own past outputs; the first
   /// max_lag outputs are taken from y0 (size >= max_lag; zeros when empty). Noise terms are zero.
   /// Stops at the first non-finite value: the rest is NaN and *escaped (if given) is set to true.
-  Eigen::VectorXd simulate(const Eigen::VectorXd& u, const Eigen::VectorXd& y0 = {}, bool* escaped = nullptr) const;
+  /// (u is read in place: a column or segment of a record is not copied.)
+  Eigen::VectorXd simulate(const Eigen::Ref<const Eigen::VectorXd>& u, const Eigen::VectorXd& y0 = {},
+                           bool* escaped = nullptr) const;
   /// k-step-ahead prediction from measured (u, y): y^(k | k - steps); steps = 1 is the one-step predictor.
   /// Noise terms use the one-step residuals. The first max_lag values are the measured ones.
   Eigen::VectorXd predict(const Eigen::VectorXd& u, const Eigen::VectorXd& y, int steps = 1) const;

@@ -30,9 +30,14 @@ double aicc(double mse, int n_samples, int n_parameters);
 double bic(double mse, int n_samples, int n_parameters);
 /// All of the above for measured y and model output yhat with d free parameters.
 /// Throws InvalidArgument for size mismatch, fewer than 2 samples or a constant y.
-FitReport fit_report(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, int n_parameters);
+FitReport fit_report(const Eigen::Ref<const Eigen::VectorXd>& y, const Eigen::Ref<const Eigen::VectorXd>& yhat,
+                     int n_parameters);
 /// The same, but a non-finite model output (an unstable simulation) or a constant y gives
 /// fit_percent = -Inf and +Inf errors instead of an exception. Used for estimators' reports.
-FitReport fit_report_or_inf(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, int n_parameters);
+FitReport fit_report_or_inf(const Eigen::Ref<const Eigen::VectorXd>& y, const Eigen::Ref<const Eigen::VectorXd>& yhat,
+                            int n_parameters);
+/// fit_report_or_inf from sums accumulated elsewhere (a fit streamed block by block): sse = sum (y - yhat)^2 and
+/// sst = sum (y - mean(y))^2 over n_samples.
+FitReport fit_report_from_sums(double sse, double sst, int n_samples, int n_parameters);
 
 }  // namespace ctid
