@@ -44,6 +44,13 @@ def test_narx_kia_and_refinement_reconstruct_bl33(bl33):
     assert ctid.kia_linear(r.model, y_order=2, u_order=0, max=500).parameters.values.tolist() == lin.parameters.values.tolist()
     with pytest.raises(ValueError, match="Nyquist frequency pi/T = 1256.6"):
         ctid.kia_linear(r.model, max=2000)
+    # The paper's centred ERR (BL 32) is the same option name as in C++ and the CLI; it changes only the ERR
+    # scale, not the coefficients of this complete linear model (C++ test Kia.ThePapersCentredErrAndTheHoldFactorAreOptions):
+    # each ERR grows by the centring factor (here 1.0002, the mean of the synthetic data being small), ranks unchanged.
+    centred = ctid.kia_linear(r.model, y_order=2, u_order=0, err_centred=True)
+    assert np.allclose(centred.parameters.values, lin.parameters.values, rtol=1e-12)
+    ratio = centred.diagnostics.vectors["err"] / lin.diagnostics.vectors["err"]
+    assert np.allclose(ratio, ratio[0], rtol=1e-9) and 1.00001 < ratio[0] < 1.001
 
 
 def test_gfrf_and_harmonic_probing(bl33):

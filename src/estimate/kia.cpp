@@ -33,14 +33,17 @@ Eigen::VectorXd solve_stacked(const Eigen::MatrixXcd& P, const Eigen::VectorXcd&
   return x.cwiseQuotient(scale);
 }
 
-// ERR (% of b^T b, uncentred) of every column by forward orthogonal selection (BL 28-32), aligned with the columns.
-Eigen::VectorXd forward_err(const Eigen::MatrixXcd& P, const Eigen::VectorXcd& z) {
+// ERR (% of b^T b, uncentred) of every column by forward orthogonal selection (BL 28-32), aligned with the columns,
+// b the stacked real system [Re z; Im z]. *centring: b^T b / (b^T b - (sum b)^2 / rows), the factor that turns these
+// into the paper's centred ERR (BL 32: its denominator is sum z^2 - (1/N)(sum z)^2; the order of selection is the same).
+Eigen::VectorXd forward_err(const Eigen::MatrixXcd& P, const Eigen::VectorXcd& z, double* centring) {
   const Eigen::Index n = P.rows(), p = P.cols();
   Eigen::MatrixXd W(2 * n, p);
   Eigen::VectorXd b(2 * n);
   W << P.real(), P.imag();
   b << z.real(), z.imag();
   const double bb = b.squaredNorm();
+  *centring = bb / (bb - b.sum() * b.sum() / static_cast<double>(b.size()));
   Eigen::VectorXd err = Eigen::VectorXd::Zero(p);
   std::vector<bool> used(p, false);
   for (Eigen::Index step = 0; step < p; ++step) {
@@ -73,6 +76,7 @@ Eigen::VectorXd forward_err(const Eigen::MatrixXcd& P, const Eigen::VectorXcd& z
 
 struct Gls {
   Eigen::VectorXd theta, first, err;
+  double centring = 1;  // err * centring: the centred ERR (forward_err)
   int iterations = 0, order = 0;
   bool converged = true;
 };
@@ -116,7 +120,7 @@ Gls gls(const Eigen::MatrixXcd& P, const Eigen::VectorXcd& z, const Eigen::Vecto
     }
     r.iterations = std::min(r.iterations, max_iterations);
   }
-  r.err = forward_err(F.asDiagonal() * P, F.cwiseProduct(z));
+  r.err = forward_err(F.asDiagonal() * P, F.cwiseProduct(z), &r.centring);
   return r;
 }
 
@@ -199,7 +203,10 @@ OptionTable<O>& stage_settings(OptionTable<O>& t) {
       .real("gls_tolerance", &O::tolerance, "", above(0), "relative change of the coefficients that stops GLS")
       .real("err_threshold", &O::err_threshold, "%", OptionRange{0, 100, false, true, {}, {}},
             "prune terms with a smaller ERR after convergence, then re-estimate (0: keep all)")
-      .flag("zoh", &O::zoh, "divide the NARX kernels by the hold factor Z(s) (held input; the CLI takes it from the data)");
+      .flag("zoh", &O::zoh, "divide the NARX kernels by the hold factor Z(s) (held input; the CLI takes it from the data)")
+      .flag("err_centred", &O::err_centred,
+            "ERR over the centred data, sum z^2 - (sum z)^2 / N (the paper's BL 32; default: uncentred, whose ERRs of a "
+            "complete model sum to 100 %)");
 }
 }  // namespace
 
@@ -294,12 +301,18 @@ Gls gls_auto(const Eigen::MatrixXcd& P, const Eigen::VectorXcd& z, const Eigen::
   return best;
 }
 
-// Run GLS on a candidate set, prune by ERR and re-run; returns the fit and the retained column indices.
+// Run GLS on a candidate set, prune by ERR and re-run; returns the fit (its err centred when asked: the ERR the
+// pruning compares with the threshold and the one reported) and the retained column indices.
 Gls fit_and_prune(const Eigen::MatrixXcd& P, const Eigen::VectorXcd& z, const Eigen::VectorXcd& v, int G, int iters,
-                  double tol, double threshold, std::vector<int>& keep) {
+                  double tol, double threshold, bool centred, std::vector<int>& keep) {
   keep.resize(P.cols());
   for (Eigen::Index j = 0; j < P.cols(); ++j) keep[j] = static_cast<int>(j);
-  Gls r = gls_auto(P, z, v, G, iters, tol);
+  auto fit = [&](const Eigen::MatrixXcd& Pk) {
+    Gls g = gls_auto(Pk, z, v, G, iters, tol);
+    if (centred) g.err *= g.centring;
+    return g;
+  };
+  Gls r = fit(P);
   if (threshold > 0) {
     std::vector<int> kept;
     for (Eigen::Index j = 0; j < P.cols(); ++j)
@@ -308,7 +321,7 @@ Gls fit_and_prune(const Eigen::MatrixXcd& P, const Eigen::VectorXcd& z, const Ei
       Eigen::MatrixXcd Pk(P.rows(), static_cast<Eigen::Index>(kept.size()));
       for (size_t j = 0; j < kept.size(); ++j) Pk.col(static_cast<Eigen::Index>(j)) = P.col(kept[j]);
       keep = kept;
-      r = gls_auto(Pk, z, v, G, iters, tol);
+      r = fit(Pk);
     }
   }
   return r;
@@ -383,7 +396,7 @@ Result<NdeModel> kia_linear(const NarxModel& narx, const KiaLinearOptions& o) {
     terms.push_back({{{false, l}}});
   }
   std::vector<int> keep;
-  const Gls g = fit_and_prune(P, z, v, o.gls_order, o.max_iterations, o.tolerance, o.err_threshold, keep);
+  const Gls g = fit_and_prune(P, z, v, o.gls_order, o.max_iterations, o.tolerance, o.err_threshold, o.err_centred, keep);
   return extended(NdeModel({{{{false, 0}}}}, Eigen::VectorXd::Ones(1)), terms, keep, g, t_start);
 }
 
@@ -415,7 +428,7 @@ Result<NdeModel> kia_quadratic(const NarxModel& narx, const NdeModel& linear_in,
   CTID_REQUIRE(z.allFinite(), "kia_quadratic: the NARX second-order kernel is not finite at the points");
   CTID_REQUIRE(P.allFinite(), "kia_quadratic: the linear model's H_1 is not finite at the points (a pole on an axis?)");
   std::vector<int> keep;
-  const Gls g = fit_and_prune(P, z, v, o.gls_order, o.max_iterations, o.tolerance, o.err_threshold, keep);
+  const Gls g = fit_and_prune(P, z, v, o.gls_order, o.max_iterations, o.tolerance, o.err_threshold, o.err_centred, keep);
   return extended(linear, o.candidates, keep, g, t_start);
 }
 
@@ -465,7 +478,7 @@ Result<NdeModel> kia_cubic(const NarxModel& narx, const NdeModel& model_in, cons
   CTID_REQUIRE(z.allFinite(), "kia_cubic: the NARX third-order kernel is not finite at the points");
   CTID_REQUIRE(P.allFinite(), "kia_cubic: the model's kernels are not finite at the points (a pole on an axis?)");
   std::vector<int> keep;
-  const Gls g = fit_and_prune(P, z, v, o.gls_order, o.max_iterations, o.tolerance, o.err_threshold, keep);
+  const Gls g = fit_and_prune(P, z, v, o.gls_order, o.max_iterations, o.tolerance, o.err_threshold, o.err_centred, keep);
   return extended(model, o.candidates, keep, g, t_start);
 }
 

@@ -57,6 +57,11 @@ struct KiaLinearOptions {
   double tolerance = 1e-8;     ///< relative change of the coefficients between GLS iterations
   double err_threshold = 0.0;  ///< % : > 0 prunes terms with a smaller ERR after convergence, then re-estimates
   bool zoh = true;             ///< divide the NARX kernel by the hold factor Z(s) (data sampled with a held input)
+  /// ERR denominator: false (default) sum z^2 over the stacked real system, so the ERRs of a complete model sum to
+  /// 100 % (the gls_order = -1 rule relies on that); true: the paper's centred sum z^2 - (sum z)^2 / N (BL 32),
+  /// every ERR scaled by the same factor (the ranking is the same; the sum can pass 100 %). Used for pruning and
+  /// reported in "err" / "err_sum"; the automatic GLS order always uses the uncentred sum.
+  bool err_centred = false;
   void validate() const;
 };
 template <>
@@ -77,6 +82,7 @@ struct KiaQuadraticOptions {
   double tolerance = 1e-8;
   double err_threshold = 0.0;       ///< % : prune below it after convergence, then re-estimate
   bool zoh = true;
+  bool err_centred = false;         ///< as KiaLinearOptions::err_centred
   void validate() const;
 };
 template <>
@@ -95,6 +101,7 @@ struct KiaCubicOptions {
   double tolerance = 1e-8;
   double err_threshold = 0.0;
   bool zoh = true;
+  bool err_centred = false;  ///< as KiaLinearOptions::err_centred
   void validate() const;
 };
 template <>
