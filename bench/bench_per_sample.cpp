@@ -1,13 +1,14 @@
 // Time and memory per sample of SRIVC, OE, FROLS and lsim from N = 1e4 to 1e7 (issue 18, "one core"): the time per
 // sample should not grow with N (no allocation whose page faults grow with the record, no temporaries that fall out
 // of cache); the peak memory of one fit above the record itself, in bytes per sample, shows the O(N) constant.
-// Run: build/bench/bench_per_sample [N_MAX=10000000] [METHODS=srivc,oe,oe-start,frols,lsim,lsim-new]
+// Run: build/bench/bench_per_sample [N_MAX=10000000] [METHODS=srivc,oe,oe-start,frols,lsim,lsim-data,lsim-new]
 //
 // Problems: SRIVC and OE fit the Rao-Garnier system (-6400 s + 1600)/(s^4 + 5 s^3 + 408 s^2 + 416 s + 1600) (nb = 2,
 // nf = 4) to a PRBS response at Ts = 10 ms with 10 dB output noise (oe-start: from a given start, the system with each
 // coefficient 5 % off, so without the LSSVF and SRIVC start-up fits); lsim simulates it (ZOH) into a buffer reused
-// from run to run (lsim_into), lsim-new into a new vector each time (its pages faulted anew above glibc's mmap
-// threshold); FROLS selects 5 terms of the 15 degree-2 candidates of lags 1..2 (constant included) for a NARX record
+// from run to run (lsim_into with the sample times, which it reads to check they are uniform), lsim-data the same from
+// the IdData record (its sampling period, no times read), lsim-new into a new vector each time (its pages faulted anew
+// above glibc's mmap threshold); FROLS selects 5 terms of the 15 degree-2 candidates of lags 1..2 (constant included) for a NARX record
 // of the same length. Each fit is repeated until 2 s have passed (at least twice); the least time is kept. "minor
 // faults" are the page faults of one fit (getrusage), "peak" the process's resident high-water mark during one fit
 // (reset through /proc/self/clear_refs before it) less the resident size before it.
@@ -101,6 +102,10 @@ int main(int argc, char** argv) {
         {"frols", [&] { return iterations(ctid::frols(nd, cand, {.max_terms = 5}).summary.iterations); }},
         {"lsim", [&] {
            ctid::lsim_into(kRao, u, t, ctid::Intersample::Zoh, ybuf);
+           return Work{};
+         }},
+        {"lsim-data", [&] {
+           ctid::lsim_into(kRao, d, 0, ybuf);
            return Work{};
          }},
         {"lsim-new", [&] { return iterations(static_cast<int>(ctid::lsim(kRao, u, t).size() > 0)); }},

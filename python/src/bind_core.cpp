@@ -8,9 +8,8 @@ namespace ctid::python {
 namespace {
 // TransferFunction.simulate: u and t read in place (float64 arrays are not copied), the output written into a new
 // numpy array or into `out` (a float64 array of len(u), reused by the caller), with the GIL released.
-py::array_t<double> lsim_tf(const TransferFunction& g, const Eigen::Ref<const Eigen::VectorXd>& u,
-                            const Eigen::Ref<const Eigen::VectorXd>& t, const std::string& intersample,
-                            const py::object& out) {
+py::array_t<double> lsim_tf(const TransferFunction& g, const Eigen::Ref<const Eigen::VectorXd>& u, const py::object& t,
+                            const std::string& intersample, const py::object& out) {
   using Out = py::array_t<double, py::array::c_style>;
   const Intersample is = intersample_from_string(intersample);
   const auto refuse = [&](const std::string& got) {
@@ -24,9 +23,21 @@ py::array_t<double> lsim_tf(const TransferFunction& g, const Eigen::Ref<const Ei
   if (y.ndim() != 1 || y.shape(0) != u.size() || !y.writeable())
     refuse(detail::format("{} entries in {} dimension(s){}", y.size(), y.ndim(), y.writeable() ? "" : ", read-only"));
   Eigen::Map<Eigen::VectorXd> ym(y.mutable_data(), u.size());
-  {
+  // t: the sample times, or a number: the sampling period of samples from t = 0 (no times to read or check).
+  if (py::isinstance<py::float_>(t) || py::isinstance<py::int_>(t) ||
+      (py::isinstance<py::array>(t) && py::reinterpret_borrow<py::array>(t).ndim() == 0)) {
+    const double ts = t.cast<double>();
     py::gil_scoped_release release;
-    lsim_into(g, u, t, is, ym);
+    lsim_into(g, u, ts, is, ym);
+  } else {
+    // The caster keeps a converted copy (a list, an integer array) alive while the times are read.
+    py::detail::make_caster<Eigen::Ref<const Eigen::VectorXd>> times;
+    if (!times.load(t, true))
+      throw py::type_error("simulate: t must be a 1-D array of sample times or a sampling period (got " +
+                           py::str(py::type::of(t)).cast<std::string>() + ")");
+    const Eigen::Ref<const Eigen::VectorXd>& tv = times;
+    py::gil_scoped_release release;
+    lsim_into(g, u, tv, is, ym);
   }
   return y;
 }
@@ -172,7 +183,8 @@ void bind_core(py::module_& m) {
            py::arg("t"))
       .def("simulate", &lsim_tf, py::arg("u"), py::arg("t"), py::arg("intersample") = "zoh",
            py::arg("out") = py::none(),
-           "Exact simulation from rest of the input u at the times t (float64 arrays are read in place); out: a "
+           "Exact simulation from rest of the input u at the times t (float64 arrays are read in place), or, t a "
+           "number, at the uniform times 0, t, 2t, ... (seconds; the same as time_grid(t, len(u))); out: a "
            "float64 array of len(u) to write the output into (returned), e.g. reused over many simulations.")
       .def("__call__", &TransferFunction::operator(), py::arg("s"))
       .def("__repr__", [](const TransferFunction& g) { return g.to_string(6); });

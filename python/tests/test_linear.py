@@ -474,6 +474,12 @@ def test_simulate_reads_in_place_and_writes_into_out():
     y = g.simulate(u, t)
     out = np.full(n, np.nan)
     assert g.simulate(u, t, out=out) is out and np.array_equal(out, y)
+    # t a number: the sampling period of samples from 0, the same numbers bit for bit without times to read or check.
+    assert np.array_equal(g.simulate(u, 0.01), y) and np.array_equal(g.simulate(u, 0.01, out=out), y)
+    with pytest.raises(ctid.InvalidArgument, match="sampling period must be positive and finite \\(got 0\\)"):
+        g.simulate(u, 0.0)
+    with pytest.raises(TypeError, match="t must be a 1-D array of sample times or a sampling period"):
+        g.simulate(u, "0.01")
     A, B, C, D = ss.tf2ss([1.0, 3.0], [1.0, 1.2, 4.0])
     Ad, Bd, Cd, Dd, _ = ss.cont2discrete((A, B, C, D), 0.01, method="zoh")
     _, ys, _ = ss.dlsim((Ad, Bd, Cd, Dd, 0.01), u)

@@ -95,6 +95,18 @@ struct DelayedInput {
 }  // namespace
 
 namespace {
+// The one-sample recursions below are bound by their state-to-state dependency chain, which leaves the hardware
+// prefetcher too little lead on records that come from main memory: without this, 1e7 samples cost 35 % more per
+// sample than 1e6 (bench_per_sample, lsim-data: 4.5 against 3.3 ns), with it the same. Once per cache line of the
+// input's first column and the output's first column, 256 samples (2 kB) ahead.
+inline void prefetch_ahead(const Eigen::Ref<const Eigen::MatrixXd>& u, Eigen::Ref<Eigen::MatrixXd>& y, Eigen::Index k) {
+  constexpr Eigen::Index kAhead = 256;
+  if ((k & 7) == 0 && k + kAhead < u.rows()) {
+    __builtin_prefetch(u.data() + k + kAhead, 0, 0);
+    __builtin_prefetch(y.data() + k + kAhead, 1, 0);
+  }
+}
+
 // Uniform, delay-free single-input simulation with a compile-time state dimension
 // (row-major Phi and C, column vectors G0, G1, D): the hot loop of fit reports and of the
 // filtered-derivative banks of the refined IV and output-error estimators.
@@ -108,6 +120,7 @@ void simo_fixed(const double* Phi_rm, const double* g0, const double* g1, const 
   const Eigen::Index ny = y.cols();
   for (Eigen::Index k = 0; k < N; ++k) {
     const double uk = u(k, 0);
+    prefetch_ahead(u, y, k);
     for (Eigen::Index j = 0; j < ny; ++j) {
       const double* cj = c_rm + j * n;
       double yk = dvec[j] * uk;
@@ -246,6 +259,7 @@ void modal_fixed(const ModalBlocks& f, const Eigen::Ref<const Eigen::MatrixXd>& 
   const Eigen::Index N = u.rows(), ny = y.cols();
   for (Eigen::Index k = 0; k < N; ++k) {
     const double uk = u(k, 0);
+    prefetch_ahead(u, y, k);
     for (Eigen::Index j = 0; j < ny; ++j) {
       double yk = d[j] * uk;
       for (int i = 0; i < n; ++i) yk += c[j * n + i] * z[i];
@@ -393,6 +407,16 @@ void lsim_core(const StateSpace& sys, const Eigen::Ref<const Eigen::MatrixXd>& u
 
 // The time axis of uniformly sampled data, without materialising the times.
 TimeAxis axis_of(const IdData& d) { return TimeAxis{nullptr, d.t0(), d.ts(), d.size()}; }
+
+// A SISO transfer function (its delay included) on input u into y.
+void lsim_tf_core(const TransferFunction& tf, const Eigen::Ref<const Eigen::VectorXd>& u, const TimeAxis& axis,
+                  bool uniform, double h, Intersample is, Eigen::Ref<Eigen::VectorXd> y) {
+  LsimOptions o;
+  o.input_delay = tf.io_delay();
+  const Eigen::Map<const Eigen::MatrixXd> um(u.data(), u.size(), 1);
+  Eigen::Map<Eigen::MatrixXd> ym(y.data(), y.size(), 1);
+  lsim_core(tf.to_state_space(), um, axis, uniform, h, {is}, o, ym);
+}
 }  // namespace
 
 namespace {
@@ -482,11 +506,14 @@ void lsim_into(const TransferFunction& tf, const Eigen::Ref<const Eigen::VectorX
   bool uniform = false;
   double h = 0;
   const TimeAxis axis = explicit_axis(t, &uniform, &h);
-  LsimOptions o;
-  o.input_delay = tf.io_delay();
-  const Eigen::Map<const Eigen::MatrixXd> um(u.data(), u.size(), 1);
-  Eigen::Map<Eigen::MatrixXd> ym(y.data(), y.size(), 1);
-  lsim_core(tf.to_state_space(), um, axis, uniform, h, {is}, o, ym);
+  lsim_tf_core(tf, u, axis, uniform, h, is, y);
+}
+
+void lsim_into(const TransferFunction& tf, const Eigen::Ref<const Eigen::VectorXd>& u, double ts, Intersample is,
+               Eigen::Ref<Eigen::VectorXd> y) {
+  CTID_REQUIRE(ts > 0 && std::isfinite(ts), "lsim: the sampling period must be positive and finite (got {})", ts);
+  CTID_REQUIRE(y.size() == u.size(), "lsim: the output has room for {} samples but the input has {}", y.size(), u.size());
+  lsim_tf_core(tf, u, TimeAxis{nullptr, 0.0, ts, u.size()}, true, ts, is, y);
 }
 
 Eigen::VectorXd lsim(const TransferFunction& tf, const Eigen::VectorXd& u, const Eigen::VectorXd& t, Intersample is) {
@@ -505,10 +532,7 @@ void lsim_into(const TransferFunction& tf, const IdData& data, int input, Eigen:
   CTID_REQUIRE(input >= 0 && input < data.nu(), "lsim: input index {} out of range (data has {} inputs)", input, data.nu());
   CTID_REQUIRE(y.size() == data.size(), "lsim: the output has room for {} samples but the record has {}", y.size(), data.size());
   if (!data.is_uniform()) return lsim_into(tf, data.u().col(input), data.times(), data.intersample(input), y);
-  LsimOptions o;
-  o.input_delay = tf.io_delay();
-  Eigen::Map<Eigen::MatrixXd> ym(y.data(), y.size(), 1);
-  lsim_core(tf.to_state_space(), data.u().col(input), axis_of(data), true, data.ts(), {data.intersample(input)}, o, ym);
+  lsim_tf_core(tf, data.u().col(input), axis_of(data), true, data.ts(), data.intersample(input), y);
 }
 
 Eigen::VectorXd lsim(const MisoModel& m, const IdData& data) {

@@ -97,6 +97,38 @@ TEST(Lsim, BadInputsAreReported) {
   EXPECT_THROW(discretize(Eigen::MatrixXd{{-1.0}}, Eigen::MatrixXd{{1.0}}, 0.0), InvalidArgument);
 }
 
+TEST(Lsim, ASamplingPeriodIsItsTimeGrid) {
+  // lsim_into(tf, u, ts, ...) simulates at t_k = k ts without sample times to read: the same arithmetic as
+  // time_grid(ts, N) (which the check finds uniform with the same ts), so the same numbers bit for bit - dense path
+  // (order 2), modal path (order 4), a delay of 0.37 samples' worth, ZOH and FOH.
+  std::mt19937_64 rng(8);
+  std::normal_distribution<double> g;
+  const int N = 3001;
+  Eigen::VectorXd u(N);
+  for (int k = 0; k < N; ++k) u(k) = g(rng);
+  const Eigen::VectorXd t = time_grid(0.01, N);
+  TransferFunction delayed = kSecond;
+  delayed.set_io_delay(0.0037);
+  for (const TransferFunction& tf : {kSecond, kFourth, delayed})
+    for (Intersample is : {Intersample::Zoh, Intersample::Foh}) {
+      Eigen::VectorXd y(N);
+      lsim_into(tf, u, 0.01, is, y);
+      EXPECT_EQ(y, lsim(tf, u, t, is)) << tf.to_string(4);
+    }
+  Eigen::VectorXd y(N);
+  for (double ts : {0.0, -0.01, std::nan("")})
+    EXPECT_THROW(
+        {
+          try {
+            lsim_into(kSecond, u, ts, Intersample::Zoh, y);
+          } catch (const InvalidArgument& e) {
+            EXPECT_NE(std::string(e.what()).find("sampling period must be positive and finite"), std::string::npos);
+            throw;
+          }
+        },
+        InvalidArgument);
+}
+
 TEST(Lsim, GeneratedInputIsSimulatedExactly) {
   // 1/(s + 2) driven by sin 3t from rest: y = (3 e^{-2t} + 2 sin 3t - 3 cos 3t)/13 (closed form).
   const StateSpace ss = TransferFunction(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 2.0}}).to_state_space();
@@ -116,10 +148,9 @@ TEST(Lsim, GeneratedInputIsSimulatedExactly) {
 // (lsim, ZOH), tends to the DC gain -C A^-1 B + D, the impulse response equals each channel's transfer function's,
 // and the frequency-response matrix equals StateSpace::frequency_response channel by channel.
 TEST(Lsim, ModalStepOfOrdersFourToEightEqualsTheDenseStep) {
-  // Stable single-input models of order 4-8 on uniform samples take lsim's modal path (2 x 2 blocks, two samples per
+  // Stable single-input models of order 4-8 on uniform samples take lsim's modal path (2 x 2 blocks, one sample per
   // step); the same model with a second, zero input takes the dense path (one n x n step per sample). Both are exact
-  // discretisations, so they agree to rounding: 1e-10 of the output's range (ZOH and FOH, even and odd N, which
-  // end the two-sample step on either sample).
+  // discretisations, so they agree to rounding: 1e-10 of the output's range (ZOH and FOH, even and odd N).
   std::mt19937_64 rng(5);
   std::normal_distribution<double> g;
   for (int order : {4, 5, 7, 8}) {

@@ -68,6 +68,10 @@ Eigen::VectorXd lsim(const TransferFunction& tf, const Eigen::VectorXd& u, const
 void lsim_into(const TransferFunction& tf, const Eigen::Ref<const Eigen::VectorXd>& u,
                const Eigen::Ref<const Eigen::VectorXd>& t, Intersample intersample, Eigen::Ref<Eigen::VectorXd> y);
 
+/// The same on uniform samples t_k = k ts, k = 0..N-1 (ts in seconds, > 0 and finite; throws InvalidArgument
+/// otherwise): equal to passing time_grid(ts, N), without reading (or checking) N sample times.
+void lsim_into(const TransferFunction& tf, const Eigen::Ref<const Eigen::VectorXd>& u, double ts, Intersample is,
+               Eigen::Ref<Eigen::VectorXd> y);
 /// Simulate a MISO model: the sum of its channels, channel i driven by input column i.
 /// Throws InvalidArgument when the data do not have one input per channel.
 Eigen::VectorXd lsim(const MisoModel& model, const IdData& data);
