@@ -16,7 +16,7 @@ import numpy as _np
 from . import _ctid
 from ._ctid import (  # noqa: F401  (re-exported)
     CorrelationTest, DeadbeatObserver, average_periods, frf_from_periodic, FileError, FrequencyData, FsfModel, GreyboxModel, GreyboxSimulation, IdData, InputGenerator, InvalidArgument,
-    InvalidOptions, MisoModel, ModalModel, ModalWindow, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm,
+    InvalidOptions, MisoModel, ModalModel, ModalParameters, ModalWindow, modal_parameters, NarxModel, NarxTerm, NdeModel, NdeSimulation, NdeTerm,
     NonlinearCorrelationTests, PhysicalModel, ResultFile, Simulation, StateSpace, TransferFunction, add_noise_snr, crlb, fit_percent, frequency_grid,
     example_data, example_data_names, generator_fitted_to_input, html_report, kia_product_candidates,
     input_residual_crosscorrelation, load, magnitude_band, response_band, drawn_models, compare_models,

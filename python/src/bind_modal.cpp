@@ -37,6 +37,14 @@ void bind_modal(py::module_& m) {
         }, py::arg("data"), py::arg("nb"), py::arg("options"), py::arg("input") = nullptr,
         "Several records (experiments of one system) with piecewise-constant inputs, fitted jointly.");
 
+  py::class_<ModalParameters>(m, "ModalParameters", "Modal parameters of a known model (ES-C1).")
+      .def_readonly("P", &ModalParameters::P, "(max_order + 1) x n; row j is p_j")
+      .def_readonly("psi", &ModalParameters::psi, "n x n; row i is c^T e^{-A T_i}")
+      .def_readonly("condition", &ModalParameters::condition, "2-norm condition number of psi");
+  m.def("modal_parameters",
+        py::overload_cast<const TransferFunction&, const Eigen::VectorXd&, int>(&modal_parameters), py::arg("model"),
+        py::arg("shifts"), py::arg("max_order"),
+        "Modal parameters p_0 .. p_max_order of a known transfer function for n distinct shifts (s; n = its order).");
   py::class_<ModalModel>(m, "ModalModel", "Modal parameters p_j (rows of P) and modal-function coefficients q_j (rows of Q).")
       .def(py::init<Eigen::VectorXd, Eigen::MatrixXd, Eigen::MatrixXd>(), py::arg("shifts"), py::arg("P"), py::arg("Q"))
       .def_property_readonly("shifts", &ModalModel::shifts)
@@ -97,7 +105,8 @@ void bind_modal(py::module_& m) {
       .def("Q_discrete", &DeadbeatObserver::Q_discrete)
       .def("reconstruct", &DeadbeatObserver::reconstruct, py::arg("data"),
            "Phase-variable state at every sample (NaN for the first n level periods).")
-      .def("markov_parameters", &DeadbeatObserver::markov_parameters, py::arg("p_n"), py::arg("g_inf"));
+      .def("markov_parameters", &DeadbeatObserver::markov_parameters, py::arg("p_n"),
+           "ES-C14: the Markov parameters b~_1 .. b~_n from p_n (stable or unstable; refused for a pole at s = 0).");
 
   py::class_<PronyOptions>(m, "PronyOptions")
       .def(py::init<>())

@@ -137,6 +137,18 @@ def test_modal_step_and_impulse_responses_and_the_observer():
     assert np.max(np.abs(x[60:, 0] - d.y[60:, 0])) < 1e-9
     with pytest.raises(ctid.InvalidArgument):
         ctid.modal_step_response(d, m, 10 * ts, 640 * ts)  # shifts are not multiples of the level period
+    # ES-C14: S3 = (13 s + 52)/(s^3 + 4 s^2 + 30 s + 52) has b~ = (0, 13, 52 - 4 * 13) = (0, 13, 0); an unstable
+    # plant, (13 s + 52)/(s^3 + s^2 + 24 s - 26), has (0, 13, 39) (1e-8, exact modal quantities).
+    p3 = ctid.modal_parameters(S3, shifts, 3).P[3]
+    np.testing.assert_allclose(obs.markov_parameters(p3), [0.0, 13.0, 0.0], atol=1e-8)
+    unstable = ctid.TransferFunction([13.0, 52.0], [1.0, 1.0, 24.0, -26.0])
+    ou = ctid.DeadbeatObserver.from_model(unstable, T, ts)
+    np.testing.assert_allclose(ou.markov_parameters(ctid.modal_parameters(unstable, shifts, 3).P[3]),
+                               [0.0, 13.0, 39.0], atol=1e-8)
+    integrator = ctid.TransferFunction([13.0, 52.0], [1.0, 4.0, 30.0, 0.0])
+    with pytest.raises(ctid.InvalidArgument, match="pole at s = 0"):
+        ctid.DeadbeatObserver.from_model(integrator, T, ts).markov_parameters(
+            ctid.modal_parameters(integrator, shifts, 3).P[3])
 
 
 def test_prony_aliases_where_the_data_matrix_does_not():

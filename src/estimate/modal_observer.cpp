@@ -140,17 +140,27 @@ Eigen::MatrixXd DeadbeatObserver::reconstruct(const IdData& data) const {
   return X;
 }
 
-Eigen::VectorXd DeadbeatObserver::markov_parameters(const Eigen::RowVectorXd& p_n, double g_inf) const {
+Eigen::VectorXd DeadbeatObserver::markov_parameters(const Eigen::RowVectorXd& p_n) const {
   const int n = order();
+  CTID_REQUIRE(n > 0, "DeadbeatObserver: not designed");
   CTID_REQUIRE(p_n.size() == n, "DeadbeatObserver: p_n has {} entries for order {}", p_n.size(), n);
+  // The step response's constant part g_c = H(0): p_0 leaves q_00 = g_c (1 + sum_i p_0i) = q~_00 (b~_0 = 0 for a
+  // strictly proper model). 1 + sum_i p_0i is the scalar form 1 + sum_i p_0i e^{-s T_i} at s = 0 (ES 2.24): zero
+  // exactly when s = 0 is a pole.
+  const double one_plus = 1.0 + P_.row(0).sum();
+  CTID_REQUIRE(std::abs(one_plus) > 1e-9 * (1.0 + P_.row(0).cwiseAbs().sum()),
+               "DeadbeatObserver: the system has a pole at s = 0 (1 + sum p_0i = {}): an integrating plant's step "
+               "response has no constant part, so b~ cannot be separated this way (use a transfer-function fit)",
+               one_plus);
+  const double g_c = qt0_(0) / one_plus;
   Eigen::MatrixXd Pall(n + 1, n);
   Pall << P_, p_n;
   Eigen::VectorXd shifts(n);
   for (int i = 0; i < n; ++i) shifts(i) = (i + 1) * T_;
   const Polynomial a = ModalModel(shifts, Pall, Eigen::MatrixXd()).characteristic_polynomial();  // Theorem 4.1
   Eigen::VectorXd bt(n);
-  for (int j = 1; j < n; ++j) bt(j - 1) = g_inf * P_.row(j).sum() - qt0_(j);
-  double bn = g_inf * p_n.sum();
+  for (int j = 1; j < n; ++j) bt(j - 1) = g_c * P_.row(j).sum() - qt0_(j);
+  double bn = g_c * p_n.sum();
   for (int j = 0; j < n; ++j) bn += a.coefficient_of_power(j) * qt0_(j);
   bt(n - 1) = bn;
   return bt;

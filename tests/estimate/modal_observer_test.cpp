@@ -1,6 +1,7 @@
 // El-Shafey (1987) ch. 6: minimum-time observer (SEEDS-SPEC ES-C13, Table 6.1 "ours" matrices, 1e-5)
 // and the estimate of b~ (ES-C14, Table 6.2).
 #include <cmath>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -56,8 +57,8 @@ TEST(DeadbeatObserver, Table61MatricesFromTheModel) {
   expect_matrix(o.P(), P, 1e-5);
   expect_matrix(o.Qbar(0), Q0, 1e-5);
   expect_matrix(o.Qbar(10), Qh, 1e-5);  // s = T/2
-  expect_matrix(o.r(0), Eigen::Vector3d(0.07587, -0.03917, -0.94912), 1e-4);
-  expect_matrix(o.r(10), Eigen::Vector3d(0.02693, 0.08081, -0.36315), 1e-4);
+  expect_matrix(o.r(0), Eigen::Vector3d(0.07587, -0.03917, -0.94912), 1e-5);
+  expect_matrix(o.r(10), Eigen::Vector3d(0.02693, 0.08081, -0.36315), 1e-5);
   EXPECT_NEAR(o.q_tilde0()(0), 0.25899, 1e-5);
   EXPECT_EQ(o.Q_discrete().cols(), 3);
 }
@@ -95,12 +96,55 @@ TEST(DeadbeatObserver, DataRouteEqualsTheModelRouteAndGivesTheMarkovParameters) 
   for (int r : {0, 7, 10, 19}) EXPECT_LT((data.Qbar(r) - model.Qbar(r)).cwiseAbs().maxCoeff(), 1e-5) << "offset " << r;
   // ES-C14 with exact modal quantities, then with the data route.
   const Eigen::RowVectorXd p3 = modal_parameters(kS6, shifts, 3).P.row(3);
-  const Eigen::VectorXd bt = model.markov_parameters(p3, 1.0);
+  const Eigen::VectorXd bt = model.markov_parameters(p3);
   EXPECT_NEAR(bt(0), 0.0, 1e-9);
   EXPECT_NEAR(bt(1), 6.5, 1e-9);
   EXPECT_NEAR(bt(2), 26.0, 1e-8);
-  const Eigen::VectorXd bd = data.markov_parameters(mj.model.P().row(3), g.value(g.value.size() - 1));
+  const Eigen::VectorXd bd = data.markov_parameters(mj.model.P().row(3));
   EXPECT_LT((bd - Eigen::Vector3d(0.0, 6.5, 26.0)).cwiseAbs().maxCoeff(), 1e-4);
+}
+
+TEST(DeadbeatObserver, MarkovParametersOfAnUnstableSystemAndAnIntegratorRefused) {
+  // ES-C14 reads the step response's constant part; the thesis takes it as g(inf), which an unstable system does
+  // not have. Its DC gain H(0) = q~_00 / (1 + sum p_0i) is that constant part for any system without a pole at 0.
+  // (6.5 s + 52)/((s - 1)(s^2 + 2 s + 26)) = (6.5 s + 52)/(s^3 + s^2 + 24 s - 26): b~ = (b_2, b_1 - a_2 b~_1,
+  // b_0 - a_2 b~_2 - a_1 b~_1) = (0, 6.5, 52 - 6.5) = (0, 6.5, 45.5), by the model route and from data (the
+  // step response of ES-C11 on the +1, +2, -1, -2 record, which grows as e^t).
+  const TransferFunction unstable(Eigen::VectorXd{{6.5, 52.0}}, Eigen::VectorXd{{1.0, 1.0, 24.0, -26.0}});
+  const Eigen::Vector3d shifts(kT, 2 * kT, 3 * kT);
+  const DeadbeatObserver model = DeadbeatObserver::from_model(unstable, kT, kTs);
+  const Eigen::VectorXd bt = model.markov_parameters(modal_parameters(unstable, shifts, 3).P.row(3));
+  EXPECT_LT((bt - Eigen::Vector3d(0.0, 6.5, 45.5)).cwiseAbs().maxCoeff(), 1e-8);
+
+  const int N = 320;
+  const double levels[4] = {1, 2, -1, -2};
+  Eigen::VectorXd u(N);
+  for (int i = 0; i < N; ++i) u(i) = levels[i / 80];
+  const IdData d(u, lsim(unstable, u, time_grid(kTs, N)), kTs);
+  ModalOptions o{.shifts = shifts, .basis = ModalBasis::Discrete};
+  o.windows = piecewise_constant_windows(d, 3 * kT);
+  const auto m0 = modal_estimate(d, d.u(), o);
+  const TimeResponse g = modal_step_response(d, m0.model, kT, 4.0);
+  EXPECT_LT((g.value - step_response(unstable, g.t)).cwiseAbs().maxCoeff(), 1e-6 * g.value.cwiseAbs().maxCoeff());
+  const IdData step(Eigen::VectorXd::Ones(g.t.size()), g.value, kTs);
+  ModalOptions f{.shifts = shifts, .max_order = 3, .functions = 8};
+  f.windows = {{0.6, 3.2}};
+  const auto mj = modal_estimate(step, step.u(), f);
+  const DeadbeatObserver data = DeadbeatObserver::from_step_response(mj.model, g, kT);
+  const Eigen::VectorXd bd = data.markov_parameters(mj.model.P().row(3));
+  // Measured 1.3e-3 (b~_3, 2.8e-5 relative): the Fourier p_1..p_3 of a step response growing as e^t.
+  EXPECT_LT((bd - Eigen::Vector3d(0.0, 6.5, 45.5)).cwiseAbs().maxCoeff(), 2e-3);
+
+  // A pole at s = 0: refused, naming it.
+  const TransferFunction integrator(Eigen::VectorXd{{6.5, 52.0}}, Eigen::VectorXd{{1.0, 4.0, 30.0, 0.0}});
+  const DeadbeatObserver io = DeadbeatObserver::from_model(integrator, kT, kTs);
+  try {
+    io.markov_parameters(modal_parameters(integrator, shifts, 3).P.row(3));
+    ADD_FAILURE() << "an integrating plant was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("pole at s = 0"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(model.markov_parameters(Eigen::RowVector2d(1.0, 2.0)), InvalidArgument);  // p_n of the wrong size
 }
 
 TEST(DeadbeatObserver, BadInputs) {

@@ -53,10 +53,13 @@ class DeadbeatObserver {
   /// inside a level period.
   Eigen::MatrixXd reconstruct(const IdData& data) const;
 
-  /// ES-C14: b~_j = q_j0 - q~_j0 (j = 1 .. n-1), b~_n = q_n0 + sum_j a_j q~_j0, with q_j0 = g_inf sum_i p_ji
-  /// (stable system, g_inf = step response at infinity) and a from Theorem 4.1. p_n: the n-th order
-  /// modal parameters for the same shifts. Returns b~_1 .. b~_n.
-  Eigen::VectorXd markov_parameters(const Eigen::RowVectorXd& p_n, double g_inf) const;
+  /// ES-C14: b~_j = q_j0 - q~_j0 (j = 1 .. n-1), b~_n = q_n0 + sum_j a_j q~_j0, with a from Theorem 4.1 and
+  /// q_j0 = g_c sum_i p_ji the constant that p_j leaves of the step response. g_c is the step response's constant
+  /// part, the DC gain H(0) = q~_00 / (1 + sum_i p_0i) (the thesis' g(inf) for a stable system; the same formula
+  /// holds for an unstable one, whose step response has no limit). p_n: the n-th order modal parameters for the
+  /// same shifts. Returns b~_1 .. b~_n. Throws InvalidArgument for a wrong size of p_n, or when the system has a
+  /// pole at s = 0 (1 + sum_i p_0i = 0: the step response of an integrating plant has no constant part).
+  Eigen::VectorXd markov_parameters(const Eigen::RowVectorXd& p_n) const;
 
  private:
   double T_ = 0, Ts_ = 0;
