@@ -5,6 +5,8 @@
 #include <new>
 #include <random>
 
+#include <utility>
+
 #include <gtest/gtest.h>
 
 #include "ctid/core/error.hpp"
@@ -46,6 +48,23 @@ double max_rel_error(const Result<TransferFunction>& r, const Eigen::VectorXd& t
   return ((r.parameters.values - truth).cwiseQuotient(truth.cwiseAbs().cwiseMax(1e-300))).cwiseAbs().maxCoeff();
 }
 const Eigen::VectorXd kTruth{{1.2, 4.0, 1.0, 3.0}};  // a1 a2 b0 b1
+// First order with b1 = 1 whose a1 jumps from 2 to 4 at t = 20 s, PRBS input held over each sample (exact).
+std::pair<Eigen::VectorXd, Eigen::VectorXd> jump_record(const Eigen::VectorXd& t) {
+  const Eigen::Index N = t.size();
+  const double dt = t(1) - t(0);
+  PrbsOptions po;
+  po.register_length = 9;
+  po.clock_period = 20;
+  const Eigen::VectorXd u = prbs(static_cast<int>(N), po);
+  Eigen::VectorXd y(N);
+  double x = 0;
+  for (Eigen::Index k = 0; k < N; ++k) {
+    y(k) = x;
+    const double a = t(k) < 20 ? 2.0 : 4.0;
+    x = std::exp(-a * dt) * x + (1 - std::exp(-a * dt)) / a * u(k);
+  }
+  return {u, y};
+}
 }  // namespace
 
 TEST(Lssvf, NoiseFreeRecoveryConvergesAsTsSquared) {
@@ -135,7 +154,22 @@ TEST(Lssvf, DiagnosticsWarnings) {
   // Exponential weighting does not bias noise-free estimates (the relation is exact).
   o.alpha = 0.5;
   o.tau = 0.3;
-  EXPECT_LT(max_rel_error(lssvf(simulate(kG, 0.001, 30), {2, 2, 0}, o), kTruth), 1e-5);
+  const auto ok = lssvf(simulate(kG, 0.001, 30), {2, 2, 0}, o);
+  EXPECT_LT(max_rel_error(ok, kTruth), 1e-5);
+  // RJ 55's pole condition: kG's poles -0.6 +- 1.91j lie left of -alpha = -0.5, so no warning; with alpha = 1
+  // (tau = 0.3 still below 1/alpha) they do not, and the warning names the pole and -alpha.
+  auto has = [](const Result<TransferFunction>& r, const char* text) {
+    for (const auto& s : r.diagnostics.warnings)
+      if (s.find(text) != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_FALSE(has(ok, "G(s - alpha) is not stable"));
+  EXPECT_FALSE(has(ok, "1/alpha"));
+  o.alpha = 1.0;
+  const auto late = lssvf(simulate(kG, 0.001, 30), {2, 2, 0}, o);
+  EXPECT_TRUE(has(late, "real part >= -alpha = -1: G(s - alpha) is not stable (RJ 55)"));
+  EXPECT_TRUE(has(late, "pole -0.59999"));  // the estimated pole (-0.5999991 + 1.9079j)
+  EXPECT_FALSE(has(late, "1/alpha"));
 }
 
 // A constant channel is refused before any computation (require_io_data, the check shared by every estimator and
@@ -244,32 +278,32 @@ TEST(RlsSvf, ForgettingTracksAParameterJump) {
   // a1 jumps from 2 to 4 at t = 20 s (first order, b1 = 1). The jump is tracked with forgetting
   // (forgetting 0.998 per 10 ms: memory ~5 s, weight of pre-jump data e^-8 after 40 s) the
   // estimate follows to 1e-2; without forgetting it stays between the two values.
+  // RJ's exponential weighting e^{-2 alpha t} (RJ 55-58) sampled every dt is the forgetting factor e^{-2 alpha dt}
+  // per update: alpha = 0.1 /s at dt = 10 ms equals forgetting e^{-0.002} (to the rounding of the two products,
+  // 1e-9) and alpha and forgetting multiply.
   const double dt = 0.01;
   const int N = 6000;
   const Eigen::VectorXd t = time_grid(dt, N);
-  PrbsOptions po;
-  po.register_length = 9;
-  po.clock_period = 20;
-  const Eigen::VectorXd u = prbs(N, po);
-  Eigen::VectorXd y(N);
-  double x = 0;
-  for (int k = 0; k < N; ++k) {
-    y(k) = x;
-    const double a = t(k) < 20 ? 2.0 : 4.0;
-    x = std::exp(-a * dt) * x + (1 - std::exp(-a * dt)) / a * u(k);
-  }
-  auto run = [&](double lambda, bool fix) {
+  const auto record = jump_record(t);
+  const Eigen::VectorXd &u = record.first, &y = record.second;
+  auto run = [&](double lambda, bool fix, double alpha = 0.0) {
     RlsSvfOptions o;
     o.tau = 0.2;
     o.forgetting = lambda;
+    o.alpha = alpha;
     if (fix) o.fixed = {{"b0", 1.0}};
     RlsSvf r({1, 1, 0}, o);
     for (int k = 0; k < N; ++k) r.update(t(k), u(k), y(k));
-    return r.parameters()(0);
+    return Eigen::VectorXd(r.parameters());
   };
-  EXPECT_NEAR(run(0.998, false), 4.0, 0.01);
-  EXPECT_NEAR(run(0.998, true), 4.0, 0.01);  // physical coordinates with b1 known
-  EXPECT_LT(run(1.0, false), 3.8);
+  EXPECT_NEAR(run(0.998, false)(0), 4.0, 0.01);
+  EXPECT_NEAR(run(0.998, true)(0), 4.0, 0.01);  // physical coordinates with b1 known
+  EXPECT_LT(run(1.0, false)(0), 3.8);
+  const Eigen::VectorXd by_alpha = run(1.0, false, 0.1), by_lambda = run(std::exp(-2 * 0.1 * dt), false);
+  EXPECT_LT((by_alpha - by_lambda).cwiseAbs().maxCoeff(), 1e-9 * by_lambda.cwiseAbs().maxCoeff());
+  EXPECT_NEAR(by_alpha(0), 4.0, 0.01);
+  EXPECT_LT((run(std::exp(-0.001), false, 0.05) - by_lambda).cwiseAbs().maxCoeff(),
+            1e-9 * by_lambda.cwiseAbs().maxCoeff());
 }
 
 TEST(RlsSvf, BadUse) {
