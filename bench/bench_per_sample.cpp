@@ -8,10 +8,10 @@
 // coefficient 5 % off, so without the LSSVF and SRIVC start-up fits); lsim simulates it (ZOH) into a buffer reused
 // from run to run (lsim_into with the sample times, which it reads to check they are uniform), lsim-data the same from
 // the IdData record (its sampling period, no times read), lsim-new into a new vector each time (its pages faulted anew
-// above glibc's mmap threshold); FROLS selects 5 terms of the 15 degree-2 candidates of lags 1..2 (constant included) for a NARX record
-// of the same length. Each fit is repeated until 2 s have passed (at least twice); the least time is kept. "minor
-// faults" are the page faults of one fit (getrusage), "peak" the process's resident high-water mark during one fit
-// (reset through /proc/self/clear_refs before it) less the resident size before it.
+// above glibc's mmap threshold); FROLS selects 5 terms of the 15 degree-2 candidates of lags 1..2 (constant included)
+// for a NARX record of the same length. Each fit is repeated until 2 s have passed (at least twice); the least time
+// is kept. "minor faults" are the page faults of one fit (getrusage), "peak" the process's resident high-water mark
+// during one fit (reset through /proc/self/clear_refs before it) less the resident size before it.
 #include <sys/resource.h>
 
 #include <algorithm>

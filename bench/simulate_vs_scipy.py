@@ -7,8 +7,9 @@ Models: Butterworth-like low-pass filters of order 2, 4 and 8 (poles on a circle
 array (out=); simulate(u, Ts), the sampling period instead of the times (what lfilter is given: no times to read and
 check), into a new array; the speed-up is SciPy's time over this one's. SciPy: scipy.signal.cont2discrete of the
 transfer function (ZOH) then lfilter, the way a SciPy user simulates a sampled transfer function, timed without the
-(one-off) c2d; and dlsim of the discretised state space for reference. Accuracy: the largest difference from an exact reference (SciPy's matrix-exponential discretisation
-of the state space, run through dlsim) relative to the output's range.
+(one-off) c2d; and dlsim of the discretised state space for reference. Accuracy: the largest difference from an
+exact reference (SciPy's matrix-exponential discretisation of the state space, run through dlsim) relative to the
+output's range.
 """
 import argparse
 

@@ -201,8 +201,9 @@ TEST(ModalModel, Table47WalshRowFollowsFromTables311And312) {
   // The thesis does not say the basis of its q^. It is found here from the model, not from b^: the published q^
   // equal M q_true with x' = M x = -[cos w(t - t0), sin w(t - t0)] and t0 = 24 Ts for both frequencies (the model's
   // q_true mapped this way match the published Fourier q^ to 0.10 and 0.19 % and the Walsh q^ to 1.05 and 0.71 % of
-  // each table's largest entry, the estimates' own error; a phase t0 one sample off moves b1 by 0.3). With that basis and a^ by Theorem 4.1 from the same tables' p^ (stacked over
-  // the two pairs, as modal_theorems_tf does), the Walsh row (51.81, 12.66, -0.06689) is reproduced within the
+  // each table's largest entry, the estimates' own error; a phase t0 one sample off moves b1 by 0.3). With that
+  // basis and a^ by Theorem 4.1 from the same tables' p^ (stacked over the two pairs, as modal_theorems_tf does),
+  // the Walsh row (51.81, 12.66, -0.06689) is reproduced within the
   // spread that the printed inputs' rounding allows (half a unit in the 4th digit of every p^ and q^, 20 000 draws:
   // b0 51.68..51.89, b1 12.656..12.672, b2 -0.0685..-0.0647; ours 51.783, 12.663, -0.06661).
   // The Fourier row (51.91, 12.91, -0.03879) does not follow from Tables 3.8/3.9 in any basis we found: the same
