@@ -120,3 +120,11 @@ def test_batch_rls_svf_matches_the_recursive_estimator():
     np.testing.assert_allclose(r.parameters.values, rec.parameters(), rtol=1e-12)
     assert r.parameters.values == pytest.approx([1.0, 2.0], rel=1e-3)  # noise-free record of 2/(s + 1)
     assert r.fit.fit_percent > 99.0
+    # The continuous-time recursion (RJ 56-57) by the same option name as in C++ and the CLI.
+    c = ctid.rls_svf(d, 1, 1, tau=0.5, recursion="continuous", alpha=0.1)
+    rec = ctid.rls_svf_recursive(1, 1, tau=0.5, recursion="continuous", alpha=0.1)
+    rec.run(t, u, d.y[:, 0])
+    np.testing.assert_allclose(c.parameters.values, rec.parameters(), rtol=1e-12)
+    assert c.parameters.values == pytest.approx([1.0, 2.0], rel=1e-3)
+    with pytest.raises(ctid.InvalidOptions, match="forgetting 0.99"):
+        ctid.rls_svf(d, 1, 1, recursion="continuous", forgetting=0.99)

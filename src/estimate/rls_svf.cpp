@@ -1,5 +1,5 @@
-// Recursive LSSVF (Johansson 1986, RJ 52-53, 59-60) and the single-coefficient tracker
-// (RJ 74-79; SEEDS-SPEC RJ-A6, RJ-A7). See include/ctid/estimate/rls_svf.hpp.
+// Recursive LSSVF (Johansson 1986, RJ 52-53, sampled RJ 59-60, continuous-time RJ 56-58) and the
+// single-coefficient tracker (RJ 74-79; SEEDS-SPEC RJ-A6, RJ-A7). See include/ctid/estimate/rls_svf.hpp.
 #include "ctid/estimate/rls_svf.hpp"
 
 #include <chrono>
@@ -25,6 +25,8 @@ const OptionTable<RlsSvfOptions>& option_table<RlsSvfOptions>() {
           .real("alpha", &O::alpha, "1/s", at_least(0), "exponential weighting rate: lambda times e^{-2 alpha dt}")
           .real("regression_interval", &O::regression_interval, "s", at_least(0),
                 "time between regression updates; 0: every sample")
+          .choice("recursion", &O::recursion, {{"sampled", RlsRecursion::Sampled}, {"continuous", RlsRecursion::Continuous}},
+                  "sampled sum (RJ 59-60) or continuous-time recursion integrated exactly between updates (RJ 56-57)")
           .choice("input_intersample", &O::input_intersample,
                   {{"zoh", Intersample::Zoh}, {"foh", Intersample::Foh}, {"bl", Intersample::BandLimited}},
                   "intersample behaviour of the input in the filters (a fit to a record takes the record's)")
@@ -34,7 +36,13 @@ const OptionTable<RlsSvfOptions>& option_table<RlsSvfOptions>() {
   return t;
 }
 
-void RlsSvfOptions::validate() const { option_table<RlsSvfOptions>().check(*this); }
+void RlsSvfOptions::validate() const {
+  option_table<RlsSvfOptions>().check(*this);
+  CTID_REQUIRE_OPTION(recursion == RlsRecursion::Sampled || forgetting == 1.0,
+                      "rls_svf: forgetting is a factor per sampled update; with recursion=continuous weight the past "
+                      "by alpha (1/s) instead (got forgetting {})",
+                      forgetting);
+}
 
 RlsSvf::RlsSvf(const TfOrders& orders, const RlsSvfOptions& options)
     : orders_((orders.validate(), orders)),
@@ -58,6 +66,8 @@ RlsSvf::RlsSvf(const TfOrders& orders, const RlsSvfOptions& options)
   P_.resize(p, p);
   Pphi_.resize(p);
   row_.resize(p);
+  row_prev_.resize(p);
+  scratch_.resize(p);
   psi_.resize(2 * n);
   reset();
 }
@@ -85,9 +95,30 @@ void RlsSvf::reset() {
     }
   }
   n_updates_ = 0;
+  have_prev_ = false;
 }
 
-void RlsSvf::start_record() { stream_.reset(); }
+void RlsSvf::start_record() {
+  stream_.reset();
+  have_prev_ = false;  // the continuous criterion's integral does not bridge two records
+}
+
+// One rank-one step of the weighted information update P^{-1} <- P^{-1} + w phi phi^T, P^{-1} theta <- P^{-1} theta +
+// w phi target (Sherman-Morrison): K = w P phi / (1 + w phi^T P phi).
+void RlsSvf::weighted_update(const Eigen::VectorXd& phi, double target, double w) {
+  const int p = static_cast<int>(theta_.size());
+  double den = 1.0, err = target;
+  for (int i = 0; i < p; ++i) {
+    double s = 0;
+    for (int j = 0; j < p; ++j) s += P_(i, j) * phi(j);
+    Pphi_(i) = s;
+    den += w * phi(i) * s;
+    err -= theta_(i) * phi(i);
+  }
+  for (int i = 0; i < p; ++i) theta_(i) += w * Pphi_(i) / den * err;
+  for (int j = 0; j < p; ++j)
+    for (int i = 0; i < p; ++i) P_(i, j) -= w * Pphi_(i) * Pphi_(j) / den;
+}
 
 void RlsSvf::update(double t, double u, double y) {
   if (!stream_.push(t, u, y)) return;
@@ -111,21 +142,54 @@ void RlsSvf::update(double t, double u, double y) {
       if (fixed_[k]) target -= theta_fixed_(k) * psi_(k);
     for (int j = 0; j < p; ++j) row_(j) = psi_(free_[j]);
   }
+  if (opt_.recursion == RlsRecursion::Continuous) {
+    if (have_prev_) {
+      continuous_step(dt, target);
+      ++n_updates_;
+    }
+    row_prev_ = row_;
+    target_prev_ = target;
+    have_prev_ = true;
+    return;
+  }
   const double lambda = opt_.forgetting * (opt_.alpha > 0 ? std::exp(-2.0 * opt_.alpha * dt) : 1.0);
   // RLS (RJ 59-60) with forgetting: K = P phi / (lambda + phi' P phi), P = (P - K phi' P) / lambda.
-  double den = lambda, err = target;
-  for (int i = 0; i < p; ++i) {
-    double s = 0;
-    for (int j = 0; j < p; ++j) s += P_(i, j) * row_(j);
-    Pphi_(i) = s;
-    den += row_(i) * s;
-    err -= theta_(i) * row_(i);
-  }
-  for (int i = 0; i < p; ++i) theta_(i) += Pphi_(i) / den * err;
-  const double il = 1.0 / lambda;
-  for (int j = 0; j < p; ++j)
-    for (int i = 0; i < p; ++i) P_(i, j) = (P_(i, j) - Pphi_(i) * Pphi_(j) / den) * il;
+  if (lambda != 1.0) P_ *= 1.0 / lambda;
+  weighted_update(row_, target, 1.0);
   ++n_updates_;
+}
+
+// RJ 56-57 over one step h from the last regression instant, exact for a regressor and target linear in between (the
+// header's formula): P <- e^{2 alpha h} P, then one weighted update along each eigenvector e of W, with regressor
+// e_0 phi_k + e_1 phi_k+1 and target e_0 y_k + e_1 y_k+1.
+void RlsSvf::continuous_step(double h, double target) {
+  // W / h = int_0^1 e^{-x u} [u^2, u (1 - u), (1 - u)^2] du with x = 2 alpha h and u the fraction of the step before its
+  // end (the older sample weighs u, the newer 1 - u): a power series below x = 1 (terms to 1e-19), closed form above.
+  const double x = 2.0 * opt_.alpha * h;
+  double w00 = 0, w01 = 0, w11 = 0;
+  if (x < 1.0) {
+    double term = 1.0;  // (-x)^m / m!
+    for (int m = 0; m < 22; ++m) {
+      const double k1 = 1.0 / (m + 1), k2 = 1.0 / (m + 2), k3 = 1.0 / (m + 3);
+      w00 += term * k3;
+      w01 += term * (k2 - k3);
+      w11 += term * (k1 - 2 * k2 + k3);
+      term *= -x / (m + 1);
+    }
+  } else {
+    const double E = std::exp(-x), x2 = x * x, x3 = x2 * x;
+    w00 = 2 * (1 - E) / x3 - 2 * E / x2 - E / x;
+    w01 = (1 + E) / x2 - 2 * (1 - E) / x3;
+    w11 = 1 / x - 2 / x2 + 2 * (1 - E) / x3;
+  }
+  if (x > 0) P_ *= std::exp(x);  // the information decays by e^{-2 alpha h} over the step
+  // The eigenvectors (c, s) and (-s, c) of [[w00, w01], [w01, w11]], eigenvalues m +- r (both > 0).
+  const double m = 0.5 * (w00 + w11), r = std::hypot(0.5 * (w00 - w11), w01);
+  const double angle = 0.5 * std::atan2(2 * w01, w00 - w11), c = std::cos(angle), s = std::sin(angle);
+  scratch_ = c * row_prev_ + s * row_;
+  weighted_update(scratch_, c * target_prev_ + s * target, h * (m + r));
+  scratch_ = -s * row_prev_ + c * row_;
+  weighted_update(scratch_, -s * target_prev_ + c * target, h * (m - r));
 }
 
 Eigen::VectorXd RlsSvf::theta_tau() const {

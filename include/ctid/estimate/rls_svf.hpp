@@ -1,10 +1,20 @@
 // ctid — recursive estimation with Johansson's operator z = 1/(1 + p tau).
 //
-// Johansson, R. (1986), Lund TFRT-7318: sampled recursive least squares (RJ 59-60) on
-// the filtered regression y = theta_tau^T phi_tau (RJ 11), with exponential weighting
-// of rate alpha (RJ 52-53; per update the forgetting factor is e^{-2 alpha dt}) or a
-// plain forgetting factor; and the single-unknown-coefficient tracker of a partially
-// known system (RJ 74-79, sign of RJ 78 corrected as in SEEDS-SPEC RJ-A7).
+// Johansson, R. (1986), Lund TFRT-7318: recursive least squares on the filtered regression
+// y = theta_tau^T phi_tau (RJ 11), sampled (RJ 59-60) or continuous-time (RJ 56-58), with
+// exponential weighting of rate alpha (RJ 52-53; per sampled update the forgetting factor is
+// e^{-2 alpha dt}) or a plain forgetting factor; and the single-unknown-coefficient tracker of a
+// partially known system (RJ 74-79, sign of RJ 78 corrected as in SEEDS-SPEC RJ-A7).
+//
+// The continuous-time recursion dtheta/dt = P phi (y_f - theta^T phi), dP/dt = 2 alpha P - P phi phi^T P
+// (RJ 56-57 with the weighting of RJ 53) is integrated exactly between regression instants for a
+// regressor and target linear in between: its information form dP^{-1}/dt = -2 alpha P^{-1} + phi phi^T,
+// d(P^{-1} theta)/dt = -2 alpha P^{-1} theta + phi y_f gives over a step h
+//   P^{-1} <- e^{-2 alpha h} P^{-1} + [phi_k phi_k+1] W [phi_k phi_k+1]^T,
+//   W_ij = int_0^h e^{-2 alpha (h - s)} l_i(s) l_j(s) ds   (l_0 = 1 - s/h, l_1 = s/h),
+// and the same W on the targets; W's two eigen-directions make it two weighted rank-one updates of P.
+// Without noise V = theta~^T P^{-1} theta~ then obeys dV/dt = -2 alpha V - (theta~^T phi)^2 (RJ 58,
+// sign and square as in SEEDS-SPEC RJ-A6).
 //
 // The filters run at every sample given to update(); the regression is updated at every
 // sample or at most every `regression_interval` seconds (Johansson's h, which need not be
@@ -26,12 +36,20 @@
 
 namespace ctid {
 
+/// The recursion minimising the least-squares criterion: the sampled sum (RJ 59-60) or the time
+/// integral (RJ 44/52, recursion RJ 56-57).
+enum class RlsRecursion { Sampled, Continuous };
+
 struct RlsSvfOptions {
   double tau = 1.0;                 ///< filter time constant (s), > 0
   double p0 = 1e4;                  ///< P(0) = p0 * I, > 0
   double forgetting = 1.0;          ///< lambda in (0, 1] per regression update
   double alpha = 0.0;               ///< exponential weighting rate (1/s) >= 0; multiplies lambda by e^{-2 alpha dt}
   double regression_interval = 0.0; ///< h (s) between regression updates; 0 = every sample
+  /// Sampled: one unit-weight update per regression instant (RJ 59-60). Continuous: RJ 56-57 integrated
+  /// exactly between regression instants (information per second, so P(0) = p0 I weighs as p0 * h of the
+  /// sampled form); forgetting must then be 1 (alpha weights the past).
+  RlsRecursion recursion = RlsRecursion::Sampled;
   Intersample input_intersample = Intersample::Zoh;
   FixedValues fixed;  ///< known coefficients by name (a1.., b0..)
   Eigen::VectorXd theta0;           ///< initial parameter values [a1..an, b0..]; empty = 0
@@ -81,7 +99,12 @@ class RlsSvf {
   Eigen::VectorXd theta_;   // in the recursion's coordinates
   Eigen::MatrixXd P_;
   Eigen::VectorXd Pphi_, row_, psi_;
+  Eigen::VectorXd row_prev_, scratch_;  // continuous recursion: the regressor at the last regression instant
+  double target_prev_ = 0;
+  bool have_prev_ = false;
   long long n_updates_ = 0;
+  void weighted_update(const Eigen::VectorXd& phi, double target, double weight);
+  void continuous_step(double h, double target);
 };
 
 /// The recursion run once over a whole record (one input, one output, nk = 0): the final estimate as a result,
