@@ -233,8 +233,9 @@ int run_closed_loop(const FitArgs& a) {
 
 // Frequency-response data: columns w, re, im (G) or the spectra U and Y.
 int run_frequency(const FitArgs& a) {
-  if (a.method != "tfest" && a.method != "oe" && a.method != "srivc")
-    throw UsageError("frequency data are fitted with --method tfest (Sanathanan-Koerner + output error)");
+  if (a.method != "tfest" && a.method != "oe" && a.method != "srivc" && a.method != "lssvf")
+    throw UsageError("frequency data are fitted with --method tfest (Sanathanan-Koerner + output error) or --method "
+                     "lssvf (Johansson's criterion in the frequency domain, RJ 45)");
   FrequencyData fd;
   try {
     const CsvTable t = read_csv(a.data.path);
@@ -258,20 +259,26 @@ int run_frequency(const FitArgs& a) {
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }
+  const bool svf = a.method == "lssvf";
+  if (svf && a.delay) throw UsageError("--delay: the frequency-domain lssvf fits no delay (use --method tfest)");
   FrequencyFitOptions o;
+  LssvfOptions so;
   o.estimate_delay = a.delay;
-  apply_sets("tf_from_frequency", a.sets, o);
-  const Result<TransferFunction> r = call_library([&] { return tf_from_frequency(fd, siso_orders(a), o); });
-  std::printf("method: tfest (frequency data)   frequencies: %d   from %.4g to %.4g rad/s\n", fd.size(), fd.w()(0),
-              fd.w()(fd.size() - 1));
+  if (svf) apply_sets("lssvf", a.sets, so);
+  else apply_sets("tf_from_frequency", a.sets, o);
+  const Result<TransferFunction> r = call_library(
+      [&] { return svf ? lssvf(fd, siso_orders(a), so) : tf_from_frequency(fd, siso_orders(a), o); });
+  std::printf("method: %s (frequency data)   frequencies: %d   from %.4g to %.4g rad/s\n", svf ? "lssvf" : "tfest",
+              fd.size(), fd.w()(0), fd.w()(fd.size() - 1));
   std::printf("model:  G(s) = %s\n", r.model.to_string(6).c_str());
   for (int i = 0; i < r.parameters.size(); ++i)
     std::printf("  %-5s = %14.6g +- %-12.4g\n", r.parameters.names[i].c_str(), r.parameters.values(i), r.parameters.std(i));
   std::printf("fit (complex response): %s %%   termination: %s\n", fit_percent_text(r.fit.fit_percent).c_str(), to_string(r.summary.termination));
   if (!a.json.empty()) {
-    write_result_json(a.json, r, "tfest-frequency");
+    write_result_json(a.json, r, svf ? "lssvf-frequency" : "tfest-frequency");
     std::printf("wrote %s\n", a.json.c_str());
   }
+  if (!r.usable()) std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", r.why_not_usable().c_str());
   return r.usable() ? kOk : kNotUsable;
 }
 

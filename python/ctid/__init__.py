@@ -23,6 +23,7 @@ from ._ctid import (  # noqa: F401  (re-exported)
     html_comparison_report, ModelComparison, mode_uncertainty, frequency_response_std, methods, settings, diagnostics, narx_candidates, narx_noise_candidates,
     nonlinear_correlation_tests, one_sided_dft, piecewise_constant_windows, prbs, random_binary, multisine, steps, white_noise, read_narx_json, read_nde_json,
     greybox_initial_state, read_result, residual_autocorrelation, response_horizon, time_grid, write_result,
+    svf_gamma, svf_information, SvfInformation,
 )
 
 __version__ = _ctid.__version__
@@ -314,7 +315,8 @@ NarxModel.freqresp, NarxModel.step = _narx_freqresp, _narx_step
 # ---- estimators with keyword options (names as in C++) ----
 
 def lssvf(data, nb, nf, nk=0, **options):
-    """Johansson (1986): least squares on state-variable-filtered signals (options: LssvfOptions)."""
+    """Johansson (1986): least squares on state-variable-filtered signals (options: LssvfOptions). data: an IdData, a
+    list of IdData (several experiments), or a FrequencyData — the same criterion in the frequency domain (RJ 45)."""
     return _ctid.lssvf(data, nb, nf, nk, _options(_ctid.LssvfOptions, "lssvf", options))
 
 

@@ -217,6 +217,25 @@ void bind_linear(py::module_& m) {
       py::arg("data"), py::arg("nb"), py::arg("nf"), py::arg("options") = FrequencyFitOptions{},
       "Sanathanan-Koerner iterations, then output-error refinement on G(jw).");
   m.def(
+      "lssvf",
+      [](const FrequencyData& d, int nb, int nf, int nk, const LssvfOptions& o) {
+        return interruptible([&] { return lssvf(d, TfOrders{nb, nf, nk}, o); });
+      },
+      py::arg("data"), py::arg("nb"), py::arg("nf"), py::arg("nk") = 0, py::arg("options") = LssvfOptions{},
+      "Johansson's least squares in the frequency domain (RJ 45) on frequency-response data.");
+  m.def("svf_gamma", &svf_gamma, py::arg("model"), py::arg("tau"), py::arg("w"),
+        "Gamma_tau(i w) = [z G0, .., z^n G0, z, .., z^n] (RJ 49-50): the filtered regressor's response to the input.");
+  py::class_<SvfInformation>(m, "SvfInformation",
+                             "Information matrix of theta_tau per second of data for an input line spectrum (RJ 47-50).")
+      .def_readonly("matrix", &SvfInformation::matrix)
+      .def_readonly("eigenvalues", &SvfInformation::eigenvalues)
+      .def_readonly("directions", &SvfInformation::directions)
+      .def_readonly("rank", &SvfInformation::rank)
+      .def_readonly("condition", &SvfInformation::condition)
+      .def_property_readonly("identifiable", &SvfInformation::identifiable);
+  m.def("svf_information", &svf_information, py::arg("model"), py::arg("tau"), py::arg("w"), py::arg("power"),
+        "Information matrix of theta_tau for u = sum A_k cos(w_k t + phase_k), power_k = A_k^2 / 2 (RJ 47-50).");
+  m.def(
       "select_order",
       [](const IdData& d, std::pair<int, int> nb, std::pair<int, int> nf, std::pair<int, int> nk,
          const OrderSelectionOptions& o) {

@@ -143,6 +143,22 @@ def test_srivc_closed_loop_with_known_pi_controller():
         ctid.srivc_closed_loop([d, d2], r_, 1, 2, controller=ctid.TransferFunction(nc, dc))
 
 
+def test_lssvf_on_frequency_data_and_the_information_matrix():
+    # Johansson's criterion in the frequency domain (RJ 45) on exact G of (s + 3)/(s^2 + 1.2 s + 4): the model to 1e-9;
+    # the information matrix of one sinusoid has rank 2 of 4 (not identifiable), of two rank 4 (RJ 47-50).
+    g = ctid.TransferFunction([1.0, 3.0], [1.0, 1.2, 4.0])
+    w = np.array([0.3, 0.8, 1.5, 2.2, 4.0])
+    r = ctid.lssvf(ctid.FrequencyData(w, g.freqresp(w)), 2, 2, tau=0.5)
+    np.testing.assert_allclose(r.parameters.values, [1.2, 4.0, 1.0, 3.0], rtol=1e-9)
+    one = ctid.svf_information(g, 0.5, np.array([1.0]), np.array([0.5]))
+    two = ctid.svf_information(g, 0.5, np.array([1.0, 2.0]), np.array([0.5, 0.5]))
+    assert (one.rank, one.identifiable, two.rank, two.identifiable) == (2, False, 4, True)
+    gamma = ctid.svf_gamma(g, 0.5, 1.0)
+    np.testing.assert_allclose(one.matrix, 0.5 * np.real(np.outer(gamma, gamma.conj())), rtol=1e-12)
+    with pytest.raises(ctid.InvalidOptions, match="nk must be 0"):
+        ctid.lssvf(ctid.FrequencyData(w, g.freqresp(w)), 2, 2, 1, tau=0.5)
+
+
 def test_tf_from_frequency_exact_data_and_pairs():
     # 60 exact samples of 4/(s^2 + 0.8 s + 4) (log-spaced 0.1..30 rad/s): the fit returns it to 1e-8.
     g = ctid.TransferFunction([4.0], [1.0, 0.8, 4.0])

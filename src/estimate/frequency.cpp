@@ -229,14 +229,7 @@ Result<TransferFunction> tf_from_frequency(const FrequencyData& data, const TfOr
   const double sigma2 = 2.0 * lm.cost / std::max(1, 2 * K - p);  // per real/imaginary part
   const Eigen::MatrixXd Cs = internal::covariance(lm.jtj, sigma2);
   r.parameters.set_covariance(Cs.size() ? Eigen::MatrixXd(scale.asDiagonal() * Cs * scale.asDiagonal()) : Cs);
-  // Fit on the complex response: 100 (1 - ||G - Gm|| / ||G - mean(G)||).
-  Eigen::VectorXcd Gm = r.model.frequency_response(data.w());
-  const double num = (G - Gm).norm(), den = (G.array() - G.mean()).matrix().norm();
-  r.fit.n_samples = K;
-  r.fit.n_parameters = p;
-  r.fit.mse = (G - Gm).squaredNorm() / K;
-  r.fit.nrmse = den > 0 ? num / den : INFINITY;
-  r.fit.fit_percent = 100.0 * (1.0 - r.fit.nrmse);
+  r.fit = tf_detail::frequency_fit(r.model, data.w(), G, p);
   r.diagnostics.set(diagnostic::noise_variance, sigma2);
   r.diagnostics.set(diagnostic::frequency_scale, w0);
   r.diagnostics.set(diagnostic::sk_iterations, sk_done);

@@ -173,9 +173,17 @@ TransferFunction tf_from_theta(const SvfLayout& L, const Eigen::VectorXd& th, do
 
 Result<TransferFunction> make_result(const std::vector<IdData>& data, const TfOrders& o, const SvfLayout& L,
                                      const internal::LinearSolution& sol, double alpha) {
+  Result<TransferFunction> r = make_model_result(o, L, sol, alpha, o.nk > 0 ? o.nk * data.front().ts() : 0.0);
+  // Output-error fit of the model on the estimation data.
+  r.fit = simulation_fit(r.model, data, static_cast<int>(L.free.size()));
+  if (data.size() > 1) r.diagnostics.set(diagnostic::experiments, static_cast<double>(data.size()));
+  return r;
+}
+
+Result<TransferFunction> make_model_result(const TfOrders& o, const SvfLayout& L, const internal::LinearSolution& sol,
+                                           double alpha, double delay) {
   Result<TransferFunction> r;
   const Eigen::VectorXd th = full_theta(L, sol.theta);
-  const double delay = o.nk > 0 ? o.nk * data.front().ts() : 0.0;
   const int np = o.nf + o.nb;
   r.parameters.names = tf_parameter_names(o);
   r.parameters.values.resize(np);
@@ -238,9 +246,6 @@ Result<TransferFunction> make_result(const std::vector<IdData>& data, const TfOr
         break;
       }
   }
-  // Output-error fit of the model on the estimation data.
-  r.fit = simulation_fit(r.model, data, static_cast<int>(L.free.size()));
-  if (data.size() > 1) r.diagnostics.set(diagnostic::experiments, static_cast<double>(data.size()));
   return r;
 }
 

@@ -83,8 +83,12 @@ internal::LinearSolution solve_iv(const std::vector<PreparedData>& P, const SvfL
 Eigen::VectorXd full_theta(const SvfLayout& L, const Eigen::VectorXd& theta_free);
 Eigen::VectorXd svf_transform(const SvfLayout& L, const Eigen::VectorXd& theta);
 TransferFunction tf_from_theta(const SvfLayout& L, const Eigen::VectorXd& theta, double delay);
+/// The result of a solved regression: parameters and covariance, model, diagnostics and warnings (RJ-A4, A5, RJ 55);
+/// make_result adds the simulation fit on the records, make_model_result leaves the fit to the caller.
 Result<TransferFunction> make_result(const std::vector<IdData>& data, const TfOrders& o, const SvfLayout& L,
                                      const internal::LinearSolution& sol, double alpha);
+Result<TransferFunction> make_model_result(const TfOrders& o, const SvfLayout& L, const internal::LinearSolution& sol,
+                                           double alpha, double delay);
 double choose_tau(const std::vector<IdData>& data, const TfOrders& o, const LssvfOptions& opt, Eigen::VectorXd* grid,
                   Eigen::VectorXd* fits);
 

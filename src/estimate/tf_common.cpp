@@ -98,6 +98,18 @@ Result<TransferFunction> pre_estimate(const IdData& data, int nf, bool equation_
   return have ? best : lssvf(d, TfOrders{2, 2, 0});
 }
 
+FitReport frequency_fit(const TransferFunction& g, const Eigen::VectorXd& w, const Eigen::VectorXcd& G, int n_parameters) {
+  const Eigen::VectorXcd Gm = g.frequency_response(w);
+  const double den = (G.array() - G.mean()).matrix().norm();
+  FitReport f;
+  f.n_samples = static_cast<int>(G.size());
+  f.n_parameters = n_parameters;
+  f.mse = (G - Gm).squaredNorm() / static_cast<double>(G.size());
+  f.nrmse = den > 0 ? (G - Gm).norm() / den : std::numeric_limits<double>::infinity();
+  f.fit_percent = 100.0 * (1.0 - f.nrmse);
+  return f;
+}
+
 bool warn_poles_beyond_bandwidth(Result<TransferFunction>& r, const IdData& d) {
   const double wn = nyquist(d);
   for (const auto& p : r.model.poles())

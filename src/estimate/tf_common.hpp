@@ -40,6 +40,8 @@ bool pole_beyond_bandwidth(const TransferFunction& g, const IdData& d);
 /// A warning for each pole of r.model faster than 10 times the data's Nyquist frequency: the data cannot
 /// resolve it (a lower order likely describes them as well). Returns whether there was one.
 bool warn_poles_beyond_bandwidth(Result<TransferFunction>& r, const IdData& d);
+/// The fit of a model to frequency-response data on the complex response: 100 (1 - ||G - Gm|| / ||G - mean G||).
+FitReport frequency_fit(const TransferFunction& g, const Eigen::VectorXd& w, const Eigen::VectorXcd& G, int n_parameters);
 
 /// A rough model of d for the automatic settings of other methods (the FSF window, modal shifts), fitted to the
 /// record with its means removed: SRIVC of order nf (nb = nf; nf = 0: srivc_auto without the delay search) when

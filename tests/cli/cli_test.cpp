@@ -581,6 +581,15 @@ TEST(Cli, FrequencyData) {
   const CliRun r = ctid_run("fit " + csv + " --frequency --method tfest --nb 2 --nf 4 --json " + json);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NEAR(parse_result_json(read_text_file(json)).parameters.value("a2"), 408.0, 408e-6);
+  // The same data by Johansson's criterion in the frequency domain (RJ 45): exact data give the model (to 1e-6).
+  fs::remove(json);
+  const CliRun s = ctid_run("fit " + csv + " --frequency --method lssvf --nb 2 --nf 4 --set tau=0.05 --json " + json);
+  ASSERT_EQ(s.code, 0) << s.err;
+  EXPECT_NE(s.out.find("method: lssvf (frequency data)"), std::string::npos) << s.out;
+  EXPECT_NEAR(parse_result_json(read_text_file(json)).parameters.value("a2"), 408.0, 408e-6);
+  const CliRun t = ctid_run("fit " + csv + " --frequency --method lssvf --nb 2 --nf 4 --set alpha=1");
+  EXPECT_EQ(t.code, 2) << t.err;
+  EXPECT_NE(t.err.find("no meaning for frequency data"), std::string::npos) << t.err;
   std::swap(m(10, 0), m(11, 0));  // non-increasing w
   const std::string bad = test::temp_path("freq_bad.csv");
   write_csv(bad, {"w", "re", "im"}, m);

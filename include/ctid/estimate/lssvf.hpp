@@ -6,7 +6,8 @@
 // (RJ 18-23), direct estimation of the physical coefficients with known ones fixed
 // (RJ 24-25), LS criterion with Riemann or trapezoidal weights (RJ 44, 59-61),
 // exponential weighting e^{2 alpha t} (RJ 52-55), B(-1/tau) != 0 identifiability
-// condition (RJ 26-41). SEEDS-SPEC Part RJ.
+// condition (RJ 26-41); the frequency-domain criterion (RJ 45) on frequency-response data and
+// the information matrix of an input spectrum (RJ 47-50). SEEDS-SPEC Part RJ.
 //
 // Model: G(s) = e^{-s nk Ts} (b_0 s^{nb-1} + .. + b_{nb-1}) / (s^nf + a_1 s^{nf-1} + .. + a_nf).
 // Parameter names: "a1".."a<nf>", "b0".."b<nb-1>" (b0 multiplies the highest power).
@@ -20,6 +21,7 @@
 #include <string>
 
 #include "ctid/core/types.hpp"
+#include "ctid/data/frequency_data.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/estimate/orders.hpp"
 #include "ctid/estimate/options.hpp"
@@ -81,6 +83,43 @@ Result<TransferFunction> ivsvf(const IdData& data, const TfOrders& orders, const
 /// functions, naming the record.
 Result<TransferFunction> lssvf(const std::vector<IdData>& data, const TfOrders& orders, const LssvfOptions& options = {});
 Result<TransferFunction> ivsvf(const std::vector<IdData>& data, const TfOrders& orders, const IvsvfOptions& options = {});
+
+/// Frequency-domain LSSVF (RJ 45): theta fitted to frequency-response data G_k = G(i w_k) by least squares on the
+/// filtered equation error G_k - theta^T Gamma~_k, Gamma~_k = [z G_k, .., z^n G_k, z, .., z^n], z = 1/(1 + i w_k tau)
+/// (real and imaginary parts), in the physical coefficients with fixed ones as in the time domain. Each frequency
+/// weighs 1 / variance of G_k when the data carry variances (e.g. frf_from_periodic), else 1 — the input spectrum of a
+/// multisine of equal amplitudes, for which the criterion equals the time-domain one (RJ 44) over whole periods in
+/// steady state (Parseval) — times |F(i w_k)|^2 with a data_filter F. tau = 0 chooses tau on a log grid from
+/// 0.1 / w_max to 10 / w_min by the weighted fit of the model's response to the data. Standard deviations assume a
+/// white equation error (indicative, as in the time domain). The fit is on the complex response (as
+/// tf_from_frequency). Throws InvalidArgument for several channels or fewer real equations than free parameters;
+/// InvalidOptions for nk > 0 or the time-domain settings alpha, transient_time and trapezoidal weights.
+Result<TransferFunction> lssvf(const FrequencyData& data, const TfOrders& orders, const LssvfOptions& options = {});
+
+/// The regressor's response to the input (RJ 49-50): phi_tau = Gamma_tau(s) U(s) with
+/// Gamma_tau(i w) = [z G0, .., z^n G0, z, .., z^n], z = 1 / (1 + i w tau), n = g0's order (theta_tau coordinates,
+/// nb = nf = n). A delay of g0 is included. Throws InvalidArgument for tau <= 0, w < 0 or a static g0.
+Eigen::VectorXcd svf_gamma(const TransferFunction& g0, double tau, double w);
+
+/// The information matrix of theta_tau per second of data (RJ 47, 50) for a stationary input of known line spectrum:
+/// u = sum_k A_k cos(w_k t + phase_k) in steady state gives mean(phi_tau phi_tau^T) = sum_k power_k Re[Gamma(i w_k)
+/// Gamma(i w_k)^H], power_k the line's mean square (A_k^2 / 2; a constant c at w = 0 has power c^2). A continuous
+/// spectrum enters as lines on a fine grid (power_k = its one-sided density times the grid step). Experiment design:
+/// theta_tau is identifiable from this input exactly when the matrix has full rank 2n (every sinusoid adds rank 2, a
+/// constant rank 1); the weakest direction and the condition number say how well. For least squares with a white
+/// equation error of intensity lambda (y^2 s), cov(theta_tau) is about lambda / T times the inverse over T seconds.
+struct SvfInformation {
+  Eigen::MatrixXd matrix;       ///< 2n x 2n, per second of data
+  Eigen::VectorXd eigenvalues;  ///< ascending
+  Eigen::MatrixXd directions;   ///< unit eigenvectors as columns, in the eigenvalues' order
+  int rank = 0;                 ///< eigenvalues above 1e-10 times the largest
+  double condition = 0.0;       ///< largest / smallest eigenvalue (infinite when rank < 2n)
+  bool identifiable() const { return rank == matrix.rows(); }
+};
+/// Throws InvalidArgument for an unstable g0 (no stationary response), tau <= 0, w and power of different lengths or
+/// empty, a negative or repeated frequency (w must increase), or a negative power.
+SvfInformation svf_information(const TransferFunction& g0, double tau, const Eigen::VectorXd& w,
+                               const Eigen::VectorXd& power);
 
 /// Parameter names for the given orders: a1..a<nf>, b0..b<nb-1>.
 std::vector<std::string> tf_parameter_names(const TfOrders& orders);
