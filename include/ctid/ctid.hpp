@@ -55,6 +55,7 @@
 #include "ctid/signal/prefilter.hpp"
 #include "ctid/signal/svf.hpp"
 #include "ctid/signal/walsh.hpp"
+#include "ctid/simulate/closed_loop.hpp"
 #include "ctid/simulate/example_data.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/simulate/simulate.hpp"

@@ -23,7 +23,7 @@ from ._ctid import (  # noqa: F401  (re-exported)
     html_comparison_report, ModelComparison, mode_uncertainty, frequency_response_std, methods, settings, diagnostics, narx_candidates, narx_noise_candidates,
     nonlinear_correlation_tests, one_sided_dft, piecewise_constant_windows, prbs, random_binary, multisine, steps, white_noise, read_narx_json, read_nde_json,
     greybox_initial_state, read_result, residual_autocorrelation, response_horizon, time_grid, write_result,
-    svf_gamma, svf_information, SvfInformation,
+    svf_gamma, svf_information, SvfInformation, RstController, simulate_closed_loop,
 )
 
 __version__ = _ctid.__version__

@@ -1,6 +1,7 @@
 // ctid Python module — data, results, linear models, simulation and validation.
 #include "common.hpp"
 #include "ctid/core/check.hpp"
+#include "ctid/simulate/closed_loop.hpp"
 #include "ctid/simulate/example_data.hpp"
 
 namespace ctid::python {
@@ -192,6 +193,20 @@ void bind_core(py::module_& m) {
   def_report<TransferFunction>(m);
 
   m.def("time_grid", &time_grid, py::arg("ts"), py::arg("n"));
+  py::class_<RstController>(m, "RstController",
+                            "Digital controller P(q^-1) v_k = T(q^-1) r_k - S(q^-1) y_k, u_k = clip(v_k, u_min, u_max).")
+      .def(py::init<>())
+      .def_readwrite("P", &RstController::P)
+      .def_readwrite("S", &RstController::S)
+      .def_readwrite("T", &RstController::T)
+      .def_readwrite("u_min", &RstController::u_min)
+      .def_readwrite("u_max", &RstController::u_max)
+      .def_static("gains", &RstController::gains, py::arg("r_gain"), py::arg("y_gain"), "u = r_gain r - y_gain y.")
+      .def_static("pid", &RstController::pid, py::arg("kp"), py::arg("ki"), py::arg("kd"), py::arg("tf"), py::arg("ts"),
+                  "Digital PID: e = r - y, I += Ts e, D = (tf D + kd (y - y_prev)) / (tf + Ts), u = kp e + ki I - D.");
+  m.def("simulate_closed_loop", &simulate_closed_loop, py::arg("plant"), py::arg("controller"), py::arg("reference"),
+        py::arg("ts"), py::arg("noise") = Eigen::VectorXd(),
+        "A continuous plant under a digital RST controller, sampled every ts with the input held: IdData (u, y).");
   py::class_<ExampleData>(m, "ExampleData", "A simulated example record (ctid example-data): its table and what it is.")
       .def_readonly("name", &ExampleData::name)
       .def_readonly("description", &ExampleData::description)

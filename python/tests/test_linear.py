@@ -143,6 +143,32 @@ def test_srivc_closed_loop_with_known_pi_controller():
         ctid.srivc_closed_loop([d, d2], r_, 1, 2, controller=ctid.TransferFunction(nc, dc))
 
 
+def test_simulate_closed_loop_pid_against_the_difference_equations():
+    # The unstable circuit 1/(s^2 - 1) under digital PD with an actuator clamp, against the loop written out in
+    # NumPy from the ZOH discretisation (matrix exponential of the augmented [A B; 0 0]), to 1e-9.
+    from scipy.linalg import expm
+    ts, m = 0.01, 3000
+    w = np.where((np.arange(m) // 150) % 3 == 0, 0.5, -0.5)
+    pid = ctid.RstController.pid(3.0, 0.0, 3.0, 0.1, ts)
+    pid.u_min, pid.u_max = -1.2, 1.2
+    d = ctid.simulate_closed_loop(ctid.TransferFunction([1.0], [1.0, 0.0, -1.0]), pid, w, ts)
+    a = np.array([[0.0, 1.0], [1.0, 0.0]])  # x = (y, y')
+    e = expm(np.block([[a, np.array([[0.0], [1.0]])], [np.zeros((1, 3))]]) * ts)
+    phi, gam = e[:2, :2], e[:2, 2]
+    x, der, yprev, u, y = np.zeros(2), 0.0, 0.0, np.zeros(m), np.zeros(m)
+    for i in range(m):
+        y[i] = x[0]
+        der = (0.1 * der + (y[i] - yprev)) / (0.1 + ts)
+        yprev = y[i]
+        u[i] = np.clip(3.0 * (w[i] - y[i] - der), -1.2, 1.2)
+        x = phi @ x + gam * u[i]
+    np.testing.assert_allclose(d.y[:, 0], y, atol=1e-9)
+    np.testing.assert_allclose(d.u[:, 0], u, atol=1e-9)
+    assert np.abs(u).max() == pytest.approx(1.2)
+    with pytest.raises(ctid.InvalidArgument, match="algebraic loop"):
+        ctid.simulate_closed_loop(ctid.TransferFunction([1.0, 2.0], [1.0, 1.0]), ctid.RstController.gains(1, 2), w, ts)
+
+
 def test_lssvf_on_frequency_data_and_the_information_matrix():
     # Johansson's criterion in the frequency domain (RJ 45) on exact G of (s + 3)/(s^2 + 1.2 s + 4): the model to 1e-9;
     # the information matrix of one sinusoid has rank 2 of 4 (not identifiable), of two rank 4 (RJ 47-50).

@@ -16,6 +16,7 @@
 #include "ctid/model/nde.hpp"
 #include "ctid/model/state_space.hpp"
 #include "ctid/model/transfer_function.hpp"
+#include "ctid/simulate/closed_loop.hpp"
 #include "ctid/simulate/lsim.hpp"
 
 namespace ctid {
@@ -45,21 +46,11 @@ ExampleData circuit() {
   // +-0.5 square wave of period 4.5 s; Ts = 0.01 s, 4000 samples; measurement noise std 0.01 (inside the loop).
   const double Ts = 0.01;
   const int M = 4000;
-  const StateSpace ss = TransferFunction(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 0.0, -1.0}}).to_state_space();
-  const Discretization D = discretize(ss.A(), ss.B(), Ts);
-  const Eigen::VectorXd v = white_noise(M, 0.01, 17);
-  Eigen::MatrixXd m(M, 3);
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(2);
-  double d = 0, yprev = 0;
-  for (int i = 0; i < M; ++i) {
-    const double w = (i / 150) % 3 == 0 ? 0.5 : -0.5;
-    const double y = (ss.C() * x)(0) + v(i);
-    d = (0.1 * d + (y - yprev)) / (0.1 + Ts);
-    yprev = y;
-    const double u = 3.0 * (w - y - d);
-    m.row(i) << i * Ts, u, y;
-    x = D.Phi * x + D.Gamma0 * u;
-  }
+  Eigen::VectorXd w(M);
+  for (int i = 0; i < M; ++i) w(i) = (i / 150) % 3 == 0 ? 0.5 : -0.5;
+  const IdData loop = simulate_closed_loop(TransferFunction(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 0.0, -1.0}}),
+                                           RstController::pid(3.0, 0.0, 3.0, 0.1, Ts), w, Ts, white_noise(M, 0.01, 17));
+  const Eigen::MatrixXd m = columns({time_grid(Ts, M), loop.u().col(0), loop.y().col(0)});
   return {"circuit",
           "Gawthrop & Wang's unstable circuit k1/(s^2 - k2), k1 = k2 = 1, under digital PD control (SEEDS-SPEC GW.3); "
           "Ts = 0.01 s, 4000 samples, measurement noise std 0.01 inside the loop",

@@ -602,20 +602,12 @@ TEST(Cli, GawthropWangFsfAndPhysical) {
   // Unstable circuit 1/(s^2 - 1) under digital PD (SEEDS-SPEC GW.3), noise-free, written as CSV.
   const double Ts = 0.01;
   const int M = 4000;
-  const StateSpace ss = TransferFunction(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 0.0, -1.0}}).to_state_space();
-  const Discretization D = discretize(ss.A(), ss.B(), Ts);
+  Eigen::VectorXd w(M);
+  for (int i = 0; i < M; ++i) w(i) = (i / 150) % 3 == 0 ? 0.5 : -0.5;
+  const IdData loop = simulate_closed_loop(TransferFunction(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 0.0, -1.0}}),
+                                           RstController::pid(3.0, 0.0, 3.0, 0.1, Ts), w, Ts);
   Eigen::MatrixXd m(M, 3);
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(2);
-  double d = 0, yprev = 0;
-  for (int i = 0; i < M; ++i) {
-    const double w = (i / 150) % 3 == 0 ? 0.5 : -0.5;
-    const double y = (ss.C() * x)(0);
-    d = (0.1 * d + (y - yprev)) / (0.1 + Ts);
-    yprev = y;
-    const double u = 3.0 * (w - y - d);
-    m.row(i) << i * Ts, u, y;
-    x = D.Phi * x + D.Gamma0 * u;
-  }
+  m << time_grid(Ts, M), loop.u(), loop.y();
   const std::string csv = test::temp_path("circuit.csv");
   write_csv(csv, {"t", "u", "y"}, m);
   const std::string prefix = test::temp_path("circ");

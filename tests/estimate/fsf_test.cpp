@@ -14,6 +14,7 @@
 #include "ctid/estimate/fsf.hpp"
 #include "ctid/model/state_space.hpp"
 #include "ctid/model/transfer_function.hpp"
+#include "ctid/simulate/closed_loop.hpp"
 #include "ctid/simulate/lsim.hpp"
 
 using namespace ctid;
@@ -146,20 +147,13 @@ TEST(Fsf, UnstableCircuitStandInCompressesToTheShiftedStepResponse) {
   // measured 3.9e-3 for n = 21 and 7.5e-3 for n = 11).
   const double Ts = 0.01;
   const int M = 4000;
-  const StateSpace ss = TransferFunction(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 0.0, -1.0}}).to_state_space();
-  const Discretization Dz = discretize(ss.A(), ss.B(), Ts);
   std::mt19937_64 rng(1);
   std::uniform_int_distribution<int> coin(0, 1);
-  Eigen::VectorXd u(M), y(M), x = Eigen::VectorXd::Zero(2);
-  double w = 0.5, d = 0, yprev = 0;
-  for (int i = 0; i < M; ++i) {
-    if (i % 150 == 0) w = coin(rng) ? 0.5 : -0.5;
-    y(i) = (ss.C() * x)(0);
-    d = (0.1 * d + 1.0 * (y(i) - yprev)) / (0.1 + Ts);
-    yprev = y(i);
-    u(i) = 3.0 * (w - y(i) - d);
-    x = Dz.Phi * x + Dz.Gamma0 * u(i);
-  }
+  Eigen::VectorXd w(M);
+  for (int i = 0; i < M; ++i) w(i) = i % 150 == 0 ? (coin(rng) ? 0.5 : -0.5) : w(i - 1);
+  const IdData loop = simulate_closed_loop(TransferFunction(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 0.0, -1.0}}),
+                                           RstController::pid(3.0, 0.0, 3.0, 0.1, Ts), w, Ts);
+  const Eigen::VectorXd u = loop.u().col(0), y = loop.y().col(0);
   const TransferFunction shifted(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 4.0, 3.0}});
   const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(801, 0, 8);
   const Eigen::VectorXd truth = step_response(shifted, t);
@@ -182,18 +176,11 @@ TEST(Fsf, FromSpectraAgreesWithTheTimeDomain) {
   // the time-domain one up to the neglected tail (measured 4e-11); tolerance 1e-8.
   const double Ts = 0.01;
   const int M = 4000;
-  const StateSpace ss = TransferFunction(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 0.0, -1.0}}).to_state_space();
-  const Discretization Dz = discretize(ss.A(), ss.B(), Ts);
-  Eigen::VectorXd u(M), y(M), x = Eigen::VectorXd::Zero(2);
-  double d = 0, yprev = 0;
-  for (int i = 0; i < M; ++i) {
-    const double w = (i / 150) % 3 == 0 ? 0.5 : -0.5;
-    y(i) = (ss.C() * x)(0);
-    d = (0.1 * d + (y(i) - yprev)) / (0.1 + Ts);
-    yprev = y(i);
-    u(i) = 3.0 * (w - y(i) - d);
-    x = Dz.Phi * x + Dz.Gamma0 * u(i);
-  }
+  Eigen::VectorXd w(M);
+  for (int i = 0; i < M; ++i) w(i) = (i / 150) % 3 == 0 ? 0.5 : -0.5;
+  const IdData loop = simulate_closed_loop(TransferFunction(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 0.0, -1.0}}),
+                                           RstController::pid(3.0, 0.0, 3.0, 0.1, Ts), w, Ts);
+  const Eigen::VectorXd u = loop.u().col(0), y = loop.y().col(0);
   const auto td = fsf(IdData(u, y, Ts), {.T = 8.0, .n = 21, .a = 2.0});
   int L = 2;
   while (L < M + 800) L *= 2;

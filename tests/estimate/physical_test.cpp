@@ -12,6 +12,7 @@
 #include "ctid/estimate/fsf.hpp"
 #include "ctid/estimate/physical.hpp"
 #include "ctid/model/state_space.hpp"
+#include "ctid/simulate/closed_loop.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/simulate/simulate.hpp"
 #include "test_util.hpp"
@@ -24,22 +25,13 @@ namespace {
 // Unstable circuit stand-in: 1/(s^2 - 1) under digital PD (SEEDS-SPEC GW.3).
 IdData circuit(double noise_sd, std::uint64_t seed, std::uint64_t reference_seed = 1, int M = 4000) {
   const double Ts = 0.01;
-  const StateSpace ss = TransferFunction(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 0.0, -1.0}}).to_state_space();
-  const Discretization D = discretize(ss.A(), ss.B(), Ts);
   std::mt19937_64 rng(reference_seed);
   std::uniform_int_distribution<int> coin(0, 1);
-  const Eigen::VectorXd e = white_noise(M, noise_sd, seed);
-  Eigen::VectorXd u(M), y(M), x = Eigen::VectorXd::Zero(2);
-  double w = 0.5, d = 0, yprev = 0;
-  for (int i = 0; i < M; ++i) {
-    if (i % 150 == 0) w = coin(rng) ? 0.5 : -0.5;
-    y(i) = (ss.C() * x)(0) + e(i);
-    d = (0.1 * d + (y(i) - yprev)) / (0.1 + Ts);
-    yprev = y(i);
-    u(i) = 3.0 * (w - y(i) - d);
-    x = D.Phi * x + D.Gamma0 * u(i);
-  }
-  return IdData(u, y, Ts);
+  Eigen::VectorXd w(M);
+  for (int i = 0; i < M; ++i) w(i) = i % 150 == 0 ? (coin(rng) ? 0.5 : -0.5) : w(i - 1);
+  // PD u = 3 (w - y - D), D the derivative of y filtered with 0.1 s.
+  return simulate_closed_loop(TransferFunction(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 0.0, -1.0}}),
+                              RstController::pid(3.0, 0.0, 3.0, 0.1, Ts), w, Ts, white_noise(M, noise_sd, seed));
 }
 }  // namespace
 
@@ -288,21 +280,13 @@ TEST(GawthropWang, BallAndBeamWithinOnePercentAndBPositiveDegrades) {
   // (criterion: within 1 % of 2.5); b = 0.9 fails and is warned about.
   const double Ts = 0.01;
   const int M = 6000;
-  const StateSpace ss = TransferFunction(Eigen::VectorXd{{2.5}}, Eigen::VectorXd{{1.0, 0.0, 0.0}}).to_state_space();
-  const Discretization D = discretize(ss.A(), ss.B(), Ts);
-  const Eigen::VectorXd e = white_noise(M, 0.02, 11);
-  Eigen::VectorXd u(M), y(M), x = Eigen::VectorXd::Zero(2);
-  double d = 0, yprev = 0, integral = 0;
-  for (int i = 0; i < M; ++i) {
-    const double w = std::fmod(i * Ts, 20.0) < 10.0 ? 0.5 : -0.5;
-    y(i) = (ss.C() * x)(0) + e(i);
-    d = (0.05 * d + 0.8 * (y(i) - yprev)) / (0.05 + Ts);
-    yprev = y(i);
-    integral += Ts * (w - y(i));
-    u(i) = std::clamp(1.0 * (w - y(i)) - d + 0.1 * integral, -1.5, 1.5);
-    x = D.Phi * x + D.Gamma0 * u(i);
-  }
-  const IdData data(u, y, Ts);
+  Eigen::VectorXd w(M);
+  for (int i = 0; i < M; ++i) w(i) = std::fmod(i * Ts, 20.0) < 10.0 ? 0.5 : -0.5;
+  RstController pid = RstController::pid(1.0, 0.1, 0.8, 0.05, Ts);
+  pid.u_min = -1.5;
+  pid.u_max = 1.5;
+  const IdData data = simulate_closed_loop(TransferFunction(Eigen::VectorXd{{2.5}}, Eigen::VectorXd{{1.0, 0.0, 0.0}}),
+                                           pid, w, Ts, white_noise(M, 0.02, 11));
   const PhysicalModel m("K/s^2", {"K"});
   const auto c0 = fsf(data, {.T = 10.0, .n = 21, .a = 1.0});
   EXPECT_TRUE(c0.diagnostics.warnings.empty());
@@ -339,20 +323,10 @@ TEST(GawthropWang, FastSamplingGivesTheSameParametersWhileArxDegrades) {
   // ARX(2,2,1) + d2c gives k1 = 660 and 61500.
   auto circuit_at = [](double Ts) {
     const int M = static_cast<int>(std::lround(40.0 / Ts));
-    const StateSpace ss = TransferFunction(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 0.0, -1.0}}).to_state_space();
-    const Discretization D = discretize(ss.A(), ss.B(), Ts);
-    const Eigen::VectorXd e = white_noise(M, 0.01, 3);
-    Eigen::VectorXd u(M), y(M), x = Eigen::VectorXd::Zero(2);
-    double d = 0, yprev = 0;
-    for (int i = 0; i < M; ++i) {
-      const double w = static_cast<int>(i * Ts / 1.5) % 3 == 0 ? 0.5 : -0.5;
-      y(i) = (ss.C() * x)(0) + e(i);
-      d = (0.1 * d + (y(i) - yprev)) / (0.1 + Ts);
-      yprev = y(i);
-      u(i) = 3.0 * (w - y(i) - d);
-      x = D.Phi * x + D.Gamma0 * u(i);
-    }
-    return IdData(u, y, Ts);
+    Eigen::VectorXd w(M);
+    for (int i = 0; i < M; ++i) w(i) = static_cast<int>(i * Ts / 1.5) % 3 == 0 ? 0.5 : -0.5;
+    return simulate_closed_loop(TransferFunction(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 0.0, -1.0}}),
+                                RstController::pid(3.0, 0.0, 3.0, 0.1, Ts), w, Ts, white_noise(M, 0.01, 3));
   };
   // ARX(2,2,1) by least squares, converted with the matrix logarithm (ZOH); returns k1 of k1/(s^2 - k2).
   auto arx_k1 = [](const IdData& d) {
