@@ -5,13 +5,16 @@
 // the orthogonal part of an unselected candidate m after s selections has
 //     w_m^T y = p_m^T y - sum_s (p_m^T w_s) g_s,   w_m^T w_m = p_m^T p_m - sum_s (p_m^T w_s)^2 / (w_s^T w_s),
 // so ERR_m = (w_m^T y)^2 / (w_m^T w_m y^T y) needs only the inner products c_sm = p_m^T w_s: one pass over
-// freshly generated candidate blocks per selected term.
+// freshly generated candidate blocks per selected term — or, when the candidates' Gram matrix is cheaper to form
+// than those passes, c_sm = G(m, sel_s) - sum_{r<s} A(r, s) c_rm from G = P^T P formed in one pass (Korenberg's fast
+// orthogonal search: Korenberg 1988, Ann. Biomed. Eng. 16, 123-142; GramMoments below).
 #include "ctid/estimate/frols.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "ctid/core/check.hpp"
 #include "ctid/core/progress.hpp"
@@ -33,7 +36,10 @@ const OptionTable<FrolsOptions>& option_table<FrolsOptions>() {
                    {"aicc", InformationCriterion::Aicc}, {"bic", InformationCriterion::Bic},
                    {"fpe", InformationCriterion::Fpe}},
                   "model size: the number of terms minimising it along the greedy pass (none: all selected)")
-          .integer("block_rows", &O::block_rows, "", at_least(16), "rows of candidate columns generated at a time (memory)");
+          .integer("block_rows", &O::block_rows, "", at_least(16), "rows of candidate columns generated at a time (memory)")
+          .choice("route", &O::route, {{"auto", FrolsRoute::Auto}, {"passes", FrolsRoute::Passes}, {"gram", FrolsRoute::Gram}},
+                  "products with the orthogonalised terms: a pass per term, or the candidates' Gram matrix from one "
+                  "pass (auto: the one with fewer products per row)");
   return t;
 }
 
@@ -82,6 +88,7 @@ class CandidateProducts {
     }
     const Eigen::Index V = static_cast<Eigen::Index>(vars_.size()) + 1;
     Z.assign(prefixes_.size(), Eigen::MatrixXd::Zero(V, V));
+    pass_cost_ = static_cast<double>(prefixes_.size()) * static_cast<double>(V * V);
     X.resize(block, V);
     Vw.resize(block, V);
     om.resize(block);
@@ -122,11 +129,14 @@ class CandidateProducts {
     }
     return c;
   }
+  /// Products per row of one pass (each prefix group's (V+1)^2 matrix), the unit of the route choice.
+  double pass_cost() const { return pass_cost_; }
 
  private:
   struct Item {
     int group = 0, a = 0, b = 0;
   };
+  double pass_cost_ = 0;
   std::vector<NarxFactor> vars_;
   std::vector<std::vector<int>> prefixes_;
   std::vector<Item> items_;
@@ -162,6 +172,92 @@ class RowMask {
  private:
   Eigen::Index rows_;
   std::vector<std::pair<Eigen::Index, Eigen::Index>> holes_;
+};
+
+// The candidates' Gram matrix P^T P, P^T y and y^T y over the used rows in one pass over the signals. Each entry is the
+// sum of a monomial in the distinct lagged signals and y(k) itself (the union of two candidates' factors); a monomial
+// is its parent (one factor fewer) times one signal, so a block of rows costs one product per monomial and row.
+// The constructor stops at `limit` monomials (then ok() is false: the passes are cheaper).
+class GramMoments {
+ public:
+  GramMoments(const std::vector<NarxTerm>& cand, double limit) : limit_(limit) {
+    key({});
+    std::vector<std::vector<int>> ck;
+    for (const auto& t : cand) {
+      std::vector<int> k;
+      for (const auto& f : t.factors) k.push_back(var_of(f));
+      ck.push_back(std::move(k));
+    }
+    const int y = var_of({NarxSignal::Output, 0});
+    const int M = static_cast<int>(cand.size());
+    pair_.resize(M, M);
+    cy_.resize(M);
+    for (int a = 0; a < M && ok_; ++a) {
+      for (int b = a; b < M && ok_; ++b) {
+        std::vector<int> k = ck[a];
+        k.insert(k.end(), ck[b].begin(), ck[b].end());
+        pair_(a, b) = pair_(b, a) = key(std::move(k));
+      }
+      std::vector<int> k = ck[a];
+      k.push_back(y);
+      cy_[a] = key(std::move(k));
+    }
+    yy_ = key({y, y});
+  }
+  bool ok() const { return ok_; }
+  int monomials() const { return static_cast<int>(parent_.size()); }
+
+  void accumulate(const Signals& sig, Eigen::Index L, Eigen::Index Ne, const RowMask& mask, Eigen::Index block) {
+    const int V = static_cast<int>(vars_.size()), nm = monomials();
+    Eigen::MatrixXd X(block, V + 1), C(block, nm);
+    sums_ = Eigen::VectorXd::Zero(nm);
+    for (Eigen::Index r0 = 0; r0 < Ne; r0 += block) {
+      const Eigen::Index rows = std::min(block, Ne - r0);
+      for (int v = 0; v < V; ++v) {
+        const NarxFactor& f = vars_[static_cast<size_t>(v)];
+        X.col(v + 1).head(rows) = sig.of(f.signal).segment(L + r0 - f.lag, rows);
+      }
+      C.col(0).head(rows).setOnes();
+      mask.zero(C.col(0).head(rows), r0);
+      for (int i = 1; i < nm; ++i)
+        C.col(i).head(rows) = C.col(parent_[i]).head(rows).cwiseProduct(X.col(var_[i]).head(rows));
+      sums_ += C.topRows(rows).colwise().sum().transpose();
+    }
+  }
+  double gram(int a, int b) const { return sums_(pair_(a, b)); }
+  double with_y(int a) const { return sums_(cy_[a]); }
+  double yy() const { return sums_(yy_); }
+
+ private:
+  int var_of(const NarxFactor& f) {
+    for (size_t i = 0; i < vars_.size(); ++i)
+      if (vars_[i] == f) return static_cast<int>(i) + 1;
+    vars_.push_back(f);
+    return static_cast<int>(vars_.size());
+  }
+  // The index of a monomial (sorted variable indices; 0: the constant), its parents created first.
+  int key(std::vector<int> k) {
+    std::sort(k.begin(), k.end());
+    if (auto it = index_.find(k); it != index_.end()) return it->second;
+    if (static_cast<double>(parent_.size()) >= limit_) {
+      ok_ = false;
+      return 0;
+    }
+    const int p = k.empty() ? 0 : key(std::vector<int>(k.begin(), k.end() - 1));
+    const int i = static_cast<int>(parent_.size());
+    parent_.push_back(p);
+    var_.push_back(k.empty() ? 0 : k.back());
+    index_.emplace(std::move(k), i);
+    return i;
+  }
+  double limit_;
+  bool ok_ = true;
+  std::vector<NarxFactor> vars_;
+  std::map<std::vector<int>, int> index_;
+  std::vector<int> parent_, var_, cy_;
+  Eigen::MatrixXi pair_;
+  int yy_ = 0;
+  Eigen::VectorXd sums_;
 };
 
 double criterion_value(InformationCriterion c, double mse, int n, int k) {
@@ -200,24 +296,42 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
   const int K = std::min(o.max_terms, M);
   const Eigen::Index BR = std::min<Eigen::Index>(o.block_rows, Ne);
 
-  // Pass 0: p_m^T y, p_m^T p_m and y^T y over the used rows.
+  // The route: K + 2 passes of CandidateProducts, or one pass of GramMoments when it needs fewer products per row.
   CandidateProducts products(cand, BR);
-  Eigen::VectorXd wb(BR);
+  constexpr double kMaxMoments = 50000;
+  GramMoments moments(cand, o.route == FrolsRoute::Passes ? 0.0
+                            : o.route == FrolsRoute::Gram  ? kMaxMoments
+                                                           : std::min(kMaxMoments, (K + 2) * products.pass_cost()));
+  CTID_REQUIRE_OPTION(o.route != FrolsRoute::Gram || moments.ok(),
+                      "frols: route=gram needs more than {} moments for these {} candidates; use route=passes or auto",
+                      kMaxMoments, M);
+  const bool gram = o.route != FrolsRoute::Passes && moments.ok();
+  Eigen::VectorXd wb(BR), py(M), pp(M);
   double yy = 0;
-  const Eigen::VectorXd py = products.dot(sig, L, Ne, [&](Eigen::Index r0, Eigen::Index rows) {
-    auto w = wb.head(rows);
-    w = y.segment(L + r0, rows);
-    mask.zero(w, r0);
-    yy += w.squaredNorm();
-    return w;
-  });
+  if (gram) {
+    moments.accumulate(sig, L, Ne, mask, std::min<Eigen::Index>(BR, 512));
+    yy = moments.yy();
+    for (int m = 0; m < M; ++m) {
+      py(m) = moments.with_y(m);
+      pp(m) = moments.gram(m, m);
+    }
+  } else {
+    // Pass 0: p_m^T y, p_m^T p_m and y^T y over the used rows.
+    py = products.dot(sig, L, Ne, [&](Eigen::Index r0, Eigen::Index rows) {
+      auto w = wb.head(rows);
+      w = y.segment(L + r0, rows);
+      mask.zero(w, r0);
+      yy += w.squaredNorm();
+      return w;
+    });
+    pp = products.dot(sig, L, Ne, [&](Eigen::Index r0, Eigen::Index rows) {
+      auto w = wb.head(rows);
+      w.setOnes();
+      mask.zero(w, r0);
+      return w;
+    }, true);
+  }
   CTID_REQUIRE(yy > 0, "frols: the output is identically zero");
-  const Eigen::VectorXd pp = products.dot(sig, L, Ne, [&](Eigen::Index r0, Eigen::Index rows) {
-    auto w = wb.head(rows);
-    w.setOnes();
-    mask.zero(w, r0);
-    return w;
-  }, true);
 
   std::vector<int> sel;
   std::vector<double> err, g, ww;
@@ -229,7 +343,7 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
   // The orthogonal columns w_r of the selected terms are not stored (N x K): each pass regenerates them block by
   // block from the candidate columns with the Gram-Schmidt coefficients already found, w_r = p_sel(r) - sum_{q<r}
   // A(q, r) w_q (an (s + 1)-column block in the cache costs less than reading s stored N-columns from memory).
-  Eigen::MatrixXd Wb(BR, K);
+  Eigen::MatrixXd Wb(gram ? 0 : BR, K);
   double err_sum = 0;
   bool interrupted = false;
   for (int s = 0; s < K; ++s) {
@@ -257,20 +371,33 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
     used[best] = true;
     sel.push_back(best);
     for (int q = 0; q < s; ++q) A(q, s) = C(q, best) / ww[q];
-    // One pass: w_s block by block, its norm and w_s^T y, and c_s,m = p_m^T w_s for every candidate.
     double w2 = 0, wy = 0;
-    C.row(s) = products.dot(sig, L, Ne, [&](Eigen::Index r0, Eigen::Index rows) {
-      for (int r = 0; r <= s; ++r) {
-        auto w = Wb.col(r).head(rows);
-        candidate_column(cand[sel[r]], sig, L + r0, w);
-        mask.zero(w, r0);
-        w.noalias() -= Wb.topLeftCorner(rows, r) * A.col(r).head(r);
+    if (gram) {
+      // From the Gram matrix: c_s,m = G(m, best) - sum_{q<s} A(q, s) c_q,m; w_s^T w_s = c_s,best and
+      // w_s^T y = p_best^T y - sum_{q<s} c_q,best g_q (w_s is orthogonal to the earlier w_q).
+      for (int m = 0; m < M; ++m) {
+        double c = moments.gram(m, best);
+        for (int q = 0; q < s; ++q) c -= A(q, s) * C(q, m);
+        C(s, m) = c;
       }
-      const auto w = Wb.col(s).head(rows);
-      w2 += w.squaredNorm();
-      wy += w.dot(y.segment(L + r0, rows));  // (w is zero on the masked rows)
-      return w;
-    }).transpose();
+      w2 = C(s, best);
+      wy = py(best);
+      for (int q = 0; q < s; ++q) wy -= C(q, best) * g[q];
+    } else {
+      // One pass: w_s block by block, its norm and w_s^T y, and c_s,m = p_m^T w_s for every candidate.
+      C.row(s) = products.dot(sig, L, Ne, [&](Eigen::Index r0, Eigen::Index rows) {
+        for (int r = 0; r <= s; ++r) {
+          auto w = Wb.col(r).head(rows);
+          candidate_column(cand[sel[r]], sig, L + r0, w);
+          mask.zero(w, r0);
+          w.noalias() -= Wb.topLeftCorner(rows, r) * A.col(r).head(r);
+        }
+        const auto w = Wb.col(s).head(rows);
+        w2 += w.squaredNorm();
+        wy += w.dot(y.segment(L + r0, rows));  // (w is zero on the masked rows)
+        return w;
+      }).transpose();
+    }
     ww.push_back(w2);
     g.push_back(wy / w2);
     err.push_back(g.back() * g.back() * w2 / yy);
@@ -449,7 +576,7 @@ const OptionTable<NarxOptions>& option_table<NarxOptions>() {
           .integer("noise_terms", &O::noise_terms, "samples", at_least(0),
                    "NARMAX residual lags e(k-1 .. k-noise_terms); 0: NARX by FROLS")
           .include(&O::narmax, option_table<NarmaxOptions>(),
-                   {"max_terms", "err_tolerance", "criterion", "block_rows", "max_noise_terms", "iterations", "tolerance"},
+                   {"max_terms", "err_tolerance", "criterion", "block_rows", "route", "max_noise_terms", "iterations", "tolerance"},
                    {{"iterations", "narmax_iterations"}, {"tolerance", "narmax_tolerance"}});
   return t;
 }
