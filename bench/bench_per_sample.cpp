@@ -1,7 +1,7 @@
 // Time and memory per sample of SRIVC, OE, FROLS and lsim from N = 1e4 to 1e7 (issue 18, "one core"): the time per
 // sample should not grow with N (no allocation whose page faults grow with the record, no temporaries that fall out
 // of cache); the peak memory of one fit above the record itself, in bytes per sample, shows the O(N) constant.
-// Run: build/bench/bench_per_sample [N_MAX=10000000] [METHODS=srivc,oe,oe-start,frols,lsim,lsim-data,lsim-new]
+// Run: build/bench/bench_per_sample [N_MAX=10000000] [METHODS=srivc,oe,oe-start,frols,frols-passes,lsim,lsim-data,lsim-new]
 //
 // Problems: SRIVC and OE fit the Rao-Garnier system (-6400 s + 1600)/(s^4 + 5 s^3 + 408 s^2 + 416 s + 1600) (nb = 2,
 // nf = 4) to a PRBS response at Ts = 10 ms with 10 dB output noise (oe-start: from a given start, the system with each
@@ -100,6 +100,9 @@ int main(int argc, char** argv) {
            return oe_work(ctid::oe(d, {2, 4, 0}, {.initial = kStart}));
          }},
         {"frols", [&] { return iterations(ctid::frols(nd, cand, {.max_terms = 5}).summary.iterations); }},
+        {"frols-passes", [&] {  // the K + 2 passes route (auto takes the Gram matrix for these 15 candidates)
+           return iterations(ctid::frols(nd, cand, {.max_terms = 5, .route = ctid::FrolsRoute::Passes}).summary.iterations);
+         }},
         {"lsim", [&] {
            ctid::lsim_into(kRao, u, t, ctid::Intersample::Zoh, ybuf);
            return Work{};

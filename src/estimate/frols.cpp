@@ -89,9 +89,7 @@ class CandidateProducts {
     const Eigen::Index V = static_cast<Eigen::Index>(vars_.size()) + 1;
     Z.assign(prefixes_.size(), Eigen::MatrixXd::Zero(V, V));
     pass_cost_ = static_cast<double>(prefixes_.size()) * static_cast<double>(V * V);
-    X.resize(block, V);
-    Vw.resize(block, V);
-    om.resize(block);
+    block_ = block;  // the block buffers are sized at the first pass (the Gram route makes none)
   }
 
   // c_m = sum_k p_m(k) w(k) over regression rows r = 0 .. Ne - 1 (signal index k = L + r), with w generated block by
@@ -100,7 +98,12 @@ class CandidateProducts {
   // (The block buffers are members, sized once per fit: a fresh buffer per pass would be mapped and faulted anew.)
   template <class Weights>
   Eigen::VectorXd dot(const Signals& sig, Eigen::Index L, Eigen::Index Ne, Weights&& weights, bool squared = false) {
-    const Eigen::Index V = X.cols(), block = X.rows();
+    const Eigen::Index V = static_cast<Eigen::Index>(vars_.size()) + 1, block = block_;
+    if (X.rows() != block) {
+      X.resize(block, V);
+      Vw.resize(block, V);
+      om.resize(block);
+    }
     for (auto& z : Z) z.setZero();
     for (Eigen::Index r0 = 0; r0 < Ne; r0 += block) {
       const Eigen::Index rows = std::min(block, Ne - r0);
@@ -137,6 +140,7 @@ class CandidateProducts {
     int group = 0, a = 0, b = 0;
   };
   double pass_cost_ = 0;
+  Eigen::Index block_ = 0;
   std::vector<NarxFactor> vars_;
   std::vector<std::vector<int>> prefixes_;
   std::vector<Item> items_;
@@ -213,6 +217,13 @@ class GramMoments {
     sums_ = Eigen::VectorXd::Zero(nm);
     for (Eigen::Index r0 = 0; r0 < Ne; r0 += block) {
       const Eigen::Index rows = std::min(block, Ne - r0);
+      // A block's signals are a few kilobytes read once: ask for those of the block four ahead, so that a record
+      // larger than the cache does not wait on main memory (the hardware prefetcher does not catch short runs).
+      for (NarxSignal g : {NarxSignal::Output, NarxSignal::Input, NarxSignal::Noise}) {
+        const auto& x = sig.of(g);
+        const Eigen::Index a = L + r0 + 4 * block, b = std::min<Eigen::Index>(a + block, x.size());
+        for (Eigen::Index k = a; k < b; k += 8) __builtin_prefetch(x.data() + k);
+      }
       for (int v = 0; v < V; ++v) {
         const NarxFactor& f = vars_[static_cast<size_t>(v)];
         X.col(v + 1).head(rows) = sig.of(f.signal).segment(L + r0 - f.lag, rows);
@@ -309,7 +320,9 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
   Eigen::VectorXd wb(BR), py(M), pp(M);
   double yy = 0;
   if (gram) {
-    moments.accumulate(sig, L, Ne, mask, std::min<Eigen::Index>(BR, 512));
+    // 128-row blocks: the monomial block stays in the cache (and below the allocator's mmap threshold for the
+    // candidate sets auto chooses it for, so a fit of a short record does not fault fresh pages in).
+    moments.accumulate(sig, L, Ne, mask, std::min<Eigen::Index>(BR, 128));
     yy = moments.yy();
     for (int m = 0; m < M; ++m) {
       py(m) = moments.with_y(m);
