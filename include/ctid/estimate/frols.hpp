@@ -7,7 +7,10 @@
 // each step needs only the inner products of every candidate with the newest orthogonal vector, which is
 // regenerated block by block from the selected terms' columns with the Gram-Schmidt coefficients already
 // found, and the fit's free run is simulated a block at a time. Workspace O(block x (variables + terms) +
-// M x terms); time per sample and term O(variables^2 + terms) (measured in docs/benchmarks.md).
+// M x terms); time per sample and term O(variables^2 + terms) (measured in docs/benchmarks.md). When fewer
+// products per row suffice (FrolsOptions::route), the candidates' Gram matrix is formed instead in one pass as
+// sums of monomials of the lagged signals and the selection runs in it (Korenberg 1988, fast orthogonal
+// search): the record is read once, workspace O(128 x moments + M^2).
 #pragma once
 
 #include <vector>
