@@ -317,7 +317,7 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
                       "frols: route=gram needs more than {} moments for these {} candidates; use route=passes or auto",
                       kMaxMoments, M);
   const bool gram = o.route != FrolsRoute::Passes && moments.ok();
-  Eigen::VectorXd wb(BR), py(M), pp(M);
+  Eigen::VectorXd py(M), pp(M);
   double yy = 0;
   if (gram) {
     // 128-row blocks: the monomial block stays in the cache (and below the allocator's mmap threshold for the
@@ -330,6 +330,7 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
     }
   } else {
     // Pass 0: p_m^T y, p_m^T p_m and y^T y over the used rows.
+    Eigen::VectorXd wb(BR);
     py = products.dot(sig, L, Ne, [&](Eigen::Index r0, Eigen::Index rows) {
       auto w = wb.head(rows);
       w = y.segment(L + r0, rows);

@@ -17,12 +17,11 @@ namespace ctid {
 using svf_detail::SvfLayout;
 using cd = std::complex<double>;
 
-Eigen::VectorXcd svf_gamma(const TransferFunction& g0, double tau, double w) {
-  const int n = g0.order();
-  CTID_REQUIRE(n >= 1, "svf_gamma: the model must have order >= 1 (got a static gain)");
-  CTID_REQUIRE(std::isfinite(tau) && tau > 0, "svf_gamma: tau must be > 0 (got {} s)", tau);
-  CTID_REQUIRE(std::isfinite(w) && w >= 0, "svf_gamma: the frequency must be >= 0 (got {} rad/s)", w);
-  const cd z = 1.0 / cd(1.0, w * tau), G = g0.frequency_response(Eigen::VectorXd::Constant(1, w))(0);
+namespace {
+// [z G, .., z^n G, z, .., z^n] at w with z = 1 / (1 + i w tau): Gamma_tau of RJ 50 for G the model's response, the
+// frequency-domain regressor of RJ 45 for G a measured one.
+Eigen::VectorXcd filtered_regressor(cd G, double w, double tau, int n) {
+  const cd z = 1.0 / cd(1.0, w * tau);
   Eigen::VectorXcd gamma(2 * n);
   cd zk = 1.0;
   for (int k = 0; k < n; ++k) {
@@ -31,6 +30,15 @@ Eigen::VectorXcd svf_gamma(const TransferFunction& g0, double tau, double w) {
     gamma(n + k) = zk;
   }
   return gamma;
+}
+}  // namespace
+
+Eigen::VectorXcd svf_gamma(const TransferFunction& g0, double tau, double w) {
+  const int n = g0.order();
+  CTID_REQUIRE(n >= 1, "svf_gamma: the model must have order >= 1 (got a static gain)");
+  CTID_REQUIRE(std::isfinite(tau) && tau > 0, "svf_gamma: tau must be > 0 (got {} s)", tau);
+  CTID_REQUIRE(std::isfinite(w) && w >= 0, "svf_gamma: the frequency must be >= 0 (got {} rad/s)", w);
+  return filtered_regressor(g0.frequency_response(Eigen::VectorXd::Constant(1, w))(0), w, tau, n);
 }
 
 SvfInformation svf_information(const TransferFunction& g0, double tau, const Eigen::VectorXd& w,
@@ -67,22 +75,14 @@ internal::LinearSolution solve_frequency(const FrequencyData& d, const SvfLayout
   const svf_detail::RowMap map(L);
   const int n = L.n;
   internal::StreamingLeastSquares ls(map.p);
-  std::vector<double> yr(n), yi(n), ur(n), ui(n), row(map.p);
+  std::vector<double> row(map.p);
   const Eigen::VectorXcd& G = d.response();
   for (int k = 0; k < d.size(); ++k) {
-    const cd z = 1.0 / cd(1.0, d.w()(k) * L.tau);
-    cd zk = 1.0;
-    for (int i = 0; i < n; ++i) {
-      zk *= z;
-      const cd py = zk * G(k);
-      yr[i] = py.real();
-      yi[i] = py.imag();
-      ur[i] = zk.real();
-      ui[i] = zk.imag();
-    }
-    double lhs = map.apply(yr.data(), ur.data(), G(k).real(), row.data());
+    const Eigen::VectorXcd phi = filtered_regressor(G(k), d.w()(k), L.tau, n);
+    const Eigen::VectorXd re = phi.real(), im = phi.imag();  // [z^i G; z^i]: map.apply reads the halves
+    double lhs = map.apply(re.data(), re.data() + n, G(k).real(), row.data());
     ls.add(row.data(), lhs, weight(k));
-    lhs = map.apply(yi.data(), ui.data(), G(k).imag(), row.data());
+    lhs = map.apply(im.data(), im.data() + n, G(k).imag(), row.data());
     ls.add(row.data(), lhs, weight(k));
   }
   return ls.solve();

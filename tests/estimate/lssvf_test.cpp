@@ -343,6 +343,16 @@ Regression regression(const IdData& d, int n, double tau) {
   }
   return r;
 }
+
+// The continuous recursion of the RJ 56-58 tests: tau = 0.5 s, P(0) = 10 I.
+RlsSvfOptions continuous(double alpha) {
+  RlsSvfOptions o;
+  o.tau = 0.5;
+  o.p0 = 10;
+  o.alpha = alpha;
+  o.recursion = RlsRecursion::Continuous;
+  return o;
+}
 }  // namespace
 
 // Issue 19 (RJ 56-57): the continuous-time recursion dtheta/dt = P phi (y - theta' phi), dP/dt = 2 alpha P - P phi phi' P
@@ -357,12 +367,7 @@ TEST(RlsSvf, ContinuousRecursionIsRJ56And57IntegratedExactly) {
     // directions, and P grows as e^{2 alpha t} in the others, as the ODE's own solution does; 0.1 s keeps it finite.
     const IdData d = simulate(kG, 0.01, alpha > 1 ? 0.1 : 3.0);
     const Regression reg = regression(d, 2, 0.5);
-    RlsSvfOptions o;
-    o.tau = 0.5;
-    o.p0 = 10;
-    o.alpha = alpha;
-    o.recursion = RlsRecursion::Continuous;
-    RlsSvf rls({2, 2, 0}, o);
+    RlsSvf rls({2, 2, 0}, continuous(alpha));
     for (int k = 0; k < d.size(); ++k) rls.update(d.time(k), d.u()(k, 0), d.y()(k, 0));
     EXPECT_EQ(rls.n_updates(), static_cast<long long>(reg.t.size()) - 1);
 
@@ -403,12 +408,7 @@ TEST(RlsSvf, ContinuousRecursionLyapunovFunctionDecreasesAsRJ58) {
   const Regression reg = regression(d, 2, 0.5);
   const Eigen::VectorXd truth = theta_tau_from_ab(Eigen::Vector2d(1.2, 4.0), Eigen::Vector2d(1.0, 3.0), 0.5);
   for (const double alpha : {0.0, 0.5}) {
-    RlsSvfOptions o;
-    o.tau = 0.5;
-    o.p0 = 10;
-    o.alpha = alpha;
-    o.recursion = RlsRecursion::Continuous;
-    RlsSvf rls({2, 2, 0}, o);
+    RlsSvf rls({2, 2, 0}, continuous(alpha));
     std::size_t r = 0;
     double v_prev = 0, rate_prev = 0, worst_rise = 0, worst_rate = 0, v_first = 0, integral = 0;
     for (int k = 0; k < d.size(); ++k) {
