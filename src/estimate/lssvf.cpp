@@ -171,7 +171,7 @@ TransferFunction tf_from_theta(const SvfLayout& L, const Eigen::VectorXd& th, do
   return TransferFunction(num, den, delay);
 }
 
-Result<TransferFunction> make_result(const std::vector<IdData>& data, const TfOrders& o, const SvfLayout& L,
+Result<TransferFunction> make_result(const internal::RecordRefs& data, const TfOrders& o, const SvfLayout& L,
                                      const internal::LinearSolution& sol, double alpha) {
   Result<TransferFunction> r = make_model_result(o, L, sol, alpha, o.nk > 0 ? o.nk * data.front().ts() : 0.0);
   // Output-error fit of the model on the estimation data.
@@ -256,7 +256,7 @@ Eigen::VectorXd svf_transform(const SvfLayout& L, const Eigen::VectorXd& th) {
   return tt;
 }
 
-double choose_tau(const std::vector<IdData>& data, const TfOrders& o, const LssvfOptions& opt, Eigen::VectorXd* grid_out,
+double choose_tau(const internal::RecordRefs& data, const TfOrders& o, const LssvfOptions& opt, Eigen::VectorXd* grid_out,
                   Eigen::VectorXd* fit_out) {
   std::vector<PreparedData> P;
   double h = 0, shortest = std::numeric_limits<double>::infinity();
@@ -297,7 +297,7 @@ using namespace svf_detail;
 
 namespace {
 // The records prepared for the SVF regressions; `who` names the record when there are several.
-std::vector<PreparedData> prepare_all(const std::vector<IdData>& data, const TfOrders& o, const LssvfOptions& opt,
+std::vector<PreparedData> prepare_all(const internal::RecordRefs& data, const TfOrders& o, const LssvfOptions& opt,
                                       const char* who) {
   CTID_REQUIRE(!data.empty(), "{}: no records given", who);
   std::vector<PreparedData> P;
@@ -310,17 +310,9 @@ std::vector<PreparedData> prepare_all(const std::vector<IdData>& data, const TfO
   }
   return P;
 }
-}  // namespace
-
-Result<TransferFunction> lssvf(const IdData& data, const TfOrders& orders, const LssvfOptions& options) {
-  return lssvf(std::vector<IdData>{data}, orders, options);
-}
-
-Result<TransferFunction> ivsvf(const IdData& data, const TfOrders& orders, const IvsvfOptions& options) {
-  return ivsvf(std::vector<IdData>{data}, orders, options);
-}
-
-Result<TransferFunction> lssvf(const std::vector<IdData>& data, const TfOrders& orders, const LssvfOptions& options) {
+// lssvf and ivsvf of one record or of several, without copying them.
+Result<TransferFunction> lssvf_records(const internal::RecordRefs& data, const TfOrders& orders,
+                                       const LssvfOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   orders.validate();
   options.validate();
@@ -353,11 +345,12 @@ Result<TransferFunction> lssvf(const std::vector<IdData>& data, const TfOrders& 
   return r;
 }
 
-Result<TransferFunction> ivsvf(const std::vector<IdData>& data, const TfOrders& orders, const IvsvfOptions& options) {
+Result<TransferFunction> ivsvf_records(const internal::RecordRefs& data, const TfOrders& orders,
+                                       const IvsvfOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   orders.validate();
   options.validate();
-  Result<TransferFunction> r = lssvf(data, orders, options.svf);
+  Result<TransferFunction> r = lssvf_records(data, orders, options.svf);
   if (!r.usable()) return r;
   const double tau = r.diagnostics.get(diagnostic::tau);
   const std::vector<PreparedData> P = prepare_all(data, orders, options.svf, "ivsvf");
@@ -416,11 +409,28 @@ Result<TransferFunction> ivsvf(const std::vector<IdData>& data, const TfOrders& 
   return out;
 }
 
+}  // namespace
+
+Result<TransferFunction> lssvf(const IdData& data, const TfOrders& orders, const LssvfOptions& options) {
+  return lssvf_records(data, orders, options);
+}
+
+Result<TransferFunction> lssvf(const std::vector<IdData>& data, const TfOrders& orders, const LssvfOptions& options) {
+  return lssvf_records(data, orders, options);
+}
+
+Result<TransferFunction> ivsvf(const IdData& data, const TfOrders& orders, const IvsvfOptions& options) {
+  return ivsvf_records(data, orders, options);
+}
+
+Result<TransferFunction> ivsvf(const std::vector<IdData>& data, const TfOrders& orders, const IvsvfOptions& options) {
+  return ivsvf_records(data, orders, options);
+}
 }  // namespace ctid
 
 namespace ctid::svf_detail {
 
-FitReport simulation_fit(const TransferFunction& model, const std::vector<IdData>& data, int n_free) {
+FitReport simulation_fit(const TransferFunction& model, const internal::RecordRefs& data, int n_free) {
   Eigen::Index total = 0;
   for (const IdData& d : data) total += d.size();
   if (total < 2) {

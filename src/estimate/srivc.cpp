@@ -272,7 +272,7 @@ SrivcRun srivc_fixed_delay(const Records& ds, const TfOrders& o, double delay, E
   for (const IdData& d : ds) {
     ts.push_back(d.times());
     ys.push_back(d.y().col(0));
-    chs.push_back({{d.u().col(0), d.intersample(0), delay, o.nb}});
+    chs.emplace_back().push_back({d.u().col(0), d.intersample(0), delay, o.nb});  // one copy of u (a braced list would copy it twice)
   }
   std::vector<srivc_detail::IvWorkspace> ws(ds.size());
   std::vector<srivc_detail::IvRecord> recs;
@@ -317,18 +317,18 @@ Eigen::VectorXd initial_theta(const Records& ds, const TfOrders& o, double delay
   }
   // LSSVF with an automatic filter on the delay-shifted input (nk = 0, strictly proper), on the longest record.
   const IdData& d = *std::max_element(ds.begin(), ds.end(), [](const IdData& a, const IdData& b) { return a.size() < b.size(); });
-  IdData shifted = d;
+  std::optional<IdData> shifted;  // only a delay makes a new record; otherwise the record itself
   if (delay > 0) {
     const Eigen::VectorXd ud = filtered_derivatives(TransferFunction(Polynomial{1.0}, Polynomial{1.0}), 0, d.u().col(0),
                                                     d.times(), d.intersample(0), delay);
     Eigen::MatrixXd u = ud;
     shifted = d.is_uniform() ? IdData(u, d.y(), d.ts(), d.t0()) : IdData(u, d.y(), d.times());
-    shifted.set_intersample(0, d.intersample(0));
+    shifted->set_intersample(0, d.intersample(0));
   }
   const TfOrders lo{std::min(o.nb, o.nf), o.nf, 0};
   LssvfOptions lso;
   lso.tau_grid_size = 3;  // a rough start is enough: SRIVC's own iterations do the rest
-  const Result<TransferFunction> ls = lssvf(shifted, lo, lso);
+  const Result<TransferFunction> ls = lssvf(shifted ? *shifted : d, lo, lso);
   Eigen::VectorXd th = Eigen::VectorXd::Zero(o.nf + o.nb);
   th.head(o.nf) = ls.parameters.values.head(o.nf);
   th.tail(lo.nb) = ls.parameters.values.tail(lo.nb);
@@ -791,7 +791,7 @@ Result<TransferFunction> srivc_closed_loop_in_units(const std::vector<IdData>& d
     cl.push_back({refs[e], opt.reference_intersample, opt.controller, opt.reference_at_plant_input});
     ys.push_back(ds[e].y().col(0));
     ts.push_back(ds[e].times());
-    chs.push_back({{ds[e].u().col(0), ds[e].intersample(0), 0.0, orders.nb}});
+    chs.emplace_back().push_back({ds[e].u().col(0), ds[e].intersample(0), 0.0, orders.nb});
   }
   std::vector<srivc_detail::IvRecord> recs;
   for (std::size_t e = 0; e < E; ++e) recs.push_back({&ys[e], &ts[e], &chs[e], first_after(ds[e], opt.transient_time), &cl[e]});

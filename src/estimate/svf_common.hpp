@@ -14,6 +14,7 @@
 #include "ctid/estimate/lssvf.hpp"
 #include "ctid/model/transfer_function.hpp"
 #include "ctid/signal/svf.hpp"
+#include "data/record_refs.hpp"
 #include "internal/least_squares.hpp"
 
 namespace ctid::svf_detail {
@@ -85,16 +86,16 @@ Eigen::VectorXd svf_transform(const SvfLayout& L, const Eigen::VectorXd& theta);
 TransferFunction tf_from_theta(const SvfLayout& L, const Eigen::VectorXd& theta, double delay);
 /// The result of a solved regression: parameters and covariance, model, diagnostics and warnings (RJ-A4, A5, RJ 55);
 /// make_result adds the simulation fit on the records, make_model_result leaves the fit to the caller.
-Result<TransferFunction> make_result(const std::vector<IdData>& data, const TfOrders& o, const SvfLayout& L,
+Result<TransferFunction> make_result(const internal::RecordRefs& data, const TfOrders& o, const SvfLayout& L,
                                      const internal::LinearSolution& sol, double alpha);
 Result<TransferFunction> make_model_result(const TfOrders& o, const SvfLayout& L, const internal::LinearSolution& sol,
                                            double alpha, double delay);
-double choose_tau(const std::vector<IdData>& data, const TfOrders& o, const LssvfOptions& opt, Eigen::VectorXd* grid,
+double choose_tau(const internal::RecordRefs& data, const TfOrders& o, const LssvfOptions& opt, Eigen::VectorXd* grid,
                   Eigen::VectorXd* fits);
 
 /// Output-error fit of a model on the records (each simulated from rest, concatenated); -Inf fit when a
 /// simulation diverges.
-FitReport simulation_fit(const TransferFunction& model, const std::vector<IdData>& data, int n_free);
+FitReport simulation_fit(const TransferFunction& model, const internal::RecordRefs& data, int n_free);
 
 
 /// psi = F_tau^T phi (physical-coefficient regressor, RJ 25) from the chain outputs;

@@ -232,7 +232,7 @@ Eigen::Index first_after(const IdData& d, double transient) {
   return k;
 }
 
-std::pair<Eigen::VectorXd, Eigen::VectorXd> pooled_outputs(const TransferFunction& g, const std::vector<IdData>& ds,
+std::pair<Eigen::VectorXd, Eigen::VectorXd> pooled_outputs(const TransferFunction& g, const internal::RecordRefs& ds,
                                                            double transient) {
   Eigen::Index total = 0;
   for (const IdData& d : ds) total += d.size() - first_after(d, transient);

@@ -25,7 +25,7 @@ double output_error_mse(const TransferFunction& g, const IdData& d);
 Eigen::Index first_after(const IdData& d, double transient);
 /// The measured and simulated (from rest) outputs of every record after its first `transient` seconds, each
 /// concatenated in record order (several experiments of one system).
-std::pair<Eigen::VectorXd, Eigen::VectorXd> pooled_outputs(const TransferFunction& g, const std::vector<IdData>& ds,
+std::pair<Eigen::VectorXd, Eigen::VectorXd> pooled_outputs(const TransferFunction& g, const internal::RecordRefs& ds,
                                                            double transient);
 /// Mirror unstable poles into the left half plane (prefilters and auxiliary models must be stable).
 TransferFunction stabilized(const TransferFunction& tf);
