@@ -8,8 +8,11 @@ SRIVC with nb = 1, nf = 2. Configurations: a plain loop in this process (the ref
 default (threads in this process) and jobs = 1, 2, and a LocalCluster of 1 and 2 worker processes (one thread each:
 the records are pickled to the workers), the same cluster given the records as files (.mat, each worker reads its
 own: only the path and the options travel), and the command line `ctid batch DIR/*.mat --jobs 1, 2` on the same
-files (peak RSS of the whole process). Each configuration is timed --repeats times (3) and the least time kept. Overhead per record: (batch time - loop time) / records on records of
-200 samples, whose fit takes well under a millisecond.
+files (peak RSS of the whole process). The speed of this shared machine drifts by 10-20 % from one minute to the next,
+so the 1- and 2-worker runs of each configuration alternate (1, 2, 1, 2, ...; both clusters started and warmed
+first), --repeats times each (5): the table gives each one's least time and, as the speed-up, the median of the
+ratios of the runs paired in time (the ratio of the least times beside it). Overhead per record: (batch time - loop
+time) / records on records of 200 samples, whose fit takes well under a millisecond.
 """
 import argparse
 import os
@@ -40,6 +43,23 @@ def loop(records):
 def best(run, repeats):
     """The least of `repeats` timings: the machine's other load only ever adds time."""
     return min(run() for _ in range(repeats))
+
+
+def alternate(one, two, repeats):
+    """Runs one() and two() in turn `repeats` times (each returns its seconds, or (seconds, peak RSS)): the least time
+    of each, the largest peak of each (None without), and the median of the ratios one/two of the pairs, which the
+    machine's drift in speed affects least."""
+    a, b, ratios = [], [], []
+    for _ in range(repeats):
+        ra, rb = one(), two()
+        a.append(ra if isinstance(ra, tuple) else (ra, None))
+        b.append(rb if isinstance(rb, tuple) else (rb, None))
+        ratios.append(a[-1][0] / b[-1][0])
+    ratios.sort()
+    m = len(ratios)
+    median = ratios[m // 2] if m % 2 else 0.5 * (ratios[m // 2 - 1] + ratios[m // 2])
+    peak = lambda runs: max(x for _, x in runs) if runs[0][1] is not None else None  # noqa: E731
+    return min(t for t, _ in a), min(t for t, _ in b), peak(a), peak(b), median
 
 
 def write_files(records, folder):
@@ -98,40 +118,49 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--records", type=int, default=2000)
     ap.add_argument("--samples", type=int, default=10000)
-    ap.add_argument("--repeats", type=int, default=3, help="each configuration timed this often, the least kept")
+    ap.add_argument("--repeats", type=int, default=5, help="each configuration timed this often (alternating)")
     ap.add_argument("--ctid", default=os.path.join(os.path.dirname(__file__), "..", "build", "ctid"))
     a = ap.parse_args()
     from distributed import Client, LocalCluster
 
     recs = make_records(a.records, a.samples)
-    rows = [("plain loop in this process", 1, best(lambda: loop(recs), a.repeats), float("nan"))]
-    for jobs in (1, 2):
-        rows.append(("fit_many, client=None (threads)", jobs, best(lambda: batch(recs, jobs=jobs), a.repeats), float("nan")))
-    for workers in (1, 2):
-        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0") as cl, \
-                Client(cl) as c:
-            rows.append(("fit_many, LocalCluster of processes", workers, best(lambda: batch(recs, client=c), a.repeats),
-                         worker_rss(c)))
+    rows = []  # (configuration, workers, seconds, peak RSS per worker, speed-up: median of paired ratios)
+
+    def pair(name, one, two, rss=(float("nan"), float("nan"))):
+        t1, t2, x1, x2, median = alternate(one, two, a.repeats)
+        rows.append((name, 1, t1, x1 if x1 is not None else rss[0], float("nan")))
+        rows.append((name, 2, t2, x2 if x2 is not None else rss[1], median))
+
+    rows.append(("plain loop in this process", 1, best(lambda: loop(recs), a.repeats), float("nan"), float("nan")))
+    pair("fit_many, client=None (threads)", lambda: batch(recs, jobs=1), lambda: batch(recs, jobs=2))
+
+    def clusters(name, records, **options):
+        """Both clusters started and warmed (ctid imported in every worker), then their runs alternate."""
+        with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0") as cl1, \
+                Client(cl1) as c1, \
+                LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cl2, \
+                Client(cl2) as c2:
+            for c in (c1, c2):
+                batch(records[:40], client=c, **options)
+            pair(name, lambda: batch(records, client=c1, **options), lambda: batch(records, client=c2, **options),
+                 (worker_rss(c1), worker_rss(c2)))
+
+    clusters("fit_many, LocalCluster of processes (records pickled)", recs)
     with tempfile.TemporaryDirectory() as folder:
         paths = write_files(recs, folder)
         os.sync()  # the files on disk before timing: no write-back of 320 MB shares the cores with the fits
-        del recs
+        recs.clear()  # the records in memory no longer needed
         files = dict(inputs="u", outputs="y", ts=0.02)
-        for jobs in (1, 2):  # first: no cluster process still exiting shares the cores
-            runs = [cli(a.ctid, folder, jobs) for _ in range(a.repeats)]
-            dt, rss = min(r[0] for r in runs), max(r[1] for r in runs)
-            rows.append(("ctid batch DIR/*.mat --jobs N (threads)", jobs, dt, rss))
-        for workers in (1, 2):
-            with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0") as cl, \
-                    Client(cl) as c:
-                rows.append(("fit_many, LocalCluster of processes, records as .mat files", workers,
-                             best(lambda: batch(paths, client=c, **files), a.repeats), worker_rss(c)))
-    print(f"{a.records} records of {a.samples} samples, SRIVC nb=1 nf=2")
-    print("| configuration | workers | seconds | records/s | speed-up vs 1 worker | peak RSS per worker (MB) |")
-    print("|---|---|---|---|---|---|")
-    one = {name: dt for name, w, dt, _ in rows if w == 1}
-    for name, w, dt, rss in rows:
-        print(f"| {name} | {w} | {dt:.2f} | {a.records / dt:.0f} | {one[name] / dt:.2f} | "
+        pair("ctid batch DIR/*.mat --jobs N (threads)", lambda: cli(a.ctid, folder, 1), lambda: cli(a.ctid, folder, 2))
+        clusters("fit_many, LocalCluster of processes, records as .mat files", paths, **files)
+    print(f"{a.records} records of {a.samples} samples, SRIVC nb=1 nf=2; least of {a.repeats} alternating runs")
+    print("| configuration | workers | seconds | records/s | speed-up vs 1 worker (median of paired runs) | "
+          "ratio of the least times | peak RSS per worker (MB) |")
+    print("|---|---|---|---|---|---|---|")
+    one = {name: dt for name, w, dt, _, _ in rows if w == 1}
+    for name, w, dt, rss, median in rows:
+        sp = "1.00" if w == 1 else f"{median:.2f}"
+        print(f"| {name} | {w} | {dt:.2f} | {a.records / dt:.0f} | {sp} | {one[name] / dt:.2f} | "
               f"{'' if rss != rss else f'{rss:.0f}'} |")
     small = make_records(a.records, 200)
     t_small = loop(small)
