@@ -9,6 +9,7 @@
 
 #include "ctid/core/check.hpp"
 #include "ctid/validate/metrics.hpp"
+#include "data/record_refs.hpp"
 #include "internal/least_squares.hpp"
 #include "internal/levenberg_marquardt.hpp"
 
@@ -44,10 +45,6 @@ const OptionTable<GreyboxOptions>& option_table<GreyboxOptions>() {
 
 void GreyboxOptions::validate() const { option_table<GreyboxOptions>().check(*this); }
 
-Result<GreyboxModel> greybox(const IdData& data, const GreyboxModel& model, const GreyboxOptions& opt) {
-  return greybox(std::vector<IdData>{data}, model, opt);
-}
-
 namespace {
 // One record as the search sees it.
 struct Record {
@@ -67,7 +64,9 @@ struct Segment {
 };
 }  // namespace
 
-Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxModel& model, const GreyboxOptions& opt) {
+namespace {
+// greybox of one record or of several, without copying them.
+Result<GreyboxModel> greybox_records(const internal::RecordRefs& records, const GreyboxModel& model, const GreyboxOptions& opt) {
   const auto clock0 = std::chrono::steady_clock::now();
   opt.validate();
   CTID_REQUIRE(!records.empty(), "greybox: no records");
@@ -507,6 +506,15 @@ Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxMo
   r.fit = fit_report_or_inf(wy, yfit, p);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
   return r;
+}
+}  // namespace
+
+Result<GreyboxModel> greybox(const IdData& data, const GreyboxModel& model, const GreyboxOptions& opt) {
+  return greybox_records(data, model, opt);
+}
+
+Result<GreyboxModel> greybox(const std::vector<IdData>& records, const GreyboxModel& model, const GreyboxOptions& opt) {
+  return greybox_records(records, model, opt);
 }
 
 }  // namespace ctid

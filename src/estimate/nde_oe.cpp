@@ -7,6 +7,7 @@
 
 #include "ctid/core/check.hpp"
 #include "ctid/validate/metrics.hpp"
+#include "data/record_refs.hpp"
 #include "internal/least_squares.hpp"
 #include "internal/levenberg_marquardt.hpp"
 #include "internal/ode.hpp"
@@ -32,11 +33,9 @@ const OptionTable<NdeOeOptions>& option_table<NdeOeOptions>() {
 
 void NdeOeOptions::validate() const { option_table<NdeOeOptions>().check(*this); }
 
-Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOeOptions& opt) {
-  return nde_oe(std::vector<IdData>{data}, initial, opt);
-}
-
-Result<NdeModel> nde_oe(const std::vector<IdData>& records, const NdeModel& initial, const NdeOeOptions& opt) {
+namespace {
+// nde_oe of one record or of several, without copying them.
+Result<NdeModel> nde_oe_records(const internal::RecordRefs& records, const NdeModel& initial, const NdeOeOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   opt.validate();
   CTID_REQUIRE(!records.empty(), "nde_oe: no records");
@@ -283,6 +282,15 @@ Result<NdeModel> nde_oe(const std::vector<IdData>& records, const NdeModel& init
   r.fit = fit_report_or_inf(y, yfit, p);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
+}
+}  // namespace
+
+Result<NdeModel> nde_oe(const IdData& data, const NdeModel& initial, const NdeOeOptions& opt) {
+  return nde_oe_records(data, initial, opt);
+}
+
+Result<NdeModel> nde_oe(const std::vector<IdData>& records, const NdeModel& initial, const NdeOeOptions& opt) {
+  return nde_oe_records(records, initial, opt);
 }
 
 }  // namespace ctid

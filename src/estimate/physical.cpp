@@ -299,13 +299,10 @@ Result<TransferFunction> fit_physical_frequency(const PhysicalModel& model, cons
                              data);
 }
 
-Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
-                                          const IdData& data, double a, const PhysicalFitOptions& opt) {
-  return fit_physical_raw(model, params, std::vector<IdData>{data}, a, opt);
-}
-
-Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
-                                          const std::vector<IdData>& records, double a, const PhysicalFitOptions& opt) {
+namespace {
+// fit_physical_raw of one record or of several, without copying them (one record: a span of one).
+Result<TransferFunction> fit_physical_raw_records(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
+                                                  std::span<const IdData> records, double a, const PhysicalFitOptions& opt) {
   CTID_REQUIRE(!records.empty(), "physical: no records");
   CTID_REQUIRE(std::isfinite(a) && a >= 0, "physical: the window a must be >= 0 (got {})", a);
   // Several records (experiments of one system): their residuals stacked, each record simulated from rest and
@@ -382,6 +379,17 @@ Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std:
       r.diagnostics.set(diagnostic::x0, simulate(AnyModel(r.model), records[e], so).x0, static_cast<int>(e));
   }
   return r;
+}
+}  // namespace
+
+Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
+                                          const IdData& data, double a, const PhysicalFitOptions& opt) {
+  return fit_physical_raw_records(model, params, std::span<const IdData>(&data, 1), a, opt);
+}
+
+Result<TransferFunction> fit_physical_raw(const PhysicalModel& model, const std::vector<PhysicalParameter>& params,
+                                          const std::vector<IdData>& records, double a, const PhysicalFitOptions& opt) {
+  return fit_physical_raw_records(model, params, records, a, opt);
 }
 
 }  // namespace ctid

@@ -273,11 +273,9 @@ void CoefficientTracker::update(double t, double u, double y) {
   }
 }
 
-Result<TransferFunction> rls_svf(const IdData& d, const TfOrders& orders, const RlsSvfOptions& options) {
-  return rls_svf(std::vector<IdData>{d}, orders, options);
-}
-
-Result<TransferFunction> rls_svf(const std::vector<IdData>& ds, const TfOrders& orders, const RlsSvfOptions& options) {
+namespace {
+// rls_svf of one record or of several, without copying them.
+Result<TransferFunction> rls_svf_records(const internal::RecordRefs& ds, const TfOrders& orders, const RlsSvfOptions& options) {
   CTID_REQUIRE(!ds.empty(), "rls_svf: no records");
   for (std::size_t e = 0; e < ds.size(); ++e) {
     const std::string who = ds.size() > 1 ? "rls_svf (record " + std::to_string(e + 1) + ")" : "rls_svf";
@@ -311,6 +309,15 @@ Result<TransferFunction> rls_svf(const std::vector<IdData>& ds, const TfOrders& 
   r.fit = fit_report_or_inf(y, yhat, orders.n_parameters() - static_cast<int>(options.fixed.size()));
   if (!r.model.is_stable()) r.diagnostics.warnings.push_back("the estimated model is unstable");
   return r;
+}
+}  // namespace
+
+Result<TransferFunction> rls_svf(const IdData& d, const TfOrders& orders, const RlsSvfOptions& options) {
+  return rls_svf_records(d, orders, options);
+}
+
+Result<TransferFunction> rls_svf(const std::vector<IdData>& ds, const TfOrders& orders, const RlsSvfOptions& options) {
+  return rls_svf_records(ds, orders, options);
 }
 
 }  // namespace ctid

@@ -703,11 +703,9 @@ TransferFunction time_scaled(const TransferFunction& g, double c, double gain) {
 }
 }  // namespace
 
-Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& orders, const SrivcMisoOptions& opt) {
-  return srivc_miso(std::vector<IdData>{data}, orders, opt);
-}
-
-Result<MisoModel> srivc_miso(const std::vector<IdData>& ds, const std::vector<TfOrders>& orders, const SrivcMisoOptions& opt) {
+namespace {
+// srivc_miso of one record or of several, without copying them.
+Result<MisoModel> srivc_miso_records(const internal::RecordRefs& ds, const std::vector<TfOrders>& orders, const SrivcMisoOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
   CTID_REQUIRE(!ds.empty(), "srivc_miso: no records");
   const int K = ds.front().nu();
@@ -752,6 +750,15 @@ Result<MisoModel> srivc_miso(const std::vector<IdData>& ds, const std::vector<Tf
     r.model.channels[i] = per_input[static_cast<size_t>(i)].from_normalised(r.model.channels[i], orders[i]);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
+}
+}  // namespace
+
+Result<MisoModel> srivc_miso(const IdData& data, const std::vector<TfOrders>& orders, const SrivcMisoOptions& opt) {
+  return srivc_miso_records(data, orders, opt);
+}
+
+Result<MisoModel> srivc_miso(const std::vector<IdData>& ds, const std::vector<TfOrders>& orders, const SrivcMisoOptions& opt) {
+  return srivc_miso_records(ds, orders, opt);
 }
 
 template <>

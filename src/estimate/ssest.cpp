@@ -10,6 +10,7 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <span>
 #include <tuple>
 
 #include "ctid/core/check.hpp"
@@ -81,7 +82,7 @@ struct ScaledRecord {
   std::vector<Intersample> intersample;  // of each input
 };
 
-std::vector<ScaledRecord> records_of(const std::vector<IdData>& ds, const Eigen::VectorXd& su, const Eigen::VectorXd& sy) {
+std::vector<ScaledRecord> records_of(std::span<const IdData> ds, const Eigen::VectorXd& su, const Eigen::VectorXd& sy) {
   std::vector<ScaledRecord> out;
   for (const IdData& d : ds) {
     ScaledRecord r;
@@ -440,7 +441,7 @@ Search search(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>& h
   return search_records(L, theta, held, recs, o, free_coordinates, damping);
 }
 
-void check_records(const std::vector<IdData>& ds) {
+void check_records(std::span<const IdData> ds) {
   CTID_REQUIRE(!ds.empty(), "ssest: no records were given");
   const int nu = ds.front().nu(), ny = ds.front().ny();
   CTID_REQUIRE(nu >= 1 && ny >= 1, "ssest: the data need at least one input and one output (got {} and {})", nu, ny);
@@ -475,7 +476,7 @@ void hold_structure(const Layout& L, const SsestOptions& o, Point& p, std::vecto
 // The result at the final model `fin` (user units): the modal form (or the user's coordinates), the parameters and
 // their covariance (J^T W J)^-1 with W the inverse noise variances (the residuals' or, for a bound, the given ones),
 // fits, initial states, modes and their uncertainty.
-void deliver(Result<StateSpace>& res, const std::vector<IdData>& ds, Point fin, bool user_coordinates,
+void deliver(Result<StateSpace>& res, std::span<const IdData> ds, Point fin, bool user_coordinates,
              const std::vector<bool>& held, int similar, const SsestOptions& o, const Eigen::VectorXd* noise_variance) {
   const int nx = static_cast<int>(fin.A.rows()), nu = ds.front().nu(), ny = ds.front().ny();
   const int E = static_cast<int>(ds.size());
@@ -556,7 +557,7 @@ void deliver(Result<StateSpace>& res, const std::vector<IdData>& ds, Point fin, 
   report_modes(res);
   }
 
-Result<StateSpace> fit_from(const std::vector<IdData>& ds, Point start, bool user_coordinates,
+Result<StateSpace> fit_from(std::span<const IdData> ds, Point start, bool user_coordinates,
                             const Eigen::VectorXd& singular_values, const SsestOptions& o, Clock::time_point t0) {
   const int nx = static_cast<int>(start.A.rows()), nu = ds.front().nu(), ny = ds.front().ny();
   const int E = static_cast<int>(ds.size());
@@ -630,7 +631,7 @@ struct Start {
   bool failed = false;
 };
 
-Start subspace_start(const std::vector<IdData>& ds, int nx, const SsestOptions& o) {
+Start subspace_start(std::span<const IdData> ds, int nx, const SsestOptions& o) {
   size_t longest = 0;
   for (size_t e = 1; e < ds.size(); ++e)
     if (ds[e].size() > ds[longest].size()) longest = e;
@@ -684,7 +685,7 @@ void with_integrators(Point& p, int k) {
   p.A.leftCols(k).setZero();
 }
 
-Result<StateSpace> ssest_order(const std::vector<IdData>& ds, int nx, const SsestOptions& o, Clock::time_point t0) {
+Result<StateSpace> ssest_order(std::span<const IdData> ds, int nx, const SsestOptions& o, Clock::time_point t0) {
   Start s = subspace_start(ds, nx, o);
   if (s.failed) {
     Result<StateSpace> r = std::move(s.failure);
@@ -697,9 +698,8 @@ Result<StateSpace> ssest_order(const std::vector<IdData>& ds, int nx, const Sses
   return r;
 }
 
-}  // namespace
-
-Result<StateSpace> ssest(const std::vector<IdData>& data, const SsestOptions& options) {
+// ssest of one record (a span of one, not copied) or of several.
+Result<StateSpace> ssest_records(std::span<const IdData> data, const SsestOptions& options) {
   const auto t0 = Clock::now();
   options.validate();
   check_records(data);
@@ -710,9 +710,13 @@ Result<StateSpace> ssest(const std::vector<IdData>& data, const SsestOptions& op
   return best;
 }
 
+}  // namespace
+
 Result<StateSpace> ssest(const IdData& data, const SsestOptions& options) {
-  return ssest(std::vector<IdData>{data}, options);
+  return ssest_records(std::span<const IdData>(&data, 1), options);
 }
+
+Result<StateSpace> ssest(const std::vector<IdData>& data, const SsestOptions& options) { return ssest_records(data, options); }
 
 Result<StateSpace> ssest(const std::vector<IdData>& data, const StateSpace& initial, const SsestOptions& options) {
   const auto t0 = Clock::now();
