@@ -416,16 +416,15 @@ Result<TransferFunction> modal_transfer_function(const IdData& data, const Input
 }
 
 namespace {
-Result<TransferFunction> modal_fit_undelayed(const std::vector<IdData>& data, int nb, ModalOptions o,
+Result<TransferFunction> modal_fit_undelayed(const internal::RecordRefs& data, int nb, ModalOptions o,
                                              const InputGenerator* input);
 Eigen::VectorXd automatic_shifts(const IdData& d, int n, bool piecewise_constant, std::vector<std::string>& choices);
 }  // namespace
 
-Result<TransferFunction> modal_fit(const IdData& data, int nb, ModalOptions o, const InputGenerator* input) {
-  return modal_fit(std::vector<IdData>{data}, nb, std::move(o), input);
-}
-
-Result<TransferFunction> modal_fit(const std::vector<IdData>& data, int nb, ModalOptions o, const InputGenerator* input) {
+namespace {
+// modal_fit of one record or of several, without copying them (only a delay makes delayed copies).
+Result<TransferFunction> modal_fit_records(const internal::RecordRefs& data, int nb, ModalOptions o,
+                                           const InputGenerator* input) {
   o.validate();
   CTID_REQUIRE(!data.empty(), "modal_fit: no records");
   CTID_REQUIRE(!input || data.size() == 1,
@@ -449,7 +448,7 @@ Result<TransferFunction> modal_fit(const std::vector<IdData>& data, int nb, Moda
       delayed.back().set_intersample(0, d.intersample(0));
     }
   }
-  const std::vector<IdData>& fitted = o.delay > 0.0 ? delayed : data;
+  const internal::RecordRefs fitted = o.delay > 0.0 ? internal::RecordRefs(delayed) : data;
   std::vector<std::string> choices;
   if (o.shifts.size() == 0) o.shifts = automatic_shifts(fitted.front(), o.order, input == nullptr, choices);
   const double delay = o.delay;
@@ -458,6 +457,15 @@ Result<TransferFunction> modal_fit(const std::vector<IdData>& data, int nb, Moda
   if (delay > 0.0) r.model.set_io_delay(delay);
   r.diagnostics.choices = std::move(choices);
   return r;
+}
+}  // namespace
+
+Result<TransferFunction> modal_fit(const IdData& data, int nb, ModalOptions o, const InputGenerator* input) {
+  return modal_fit_records(data, nb, std::move(o), input);
+}
+
+Result<TransferFunction> modal_fit(const std::vector<IdData>& data, int nb, ModalOptions o, const InputGenerator* input) {
+  return modal_fit_records(data, nb, std::move(o), input);
 }
 
 namespace {
@@ -500,7 +508,7 @@ Eigen::VectorXd automatic_shifts(const IdData& d, int n, bool piecewise_constant
   return c.shifts;
 }
 
-Result<TransferFunction> modal_fit_undelayed(const std::vector<IdData>& data, int nb, ModalOptions o,
+Result<TransferFunction> modal_fit_undelayed(const internal::RecordRefs& data, int nb, ModalOptions o,
                                              const InputGenerator* input) {
   const auto t_start = std::chrono::steady_clock::now();
   const int n = static_cast<int>(o.shifts.size());
