@@ -16,6 +16,7 @@ time) / records on records of 200 samples, whose fit takes well under a millisec
 """
 import argparse
 import os
+import statistics
 import subprocess
 import tempfile
 import time
@@ -55,11 +56,10 @@ def alternate(one, two, repeats):
         a.append(ra if isinstance(ra, tuple) else (ra, None))
         b.append(rb if isinstance(rb, tuple) else (rb, None))
         ratios.append(a[-1][0] / b[-1][0])
-    ratios.sort()
-    m = len(ratios)
-    median = ratios[m // 2] if m % 2 else 0.5 * (ratios[m // 2 - 1] + ratios[m // 2])
-    peak = lambda runs: max(x for _, x in runs) if runs[0][1] is not None else None  # noqa: E731
-    return min(t for t, _ in a), min(t for t, _ in b), peak(a), peak(b), median
+    def peak(runs):
+        return max(x for _, x in runs) if runs[0][1] is not None else None
+
+    return min(t for t, _ in a), min(t for t, _ in b), peak(a), peak(b), statistics.median(ratios)
 
 
 def write_files(records, folder):
