@@ -77,8 +77,8 @@ def fit_one(rid, record, method, options, file_options):
 
 
 def fit_chunk(items, method, options, file_options):
-    """fit_one over several (id, record) pairs: one Dask task (a task costs about a millisecond of scheduling, as
-    much as a fit of a few thousand samples)."""
+    """fit_one over several (id, record) pairs: one Dask task (a task costs milliseconds of scheduling, as much as
+    a fit of a few thousand samples)."""
     return [fit_one(rid, rec, method, options, file_options) for rid, rec in items]
 
 
@@ -174,10 +174,20 @@ def _threads(client, jobs):
     return max(1, sum(client.nthreads().values()))
 
 
-def _chunk_size(n, threads):
-    """Items per task: enough tasks for 8 per thread, at most 32 items each (a Dask task costs about a millisecond
-    of scheduling, as much as a fit of a few thousand samples, while the load should stay balanced)."""
-    return max(1, min(32, -(-n // (8 * threads))))
+#: At most this many records (or Monte Carlo runs) per task, and at most this many bytes of records held in memory:
+#: a task's rows reach the output file, the progress line and a resumed batch when the task ends.
+CHUNK_MAX, CHUNK_BYTES = 256, 16 << 20
+
+
+def _chunk_size(n, threads, record_bytes=0):
+    """Items per task: 8 tasks per thread (the load stays balanced), at most CHUNK_MAX items and CHUNK_BYTES of
+    records in memory. A Dask task costs about 8 ms of CPU in the client and the worker processes together (measured
+    on 2 cores, docs/scale.md): at most 32 records of 10 000 samples per task took 15 % of the cores beside the fits,
+    8 tasks per thread 9 %."""
+    size = min(CHUNK_MAX, -(-n // (8 * threads)))
+    if record_bytes:
+        size = min(size, CHUNK_BYTES // record_bytes)
+    return max(1, size)
 
 
 def _execute(func, tasks, client, jobs, retries, rows, writer, progress, done, total, label):
@@ -219,6 +229,36 @@ def _execute(func, tasks, client, jobs, retries, rows, writer, progress, done, t
             pool.shutdown(cancel_futures=True)
 
 
+def local_cluster(workers=None, **kwargs):
+    """A dask.distributed LocalCluster for batches of ctid fits on this machine: `workers` worker processes (default:
+    every core) of one thread each, with Dask's statistical profiler off and its event-loop health check every
+    500 ms instead of 20 ms. The profiler samples the stack of every worker thread every 10 ms to profile Python
+    code; a ctid fit is C++ and releases the GIL, so it sees nothing and only takes CPU from the fits. With a worker
+    per core those wake-ups take the fits' cores: on 2 cores the two settings cut the CPU used beside the fits from
+    about 9 % to 5 % (docs/scale.md). The settings also hold for the workers the nannies restart. kwargs go to
+    LocalCluster (e.g. dashboard_address=":0"; a config= dict for the workers is merged over the settings). Give the
+    cluster to dask.distributed.Client, and the client to fit_many or monte_carlo. Workers started on other machines
+    get the same settings from the environment: DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False and
+    DASK_DISTRIBUTED__ADMIN__TICK__INTERVAL=500ms."""
+    import dask
+    import distributed
+
+    if workers is not None and not (isinstance(workers, int) and workers >= 1):
+        raise ValueError(f"local_cluster: workers must be a whole number >= 1 (got {workers!r})")
+    kwargs.setdefault("threads_per_worker", 1)
+    kwargs.setdefault("processes", True)
+    with dask.config.set(LEAN_DASK_CONFIG):
+        # The scheduler and the nannies read the settings now; each nanny also passes its own copy of the whole
+        # configuration to every worker process it starts, restarts included (without a deep copy of its own it
+        # would share Dask's global one, from which the settings are gone after this block).
+        whole = dask.config.merge(dask.config.config, kwargs.pop("config", {}))
+        return distributed.LocalCluster(n_workers=workers or _os.cpu_count() or 1, config=whole, **kwargs)
+
+
+#: The Dask settings of local_cluster (see there).
+LEAN_DASK_CONFIG = {"distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "500ms"}
+
+
 def fit_many(records, method="srivc", client=None, *, out=None, resume=False, progress=True, retries=2, jobs=None,
              chunk=None,
              inputs=None, outputs=None, time=None, ts=None, intersample=None, **options):
@@ -232,9 +272,9 @@ def fit_many(records, method="srivc", client=None, *, out=None, resume=False, pr
     out: a .csv or .jsonl file the rows are written to as they arrive; resume=True continues a batch that stopped
     (the records whose id is in `out` are not fitted again; without resume an existing file is an error, never
     overwritten). progress: True prints a line on stderr, a callable gets (done, total) after each row.
-    retries: how often Dask runs a task again whose worker was lost. chunk: records per Dask task (default: enough
-    tasks for 8 per worker thread, at most 32 records each, so that the scheduling of a task, about a millisecond, is
-    small beside its fits while the load stays balanced).
+    retries: how often Dask runs a task again whose worker was lost. chunk: records per Dask task (default: 8 tasks
+    per worker thread, at most CHUNK_MAX records and CHUNK_BYTES of records in memory each, so that the scheduling of
+    a task, about 8 ms of CPU, is small beside its fits while the load stays balanced).
 
     Columns: id, method, model (its type), orders, fit_percent, termination, usable, seconds, error ('' for a usable
     fit; the exception, or why the fit is not usable), then NAME and NAME_std for each parameter. Rows are in the
@@ -254,7 +294,9 @@ def fit_many(records, method="srivc", client=None, *, out=None, resume=False, pr
     rows = {str(r["id"]): r for r in writer.rows} if writer else {}  # those of an earlier run (resume)
     todo = [(rid, rec) for rid, rec in pairs if rid not in rows]
 
-    size = chunk or _chunk_size(len(todo), _threads(client, jobs))
+    in_memory = [rec for _, rec in todo if isinstance(rec, ctid.IdData)]
+    record_bytes = max((len(r) * (r.nu + r.ny + 1) * 8 for r in in_memory), default=0)
+    size = chunk or _chunk_size(len(todo), _threads(client, jobs), record_bytes)
     chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
     _execute(fit_chunk, [(c, method, options, file_options) for c in chunks], client, jobs, retries, rows, writer,
              progress, len(pairs) - len(todo), len(pairs), "fit_many")

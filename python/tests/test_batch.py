@@ -41,7 +41,7 @@ def records(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def client():
-    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0")
+    cluster = ctid.batch.local_cluster(2, dashboard_address=":0")  # a LocalCluster of 2 processes, 1 thread each
     c = distributed.Client(cluster)
     yield c
     c.close()
@@ -98,6 +98,23 @@ def test_a_worker_killed_mid_batch_loses_no_row_and_duplicates_none(records, cli
     check_frame(df, paths, broken)
     client.wait_for_workers(2, timeout=60)  # the nanny restarts the worker
     assert killed[0] not in client.run(os.getpid).values()
+    # ... with local_cluster's settings (the profiler off, the event-loop check every 500 ms), as the other one.
+    assert list(client.run(lean_settings).values()) == [(False, "500ms")] * 2
+
+
+def lean_settings():
+    import dask
+    return dask.config.get("distributed.worker.profile.enabled"), dask.config.get("distributed.admin.tick.interval")
+
+
+def test_local_cluster_and_the_records_per_task():
+    with pytest.raises(ValueError, match="workers must be a whole number >= 1 \\(got 0\\)"):
+        ctid.batch.local_cluster(0)
+    # 8 tasks per thread, at most CHUNK_MAX = 256 records and CHUNK_BYTES = 16 MiB of records in memory per task.
+    size = ctid.batch._chunk_size
+    assert size(2000, 2) == 125 and size(2000, 1) == 250 and size(10 ** 6, 2) == 256 and size(3, 8) == 1
+    assert size(2000, 2, 10000 * 2 * 8) == 104  # 16 MiB / 160 kB (10 000 samples of u and y)
+    assert size(2000, 2, 10 ** 9) == 1  # a record larger than the budget still travels, alone
 
 
 def test_an_interrupted_batch_resumes_with_only_the_missing_rows(records, client, tmp_path):
