@@ -13,6 +13,7 @@
 #include "ctid/estimate/gfrf.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/validate/metrics.hpp"
+#include "data/record_refs.hpp"
 
 namespace ctid {
 
@@ -482,10 +483,6 @@ Result<NdeModel> kia_cubic(const NarxModel& narx, const NdeModel& model_in, cons
   return extended(model, o.candidates, keep, g, t_start);
 }
 
-KiaRun kia(const IdData& d, const NarxModel& narx, const KiaOptions& o) {
-  return kia(std::vector<IdData>{d}, narx, o);
-}
-
 std::vector<NdeTerm> kia_product_candidates(int degree, int y_order, int u_order) {
   CTID_REQUIRE(degree >= 1 && y_order >= 0 && u_order >= 0, "kia_product_candidates: degree {} >= 1, orders {} and {} >= 0",
                degree, y_order, u_order);
@@ -508,7 +505,11 @@ std::vector<NdeTerm> kia_product_candidates(int degree, int y_order, int u_order
   return out;
 }
 
-KiaRun kia(const std::vector<IdData>& ds, const NarxModel& narx, const KiaOptions& o) {
+namespace {
+// kia of one record or of several, without copying them; `refine` is nde_oe of the same records as the caller gave
+// them (nde_oe's public calls, which do not copy either).
+template <class Refine>
+KiaRun kia_records(const internal::RecordRefs& ds, const NarxModel& narx, const KiaOptions& o, const Refine& refine) {
   CTID_REQUIRE(!ds.empty(), "kia: no records");
   const int E = static_cast<int>(ds.size());
   for (int e = 0; e < E; ++e) {
@@ -602,10 +603,19 @@ KiaRun kia(const std::vector<IdData>& ds, const NarxModel& narx, const KiaOption
         std::round(r.fit.fit_percent * 100) / 100, std::round(run.narx_fit_percent * 100) / 100);
   }
   if (o.refine) {
-    run.refined = nde_oe(ds, r.model, o.refinement);
+    run.refined = refine(r.model);
     run.refined->diagnostics.choices.insert(run.refined->diagnostics.choices.begin(), choices.begin(), choices.end());
   }
   return run;
+}
+}  // namespace
+
+KiaRun kia(const IdData& d, const NarxModel& narx, const KiaOptions& o) {
+  return kia_records(d, narx, o, [&](const NdeModel& m) { return nde_oe(d, m, o.refinement); });
+}
+
+KiaRun kia(const std::vector<IdData>& ds, const NarxModel& narx, const KiaOptions& o) {
+  return kia_records(ds, narx, o, [&](const NdeModel& m) { return nde_oe(ds, m, o.refinement); });
 }
 
 }  // namespace ctid
