@@ -182,8 +182,8 @@ CHUNK_MAX, CHUNK_BYTES = 256, 16 << 20
 def _chunk_size(n, threads, record_bytes=0):
     """Items per task: 8 tasks per thread (the load stays balanced), at most CHUNK_MAX items and CHUNK_BYTES of
     records in memory. A Dask task costs about 8 ms of CPU in the client and the worker processes together (measured
-    on 2 cores, docs/scale.md): at most 32 records of 10 000 samples per task took 15 % of the cores beside the fits,
-    8 tasks per thread 9 %."""
+    on 2 cores, docs/scale.md): with at most 32 records of 10 000 samples per task 15-16 % of the CPU went beside the
+    fits, with 8 tasks per thread 9-11 %."""
     size = min(CHUNK_MAX, -(-n // (8 * threads)))
     if record_bytes:
         size = min(size, CHUNK_BYTES // record_bytes)
@@ -235,7 +235,7 @@ def local_cluster(workers=None, **kwargs):
     500 ms instead of 20 ms. The profiler samples the stack of every worker thread every 10 ms to profile Python
     code; a ctid fit is C++ and releases the GIL, so it sees nothing and only takes CPU from the fits. With a worker
     per core those wake-ups take the fits' cores: on 2 cores the two settings cut the CPU used beside the fits from
-    about 9 % to 5 % (docs/scale.md). The settings also hold for the workers the nannies restart. kwargs go to
+    9-11 % to 5-6 % (docs/scale.md). The settings also hold for the workers the nannies restart. kwargs go to
     LocalCluster (e.g. dashboard_address=":0"; a config= dict for the workers is merged over the settings). Give the
     cluster to dask.distributed.Client, and the client to fit_many or monte_carlo. Workers started on other machines
     get the same settings from the environment: DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False and
@@ -243,7 +243,7 @@ def local_cluster(workers=None, **kwargs):
     import dask
     import distributed
 
-    if workers is not None and not (isinstance(workers, int) and workers >= 1):
+    if workers is not None and (isinstance(workers, bool) or not (isinstance(workers, int) and workers >= 1)):
         raise ValueError(f"local_cluster: workers must be a whole number >= 1 (got {workers!r})")
     kwargs.setdefault("threads_per_worker", 1)
     kwargs.setdefault("processes", True)
