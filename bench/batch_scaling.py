@@ -163,10 +163,10 @@ def main():
     recs = make_records(a.records, a.samples)
     rows = []  # (configuration, workers, seconds, peak RSS per worker, CPU beside the fits, speed-up)
 
-    def pair(name, one, two, rss=(None, None)):
+    def pair(name, one, two):
         (t1, x1, c1), (t2, x2, c2), median = alternate(one, two, a.repeats)
-        rows.append((name, 1, t1, x1 if x1 is not None else rss[0], c1, None))
-        rows.append((name, 2, t2, x2 if x2 is not None else rss[1], c2, median))
+        rows.append((name, 1, t1, x1, c1, None))
+        rows.append((name, 2, t2, x2, c2, median))
 
     rows.append(("plain loop in this process", 1, best(lambda: loop(recs), a.repeats), None, None, None))
     pair("fit_many, client=None (threads)", lambda: batch(recs, jobs=1), lambda: batch(recs, jobs=2))

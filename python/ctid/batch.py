@@ -229,6 +229,10 @@ def _execute(func, tasks, client, jobs, retries, rows, writer, progress, done, t
             pool.shutdown(cancel_futures=True)
 
 
+#: The Dask settings of local_cluster (see there).
+LEAN_DASK_CONFIG = {"distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "500ms"}
+
+
 def local_cluster(workers=None, **kwargs):
     """A dask.distributed LocalCluster for batches of ctid fits on this machine: `workers` worker processes (default:
     every core) of one thread each, with Dask's statistical profiler off and its event-loop health check every
@@ -253,10 +257,6 @@ def local_cluster(workers=None, **kwargs):
         # would share Dask's global one, from which the settings are gone after this block).
         whole = dask.config.merge(dask.config.config, kwargs.pop("config", {}))
         return distributed.LocalCluster(n_workers=workers or _os.cpu_count() or 1, config=whole, **kwargs)
-
-
-#: The Dask settings of local_cluster (see there).
-LEAN_DASK_CONFIG = {"distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "500ms"}
 
 
 def fit_many(records, method="srivc", client=None, *, out=None, resume=False, progress=True, retries=2, jobs=None,
@@ -294,8 +294,7 @@ def fit_many(records, method="srivc", client=None, *, out=None, resume=False, pr
     rows = {str(r["id"]): r for r in writer.rows} if writer else {}  # those of an earlier run (resume)
     todo = [(rid, rec) for rid, rec in pairs if rid not in rows]
 
-    in_memory = [rec for _, rec in todo if isinstance(rec, ctid.IdData)]
-    record_bytes = max((len(r) * (r.nu + r.ny + 1) * 8 for r in in_memory), default=0)
+    record_bytes = max((len(r) * (r.nu + r.ny + 1) * 8 for _, r in todo if isinstance(r, ctid.IdData)), default=0)
     size = chunk or _chunk_size(len(todo), _threads(client, jobs), record_bytes)
     chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
     _execute(fit_chunk, [(c, method, options, file_options) for c in chunks], client, jobs, retries, rows, writer,
