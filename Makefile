@@ -1,4 +1,4 @@
-# Thin wrapper around CMake (DESIGN.md §2).
+# Thin wrapper around CMake (docs/architecture.md, "Build").
 #   make demo   install dependencies, build the library and the command-line tool only (unity build,
 #               CTID_UNITY_BUILD, with RELEASE_CXX), run `ctid demo` on the bundled data
 #   make test   install dependencies, build, run every test (ctest), then the sanitizer build's tests

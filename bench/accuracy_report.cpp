@@ -1,4 +1,4 @@
-// Monte Carlo accuracy report for issue 3 (docs/accuracy.md). Prints markdown tables.
+// Monte Carlo accuracy report of the SRIVC/OE set-ups (docs/accuracy.md). Prints markdown tables.
 //   build/bench/accuracy_report [runs]      (default 100 runs per set-up)
 // Every set-up uses fixed seeds and exact simulation; the numbers in docs/accuracy.md are
 // this program's output.

@@ -1,4 +1,4 @@
-"""Batch identification on Dask (issue 18): records per second of ctid.batch.fit_many with 1 and 2 workers, the
+"""Batch identification on Dask: records per second of ctid.batch.fit_many with 1 and 2 workers, the
 scheduling overhead per record, and peak memory per worker.
 
     PYTHONPATH=build/python /usr/bin/python3 bench/batch_scaling.py [--records 2000] [--samples 10000] [--ctid build/ctid]

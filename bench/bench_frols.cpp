@@ -1,4 +1,4 @@
-// FROLS on SysIdentPy's benchmark problem (issue 6): polynomial degree 2, input and output lags 1..16
+// FROLS on SysIdentPy's benchmark problem: polynomial degree 2, input and output lags 1..16
 // (561 candidates with the constant), 20 terms, N = 1e3 .. 1e6; and the same with AIC over the 20 model
 // sizes read off the one greedy pass.
 // Run: build/bench/bench_frols --benchmark_repetitions=3 --benchmark_report_aggregates_only=true

@@ -1,4 +1,4 @@
-// Gawthrop-Wang stage 1 (issue 4): FSF compression of N = 1e6 samples, T/Delta = 1000, n = 21.
+// Gawthrop-Wang stage 1: FSF compression of N = 1e6 samples, T/Delta = 1000, n = 21.
 // Run: build/bench/bench_fsf --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <sys/resource.h>
 
@@ -23,7 +23,7 @@ void BM_FsfCompression(benchmark::State& state) {
   state.counters["peak_rss_MB"] = ru.ru_maxrss / 1024.0;
 }
 BENCHMARK(BM_FsfCompression)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->Iterations(3);
-// Unstable circuit stand-in (SEEDS-SPEC GW.3) with M samples at 10 ms: two-stage route
+// Unstable circuit stand-in (Gawthrop & Wang 2005, §5) with M samples at 10 ms: two-stage route
 // (FSF compression + LM on the compressed step response) versus output error on the raw record.
 ctid::IdData circuit(int M) {
   const double Ts = 0.01;

@@ -1,4 +1,4 @@
-// Kernel Invariance Algorithm stage times (issue 6) on the published NARX model (34) of Billings & Li:
+// Kernel Invariance Algorithm stage times on the published NARX model (34) of Billings & Li:
 // H_1 at 500 points, H_2 on a 70 x 70 grid, the linear stage (500 points, GLS order 10) and the quadratic
 // stage (70 point pairs, GLS order 3); the output-error refinement (nde_oe) of the reconstructed equation of
 // Billings & Li (33) on 1000 samples of its 20 dB record.
@@ -10,7 +10,7 @@
 #include "ctid/ctid.hpp"
 
 namespace {
-ctid::NarxModel bl34() {  // Billings & Li (1999) model (34) as printed (SEEDS-SPEC BL.3)
+ctid::NarxModel bl34() {  // Billings & Li (1999) model (34) as printed
   return ctid::read_narx_json(std::string(CTID_EXAMPLES_DATA_DIR) + "/bl34_narx.json");
 }
 

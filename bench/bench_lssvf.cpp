@@ -1,4 +1,4 @@
-// LSSVF fit time (issue 2): n = 2 and 4 at N = 1e4 .. 1e7 (fixed tau; includes the
+// LSSVF fit time: n = 2 and 4 at N = 1e4 .. 1e7 (fixed tau; includes the
 // output-error fit report), and the RLS-SVF update cost for n = 2 and 4.
 // Run: build/bench/bench_lssvf --benchmark_min_time=0.5
 #include <benchmark/benchmark.h>

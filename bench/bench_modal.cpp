@@ -1,4 +1,4 @@
-// El-Shafey modal functions (issue 5): modal-parameter estimation (Fourier recursion to j = n, and the
+// El-Shafey modal functions: modal-parameter estimation (Fourier recursion to j = n, and the
 // discrete least squares on constant-input windows) and the free-response data-matrix pole method, at
 // N = 1e4 .. 1e6 samples. Must be linear in N.
 // Run: build/bench/bench_modal --benchmark_repetitions=3 --benchmark_report_aggregates_only=true

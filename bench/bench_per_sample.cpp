@@ -1,4 +1,4 @@
-// Time and memory per sample of SRIVC, OE, FROLS and lsim from N = 1e4 to 1e7 (issue 18, "one core"): the time per
+// Time and memory per sample of SRIVC, OE, FROLS and lsim from N = 1e4 to 1e7 on one core: the time per
 // sample should not grow with N (no allocation whose page faults grow with the record, no temporaries that fall out
 // of cache); the peak memory of one fit above the record itself, in bytes per sample, shows the O(N) constant.
 // Run: build/bench/bench_per_sample [N_MAX=10000000] [METHODS=srivc,oe,oe-start,frols,frols-passes,lsim,lsim-data,lsim-new]

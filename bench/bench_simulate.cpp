@@ -1,4 +1,4 @@
-// Exact simulation throughput (issue 2): order 2, 4, 8 at N = 1e4 .. 1e6, ZOH input, uniform Ts.
+// Exact simulation throughput: order 2, 4, 8 at N = 1e4 .. 1e6, ZOH input, uniform Ts.
 // Run: build/bench/bench_simulate --benchmark_min_time=0.5
 #include <benchmark/benchmark.h>
 

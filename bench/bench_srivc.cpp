@@ -1,4 +1,4 @@
-// SRIVC / tfest / frequency-domain fit times (issue 3) and SRIVC scaling in N with peak memory.
+// SRIVC / tfest / frequency-domain fit times and SRIVC scaling in N with peak memory.
 // Run: build/bench/bench_srivc --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <sys/resource.h>
 

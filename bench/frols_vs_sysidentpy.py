@@ -1,4 +1,4 @@
-"""FROLS of ctid and of SysIdentPy on the same records, in the same run (issue 18: speed ratios only from one run).
+"""FROLS of ctid and of SysIdentPy on the same records, in the same run (speed ratios only from one run).
 
     PYTHONPATH=build/python:SYSIDENTPY_SRC /usr/bin/python3 bench/frols_vs_sysidentpy.py [--sizes 1000,10000,100000]
 

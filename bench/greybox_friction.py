@@ -1,4 +1,4 @@
-"""Benchmark (issue 15): one grey-box fit of a 25 000-sample record — a mass on a spring with viscous and Coulomb
+"""Benchmark: one grey-box fit of a 25 000-sample record — a mass on a spring with viscous and Coulomb
 friction, 4 parameters and one initial state, from a start 20 % off — timed on one core (median of 5). Two friction
 laws: smoothed, fc tanh(v/0.05), and the discontinuous fc sign(v) with stick-slip (the mass is at rest for part of
 the record: located switchings, Filippov sliding while it sticks, sensitivity jumps; docs/methods/greybox.md).

@@ -1,4 +1,4 @@
-"""Side by side (issue 15): the same grey-box fit by ctid and by SciPy (least_squares + solve_ivp with
+"""Side by side: the same grey-box fit by ctid and by SciPy (least_squares + solve_ivp with
 finite-difference Jacobians) — a mass on a spring with viscous and smoothed Coulomb friction, 4 parameters and one
 initial state, the same data, the same start 20 % off, both on one core in this one run. Prints both optima (they
 must agree), both times and the ratio.

@@ -1,4 +1,4 @@
-"""Benchmark (issue 15): multiple shooting of an unstable plant — the magnetic levitation of
+"""Benchmark: multiple shooting of an unstable plant — the magnetic levitation of
 python/examples/greybox_levitation.py (k i^2 / y^2, open-loop pole +44 1/s) from PD-loop records of 3 000, 12 000
 and 24 000 samples (automatic segments of 25 samples: 120, 480 and 960 segments, 2 free states each), one core,
 median of 3 fits. The Jacobian is block sparse and the normal equations are solved by Eigen's simplicial LDL^T.

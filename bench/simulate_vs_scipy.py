@@ -1,4 +1,4 @@
-"""TransferFunction.simulate against SciPy's c2d + lfilter, measured in the same run (issue 18).
+"""TransferFunction.simulate against SciPy's c2d + lfilter, measured in the same run.
 
     PYTHONPATH=build/python /usr/bin/python3 bench/simulate_vs_scipy.py [--samples 1000000]
 

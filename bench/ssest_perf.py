@@ -1,4 +1,4 @@
-"""Benchmark (issue 16): ssest on a 3-input 3-output record, nx = 8, N = 1e5 samples (Ts = 0.01 s, held random
+"""Benchmark: ssest on a 3-input 3-output record, nx = 8, N = 1e5 samples (Ts = 0.01 s, held random
 levels, 20 dB of white noise on each output), one core, median of 3 runs: the subspace start (tau searched, and tau
 given) and the output-error refinement (time, iterations), the peak memory of the process, and the accuracy of the
 modes. Two systems: four well-separated modes (wn 0.5, 1.3, 3, 7 rad/s; zeta 0.1, 0.3, 0.05, 0.5; random B, C) and

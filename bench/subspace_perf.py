@@ -1,4 +1,4 @@
-"""Benchmark (issue 16): the subspace start on a 3-input 3-output record, nx = 8, N = 1e5 samples (Ts = 0.01 s,
+"""Benchmark: the subspace start on a 3-input 3-output record, nx = 8, N = 1e5 samples (Ts = 0.01 s,
 held random levels, noise-free), one core, median of 3 runs; and the largest matrix it forms.
 Run: PYTHONPATH=build/python taskset -c 0 /usr/bin/python3 bench/subspace_perf.py   (numbers: docs/benchmarks.md)."""
 import statistics

@@ -1,4 +1,4 @@
-// ctid batch PATTERN... --method M [ctid fit's options] --out results.csv [--jobs N] [--resume] (issue 18): one
+// ctid batch PATTERN... --method M [ctid fit's options] --out results.csv [--jobs N] [--resume]: one
 // method over many records on a pool of threads, one row per record — the columns of Python's
 // ctid.batch.fit_many (python/ctid/batch.py), so that either tool can resume the other's file.
 #include <glob.h>

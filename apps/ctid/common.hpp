@@ -14,7 +14,7 @@
 
 namespace ctid::cli {
 
-// Exit codes (DESIGN.md §4).
+// Exit codes (docs/guide.md, "Exit codes").
 constexpr int kOk = 0;
 constexpr int kNotUsable = 1;
 constexpr int kUsage = 2;

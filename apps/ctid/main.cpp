@@ -1,4 +1,4 @@
-// ctid — command-line tool. Subcommands: fit, simulate, validate, order, poles, response, gfrf, report, compare, demo, example-data (DESIGN.md §8).
+// ctid — command-line tool. Subcommands: fit, simulate, validate, order, poles, response, gfrf, report, compare, demo, example-data (docs/guide.md).
 // Exit codes: 0 ok, 1 estimate not usable, 2 usage, 3 input file error; one line on stderr.
 #include <atomic>
 #include <chrono>

@@ -15,7 +15,7 @@ check "tfest [1 3] test RMSE" "$(awk -v m="$(mse_of tanks_tfest.json "$tanks" $v
   --report tanks_narx.html --force >/dev/null
 "$ctid" simulate tanks_narx.json "$tanks" --ts 4 --input uVal --detrend mean --out tanks_narx_sim.csv --force >/dev/null
 check "NARX (degree 3, lags 3, BIC) free-run test RMSE" "$(rms tanks_narx_sim.csv "$tanks" 4)" lt 0.75
-# Grey box (issue 15): Torricelli-type outflows with free exponents, overflow of both tanks, a sensor offset; no mean
+# Grey box: Torricelli-type outflows with free exponents, overflow of both tanks, a sensor offset; no mean
 # removed; the test record's state from its first 5 samples only (the benchmark protocol), RMSE over the whole record.
 "$ctid" fit "$tanks" --ts 4 --input uEst --output yEst --method greybox --model "$examples/cascaded_tanks_greybox.json" \
   --set max_iterations=1000 --json tanks_greybox.json --report tanks_greybox.html --force | grep -E "^fit:"

@@ -1,4 +1,4 @@
-"""F-16 ground vibration test, the whole 2-15 Hz band (docs/gallery.md, issue 16): the modes of a MIMO continuous-time
+"""F-16 ground vibration test, the whole 2-15 Hz band (docs/gallery.md): the modes of a MIMO continuous-time
 state-space model (force -> the three accelerations) at each of the 7 excitation levels, with their standard deviations.
 
 For each full-grid multisine record: the FRF matrix (1 input x 3 outputs) at the 267 excited lines of 2-15 Hz by

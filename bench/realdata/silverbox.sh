@@ -18,7 +18,7 @@ s="--ts 0.0016384 --input V1 --output V2 --detrend mean"
   --force >/dev/null
 check "NARX free-run RMS (references: SysIdentPy NARX 0.00415, SUBNET 0.00579)" "$(rms sb_narx_sim.csv sb_test.csv 2)" lt 0.0045
 check "KIA + output-error Duffing equation free-run RMS" "$(rms sb_nde_sim.csv sb_test.csv 2)" lt 0.0015
-# Grey box (issue 15), the benchmark protocol exactly: nothing removed from either record (offsets are parameters),
+# Grey box, the benchmark protocol exactly: nothing removed from either record (offsets are parameters),
 # 10000 samples of the multisine part; the test state from its first 50 samples, the RMS over the rest. The input is
 # band-limited between samples (--intersample bl: windowed-sinc interpolation; the generator has a reconstruction
 # filter), which a held or linearly interpolated input is not (foh: 0.929 / 0.738 mV).

@@ -1,4 +1,4 @@
-"""ctid.batch — one identification method over many records, on threads or a Dask cluster (issue 18).
+"""ctid.batch — one identification method over many records, on threads or a Dask cluster.
 
 ``fit_many(records, method="srivc", client=None, **options)`` fits every record with the single-record function
 ``ctid.<method>`` and the same keyword arguments (``fit_many(paths, method="srivc", nb=1, nf=1)`` is

@@ -1,4 +1,4 @@
-// ctid Python module `ctid._ctid` (DESIGN.md §2): the C++ library bound with pybind11; the pure-Python
+// ctid Python module `ctid._ctid`: the C++ library bound with pybind11; the pure-Python
 // package `ctid` (python/ctid) adds keyword arguments, reports and plots on top.
 #include "common.hpp"
 

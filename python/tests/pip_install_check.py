@@ -1,4 +1,4 @@
-"""ctest python.pip_install (issue 17): `pip install --no-build-isolation --no-deps --no-index --target T .` from the
+"""ctest python.pip_install: `pip install --no-build-isolation --no-deps --no-index --target T .` from the
 source tree, offline with Debian's pip and setuptools, reusing the test build's CMake tree (CTID_CMAKE_BUILD_DIR:
 nothing is recompiled); then, from another folder and without PYTHONPATH to the build tree, `import ctid` loads the
 installed package and fits. Usage: pip_install_check.py SOURCE_DIR CMAKE_BUILD_DIR"""

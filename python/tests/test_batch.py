@@ -1,4 +1,4 @@
-"""ctid.batch.fit_many on a real dask.distributed cluster of 2 worker processes (issue 18): 200 records with 5
+"""ctid.batch.fit_many on a real dask.distributed cluster of 2 worker processes: 200 records with 5
 broken ones, a worker killed mid-batch, and a batch interrupted and resumed."""
 import csv
 import os

@@ -1,4 +1,4 @@
-"""ctid.greybox (issue 15): the model as a dict or a file, the fit, result files and simulation from Python."""
+"""ctid.greybox: the model as a dict or a file, the fit, result files and simulation from Python."""
 import numpy as np
 import pytest
 

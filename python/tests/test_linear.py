@@ -240,7 +240,7 @@ def _interrupt_after(seconds):
 
 def test_ctrl_c_stops_order_selection_and_raises_keyboard_interrupt():
     # 120 structures on 20000 samples take several seconds; SIGINT after 0.3 s must stop the whole search within
-    # about a second (each structure and each SRIVC iteration checks) and raise KeyboardInterrupt. Before issue 13
+    # about a second (each structure and each SRIVC iteration checks) and raise KeyboardInterrupt. Before 2026-12-01
     # the next fits saw the consumed interrupt at their first iteration and segfaulted.
     d = _second_order_record(20000)
     timer = _interrupt_after(0.3)
@@ -267,7 +267,7 @@ def test_ctrl_c_stops_a_delay_grid_within_a_second():
 
 
 def test_data_loading_traps_are_errors_or_right():
-    # Issue 13: a time vector of another length, complex signals, and pandas time columns.
+    # A time vector of another length, complex signals, and pandas time columns.
     u, y = np.ones(10), np.arange(10.0)
     with pytest.raises(ctid.InvalidArgument, match="time vector has 9 samples but y has 10"):
         ctid.IdData.from_arrays(u, y, t=np.arange(9.0))
@@ -282,7 +282,7 @@ def test_data_loading_traps_are_errors_or_right():
 
 
 def test_unstable_plant_in_open_loop_and_fixed_integrator():
-    # Issue 13: tfest on 1/(s - 0.5) (400 samples at 20 ms, 1 % noise) returned a stable a1 = 1.3e-12, "converged".
+    # Tfest on 1/(s - 0.5) (400 samples at 20 ms, 1 % noise) returned a stable a1 = 1.3e-12, "converged".
     # Output error now fits the unstable pole (measured a1 = -0.4993); SRIVC says why it cannot and names tfest.
     rng = np.random.default_rng(1)
     n, ts = 400, 0.02
@@ -309,7 +309,7 @@ def test_unstable_plant_in_open_loop_and_fixed_integrator():
 
 
 def test_delay_bounds_hold_in_the_output_error_refinement(plant):
-    # Issue 13: tfest --delay with delay_max = 30 returned a delay of 415 s. The refinement keeps
+    # Tfest --delay with delay_max = 30 returned a delay of 415 s. The refinement keeps
     # [delay_min, delay_max]: a record delayed by 0.3 s, searched in [0, 0.1], ends at the bound 0.1.
     g, d = plant
     y = d.y[:, 0]
@@ -322,7 +322,7 @@ def test_delay_bounds_hold_in_the_output_error_refinement(plant):
 
 
 def test_units_do_not_matter_and_useless_fits_say_why(plant):
-    # Issue 13, as the C++ property test and CLI cases: the same record in nanoseconds and 1e20 output units
+    # as the C++ property test and CLI cases: the same record in nanoseconds and 1e20 output units
     # gives the same model after rescaling (1e-6 relative; SRIVC and tfest work in normalised units).
     g, d = plant
     c, ky = 1e-9, 1e20
@@ -354,7 +354,7 @@ def two_records():
 
 
 def test_srivc_on_several_experiments_is_one_joint_estimate():
-    # Issue 14 (item 2): a list of IdData is several experiments of one system, fitted jointly; noise-free records
+    # A list of IdData is several experiments of one system, fitted jointly; noise-free records
     # with different inputs give the true parameters (to 1e-6), one record alone the same, and the joint result is
     # what C++ returns for the same list (bindings of srivc(std::vector<IdData>)).
     g, t, u1, d1, d2 = two_records()
@@ -504,7 +504,7 @@ def test_innovation_gain_predictor_and_prediction_error_ssest():
 
 
 def test_simulate_reads_in_place_and_writes_into_out():
-    """TransferFunction.simulate (issue 18): the output equals the library's lsim (through a fresh array or `out`,
+    """TransferFunction.simulate: the output equals the library's lsim (through a fresh array or `out`,
     which is returned and reused: the same numbers bit for bit), and matches SciPy's exact ZOH discretisation of the
     state space (scipy.signal.cont2discrete + dlsim) to 1e-12 of the output's range; a wrong `out` is named."""
     import numpy as np

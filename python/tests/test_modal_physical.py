@@ -23,7 +23,7 @@ def test_modal_fit_two_sinusoid_test_recovers_s3():
 
 
 def test_modal_fit_on_several_records_is_one_joint_estimate():
-    # Issue 14 (item 2): two records of S3 from rest with different piecewise-constant inputs (Ts = pi/320, shifts
+    # Two records of S3 from rest with different piecewise-constant inputs (Ts = pi/320, shifts
     # 16, 32, 48 samples, Walsh), noise-free: the joint fit is S3 to 1e-6 as in the C++ test ModalFit.SeveralRecords...
     ts = math.pi / 320
 

@@ -29,12 +29,12 @@ def test_narx_kia_and_refinement_reconstruct_bl33(bl33):
         q.model.normalized().coefficient("y^2"), rel=1e-12)
     assert run.result().model.coefficient("y*Dy") == pytest.approx(refined.model.coefficient("y*Dy"), rel=1e-9)
     assert run.narx_fit_percent < 0  # this NARX model escapes in free run (above): the fidelity check is skipped
-    # Several records (issue 14): a list is several experiments; the refinement estimates an initial state each.
+    # Several records: a list is several experiments; the refinement estimates an initial state each.
     joint = ctid.kia([d, d], r.model, y_order=2, u_order=0, quadratic=["y^2", "y*Dy"])
     assert joint.reconstructed.diagnostics.scalars["experiments"] == 2
     assert joint.result().model.coefficient("y*Dy") == pytest.approx(refined.model.coefficient("y*Dy"), rel=1e-6)
     assert "x0_2" in joint.result().diagnostics.vectors
-    # Candidates left out (issue 17): all 6 products of y, Dy and u, pruned by ERR at 0.01 % to the true pair
+    # Candidates left out: all 6 products of y, Dy and u, pruned by ERR at 0.01 % to the true pair
     # (as the CLI test Cli.NarxKiaAndGfrf, which measures every coefficient within 5 %).
     assert [t.name for t in ctid.kia_product_candidates(2, 2, 0)] == ["y^2", "y*Dy", "y*u", "Dy^2", "Dy*u", "u^2"]
     auto = ctid.kia(d, r.model, y_order=2, u_order=0, refine=False)

@@ -1,4 +1,4 @@
-"""Issue 14 (item 3): one table of settings per method. The registry (ctid.methods / ctid.settings, read from the
+"""One table of settings per method. The registry (ctid.methods / ctid.settings, read from the
 C++ tables that the CLI's --help also prints) must match the Python options classes name for name, and the
 defaults Python reads must be those the registry documents."""
 import math
@@ -89,7 +89,7 @@ def test_unknown_or_mistyped_settings_name_the_closest_valid_one():
 
 
 def test_diagnostics_are_declared_per_method():
-    # Issue 14 (item 5): the keys of a result's diagnostics are declared (name, kind, unit, doc) in the library's
+    # The keys of a result's diagnostics are declared (name, kind, unit, doc) in the library's
     # catalogue, and each method lists those it can report (the C++ registry, MethodInfo::diagnostics).
     import numpy as np
     every = {d["name"]: d for d in ctid.diagnostics()}

@@ -1,4 +1,4 @@
-"""Pickling and copying of records, models and results (issue 18): every object round-trips bit for bit through
+"""Pickling and copying of records, models and results: every object round-trips bit for bit through
 pickle, copy.copy and copy.deepcopy, and a multiprocessing pool can return results."""
 import copy
 import math

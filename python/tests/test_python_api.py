@@ -1,4 +1,4 @@
-"""Python as Python users expect (issue 17): input generators, IdData slicing / to_pandas / repr, scipy.signal
+"""Python as Python users expect: input generators, IdData slicing / to_pandas / repr, scipy.signal
 conversion of transfer functions."""
 import numpy as np
 import pytest

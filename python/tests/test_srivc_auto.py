@@ -1,4 +1,4 @@
-"""srivc_auto (issue 17): the default route of `ctid fit`, the same function in Python; IdData.detrend."""
+"""srivc_auto: the default route of `ctid fit`, the same function in Python; IdData.detrend."""
 import numpy as np
 import pytest
 

@@ -1,5 +1,5 @@
 // FROLS / ERR structure detection for polynomial NARX models (Billings & Li 1999, BL 28-32;
-// SEEDS-SPEC BL-D1, BL-D6). See include/ctid/estimate/frols.hpp.
+// Billings & Li 1999, §2, BL 28-32). See include/ctid/estimate/frols.hpp.
 //
 // With p_m the candidate columns, w_s the orthogonalised selected columns and g_s = w_s^T y / w_s^T w_s,
 // the orthogonal part of an unselected candidate m after s selections has

@@ -277,7 +277,7 @@ Result<FsfModel> fsf(const IdData& data, const FsfOptions& given) {
   if (o.b > 0 && M > N)
     r.diagnostics.warnings.push_back(detail::format(
         "b = {} > 0 with a record ({} s) longer than T = {} s: the weighting amplifies the FSF truncation errors of late "
-        "data by up to e^(bT); estimates can be badly biased (SEEDS-SPEC GW-A2). Prefer b = 0",
+        "data by up to e^(bT); estimates can be badly biased (docs/methods/gawthrop-wang.md). Prefer b = 0",
         o.b, M * Ts, o.T));
   if (sol.rank_deficient) {
     r.summary.termination = Termination::RankDeficient;

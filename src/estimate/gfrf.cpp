@@ -1,4 +1,4 @@
-// GFRFs of polynomial NARX models (Billings & Li 1999, eqs 11-14; SEEDS-SPEC BL-D2, corrected recursion).
+// GFRFs of polynomial NARX models (Billings & Li 1999, eqs 11-14, corrected recursion).
 // See include/ctid/estimate/gfrf.hpp.
 #include "ctid/estimate/gfrf.hpp"
 

@@ -1,4 +1,4 @@
-// Kernel Invariance Algorithm (Billings & Li 1999, eqs 15-32; SEEDS-SPEC BL-D4, BL-D5, BL-D6).
+// Kernel Invariance Algorithm (Billings & Li 1999, eqs 15-32).
 // See include/ctid/estimate/kia.hpp.
 #include "ctid/estimate/kia.hpp"
 

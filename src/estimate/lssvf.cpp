@@ -1,4 +1,4 @@
-// LSSVF / IVSVF — Johansson (1986) RJ 11-25, 44, 52-55, 59-61 (SEEDS-SPEC RJ-A1..A5).
+// LSSVF / IVSVF — Johansson (1986) RJ 11-25, 44, 52-55, 59-61 (RJ 7-17..A5).
 // See include/ctid/estimate/lssvf.hpp.
 #include "ctid/estimate/lssvf.hpp"
 

@@ -1,4 +1,4 @@
-// El-Shafey (1987) ch. 6: minimum-time observer and b~ (ES 6.1-6.43; SEEDS-SPEC ES-C13, ES-C14).
+// El-Shafey (1987) ch. 6: minimum-time observer and b~ (ES 6.1-6.43; ES 6.1-6.36, ES 6.37-6.43).
 // See include/ctid/estimate/modal_observer.hpp.
 #include "ctid/estimate/modal_observer.hpp"
 

@@ -81,7 +81,7 @@ Result<NdeModel> nde_oe_records(const internal::RecordRefs& records, const NdeMo
     hi_c(j) = cons.upper(free[j]);
   }
   // Parameters x = [free coefficients (pc), initial state of record 1 (nx), of record 2, ...]: every record
-  // has its own initial state (several experiments of one system, DESIGN.md: per-experiment initial conditions).
+  // has its own initial state (several experiments of one system).
   const int nx = opt.estimate_initial_state ? L : 0;
   const int p = pc + E * nx;
   // Records concatenated: record e's samples are rows [start[e], start[e] + size) of the residual vector.
@@ -137,7 +137,7 @@ Result<NdeModel> nde_oe_records(const internal::RecordRefs& records, const NdeMo
     if (simulate(x0, ystart) || start_scale == 0.0) break;
   }
 
-  // Forward sensitivities (DESIGN.md §6: analytic, not differences). With x = [y, Dy, .., D^{L-1}y] and the
+  // Forward sensitivities (analytic, not differences). With x = [y, Dy, .., D^{L-1}y] and the
   // explicit form D^L y = f_L(x, u) = -(1/c_top) sum_{i != top} c_i phi_i(x, u), the sensitivity S_j = dx/dtheta_j
   // obeys S_j' = [S_j(1..L-1); grad_x f_L . S_j + df_L/dtheta_j], with df_L/dc_i = -phi_i/c_top (i != top),
   // df_L/dc_top = -f_L/c_top, 0 for the initial state, and S_j(0) = e_k for theta_j = D^k y(0).

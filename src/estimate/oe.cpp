@@ -474,7 +474,7 @@ void set_initial_states(Result<TransferFunction>& r, const internal::RecordRefs&
     r.diagnostics.set(diagnostic::x0, simulate(AnyModel(r.model), data[e], so).x0, static_cast<int>(e));
 }
 
-// oe and tfest estimate in normalised time and amplitude units (issue 13: the result does not depend on the
+// oe and tfest estimate in normalised time and amplitude units (the result does not depend on the
 // units of the record) and map the result back.
 Result<TransferFunction> oe_records(const internal::RecordRefs& data, const TfOrders& orders, const OeOptions& options) {
   check_common(data, orders, options, "oe");

@@ -1,5 +1,5 @@
 // Recursive LSSVF (Johansson 1986, RJ 52-53, sampled RJ 59-60, continuous-time RJ 56-58) and the
-// single-coefficient tracker (RJ 74-79; SEEDS-SPEC RJ-A6, RJ-A7). See include/ctid/estimate/rls_svf.hpp.
+// single-coefficient tracker (RJ 74-79; RJ 56-61, RJ 74-79). See include/ctid/estimate/rls_svf.hpp.
 #include "ctid/estimate/rls_svf.hpp"
 
 #include <chrono>

@@ -482,7 +482,7 @@ Result<TransferFunction> srivc_records(const internal::RecordRefs& data, const T
   options.validate();
   check_srivc_inputs(data, orders, options);
   // The estimation runs in normalised time and amplitude units, so that its result does not depend on the
-  // units of the records (issue 13); the result is mapped back. One normalisation for all records.
+  // units of the records; the result is mapped back. One normalisation for all records.
   const tf_detail::TfNormalisation n = tf_detail::TfNormalisation::of(data);
   SrivcOptions o = options;
   if (o.initial) o.initial = n.to_normalised(*o.initial, orders);

@@ -1,4 +1,4 @@
-// ctid — continuous-time state space from frequency-response data (issue 16, item 3): subspace(FrequencyData)
+// ctid — continuous-time state space from frequency-response data: subspace(FrequencyData)
 // (estimate/subspace.hpp) and ssest(FrequencyData) (estimate/ssest.hpp).
 //
 // Start: McKelvey, Akçay & Ljung (1996), "Subspace-based multivariable system identification from frequency

@@ -1,6 +1,6 @@
 // Johansson (1986) in the frequency domain: the least-squares criterion on frequency-response data (RJ 45, with the
 // data filter of RJ 42) and the information matrix of an input spectrum (RJ 47-50: P^-1 = int Phi(-i w) Phi^T(i w) dw,
-// Phi_tau = Gamma_tau U). SEEDS-SPEC RJ "LS criterion" (RJ 44-50). See include/ctid/estimate/lssvf.hpp.
+// Phi_tau = Gamma_tau U). Johansson 1986, the LS criterion (RJ 44-50). See include/ctid/estimate/lssvf.hpp.
 #include <chrono>
 #include <cmath>
 #include <complex>

@@ -53,7 +53,7 @@ FitReport frequency_fit(const TransferFunction& g, const Eigen::VectorXd& w, con
 /// (constant input, too short a record).
 Result<TransferFunction> pre_estimate(const IdData& d, int nf = 0, bool equation_error = false);
 
-/// Time and amplitude normalisation of a SISO transfer-function estimation (issue 13: results must not depend
+/// Time and amplitude normalisation of a SISO transfer-function estimation (results must not depend
 /// on the units of time, input and output). With t' = t / c, u' = u / su, y' = y / sy, the model
 /// G(s) = B(s)/A(s) (A monic of degree n, B with nb coefficients b_j of s^(nb-1-j)) becomes
 /// G'(s') = (su/sy) G(s'/c): a_k' = a_k c^k, b_j' = b_j c^(n-nb+1+j) su/sy, delay' = delay / c.

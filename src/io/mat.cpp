@@ -219,7 +219,7 @@ void check_mat_structure(const std::string& path) {
   V5Checker(path, be).sequence(bytes.data() + 128, bytes.size() - 128, 0, true);
 }
 
-// The library never prints (DESIGN.md §4): libmatio's own log messages are dropped (its failures come back as
+// The library never prints: libmatio's own log messages are dropped (its failures come back as
 // return values, which become FileError), and so is the HDF5 error stack that a damaged level 7.3 file makes
 // HDF5 print (29-69 lines). H5Eset_auto2 is looked up at run time in the HDF5 that libmatio loaded, so ctid
 // does not link HDF5 itself; when it is absent there is nothing to silence.

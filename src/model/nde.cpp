@@ -1,4 +1,4 @@
-// Polynomial NDE models of Billings & Li (1999), eqs 1-6 (SEEDS-SPEC BL-D3, clean convention): terms,
+// Polynomial NDE models of Billings & Li (1999), eqs 1-6 (BL 4-6, clean convention): terms,
 // harmonic probing H_1 and H_2, and simulation by adaptive Dormand-Prince 5(4). See include/ctid/model/nde.hpp.
 #include "ctid/model/nde.hpp"
 

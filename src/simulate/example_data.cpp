@@ -1,6 +1,6 @@
-// ctid — simulated example records for the README and docs/ (issue 17: every documented command runs verbatim).
+// ctid — simulated example records for the README and docs/ (every documented command runs verbatim).
 // The systems are the source documents' and the tests' own: Gawthrop & Wang's unstable circuit under PD control
-// (SEEDS-SPEC GW.3), El-Shafey's S3 and S4 (ES Tables 3.1, 4.8), Billings & Li's system (33), the Rao-Garnier
+// (Gawthrop & Wang 2005, §5, simulated), El-Shafey's S3 and S4 (ES Tables 3.1, 4.8), Billings & Li's system (33), the Rao-Garnier
 // fourth-order benchmark; inputs and noise are seeded, so every record is the same on every machine.
 #include "ctid/simulate/example_data.hpp"
 
@@ -52,7 +52,7 @@ ExampleData circuit() {
                                            RstController::pid(3.0, 0.0, 3.0, 0.1, Ts), w, Ts, white_noise(M, 0.01, 17));
   const Eigen::MatrixXd m = columns({time_grid(Ts, M), loop.u().col(0), loop.y().col(0)});
   return {"circuit",
-          "Gawthrop & Wang's unstable circuit k1/(s^2 - k2), k1 = k2 = 1, under digital PD control (SEEDS-SPEC GW.3); "
+          "Gawthrop & Wang's unstable circuit k1/(s^2 - k2), k1 = k2 = 1, under digital PD control (Gawthrop & Wang 2005, §5, simulated); "
           "Ts = 0.01 s, 4000 samples, measurement noise std 0.01 inside the loop",
           {"t", "u", "y"}, m};
 }

@@ -1,4 +1,4 @@
-// The command line: exit codes and messages of DESIGN.md §4/§8, and no partial output files.
+// The command line: exit codes and messages of docs/guide.md, and no partial output files.
 #include <algorithm>
 #include <array>
 #include <cstdio>
@@ -259,7 +259,7 @@ TEST(Cli, NoPartialOutputOnFailure) {
 }
 
 TEST(Cli, DemoRunsOnBundledData) {
-  // Issue 17: the demo is ctid fit with its defaults on the first half of the DaISy dryer, validated on the second
+  // The demo is ctid fit with its defaults on the first half of the DaISy dryer, validated on the second
   // half (SrivcAuto.HairDryerValidatesAbove85Percent: >= 85 %), and prints that command: run as printed, it gives the
   // same output.
   const CliRun r = ctid_run("demo");
@@ -356,7 +356,7 @@ TEST(Cli, SamplesAndValidateHoldOutPartOfARecord) {
 }
 
 TEST(Cli, WithoutMethodAndOrdersTheDefaultChoosesTheStructureAndRemovesTheMeans) {
-  // Issue 17: `ctid fit DATA` on the bundled hair dryer (DaISy; no header: column 1 the input, 2 the output) runs
+  // `ctid fit DATA` on the bundled hair dryer (DaISy; no header: column 1 the input, 2 the output) runs
   // srivc-auto, says on its first line which structure it chose, removes the means with a note naming them, and its
   // model validates on the record's second half as SrivcAuto.HairDryerValidatesAbove85Percent does in the library.
   const std::string dryer = std::string(CTID_EXAMPLES_DATA_DIR) + "/dryer.dat";
@@ -437,7 +437,7 @@ TEST(Cli, SrivcTfestWithDelayAndOrderSelection) {
   const CliRun o = ctid_run("order " + csv14 + " --time t --nb 1:2 --nf 1:3 --nk 13:14");
   ASSERT_EQ(o.code, 0) << o.err;
   EXPECT_NE(o.out.find("   1   1  2 14"), std::string::npos) << o.out;  // rank 1 is [1 2 14]
-  // The same ranking as JSON (issue 14: every command that computes something can write its result).
+  // The same ranking as JSON (every command that computes something can write its result).
   const std::string oj = test::temp_path("order.json");
   fs::remove(oj);
   ASSERT_EQ(ctid_run("order " + csv14 + " --time t --nb 1:2 --nf 1:3 --nk 13:14 --rank bic --json " + oj).code, 0);
@@ -599,7 +599,7 @@ TEST(Cli, FrequencyData) {
 }
 
 TEST(Cli, GawthropWangFsfAndPhysical) {
-  // Unstable circuit 1/(s^2 - 1) under digital PD (SEEDS-SPEC GW.3), noise-free, written as CSV.
+  // Unstable circuit 1/(s^2 - 1) under digital PD (Gawthrop & Wang 2005, §5, simulated), noise-free, written as CSV.
   const double Ts = 0.01;
   const int M = 4000;
   Eigen::VectorXd w(M);
@@ -626,11 +626,11 @@ TEST(Cli, GawthropWangFsfAndPhysical) {
                "--set n=21 --set a=2 --json " + json);
   ASSERT_EQ(r.code, 0) << r.err;
   const auto res = parse_result_json(read_text_file(json));
-  EXPECT_NEAR(res.parameters.value("k1"), 1.0, 0.05);  // issue 4: within 5 % of (1, 1)
+  EXPECT_NEAR(res.parameters.value("k1"), 1.0, 0.05);  // within 5 % of (1, 1)
   EXPECT_NEAR(res.parameters.value("k2"), 1.0, 0.05);
   r = ctid_run("fit " + csv + " --time t --method physical --model \"k1/(s^2-k2)\" --param k1=2 --param k2=0 --via raw --set a=2");
   EXPECT_EQ(r.code, 0) << r.err;
-  // Issue 17: declaring the plant unstable is enough; the window, T and n are chosen, printed and recorded.
+  // Declaring the plant unstable is enough; the window, T and n are chosen, printed and recorded.
   fs::remove(json);
   r = ctid_run("fit " + csv + " --time t --method physical --model \"k1/(s^2-k2)\" --param k1=2 --param k2=0 --set unstable=1 "
                "--json " + json);
@@ -689,7 +689,7 @@ TEST(Cli, ModalFitPolesAndResponses) {
   const auto& tf = std::get<TransferFunction>(m);
   EXPECT_LT((tf.den().coefficients() - kS3.den().coefficients()).cwiseAbs().maxCoeff(), 1e-5);
   EXPECT_NEAR(tf.num().coefficient_of_power(0), 52.0, 1e-4);
-  // Two DATA files (issue 14 item 2): the second record holds other levels for 96 samples; the joint fit is the
+  // Two DATA files: the second record holds other levels for 96 samples; the joint fit is the
   // library's modal_fit of both records (to 1e-9) and S3 (noise-free, to 1e-5).
   {
     const int N2 = 384;
@@ -723,7 +723,7 @@ TEST(Cli, ModalFitPolesAndResponses) {
   const CsvTable t = read_csv(g);
   const Eigen::VectorXd truth = step_response(kS3, t.values.col(0));
   EXPECT_LT((t.values.col(1) - truth).cwiseAbs().maxCoeff(), 1e-8);
-  // --json holds the same columns (issue 14 item 1: every computing command writes JSON).
+  // --json holds the same columns (every computing command writes JSON).
   const auto rj = nlohmann::json::parse(std::ifstream(gj));
   EXPECT_EQ(rj.at("type"), "response");
   EXPECT_EQ(rj.at("kind"), "step");
@@ -762,7 +762,7 @@ TEST(Cli, ModalFitPolesAndResponses) {
   for (int i = 0; i < 4; ++i) EXPECT_NEAR(cp[i], s3[i], 1e-6 * 52) << i;
   EXPECT_EQ(pjs.at("data_matrix").at("poles").size(), 3u);
   EXPECT_FALSE(pjs.at("prony").is_null());
-  // Without shifts (issue 17): uniform shifts chosen on Prony's pre-estimate, printed as 'chosen:' and kept in the
+  // Without shifts: uniform shifts chosen on Prony's pre-estimate, printed as 'chosen:' and kept in the
   // JSON; noise-free, the same polynomial to its 6 printed digits.
   fs::remove(pj);
   r = ctid_run("poles " + free + " --ts " + ts320() + " --order 3 --json " + pj);
@@ -847,7 +847,7 @@ TEST(Cli, NarxKiaAndGfrf) {
   for (const char* s : {"Dy", "D^2y", "u", "y^2", "y*Dy"})
     EXPECT_NEAR(read_nde_json(nde).coefficient(s), truth.coefficient(s), 0.05 * std::abs(truth.coefficient(s))) << s;
   fs::remove(nde);
-  // Issue 17: without --set quadratic, every product of y, Dy and u is a candidate (the NARX model has quadratic
+  // Without --set quadratic, every product of y, Dy and u is a candidate (the NARX model has quadratic
   // terms) and ERR pruning at 0.01 % keeps exactly the true pair y^2, y*Dy (measured: within 5 % as above).
   r = ctid_run("fit " + data + " --ts 0.0025 --method kia --narx " + narx + " --set refine=0 --json " + nde);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -1004,7 +1004,7 @@ TEST(Cli, ReportsOpenInABrowserWithEveryPlotDrawn) {
   mm << mu, lsim(g2, IdData(mu, Eigen::VectorXd::Zero(2000), 0.02));
   const std::string miso = test::temp_path("miso_report.csv");
   write_csv(miso, {"u1", "u2", "y"}, mm);
-  // A MIMO record (the two-mode 2 x 2 system of issue 16, 20 dB) for the state-space report.
+  // A MIMO record (the two-mode 2 x 2 system, 20 dB) for the state-space report.
   const Eigen::MatrixXd su = test::ss::levels(1500, 2, 7, 5);
   Eigen::MatrixXd sm(1500, 4);
   sm << su, test::ss::record(test::ss::two_modes(), su, Eigen::VectorXd::LinSpaced(1500, 0.0, 1499 * 0.05),
@@ -1162,7 +1162,7 @@ TEST(Cli, ReportOfAResultFile) {
 }
 
 TEST(Cli, RobustnessCampaignBadInputs) {
-  // Issue 7's table of bad inputs. Each must end with its documented exit code (2 usage, 3 input file), exactly one
+  // The table of bad inputs. Each must end with its documented exit code (2 usage, 3 input file), exactly one
   // line on stderr naming the problem, within the time limit (no hang: `timeout` would give 124), without a signal,
   // and without leaving the requested output file behind.
   const std::string base = " --time time --input force --output position ";
@@ -1248,7 +1248,7 @@ TEST(Cli, RobustnessCampaignBadInputs) {
   }
 }
 
-// Issue 13: no crash, no lost file, no wrong answer that says "converged". Each case asserts the exit code, the
+// No crash, no lost file, no wrong answer that says "converged". Each case asserts the exit code, the
 // key words of the one line on stderr, and that nothing the user gave was changed.
 TEST(Cli, TrustCampaign) {
   const std::string base = " --time time --input force --output position ";
@@ -1330,7 +1330,7 @@ TEST(Cli, TrustCampaign) {
   EXPECT_EQ(params(b.out), params(g.out)) << b.out << g.out;
 }
 
-// Issue 13: outputs are checked against every input file and each other before the fit; special files and
+// Outputs are checked against every input file and each other before the fit; special files and
 // symlinks are never replaced.
 TEST(Cli, OutputFilesNeverReplaceWhatTheUserGave) {
   const std::string base = " --time time --input force --output position --nf 2 --nb 1 --method lssvf --set tau=0.3 ";
@@ -1374,7 +1374,7 @@ TEST(Cli, OutputFilesNeverReplaceWhatTheUserGave) {
   EXPECT_EQ(read_text_file(good_csv()), data_text);
 }
 
-// Issue 13: `ctid report` refuses what `ctid validate` would: a covariance that is not positive semi-definite or
+// `ctid report` refuses what `ctid validate` would: a covariance that is not positive semi-definite or
 // of the wrong size (exit 3), a model that diverges on the record (exit 1).
 TEST(Cli, ReportRefusesUnsoundResults) {
   const std::string base = " --time time --input force --output position ";
@@ -1408,7 +1408,7 @@ TEST(Cli, ReportRefusesUnsoundResults) {
   EXPECT_NE(r.err.find("the model diverges"), std::string::npos) << r.err;
 }
 
-// Issue 14 (item 3): `ctid fit --method M --help` lists every setting of the library's registry entries of M
+// `ctid fit --method M --help` lists every setting of the library's registry entries of M
 // (estimate/methods.hpp) with its default and unit, and every one of them is accepted by --set under that name
 // (set to its own default, the fit must not stop with a usage error naming it).
 TEST(Cli, MethodHelpListsEveryRegisteredSettingAndSetAcceptsIt) {
@@ -1485,7 +1485,7 @@ TEST(Cli, MethodHelpListsEveryRegisteredSettingAndSetAcceptsIt) {
   }
 }
 
-// Issue 14 (item 2): several DATA files are several experiments of one system, fitted jointly by SRIVC: the CLI's
+// Several DATA files are several experiments of one system, fitted jointly by SRIVC: the CLI's
 // estimate is the library's srivc(std::vector<IdData>) (to 1e-9), other methods refuse several files by name.
 TEST(Cli, SeveralDataFilesAreFittedJointly) {
   const TransferFunction g(Eigen::VectorXd{{3.0}}, Eigen::VectorXd{{1.0, 1.2, 4.0}});
@@ -1600,7 +1600,7 @@ TEST(Cli, SeveralDataFilesAreFittedJointly) {
   EXPECT_NE(read_text_file(html2).find("Record 2: " + files[1]), std::string::npos);
 }
 
-// Every result file ctid writes is read back by simulate, validate and report (issue 14, item 1), the model type
+// Every result file ctid writes is read back by simulate, validate and report, the model type
 // recognised from the file; --initial chooses the simulation's initial condition.
 TEST(Cli, EveryResultFileIsReadBackAndTheInitialConditionIsExplicit) {
   const std::string data = good_csv(), cols = " --time time --input force --output position";
@@ -1652,7 +1652,7 @@ TEST(Cli, EveryResultFileIsReadBackAndTheInitialConditionIsExplicit) {
   EXPECT_NE(r.err.find("no output history"), std::string::npos) << r.err;
 }
 
-// Issue 15: `ctid fit --method greybox --model FILE` is the library's greybox() on the columns the model names;
+// `ctid fit --method greybox --model FILE` is the library's greybox() on the columns the model names;
 // simulate starts from the fitted initial state by default; --initial estimated --initial-samples N estimates it
 // from the record's first N samples only; misuse is named.
 TEST(Cli, GreyboxModelFileFitSimulateAndValidate) {
@@ -1816,7 +1816,7 @@ TEST(Cli, SsestFitsTheFrfMatrixOfPeriodicRecords) {
 }
 
 TEST(Cli, SsestRefinesWithUncertaintyOrderRangeAndAStartingModel) {
-  // The two-mode system of issue 16 with 10 dB white noise on each output (seeded); reference: the true modes.
+  // The two-mode system with 10 dB white noise on each output (seeded); reference: the true modes.
   const int N = 2000;
   const Eigen::MatrixXd u = test::ss::levels(N, 2, 7, 9);
   const Eigen::MatrixXd y =
@@ -1892,7 +1892,7 @@ TEST(Cli, SsestRefinesWithUncertaintyOrderRangeAndAStartingModel) {
 }
 
 TEST(Cli, ExampleDataWritesTheDocumentedRecords) {
-  // Issue 17: every data file the README and docs use comes from `ctid example-data NAME OUT.csv`.
+  // Every data file the README and docs use comes from `ctid example-data NAME OUT.csv`.
   CliRun r = ctid_run("example-data --list");
   ASSERT_EQ(r.code, 0) << r.err;
   for (const auto& name : example_data_names()) EXPECT_NE(r.out.find(name + " "), std::string::npos) << name;
@@ -1973,7 +1973,7 @@ std::vector<std::string> csv_ids(const std::string& path) {
 }
 }  // namespace
 
-// Issue 18: ctid batch fits each record alone with ctid fit's options on a pool of threads: 40 simulated records
+// Ctid batch fits each record alone with ctid fit's options on a pool of threads: 40 simulated records
 // (G = 4/(s^2 + 0.8 s + 4), PRBS, white output noise) and 3 broken ones give 43 rows, 40 usable, each estimate the
 // library's srivc on that record (to 1e-9) and within 5 standard deviations of the truth; the broken ones are rows
 // whose error names the cause, and the exit code is 1. --resume fits only the missing records.
@@ -2066,7 +2066,7 @@ TEST(Cli, BatchFitsEveryRecordAndResumes) {
   EXPECT_EQ(std::set<std::string>(after.begin(), after.end()).size(), 43u);
 }
 
-// Issue 18: options that cannot apply fail the batch once, in one line, leaving no file; a pattern that matches
+// Options that cannot apply fail the batch once, in one line, leaving no file; a pattern that matches
 // nothing is named.
 TEST(Cli, BatchRefusesBadOptionsOnce) {
   const std::string dir = test::temp_path("batch_bad");

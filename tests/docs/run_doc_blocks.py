@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Run every shell block of README.md and docs/**/*.md verbatim (issue 17: "every documented command runs").
+"""Run every shell block of README.md and docs/**/*.md verbatim ("every documented command runs").
 
 Each ```sh block runs with bash -e -o pipefail in a scratch folder per Markdown file (the blocks of one file in
 order, so a later block may use what an earlier one wrote), where `ctid` is the built command-line tool on PATH,

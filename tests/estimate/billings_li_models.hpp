@@ -1,4 +1,4 @@
-// Billings & Li (1999) models shared by the GFRF, KIA and NDE output-error tests (SEEDS-SPEC BL.3).
+// Billings & Li (1999) models shared by the GFRF, KIA and NDE output-error tests (Billings & Li 1999, eqs 33-34 and Tables 1-3).
 #pragma once
 
 #include <string>

@@ -185,7 +185,7 @@ IdData record_from(int N, double noise, unsigned seed, double amp, Eigen::Vector
 }
 }  // namespace
 
-// Several records (issue 14, item 2): FROLS on two records is least squares on the two records' rows stacked — no
+// Several records: FROLS on two records is least squares on the two records' rows stacked — no
 // row reaches across the records (checked against a direct solve to 1e-10); over 60 noisy runs with two records of
 // different input amplitude and initial state the joint estimate is more accurate than either record's for every
 // coefficient, and its reported standard deviation matches the spread (within 25 %: 60 runs estimate a spread to

@@ -1,5 +1,5 @@
 // Stage 1 of Gawthrop & Wang (2005): FSF identities and the unstable-circuit stand-in
-// (SEEDS-SPEC GW-A1, GW-A2, GW.3).
+// (GW 1-21; the experiments of §5, simulated).
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -64,7 +64,7 @@ TEST(Fsf, WithNEqualToNReproducesAnyFirExactly) {
   ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_LT((r.model.discrete_impulse_response() - g).cwiseAbs().maxCoeff(), 1e-10);
   EXPECT_LT((r.model.simulate(u) - y).cwiseAbs().maxCoeff(), 1e-9);
-  // fit is the simulation fit on the estimation data (issue 14, item 5): exact here (nrmse below 1e-9), the same
+  // fit is the simulation fit on the estimation data: exact here (nrmse below 1e-9), the same
   // as fit_report of the model's simulation; the regression's own figure has its own name.
   EXPECT_EQ(r.fit.n_samples, 2000);
   EXPECT_LT(r.fit.nrmse, 1e-9);
@@ -78,7 +78,7 @@ TEST(Fsf, WithNEqualToNReproducesAnyFirExactly) {
 }
 
 TEST(Fsf, EstimatesEqualThoseFromDirectFirRegressors) {
-  // Reference: the regressors of SEEDS-SPEC GW-A1 step 2 by direct summation of the N-term FIRs,
+  // Reference: the regressors of GW 1-13 (the regression) by direct summation of the N-term FIRs,
   // c_i = e^{(b-a) t_i} times sum_l e^{a l D} cos/sin(2 pi k l / N) u_{i-l} / N, and a weighted QR solve.
   // The record (2537 samples) is not a multiple of N = 100 and a, b, weights are all active; the
   // library's partial-sum evaluation must agree to round-off (1e-9 relative).
@@ -141,7 +141,7 @@ TEST(Fsf, WindowingLemmaIsExactInDiscreteTimeAndTheSafeFormEqualsTheNaive) {
 }
 
 TEST(Fsf, UnstableCircuitStandInCompressesToTheShiftedStepResponse) {
-  // SEEDS-SPEC GW.3: 1/(s^2 - 1), ZOH at 10 ms, digital PD (k = 3, Td = 1, Tf = 0.1, backward
+  // Gawthrop & Wang 2005, §5, simulated: 1/(s^2 - 1), ZOH at 10 ms, digital PD (k = 3, Td = 1, Tf = 0.1, backward
   // difference), set-point +-0.5 switched every 1.5 s at random, 40 s; a = 2, T = 8 s. The FSF
   // step response must match that of G(s + 2) = 1/((s + 1)(s + 3)) within 4-8e-3 (spec's values;
   // measured 3.9e-3 for n = 21 and 7.5e-3 for n = 11).
@@ -226,7 +226,7 @@ TEST(FsfModel, ConfidenceBandsPropagateTheCovariance) {
   }
 }
 
-// Issue 17: no setting needs picking by hand. Open loop, 1/((s+1)(s+3)) with ZOH white-noise input and 5 % output
+// No setting needs picking by hand. Open loop, 1/((s+1)(s+3)) with ZOH white-noise input and 5 % output
 // noise: T is the settling time of an SRIVC pre-estimate, which for the true system is 7.87 s (fsf_settling_time of the
 // truth; 20 % tolerance); the compressed step response then follows the truth within 0.02 (the noise alone gives
 // about 0.01 at this n); a given T that is not a whole number of sampling periods is rounded and said so.

@@ -1,4 +1,4 @@
-// GFRFs of NARX models (Billings & Li 1999 eqs 11-14; SEEDS-SPEC BL-D2) against closed forms, the published
+// GFRFs of NARX models (Billings & Li 1999 eqs 11-14; BL 11-14) against closed forms, the published
 // model (34) and the exact discretisation of a continuous-time system.
 #include <algorithm>
 #include <cmath>
@@ -45,7 +45,7 @@ TEST(NarxGfrf, ClosedFormsOfFirstSecondAndThirdOrder) {
 }
 
 TEST(NarxGfrf, PublishedModel34) {
-  // SEEDS-SPEC BL.3 [VERIFIED]: with (34) as printed H_1(1) = 0.961 and H_1 at s = j100 (z = e^{j100T}) is
+  // Billings & Li 1999, eqs 33-34 and Tables 1-3: with (34) as printed H_1(1) = 0.961 and H_1 at s = j100 (z = e^{j100T}) is
   // -0.023 - 5.06j (true system: -5j); H_2^sym(0, 0) = -0.0945 (true -0.1).
   const NarxModel m = bl34();
   EXPECT_NEAR(narx_gfrf(m, {1.0}).real(), 0.961, 5e-4);

@@ -1,4 +1,4 @@
-// Johansson (1986) Examples 1 and 2 reproduced with the stand-ins of SEEDS-SPEC RJ.3.
+// Johansson (1986) Examples 1 and 2 reproduced with stand-ins (docs/methods/johansson.md).
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -40,7 +40,7 @@ struct Example1 {
 }  // namespace
 
 TEST(JohanssonExample1, RlsMatchesVerifiedValuesWithSmallPrior) {
-  // SEEDS-SPEC RJ.3 [VERIFIED], P(0) = 100 I, (a1, b1) at t = 50 s, printed to 3 decimals.
+  // Example 1 stand-in, P(0) = 100 I, (a1, b1) at t = 50 s, printed to 3 decimals.
   // Tolerance 1.5e-3: half a unit of the last printed digit plus the O(dt^2) error of
   // filtering the sampled output (dt = 1 ms) instead of the spec's joint simulation.
   const Example1 ex(0.001);
@@ -55,7 +55,7 @@ TEST(JohanssonExample1, RlsMatchesVerifiedValuesWithSmallPrior) {
 }
 
 TEST(JohanssonExample1, LargePriorGivesExactValuesByTenSeconds) {
-  // SEEDS-SPEC RJ.3 / Appendix B: with P(0) = 1e8 all six cases give (2.000, 1.000) by t = 10 s.
+  // Example 1 stand-in: with P(0) = 1e8 all six cases give (2.000, 1.000) by t = 10 s.
   // The regression is exact; what remains is the O(dt^2) output-filtering error (measured
   // 1.1e-5 at dt = 1 ms for tau = 0.03): tolerance 3e-5.
   const Example1 ex(0.001);
@@ -98,7 +98,7 @@ TEST(JohanssonExample1, NoiseBiasesLeastSquaresAndIvRemovesMostOfIt) {
 }
 
 namespace {
-// Example 2 stand-in (SEEDS-SPEC RJ.3): m = k = 1, tau = 0.5, h = 0.05, a1(t) = 1 + 0.5 sign(sin(2 pi t/60)).
+// Example 2 stand-in (docs/methods/johansson.md): m = k = 1, tau = 0.5, h = 0.05, a1(t) = 1 + 0.5 sign(sin(2 pi t/60)).
 struct Example2 {
   static constexpr double tau = 0.5, h = 0.05, dt = 0.005, T = 150;
   Discretization lo, hi, ref;
@@ -147,7 +147,7 @@ TEST(JohanssonExample2, TracksTimeVaryingDamping) {
 
 TEST(JohanssonExample2, AdaptiveControlReachesReferenceModel) {
   // f = m[w0^2 (r - x) - 2 zeta w0 v^] + d^ v^ + k x with v^ = [(1-z)x]/tau and d^ = m a1^
-  // (SEEDS-SPEC RJ.3). Reference r = 2 sign(sin(2 pi t/20)). Relative RMS error between x and
+  // (docs/methods/johansson.md). Reference r = 2 sign(sin(2 pi t/20)). Relative RMS error between x and
   // the reference-model output after t = 30 s: measured 0.077 adaptive vs 0.31 with the
   // damping fixed at its nominal value 1. Bounds 0.1 and "less than half the fixed one".
   const Example2 ex;

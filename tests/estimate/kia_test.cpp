@@ -1,5 +1,5 @@
-// Kernel Invariance Algorithm (Billings & Li 1999; SEEDS-SPEC BL-D4..D6) on the published NARX model (34):
-// Appendix B — converged linear coefficients within 1 % of Table 2, yDy within 5 % and y^2 within 20 % of
+// Kernel Invariance Algorithm (Billings & Li 1999, BL 15-32) on the published NARX model (34):
+// converged linear coefficients within 1 % of Table 2, yDy within 5 % and y^2 within 20 % of
 // Table 3, ERR rankings as in Tables 1-3. The paper's procedure has no hold factor (zoh = false here).
 #include <algorithm>
 #include <cmath>
@@ -58,7 +58,7 @@ TEST(Kia, OverParameterisedThenPrunedByErr) {
   EXPECT_EQ(ranked[1].second, "D^2y");
   EXPECT_EQ(ranked[2].second, "Dy");
   EXPECT_LT(ranked[3].first, 0.5);
-  // Table 1's coefficients (SEEDS-SPEC BL.3; the paper's points are not published, these are the default points).
+  // Table 1's coefficients (the paper's points are not published, these are the default points).
   // Measured: u -0.9618, D^2y 1.034e-4, Dy 1.821e-3, D^4y 3.247e-10, D^2u -1.857e-6 against Table 1's -0.961,
   // 1.03e-4, 1.891e-3, 3.12e-10, -1.83e-6; tolerances about twice the measured differences. D^3y (-3.5e-9, Table 1
   // +2.885e-9) and Du (-3.4e-5, Table 1 -7.23e-5) carry under 0.002 % of the ERR in both: they are zero within what
@@ -123,7 +123,7 @@ TEST(Kia, PointsAndBadInputs) {
 }
 
 namespace {
-// Billings & Li system (33) driven by a +-1 random sequence held per sample at 400 Hz, 1000 samples (SEEDS-SPEC BL.3
+// Billings & Li system (33) driven by a +-1 random sequence held per sample at 400 Hz, 1000 samples (Billings & Li 1999, eqs 33-34 and Tables 1-3
 // set-up), simulated by the adaptive NDE integrator: the relative errors of the reconstructed Dy, D^2y, u, y^2, y*Dy,
 // row 0 KIA, row 1 KIA refined by output error (nde_oe on the same record).
 Eigen::MatrixXd end_to_end(unsigned seed, double snr_db) {
@@ -169,7 +169,7 @@ Eigen::MatrixXd end_to_end(unsigned seed, double snr_db) {
 
 TEST(Kia, EndToEndFromSimulatedData) {
   // Noise-free: NARX (FROLS, degree 2, lags 1..6, AIC) -> KIA with the hold factor: every coefficient within 1 %
-  // (issue 6 target; measured <= 0.55 % on this seed).
+  // (the target; measured <= 0.55 % on this seed).
   // Output-error refinement of that model: within 0.1 %.
   const Eigen::MatrixXd clean = end_to_end(11, 0.0);
   EXPECT_LT(clean.row(0).maxCoeff(), 0.01) << clean;
@@ -177,7 +177,7 @@ TEST(Kia, EndToEndFromSimulatedData) {
   // 20 dB output noise, NARMAX, 8 seeds. KIA alone, measured upper medians (5th of 8): Dy 5.5 %, D^2y 0.5 %,
   // u 1.8 %, y*Dy 2.2 %, y^2 21.5 % (range 2-48 %): the small y^2 effect is the weak spot of the equation-error
   // chain. Refined by output error (nde_oe): measured worst over the 8 seeds 2.8 % (y^2; its standard error is
-  // 0.9-1.9 %), so every coefficient of every seed must be within 10 % (issue 6 target).
+  // 0.9-1.9 %), so every coefficient of every seed must be within 10 % (the target).
   Eigen::MatrixXd E(8, 5);
   for (int s = 0; s < 8; ++s) {
     const Eigen::MatrixXd e = end_to_end(static_cast<unsigned>(s + 1), 20.0);
@@ -271,7 +271,7 @@ TEST(Kia, ErrChoosesTheGlsFilterOrder) {
   for (const char* s : {"D^2y", "Dy", "u"}) EXPECT_NEAR(value(chosen, s), value(ten, s), 0.01 * std::abs(value(ten, s))) << s;
 }
 
-// Issue 14 (item 2): KIA on several records of one system. Two noise-free records of the BL 3.3 equation (1000 +-1
+// KIA on several records of one system. Two noise-free records of the BL 3.3 equation (1000 +-1
 // samples each at 400 Hz, different inputs), the NARX model by FROLS on both (degree 2, lags 1..6, AIC): the workflow
 // pools the equation's and the NARX model's fits over the records, and its output-error refinement fits one equation
 // to both (an initial state each) — every coefficient within 0.1 % as from one record (EndToEndFromSimulatedData).

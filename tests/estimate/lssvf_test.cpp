@@ -1,4 +1,4 @@
-// LSSVF / IVSVF / RLS-SVF behaviour on exactly simulated data (Johansson 1986; SEEDS-SPEC RJ).
+// LSSVF / IVSVF / RLS-SVF behaviour on exactly simulated data (Johansson 1986).
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -253,7 +253,7 @@ TEST(RlsSvf, UpdateAllocatesNothingAndMatchesBatch) {
   EXPECT_EQ(ct.n_updates(), d.size() - 2);
 }
 
-// Several experiments (issue 14, item 2): the recursion runs over two records in turn, the filters restarting at
+// Several experiments: the recursion runs over two records in turn, the filters restarting at
 // rest at the second (start_record). Noise-free at 10 ms: the truth to 2e-4 relative (the filters' O(Ts^2)
 // discretisation, as LSSVF's; measured 5.0e-5). With output noise (std 0.05, about 5 % of the RMS), 30 runs: the joint
 // estimate's RMS error is below 0.85 of the worse record's for every parameter (the recursion with lambda = 1 sums the
@@ -355,7 +355,7 @@ RlsSvfOptions continuous(double alpha) {
 }
 }  // namespace
 
-// Issue 19 (RJ 56-57): the continuous-time recursion dtheta/dt = P phi (y - theta' phi), dP/dt = 2 alpha P - P phi phi' P
+// RJ 56-57: the continuous-time recursion dtheta/dt = P phi (y - theta' phi), dP/dt = 2 alpha P - P phi phi' P
 // against the same ODEs integrated by classical Runge-Kutta (200 steps per sample interval, regressor and target linear
 // in between, the recursion's stated assumption) from the first regression instant, for kG at 10 ms over 3 s. alpha =
 // 0.5 /s exercises the weights' power series (2 alpha h = 0.01), alpha = 60 /s their closed form (2 alpha h = 1.2).
@@ -401,7 +401,7 @@ TEST(RlsSvf, ContinuousRecursionIsRJ56And57IntegratedExactly) {
   }
 }
 
-// RJ 58 (sign and square as SEEDS-SPEC RJ-A6): without noise V = theta~' P^-1 theta~ obeys dV/dt = -2 alpha V -
+// RJ 58 (sign and square as RJ 56-61): without noise V = theta~' P^-1 theta~ obeys dV/dt = -2 alpha V -
 // (theta~' phi)^2, so e^{2 alpha t} V never increases. kG at 1 ms over 10 s, theta~ against kG's theta_tau.
 TEST(RlsSvf, ContinuousRecursionLyapunovFunctionDecreasesAsRJ58) {
   const IdData d = simulate(kG, 0.001, 10.0);

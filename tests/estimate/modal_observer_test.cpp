@@ -1,4 +1,4 @@
-// El-Shafey (1987) ch. 6: minimum-time observer (SEEDS-SPEC ES-C13, Table 6.1 "ours" matrices, 1e-5)
+// El-Shafey (1987) ch. 6: minimum-time observer (ES 6.1-6.36, Table 6.1 "ours" matrices, 1e-5)
 // and the estimate of b~ (ES-C14, Table 6.2).
 #include <cmath>
 #include <string>
@@ -64,7 +64,7 @@ TEST(DeadbeatObserver, Table61MatricesFromTheModel) {
 }
 
 TEST(DeadbeatObserver, ReconstructsThePhaseVariableStateInNIntervals) {
-  // Noise-free: from the n-th level period on, the state at every sample to 1e-9 (issue 5).
+  // Noise-free: from the n-th level period on, the state at every sample to 1e-9.
   const Record rec = s6_record();
   const Eigen::MatrixXd X = DeadbeatObserver::from_model(kS6, kT, kTs).reconstruct(rec.data);
   EXPECT_TRUE(std::isnan(X(59, 0)));  // the first n = 3 periods have no estimate

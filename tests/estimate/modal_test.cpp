@@ -1,5 +1,5 @@
-// El-Shafey (1987) modal-function estimators on exactly simulated data: SEEDS-SPEC ES.4 tables and
-// Appendix B ("noise-free estimators ... reproduce the true values to ~1e-6 with Simpson/exact
+// El-Shafey (1987) modal-function estimators on exactly simulated data: the tables of docs/methods/el-shafey.md
+// ("noise-free estimators ... reproduce the true values to ~1e-6 with Simpson/exact
 // quadrature"; statistical checks by seeded Monte Carlo).
 #include <algorithm>
 #include <cmath>
@@ -40,7 +40,7 @@ IdData sine_record(int N) {
 }
 
 // True q_j for u = sin wt in the basis [sin wt, cos wt]: y_j = Im(K_j e^{jwt}),
-// K_j = H(jw)((jw)^j + sum_i p_ji e^{-jw T_i}) (SEEDS-SPEC Table 3.6 "q true").
+// K_j = H(jw)((jw)^j + sum_i p_ji e^{-jw T_i}) (Table 3.6, "q true").
 Eigen::Vector2d q_true_sine(const TransferFunction& h, const Eigen::VectorXd& T, const Eigen::RowVectorXd& pj, int j,
                             double w) {
   const std::complex<double> jw(0, w);
@@ -78,7 +78,7 @@ TEST(ModalEstimate, Table31DiscreteSamplesReproduceTheTrueValues) {
 
 TEST(ModalEstimate, Table32ContinuousDataFourierAndWalshGiveTheTrueValues) {
   // ES Table 3.2: windows of Table 3.1, 6 Fourier / 8 Walsh functions (320 Ts per window: 40 Ts per Walsh
-  // block). For j = 0 any quadrature gives the exact values (SEEDS-SPEC: linear combination of exact
+  // block). For j = 0 any quadrature gives the exact values (a linear combination of exact
   // pointwise equations), so the trapezoid is checked too.
   const IdData d = step_record(900);
   const Eigen::MatrixXd P = modal_parameters(kS3, kShifts3, 0).P;
@@ -108,7 +108,7 @@ TEST(ModalEstimate, Tables36And37FourierAndWalshRecursionsToTheThirdDerivative) 
     o.windows = {{120 * kTs420, 384 * kTs420}};
     const auto r = modal_estimate(d, g, o);
     ASSERT_TRUE(r.usable()) << r.why_not_usable();
-    // Simpson at Ts = pi/420: measured relative errors <= 2.5e-7 (j = 1, 2), Appendix B asks ~1e-6.
+    // Simpson at Ts = pi/420: measured relative errors <= 2.5e-7 (j = 1, 2), the oracle asks ~1e-6.
     for (int j = 0; j <= 3; ++j) {
       EXPECT_LT(max_rel(r.model.P().row(j), P.row(j)), 1e-6) << "basis " << static_cast<int>(basis) << " j " << j;
       EXPECT_LT(max_rel(r.model.Q().row(j), Q.row(j)), 1e-6) << "basis " << static_cast<int>(basis) << " j " << j;
@@ -119,7 +119,7 @@ TEST(ModalEstimate, Tables36And37FourierAndWalshRecursionsToTheThirdDerivative) 
 }
 
 TEST(ModalEstimate, TrapezoidIntegralsReproduceTheThesisClassError) {
-  // SEEDS-SPEC ES-C5 [VERIFIED]: on Example 3.5 data, trapezoid Walsh block integrals give
+  // ES 3.18, 3.31-3.37: on Example 3.5 data, trapezoid Walsh block integrals give
   // p_1 = (2.9993, -0.2566, -0.4331), Simpson gives the exact (2.9990, -0.2564, -0.4330); Table 3.6 "ours,
   // trapezoid" (Fourier): p_1 = (3.001, -0.2569, -0.4315). Both reproduced to the printed digits.
   const IdData d = sine_record(600);
@@ -159,7 +159,7 @@ TEST(ModalEstimate, TheoremsFourOneAndFourTwoGiveTheTransferFunction) {
 
 TEST(FreeResponsePoles, Table48DataMatrixOnTheS4FreeResponse) {
   // ES Ex. 4.6: y(0) = 0.2, Dy(0) = 10, D^2y = D^3y = 0, Ts = pi/420, N = 15 pairs, shifts 40, 80, 100, 120 Ts,
-  // t_fk - t_ok = 20 Ts, spacing 20 Ts, [STAND-IN] t_o1 = 120 Ts. SEEDS-SPEC: Simpson gives (338, 221, 115.25, 6)
+  // t_fk - t_ok = 20 Ts, spacing 20 Ts, [STAND-IN] t_o1 = 120 Ts. Computed independently: Simpson gives (338, 221, 115.25, 6)
   // exactly; trapezoid (338.3, 221.2, 115.35, 6.006) (published 338.8, 221.6, 115.6, 6.014).
   const Eigen::VectorXd t = time_grid(kTs420, 600);
   const Eigen::VectorXd y =
@@ -214,7 +214,7 @@ TEST(FreeResponsePoles, Table49AugmentedWithTheGeneratorAndDeflated) {
 
 TEST(Prony, Table410AliasesWhereTheDataMatrixMethodDoesNot) {
   // ES Ex. 4.8: y = e^{-t} sin 3t + cos 100t, Ts = T_l/666, T_l = 2 pi/3; order 4, N = 10 equations.
-  // SEEDS-SPEC (double precision, start t = 0): T = 33 Ts -> -1 +- 3j and +-21.09j (100 rad/s aliases),
+  // Computed independently (double precision, start t = 0): T = 33 Ts -> -1 +- 3j and +-21.09j (100 rad/s aliases),
   // cond(R^T R) 21.5; T = 4 Ts -> exact, cond 2.25e4.
   const double Ts = 2 * kPi / 3 / 666;
   const Eigen::VectorXd t = time_grid(Ts, 2000);
@@ -275,7 +275,7 @@ TEST(ModalEstimate, BadInputs) {
 
 TEST(ModalEstimate, Tables33To35NoisyOutputBiasesLeastSquaresAndIvOrIntegralsRemoveIt) {
   // ES Ex. 3.3-3.4: the Table 3.1 set-up with N(0, 0.1^2) output noise, 200 seeded runs.
-  // SEEDS-SPEC Monte Carlo: LS median (-0.265, 0.500, -0.174, 1.023), strongly biased towards zero; IV
+  // An independent Monte Carlo: LS median (-0.265, 0.500, -0.174, 1.023), strongly biased towards zero; IV
   // (tau_iv = 25 Ts) median (-0.653, 0.614, -0.305, 0.641); continuous data (Fourier/Walsh, Table 3.4
   // published (-0.6370, ...) / (-0.6317, ...)): much less bias. Medians compared, not digits: LS within
   // 0.03 of the spec's Monte Carlo, the others within 0.05 of the true p_01 = -0.6605.
@@ -325,7 +325,7 @@ TEST(ModalEstimate, Tables38To312PrefilteredPairsOfATwoFrequencyInput) {
   // ES Ex. 3.9: S3, u = cos 6t - sin 3t from rest, T_o = 2 pi/3, Ts = T_o/384 = pi/576, T_i = 40, 80, 120 Ts.
   // L_1 (shifts T_o/8, T_o/4, l = [0, 1]) leaves -sin 3t + cos 3t; L_2 (T_o/4, T_o/2, l = [0, 1]) leaves 2 cos 6t.
   // Window [320 Ts, 704 Ts] (after the filter's and the system's shifts); 6 Fourier / 8 Walsh functions, j = 0..3.
-  // p parts = Table 3.10 (true) to 1e-6; q only via invariants: |q_j| equals |q true| (SEEDS-SPEC: the published
+  // p parts = Table 3.10 (true) to 1e-6; q only via invariants: |q_j| equals |q true| (the published
   // q^ are in another sinusoid basis, |q^ published| = |q true|, e.g. 0.5344 for q^1_0).
   const double Ts = kPi / 576, To = 384 * Ts;
   const Eigen::Vector3d T(40 * Ts, 80 * Ts, 120 * Ts);
@@ -421,7 +421,7 @@ TEST(ModalResponses, Tables51And52FrequencyResponseFromASquareWave) {
   o.windows = piecewise_constant_windows(d, kShifts3(2));
   const auto m = modal_estimate(d, d.u(), o);
   const HarmonicResponse h = modal_frequency_response(d, m.model, 2 * kPi, {1, 3, 5, 7, 9, 11}, 120 * kTs420);
-  Eigen::MatrixXd table(6, 4);  // SEEDS-SPEC Table 5.1, "ours": nu_1, nu_2, q_1, q_2
+  Eigen::MatrixXd table(6, 4);  // Table 5.1 recomputed independently: nu_1, nu_2, q_1, q_2
   table << 1.4363, 2.3589, 1.9751, 1.7512,  //
       -0.9006, 0.3565, -0.4773, 0.8428,     //
       0.1392, -0.3715, -0.6021, -0.0997,    //
@@ -439,7 +439,7 @@ TEST(ModalResponses, Tables51And52FrequencyResponseFromASquareWave) {
     EXPECT_LT(std::abs(h.response.response()(k) - truth), 2e-6 * std::abs(truth)) << "harmonic " << 2 * k + 1;
   }
   // The printed Table 5.1 (every row): ours differ from the print by at most 1.5e-3 (nu_2 at k = 11: -0.2617 against
-  // -0.2632; SEEDS-SPEC ES.4), the thesis' quadrature of u_0 and y_0 being coarser (its Table 5.2 is accordingly
+  // -0.2632; docs/methods/el-shafey.md), the thesis' quadrature of u_0 and y_0 being coarser (its Table 5.2 is accordingly
   // further from the truth than ours); asserted within 2e-3.
   Eigen::MatrixXd printed51(6, 4);
   printed51 << 1.436, 2.359, 1.974, 1.751,  //
@@ -474,7 +474,7 @@ TEST(ModalResponses, Tables51And52FrequencyResponseFromASquareWave) {
 
 TEST(ModalResponses, Tables53And54StepAndImpulseResponsesFromPiecewiseConstantData) {
   // ES Ex. 5.2: S3, input +1, +2, -1, -2 each 80 Ts, Ts = pi/320, from rest; T = 20 Ts, shifts 20, 40, 60 Ts;
-  // p_0 from the constant-input windows (SEEDS-SPEC: (-1.5883, 1.2918, -0.4559)); g on [0, 640 Ts] by ES 5.32
+  // p_0 from the constant-input windows (computed independently: (-1.5883, 1.2918, -0.4559)); g on [0, 640 Ts] by ES 5.32
   // and 5.37 equals the true step response (spec: 6e-15). Table 5.3's true column (spacing 20 Ts) to 5e-4.
   const double Ts = kPi / 320, T = 20 * Ts;
   const int N = 320;
@@ -491,7 +491,7 @@ TEST(ModalResponses, Tables53And54StepAndImpulseResponsesFromPiecewiseConstantDa
   const Eigen::VectorXd truth = step_response(kS3, g.t);
   EXPECT_LT((g.value - truth).cwiseAbs().maxCoeff(), 1e-9);
   // Every printed row of Table 5.3 (k = 0..31, samples every 20 Ts, not the printed 10): our g to 5e-4 relative
-  // (4 printed digits; 1e-6 absolute for k = 0, printed 6.047e-7, true 0). Two rows are misprints (SEEDS-SPEC ES.4):
+  // (4 printed digits; 1e-6 absolute for k = 0, printed 6.047e-7, true 0). Two rows are misprints (docs/methods/el-shafey.md):
   // k = 2 repeats row 1 (0.2291; compared here with the true 0.7141) and the estimated column's k = 19 prints 0.9804
   // (the true column and our g: 0.9894).
   const double table53[32] = {6.047e-7, 0.2291, 0.7141 /* printed 0.2291 */, 1.086, 1.154, 1.004, 0.8457, 0.8207,
@@ -503,7 +503,7 @@ TEST(ModalResponses, Tables53And54StepAndImpulseResponsesFromPiecewiseConstantDa
 
   // ES Ex. 5.3 / Table 5.4: impulse response from this step response with negative shifts (-40, -80, -120) Ts
   // (the shifts that reproduce the published p_1 [RECONSTRUCTED]), 6 Fourier functions with period 192 Ts.
-  // True p_1 = (-1.6728, 8.1618, 11.2474), q_10 = 17.736; h to 8e-7 (SEEDS-SPEC).
+  // True p_1 = (-1.6728, 8.1618, 11.2474), q_10 = 17.736; h to 8e-7 (computed independently).
   const Eigen::Vector3d neg(-40 * Ts, -80 * Ts, -120 * Ts);
   const ImpulseFromStep imp = modal_impulse_from_step(g, neg, 192 * Ts);
   EXPECT_LT((imp.p1 - Eigen::Vector3d(-1.6728, 8.1618, 11.2474)).cwiseAbs().maxCoeff(), 5e-4 * 11.25);
@@ -551,7 +551,7 @@ TEST(ModalFit, PiecewiseConstantInputsGiveTheTransferFunctionByBothRoutes) {
     EXPECT_NEAR(r.model.num().coefficient_of_power(1), 13.0, 1e-5);
     EXPECT_NEAR(r.model.num().coefficient_of_power(0), 52.0, 1e-5);
     EXPECT_GT(r.fit.fit_percent, 99.999);
-    // One naming of transfer-function coefficients across methods (issue 14): a1..a3 of s^2..s^0, b0 of the
+    // One naming of transfer-function coefficients across methods: a1..a3 of s^2..s^0, b0 of the
     // numerator's highest power — SRIVC's names for the same coefficients of S3 = (13 s + 52)/(s^3 + ...).
     EXPECT_EQ(r.parameters.names, tf_parameter_names({2, 3, 0}));
     EXPECT_NEAR(r.parameters.value("a1"), kS3.den().coefficient_of_power(2), 1e-6 * 52);
@@ -559,7 +559,7 @@ TEST(ModalFit, PiecewiseConstantInputsGiveTheTransferFunctionByBothRoutes) {
     EXPECT_NEAR(r.parameters.value("b0"), 13.0, 1e-5);
     EXPECT_NEAR(r.parameters.value("b1"), 52.0, 1e-5);
   }
-  // Issue 17: the shifts left to modal_fit (order 3 only): uniform shifts with T_3 <= half the 80-sample levels, from
+  // The shifts left to modal_fit (order 3 only): uniform shifts with T_3 <= half the 80-sample levels, from
   // the conditioning scan of an SRIVC pre-estimate (chosen: 10 samples apart); noise-free the same S3 to 1e-6 (measured
   // 5e-8), the choice stated.
   {
@@ -637,7 +637,7 @@ TEST(ModalEstimate, Tables43And44NoisyPrefilteredRouteLeastSquaresAgainstIv) {
   // ES Ex. 4.2: the Table 4.1 set-up with N(0, 0.01^2) output noise, 400 seeded runs, ES-C7 on the three
   // prefiltered pairs, 15 equations 10 Ts apart from the first instant at which a filtered pair obeys the modal
   // relation (the filter's longest shift + T_3, as Example 3.1's window w1 starts at T_3). Published single runs:
-  // LS a = (56.71, 39.45, 4.170), IV (52.53, 30.05, 4.015); SEEDS-SPEC's independent Monte Carlo (200 runs):
+  // LS a = (56.71, 39.45, 4.170), IV (52.53, 30.05, 4.015); an independent Monte Carlo (200 runs):
   // LS median a = (48.5, 29.8, 3.82), IV (tau_iv = 25 Ts) (50.0, 30.1, 3.90) with a larger spread.
   //
   // Why the instants matter: after the prefilter a filtered output is one sinusoid plus the system's decaying free
@@ -713,7 +713,7 @@ IdData level_record(const std::vector<double>& levels, int hold, int cycles, dou
 }  // namespace
 
 TEST(ModalFit, SeveralRecordsArePooledIntoOneEstimateMoreAccurateThanEither) {
-  // Issue 14 (several experiments): two records of S3 with different level sequences and hold times, each from
+  // Several experiments: two records of S3 with different level sequences and hold times, each from
   // rest. Noise-free, the joint Walsh and Discrete fits give S3 to 1e-6 (as one record does, ModalFit above) and
   // count the windows of both records.
   const double Ts = kPi / 320;
@@ -760,8 +760,8 @@ TEST(ModalFit, SeveralRecordsArePooledIntoOneEstimateMoreAccurateThanEither) {
 }
 
 TEST(ComparePoles, ShiftsLeftEmptyAreChosenOnPronysPreEstimate) {
-  // Issue 17 (no hand-picked settings): shifts T_i = i d with d of least cond(psi) for Prony's pre-estimate.
-  // Noise-free, the data-matrix method is exact whatever well-conditioned shifts it gets (SEEDS-SPEC Appendix B:
+  // No hand-picked settings: shifts T_i = i d with d of least cond(psi) for Prony's pre-estimate.
+  // Noise-free, the data-matrix method is exact whatever well-conditioned shifts it gets (an independent computation:
   // ~1e-6 with Simpson); measured 2.5e-7 on the Ex. 4.6 record (the hand-picked shifts of Table 4.8: 2.6e-7).
   const Eigen::VectorXd t = time_grid(kTs420, 600);
   const Eigen::VectorXd y =

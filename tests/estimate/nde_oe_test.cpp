@@ -63,7 +63,7 @@ TEST(NdeOe, RecoversCoefficientsAndInitialStateFromAPerturbedStart) {
   EXPECT_TRUE(r.diagnostics.warnings.empty());
 }
 
-// Several experiments (issue 14, item 2): two records from different initial states with different inputs give one
+// Several experiments: two records from different initial states with different inputs give one
 // set of coefficients (noise-free: to 1e-5 from a start 15 % off) and each record's own initial state ("r1.y(0)",
 // "r2.y(0)", ...; diagnostics x0 and x0_2). With output noise (std 0.01, 2 % of the output's RMS) every joint
 // coefficient lies within 3 reported standard deviations of the truth and its standard deviation is below either
@@ -98,7 +98,7 @@ TEST(NdeOe, SeveralRecordsShareTheCoefficientsAndKeepTheirOwnInitialStates) {
   EXPECT_THROW(nde_oe(std::vector<IdData>{}, truth), InvalidArgument);
 }
 
-// The same two records (issue 14, item 2: "the right covariance"), 60 noise draws (std 0.01): the joint estimate's
+// The same two records ("the right covariance"), 60 noise draws (std 0.01): the joint estimate's
 // RMS error is below the better single record's for every coefficient (measured 0.69-0.93 of it) and within 20 %
 // of what the two records' information combined gives, (rmse_1^-2 + rmse_2^-2)^-1/2 (60 runs: RMS errors have ~9 %
 // relative error; measured 0.80-1.11), and the reported standard deviation agrees with the Monte Carlo spread within

@@ -1,4 +1,4 @@
-// Numerical robustness (issue 7): fast sampling, badly scaled signals and near-unidentifiable structures must give
+// Numerical robustness: fast sampling, badly scaled signals and near-unidentifiable structures must give
 // either a correct estimate or usable() == false with a reason — never a confident wrong model.
 #include <random>
 
@@ -101,7 +101,7 @@ TEST(NumericalRobustness, NearPoleZeroCancellation) {
   }
 }
 
-// Issue 13 property test: every linear SISO estimator gives the same model whatever the units of time, input and
+// Property test: every linear SISO estimator gives the same model whatever the units of time, input and
 // output. Random stable systems of order 1-4 (poles in [-2, -0.2], complex pairs with damping >= 0.2), 1500
 // samples at Ts = 0.05 s of a PRBS with 30 dB output noise; then the same record with time scaled so that Ts is
 // log-uniform in [1e-6, 1e3] s and u, y scaled by factors log-uniform in [1e-30, 1e30]. The estimates, mapped

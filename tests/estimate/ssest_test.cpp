@@ -151,7 +151,7 @@ TEST(Ssest, LongRecordIsWarmedUpOnItsBeginningAndEndsAtTheSameOptimum) {
   EXPECT_NEAR(warmed.fit.fit_percent, from_truth.fit.fit_percent, 1e-3);
 }
 
-// Issue 16's proof: 100 noise realisations on one input, uniform and irregular sampling, 10 dB on each output.
+// The proof of the standard deviations: 100 noise realisations on one input, uniform and irregular sampling, 10 dB on each output.
 TEST(Ssest, MonteCarloOfTheModesIsUnbiasedAtTheCramerRaoBound) {
   const StateSpace m = two_modes();
   const int N = 2000, runs = 100;

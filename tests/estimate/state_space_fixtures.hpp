@@ -1,4 +1,4 @@
-// Shared fixtures of the state-space tests (subspace, ssest): the two-mode MIMO system of issue 16, held random
+// Shared fixtures of the state-space tests (subspace, ssest): the two-mode MIMO system, held random
 // inputs, exactly simulated noisy records, periodic multisine records and a pole distance.
 #pragma once
 
@@ -17,7 +17,7 @@
 
 namespace ctid::test::ss {
 // Two inputs, two outputs, two lightly damped modes: wn = 2 rad/s, zeta = 0.05 and wn = 5 rad/s, zeta = 0.2
-// (the system of issue 16's Monte Carlo).
+// (the system of the ssest Monte Carlo).
 inline StateSpace two_modes() {
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(4, 4);
   A.block(0, 0, 2, 2) << 0, 1, -4, -0.2;

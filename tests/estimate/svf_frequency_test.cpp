@@ -1,6 +1,6 @@
 // Johansson (1986) in the frequency domain: the information matrix of an input spectrum (RJ 47-50) and the
 // least-squares criterion on frequency-response data (RJ 45), each against its time-domain counterpart on the same
-// signals (SEEDS-SPEC RJ "LS criterion").
+// signals (Johansson 1986, RJ 44-50).
 #include <cmath>
 #include <complex>
 #include <numbers>

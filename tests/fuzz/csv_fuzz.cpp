@@ -1,4 +1,4 @@
-// libFuzzer target for the CSV/whitespace table reader and the IdData built from it (issue 7). Any input
+// libFuzzer target for the CSV/whitespace table reader and the IdData built from it. Any input
 // must either give a table (and a record, when it has the columns) or throw ctid::FileError /
 // ctid::InvalidArgument; anything else (another exception, a crash, a sanitizer report) is a bug.
 // Run: see tests/fuzz/CMakeLists.txt (make fuzz).

@@ -1,4 +1,4 @@
-// libFuzzer target for the physical-model expression parser (issue 4). Build with clang:
+// libFuzzer target for the physical-model expression parser. Build with clang:
 //   CXX=clang++ cmake -S . -B build-fuzz -DCTID_BUILD_FUZZ=ON -DCTID_BUILD_TESTS=OFF -DCTID_BUILD_APPS=OFF \
 //       -DCTID_BUILD_BENCHMARKS=OFF && cmake --build build-fuzz --target expression_fuzz
 //   build-fuzz/tests/fuzz/expression_fuzz -max_total_time=60

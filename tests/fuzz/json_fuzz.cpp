@@ -1,5 +1,5 @@
 // libFuzzer target for the JSON model and result readers (linear models, TF and MISO results, NARX and NDE models;
-// issue 7; grey-box model files and any result file, issue 15). Any input must either be read or throw ctid::FileError / ctid::InvalidArgument.
+// grey-box model files and any result file). Any input must either be read or throw ctid::FileError / ctid::InvalidArgument.
 #include <cstddef>
 #include <cstdint>
 #include <string>

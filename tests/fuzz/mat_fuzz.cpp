@@ -1,4 +1,4 @@
-// libFuzzer target for the MATLAB .mat reader (libmatio through io/mat.cpp and load_iddata; issue 7). The
+// libFuzzer target for the MATLAB .mat reader (libmatio through io/mat.cpp and load_iddata). The
 // input is written to a temporary file (matio reads files); any input must either load or throw
 // ctid::FileError / ctid::InvalidArgument.
 #include <unistd.h>

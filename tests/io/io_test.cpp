@@ -326,7 +326,7 @@ TEST(Mat, DamagedLevel4FilesAreRefused) {
   EXPECT_EQ(read_mat_variable(be, "x"), Eigen::MatrixXd(Eigen::Vector2d(1.5, -2.0)));
 }
 
-// The one reader of result files (issue 14, item 1): every model type ctid writes comes back as the same model
+// The one reader of result files: every model type ctid writes comes back as the same model
 // (to the digits JSON keeps: 17 significant, compared to 1e-15 relative), with its method and parameter table; an
 // FSF result gets its covariance back; a bare model file is a result without a parameter table.
 TEST(Json, EveryModelTypeRoundTripsThroughOneResultReader) {
@@ -383,7 +383,7 @@ TEST(Json, EveryModelTypeRoundTripsThroughOneResultReader) {
             std::string::npos);
 }
 
-// The exact model text Python's pickle uses (issue 18): doubles that have no short decimal form read back bit for
+// The exact model text Python's pickle uses: doubles that have no short decimal form read back bit for
 // bit, an NDE keeps its coefficients (the file form normalises y's to +1), an FSF model its covariance.
 TEST(Json, TheExactModelTextReadsBackBitForBit) {
   const double awkward[] = {0.1 + 0.2, 1.0 / 3.0, 1e-300, 3.141592653589793, -2.0 / 7.0};

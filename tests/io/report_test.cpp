@@ -44,7 +44,7 @@ TEST(Report, TransferFunctionReportHasEverySection) {
 }
 
 TEST(Report, SaysWhatTheNumbersMean) {
-  // Issue 17, "a report worth sending": the poles as an engineer reads them, parameters within 2 std of 0 flagged,
+  // "A report worth sending": the poles as an engineer reads them, parameters within 2 std of 0 flagged,
   // one plain-language line under each residual test, the preprocessing, the command and the version.
   // The record (test::second_order_record) is 4/(s^2 + 0.8 s + 4) at 20 dB: wn = 2 rad/s, zeta = 0.2, DC gain 1.
   const IdData d = plant();
@@ -125,7 +125,7 @@ TEST(Report, MultiInputReportHasAChannelPerInput) {
 }
 
 TEST(Report, StateSpaceReportShowsModesEveryOutputAndEveryChannel) {
-  // The two-mode 2 x 2 system of issue 16, 20 dB noise, ssest with 4 states: the report holds the singular values, a
+  // The two-mode 2 x 2 system, 20 dB noise, ssest with 4 states: the report holds the singular values, a
   // modes table (2 rows, with standard deviations and a shape column per output), each output's comparison whose fit
   // is the fit the estimator reported for that output (same initial state), its residual tests, one Bode magnitude
   // plot and one step plot per input with a curve per output.

@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
-"""Layering check (DESIGN.md section 2): a lower layer never includes a higher one.
+"""Layering check (docs/architecture.md): a lower layer never includes a higher one.
 
 Order: core -> internal -> data, poly -> model -> simulate -> signal -> validate -> estimate -> io.
 Every #include "..." of a ctid header in include/ctid/<layer>/ and src/<layer>/ is resolved to the layer it
 belongs to (ctid/<layer>/x.hpp, internal/x.hpp, or a private header next to the including file) and must not
-rank above the including file's layer. Exit 1 listing every violation as FILE:LINE: LAYER includes HIGHER.
+rank above the including file's layer. The front ends (apps/ and python/src/) stand above every layer and may
+include public headers only (ctid/...) and their own headers beside them, never src/ or internal/ ones.
+Exit 1 listing every violation as FILE:LINE: LAYER includes HIGHER.
 Usage: check_layers.py REPO_ROOT     (check_layers.py --self-test: the check finds planted violations)
 """
 import pathlib
@@ -39,10 +41,31 @@ def layer_of_file(path):
     return None
 
 
+def front_end_violations(root, f):
+    """Includes of a front-end file (apps/, python/src/) that are not public headers or its own headers."""
+    bad, checked = [], 0
+    for n, line in enumerate(f.read_text().splitlines(), 1):
+        m = INCLUDE.match(line)
+        if not m:
+            continue
+        checked += 1
+        target = pathlib.PurePosixPath(m.group(1))
+        public = target.parts[0] == "ctid" and (root / "include" / target).is_file()
+        own = len(target.parts) == 1 and (f.parent / target).is_file()
+        if not (public or own):
+            bad.append(f"{f.relative_to(root)}:{n}: the front end includes {m.group(1)}, which is not a public header")
+    return bad, checked
+
+
 def main(root):
     root = pathlib.Path(root)
     files = sorted(list((root / "include" / "ctid").rglob("*.hpp")) + list((root / "src").rglob("*.[ch]pp")))
+    front = sorted(list((root / "apps").rglob("*.[ch]pp")) + list((root / "python" / "src").rglob("*.[ch]pp")))
     bad, checked = [], 0
+    for f in front:
+        b, c = front_end_violations(root, f)
+        bad += b
+        checked += c
     for f in files:
         own = layer_of_file(f.relative_to(root))
         if own not in RANK:
@@ -59,12 +82,12 @@ def main(root):
                 bad.append(f"{f.relative_to(root)}:{n}: {own} includes {m.group(1)}, which is in no layer")
     for b in bad:
         print(b)
-    print(f"{len(files)} files, {checked} includes checked, {len(bad)} against the layer order")
+    print(f"{len(files) + len(front)} files, {checked} includes checked, {len(bad)} against the layer order")
     return 1 if bad else 0
 
 
 def self_test():
-    """Plant three violations and one allowed include in a scratch tree; the check must report exactly three."""
+    """Plant five violations and three allowed includes in a scratch tree; the check must report exactly five."""
     import contextlib
     import io
     import tempfile
@@ -74,6 +97,10 @@ def self_test():
             "src/model/a.cpp": '#include "ctid/estimate/srivc.hpp"\n#include "ctid/poly/polynomial.hpp"\n',
             "include/ctid/core/b.hpp": '#include "internal/ode.hpp"\n',
             "src/simulate/c.cpp": '#include "ctid/ctid.hpp"\n',
+            "include/ctid/ctid.hpp": "",
+            "apps/tool/own.hpp": "",
+            "apps/tool/main.cpp": '#include "ctid/ctid.hpp"\n#include "own.hpp"\n#include "internal/ode.hpp"\n',
+            "python/src/module.cpp": '#include "../../src/data/record_refs.hpp"\n',
         }.items():
             (root / rel).parent.mkdir(parents=True, exist_ok=True)
             (root / rel).write_text(text)
@@ -81,8 +108,8 @@ def self_test():
         with contextlib.redirect_stdout(out):
             code = main(root)
         found = out.getvalue().splitlines()[:-1]  # one line per violation, then the summary
-        assert code == 1 and len(found) == 3, out.getvalue()
-        print("self-test: 3 planted violations found")
+        assert code == 1 and len(found) == 5, out.getvalue()
+        print("self-test: 5 planted violations found")
     return 0
 
 

@@ -1,4 +1,4 @@
-// The grey-box model language (model/expression.hpp, issue 15): values against the same formulas written in C++
+// The grey-box model language (model/expression.hpp): values against the same formulas written in C++
 // (to 1e-15 relative), derivatives against those formulas' analytic derivatives and central differences, and the
 // parse errors a user sees.
 #include <cmath>
@@ -48,7 +48,7 @@ TEST(Expression, ValuesFollowPrecedenceAndTheFunctions) {
 }
 
 TEST(Expression, GradientsAreExact) {
-  // The cascaded-tank and friction right-hand sides of issue 15 and every function, at a point away from the kinks:
+  // The cascaded-tank and friction right-hand sides of docs/methods/greybox.md and every function, at a point away from the kinks:
   // the forward-mode gradient equals central differences to 1e-7 relative (their truncation error), and for
   // -k1*sqrt(x1) + k2*u the analytic gradient to 1e-15.
   const std::vector<double> x = {0.7, -1.3, 2.0, 0.05, 3.0, 1.5};

@@ -1,5 +1,5 @@
-// Modal parameters from known models (El-Shafey 1987; SEEDS-SPEC ES-C1, ES.4 and Appendix B
-// "exact, model-based" oracles: Tables 2.1, 3.10, 3.15; "algebraic consistency": Tables 4.5, 4.6).
+// Modal parameters from known models (El-Shafey 1987; ES 2.13-2.30; the
+// exact, model-based oracles of docs/methods/el-shafey.md: Tables 2.1, 3.10, 3.15; "algebraic consistency": Tables 4.5, 4.6).
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -56,7 +56,7 @@ TEST(ModalParameters, Table310) {
 
 TEST(ModalParameters, Table315WithTheTypoCorrected) {
   // ES Table 3.15: S4, T_i = 20, 40, 110, 160 Ts, Ts = pi/420; the printed -1.048 is a typo for -1.042
-  // (both estimates in Tables 3.13/3.14 say -1.042), 5.326 a rounding slip for 5.3235 (SEEDS-SPEC ES.4).
+  // (both estimates in Tables 3.13/3.14 say -1.042), 5.326 a rounding slip for 5.3235 (docs/methods/el-shafey.md).
   const double Ts = kPi / 420;
   const auto m = modal_parameters(kS4, Eigen::Vector4d(20 * Ts, 40 * Ts, 110 * Ts, 160 * Ts), 4);
   Eigen::MatrixXd pub(5, 4);
@@ -90,7 +90,7 @@ TEST(ModalParameters, InvariantUnderCoordinateChanges) {
 }
 
 TEST(PhaseVariableForm, MarkovParametersOfS6) {
-  // SEEDS-SPEC ES.2 [VERIFIED]: (6.5 s + 52)/(s^3 + 4 s^2 + 30 s + 52) has b~ = (0, 6.5, 26).
+  // El-Shafey 1987, ch. 2: (6.5 s + 52)/(s^3 + 4 s^2 + 30 s + 52) has b~ = (0, 6.5, 26).
   const TransferFunction s6(Eigen::VectorXd{{6.5, 52.0}}, Eigen::VectorXd{{1.0, 4.0, 30.0, 52.0}});
   const StateSpace pv = phase_variable_form(s6);
   EXPECT_NEAR(pv.B()(0, 0), 0.0, 1e-14);
@@ -132,7 +132,7 @@ TEST(ModalModel, TheoremsFourOneAndFourTwoRecoverTheModelFromExactModalQuantitie
 }
 
 TEST(ModalModel, Tables45And46FollowFromThePublishedEstimates) {
-  // Algebraic consistency (Appendix B, ~1 %): Theorem 4.1 applied to the published 4-digit p^ of
+  // Algebraic consistency (~1 %): Theorem 4.1 applied to the published 4-digit p^ of
   // Tables 3.6 (Fourier) / 3.7 (Walsh) gives Table 4.5's a^; Tables 3.13 / 3.14 give Table 4.6's.
   const double Ts = kPi / 420;
   auto a_of = [](const Eigen::VectorXd& T, const Eigen::MatrixXd& P) {
@@ -161,7 +161,7 @@ TEST(ModalModel, Tables45And46FollowFromThePublishedEstimates) {
 TEST(ModalModel, Tables45To49PolesAreTheRootsOfTheirCoefficients) {
   // The poles printed beside a^ in Tables 4.5, 4.6, 4.8 and 4.9 are the roots of the printed a^ (to the printed digits, 1e-3
   // relative + 2e-3 absolute for the last digit of a 4-digit root); Table 4.6's Walsh row prints "-1.000 + 1.500j"
-  // twice (SEEDS-SPEC ES.4: a misprint of the conjugate pair, compared here as the pair).
+  // twice (docs/methods/el-shafey.md: a misprint of the conjugate pair, compared here as the pair).
   auto expect_roots = [](const Polynomial& d, const std::vector<std::complex<double>>& pub) {
     Eigen::VectorXcd r = d.roots();
     ASSERT_EQ(r.size(), static_cast<Eigen::Index>(pub.size()));
@@ -209,7 +209,7 @@ TEST(ModalModel, Table47WalshRowFollowsFromTables311And312) {
   // The Fourier row (51.91, 12.91, -0.03879) does not follow from Tables 3.8/3.9 in any basis we found: the same
   // route gives (52.78, 13.16, -0.0211) (rounding spread 52.67..52.87 in b0), with Table 4.5's Fourier a^
   // (50.81, 13.04, 0.0012), and no basis phase t0 gives both printed b1 and b2; b0 does not depend on t0 at all.
-  // SEEDS-SPEC ES.4 reads the a^ of Table 4.7 as Table 4.5's; with that a^ the Walsh row is off by 0.3 % in b0
+  // An earlier reading took the a^ of Table 4.7 as Table 4.5's; with that a^ the Walsh row is off by 0.3 % in b0
   // (51.98), outside the rounding spread, so the thesis evidently used the pairs' own p^.
   const double Ts = kPi / 576, t0 = 24 * Ts;
   const Eigen::Vector3d T(40 * Ts, 80 * Ts, 120 * Ts);
@@ -226,7 +226,7 @@ TEST(ModalModel, Table47WalshRowFollowsFromTables311And312) {
     return M;
   };
   // The published q^ as rows q_0..q_3 per pair; p^ rows p_0..p_3 (Tables 3.8, 3.9 Fourier; 3.11, 3.12 Walsh, the
-  // latter's printed "+4.179" read as -0.4179, SEEDS-SPEC ES.4).
+  // latter's printed "+4.179" read as -0.4179, docs/methods/el-shafey.md).
   Eigen::MatrixXd qF[2] = {Eigen::MatrixXd(4, 2), Eigen::MatrixXd(4, 2)}, qW[2] = {qF[0], qF[1]};
   Eigen::MatrixXd pF[2] = {Eigen::MatrixXd(4, 3), Eigen::MatrixXd(4, 3)}, pW[2] = {pF[0], pF[1]};
   qF[0] << -0.3362, 0.4154, -1.629, 2.898, 4.215, 6.785, 72.36, -46.58;

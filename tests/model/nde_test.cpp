@@ -1,4 +1,4 @@
-// Polynomial NDE models (Billings & Li 1999, eqs 1-6; SEEDS-SPEC BL-D3): names, the linear kernel, harmonic
+// Polynomial NDE models (Billings & Li 1999, eqs 1-6): names, the linear kernel, harmonic
 // probing H_2 against a two-tone simulation, and simulation accuracy and escape detection.
 #include <cmath>
 #include <complex>
@@ -29,7 +29,7 @@ TEST(NdeModel, TermsAndTheEquation) {
   const NdeModel m = bl33();
   EXPECT_EQ(m.to_string(4), "y + 0.002 Dy + 0.0001 D^2y - u + 0.1 y^2 - 0.006 y*Dy = 0");
   EXPECT_NEAR(m.h1(0.0).real(), 1.0, 1e-15);
-  EXPECT_NEAR(m.h2(0.0, 0.0).real(), -0.1, 1e-15);  // SEEDS-SPEC BL-D3 check: -gamma_20(0,0) H_1(0)^2
+  EXPECT_NEAR(m.h2(0.0, 0.0).real(), -0.1, 1e-15);  // BL 4-6 check: -gamma_20(0,0) H_1(0)^2
   EXPECT_NEAR(NdeModel(m.terms(), 2 * m.coefficients()).normalized().coefficient("y*Dy"), -0.006, 1e-15);
 }
 

@@ -1,5 +1,5 @@
 // Modal filters, annihilating prefilters (El-Shafey 1987 ES-C6, Example 3.7 as reconstructed in
-// SEEDS-SPEC), quadrature rules and Walsh functions (ES-C5).
+// docs/methods/el-shafey.md), quadrature rules and Walsh functions (ES-C5).
 #include <cmath>
 #include <numbers>
 
@@ -49,7 +49,7 @@ TEST(ModalFilter, ShiftsAreSampleMultiplesAndTheFilterIsAWeightedShiftedSum) {
 }
 
 TEST(Annihilator, Example37ReconstructedValues) {
-  // u = e^{-2t} + e^{-t} sin 5t + e^{-t} cos 5t (ES Ex. 3.7; SEEDS-SPEC ES-C6 [RECONSTRUCTED, VERIFIED]).
+  // u = e^{-2t} + e^{-t} sin 5t + e^{-t} cos 5t (ES Ex. 3.7; ES 3.38-3.47).
   const InputGenerator real = InputGenerator::exponential(-2.0);
   const InputGenerator pair = InputGenerator::sinusoid(5.0, 1.0, 1.0, -1.0);
   const Eigen::VectorXd l1 = annihilator(real, Eigen::VectorXd::Constant(1, kPi / 10));

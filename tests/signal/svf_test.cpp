@@ -1,5 +1,5 @@
-// Johansson's filter bank and parameter transform (SEEDS-SPEC RJ-A1, RJ-A2; Appendix B:
-// "RJ M_tau/G_tau identities (1e-12)").
+// Johansson's filter bank and parameter transform (RJ 7-23; the
+// M_tau/G_tau identities to 1e-12).
 #include <cmath>
 #include <random>
 
@@ -12,7 +12,7 @@
 using namespace ctid;
 
 TEST(SvfTransform, WorkedChecksFromSpec) {
-  // n = 2, a = (3, 2), b = (1, 4), tau = 0.5 => alpha = (-0.5, 0), beta = (0.5, 0.5) (SEEDS-SPEC RJ-A2).
+  // n = 2, a = (3, 2), b = (1, 4), tau = 0.5 => alpha = (-0.5, 0), beta = (0.5, 0.5) (RJ 18-23).
   const Eigen::VectorXd th = theta_tau_from_ab(Eigen::VectorXd{{3.0, 2.0}}, Eigen::VectorXd{{1.0, 4.0}}, 0.5);
   EXPECT_NEAR(th(0), 0.5, 1e-15);  // -alpha_1
   EXPECT_NEAR(th(1), 0.0, 1e-15);  // -alpha_2

@@ -36,7 +36,7 @@ IdData hand_loop(const TransferFunction& g, double kp, double ki, double kd, dou
 }
 }  // namespace
 
-// The helper's PID in RST form is the hand-written loop: the unstable circuit 1/(s^2 - 1) under PD (SEEDS-SPEC GW.3)
+// The helper's PID in RST form is the hand-written loop: the unstable circuit 1/(s^2 - 1) under PD (Gawthrop & Wang 2005, §5, simulated)
 // and the ball and beam 2.5/s^2 under a clamped PID with measurement noise (GW.4), to 1e-9 of the signals' range
 // (measured 1.1e-13 and 1.4e-12: the RST recursion sums the same terms in another order).
 TEST(ClosedLoop, PidInRstFormIsTheHandWrittenLoop) {

@@ -144,7 +144,7 @@ TEST(Lsim, GeneratedInputIsSimulatedExactly) {
   EXPECT_THROW(lsim(ss, InputGenerator::constant(1.0), Eigen::Vector2d(1.0, 0.5)), InvalidArgument);
 }
 
-// MIMO responses of the two-mode 2x2 system (issue 16): the step response equals the exact simulation of a step input
+// MIMO responses of the two-mode 2x2 system: the step response equals the exact simulation of a step input
 // (lsim, ZOH), tends to the DC gain -C A^-1 B + D, the impulse response equals each channel's transfer function's,
 // and the frequency-response matrix equals StateSpace::frequency_response channel by channel.
 TEST(Lsim, ModalStepOfOrdersFourToEightEqualsTheDenseStep) {

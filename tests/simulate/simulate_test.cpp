@@ -1,4 +1,4 @@
-// simulate(AnyModel, IdData, initial condition): the one simulation of every front end (issue 14, item 1).
+// simulate(AnyModel, IdData, initial condition): the one simulation of every front end.
 // Expected values are closed forms or the model classes' own simulations, tolerances stated per check.
 #include <cmath>
 #include <random>
@@ -124,7 +124,7 @@ TEST(Simulate, DivergenceIsReportedAndMismatchesAreRefused) {
   EXPECT_EQ(initial_condition_from_string("measured"), InitialCondition::Measured);
 }
 
-// Responses of any model (issue 14, item 1), against closed forms: a two-input state space is its two transfer
+// Responses of any model, against closed forms: a two-input state space is its two transfer
 // functions (step to 1e-12 of the model's own; frequency response to 1e-12 of C (jwI - A)^-1 B); MISO columns are
 // the channels' (the delay included: zero before 0.13 s); NARX y(k) = 0.6 y(k-1) + u(k-1) steps to
 // (1 - 0.6^k)/0.4 exactly (to 1e-12); NDE 0.5 Dy + y = u to 1 - e^{-2t} (1e-7, the integrator's tolerance);

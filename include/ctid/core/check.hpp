@@ -1,4 +1,4 @@
-// ctid — check macros for the error tiers (DESIGN.md §4).
+// ctid — check macros for the error tiers (docs/architecture.md, "Errors").
 //
 //   CTID_REQUIRE(cond, "fmt {}", args...)          tier 1: throws ctid::InvalidArgument
 //   CTID_REQUIRE_OPTION(cond, "fmt {}", args...)   tier 1: throws ctid::InvalidOptions

@@ -1,4 +1,4 @@
-// ctid — method-specific diagnostics of a fit, declared once (issue 14, item 5: typed diagnostics).
+// ctid — method-specific diagnostics of a fit, declared once (typed diagnostics).
 //
 // Each diagnostic an estimator can report is a typed key declared in namespace ctid::diagnostic: its name (the key
 // in result files, Python's dicts and the report), its unit and its meaning. Estimators write and callers read them
@@ -91,12 +91,12 @@ inline constexpr ScalarDiagnostic gls_iterations{"gls_iterations", "", "generali
 inline constexpr ScalarDiagnostic gls_order{"gls_order", "", "order of the GLS noise model of a KIA stage"};
 inline constexpr ScalarDiagnostic err_sum{"err_sum", "%", "sum of the ERR of a KIA stage's terms"};
 // NDE output error.
-// Subspace identification (issue 16).
+// Subspace identification.
 inline constexpr VectorDiagnostic singular_values{"singular_values", "",
                                                   "singular values of the weighted projected output block (order choice)"};
 inline constexpr VectorDiagnostic output_fit_percent{"output_fit_percent", "%", "simulation fit of each output"};
 inline constexpr VectorDiagnostic x0{"x0", "", "fitted initial state of each record", true};
-// State-space output error (ssest, issue 16).
+// State-space output error (ssest).
 inline constexpr VectorDiagnostic output_noise_variance{"output_noise_variance", "y^2",
                                                         "variance of each output's error (the weights 1/variance of the cost)"};
 inline constexpr VectorDiagnostic prediction_fit_percent{

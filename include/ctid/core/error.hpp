@@ -1,4 +1,4 @@
-// ctid — error classes of the three error tiers (DESIGN.md §4).
+// ctid — error classes of the three error tiers (docs/architecture.md, "Errors").
 //
 // Tier 1, bad user input: an exception derived from a std exception whose message
 // names the thing and the values:

@@ -1,4 +1,4 @@
-// ctid — progress reporting and cancellation (DESIGN.md §4: the library never prints; progress and
+// ctid — progress reporting and cancellation (docs/architecture.md, "Errors": the library never prints; progress and
 // cancellation go through a callback). A callback installed for the current thread by ProgressScope is
 // called by the iterative estimators once per iteration (SRIVC and its delay search; every
 // Levenberg-Marquardt fit: output error, physical parameters, NDE refinement; FROLS term selection; NARMAX

@@ -1,4 +1,4 @@
-// ctid — how an estimator ended (error tier 2, DESIGN.md §4).
+// ctid — how an estimator ended (error tier 2, docs/architecture.md, "Errors").
 #pragma once
 
 #include <string>

@@ -1,4 +1,4 @@
-// ctid — the common result envelope of every estimator (DESIGN.md §1).
+// ctid — the common result envelope of every estimator (docs/architecture.md).
 #pragma once
 
 #include <map>

@@ -1,4 +1,4 @@
-// ctid — IdData: one input/output experiment (DESIGN.md §1).
+// ctid — IdData: one input/output experiment (docs/architecture.md).
 //
 // u is N x nu (nu >= 0; nu = 0 is a free response / time series), y is N x ny (ny >= 1).
 // Sample times are either uniform (t_k = t0 + k Ts) or explicit and strictly

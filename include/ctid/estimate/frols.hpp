@@ -1,5 +1,5 @@
 // ctid — forward regression orthogonal least squares (FROLS) with the error reduction ratio (ERR) for
-// polynomial NARX structure detection (Billings & Li 1999, BL-D1 and BL 28-32 / SEEDS-SPEC BL-D6; the
+// polynomial NARX structure detection (Billings & Li 1999, BL-D1 and BL 28-32; the
 // algorithm of Billings, Chen & Korenberg 1989).
 //
 // Memory: FROLS on one record stores nothing of the record's length N besides the record (several records are

@@ -1,11 +1,11 @@
 // ctid — stage 1 of Gawthrop & Wang (2005): least-squares compression of sampled data into a
 // frequency-sampling-filter model (GW eqs 6-8), with the exponential window a and residual
-// weighting b for unstable plants (GW 14-21; SEEDS-SPEC GW-A1, GW-A2).
+// weighting b for unstable plants (GW 1-21).
 //
 // Regressors phi_i = sum_{l<N} f_l u_{i-l} (zero input before the record) are computed by
 // exact FIR summation from prefix/suffix partial sums of N-sample chunks (O(n) per sample) —
 // never by the marginally stable recursive form. With a window
-// a and weight b the rows are formed as in SEEDS-SPEC GW-A2, never with e^{bt} and e^{-at}
+// a and weight b the rows are formed as in GW 14-21, never with e^{bt} and e^{-at}
 // separately:  e^{b t_i} y_{a,i} = e^{(b-a) t_i} y_i,
 //              e^{b t_i} phi_{a,i} = e^{(b-a) t_i} sum_{l<N} (f_l e^{a l Delta}) u_{i-l}.
 // The fitted model is then that of the shifted system G(s + a).
@@ -50,7 +50,7 @@ const OptionTable<FsfOptions>& option_table<FsfOptions>();
 /// pre-estimate (srivc_auto without delay; LSSVF, equation error, for a plant declared unstable: it serves
 /// closed-loop records) as documented in FsfOptions; each choice, and a T rounded to whole sampling periods, is a line of diagnostics.choices. Throws
 /// InvalidArgument / InvalidOptions for: even n, n > N, T longer than the record, b > a, negative weights, non-SISO
-/// or irregular data. A warning is reported when b > 0 and the record is longer than T (SEEDS-SPEC GW-A2 pitfall).
+/// or irregular data. A warning is reported when b > 0 and the record is longer than T (docs/methods/gawthrop-wang.md: the window's pitfall).
 /// Parameters: "theta0", "re_theta1", "im_theta1", ...; fit: one-step output of the discrete
 /// FSF model against the windowed output.
 Result<FsfModel> fsf(const IdData& data, const FsfOptions& options);
@@ -60,7 +60,7 @@ Result<FsfModel> fsf(const IdData& data, const FsfOptions& options);
 /// InvalidArgument when a setting is automatic and no pre-estimate can be made.
 FsfOptions fsf_settings(const IdData& data, const FsfOptions& options, std::vector<std::string>* choices = nullptr);
 
-/// Stage 1 from spectra (GW 24-29, SEEDS-SPEC GW-A4); T and n must be given (there is no record to pre-estimate): U and Y are the one-sided DFTs (bins
+/// Stage 1 from spectra (GW 24-29); T and n must be given (there is no record to pre-estimate): U and Y are the one-sided DFTs (bins
 /// 0..L/2, L even) of input and output records of M samples at Ts, zero-padded to L >= M + N so
 /// that linear and circular convolution coincide. The window a is applied as inverse FFT ->
 /// e^{-at} -> FFT (the paper's recommendation); b must be 0 (the authors define no frequency-

@@ -1,5 +1,5 @@
 // ctid — generalised frequency response functions (GFRFs) of polynomial NARX models, Billings & Li
-// (1999) eqs 11-14 with the corrected Peyton Jones & Billings recursion of SEEDS-SPEC BL-D2:
+// (1999) eqs 11-14 with the corrected Peyton Jones & Billings recursion of BL 11-14:
 //   H_n(z_1..z_n) = [1 - sum_k c_10(k) (z_1..z_n)^-k]^-1 { sum c_0n(k) z_1^-k_1 .. z_n^-k_n
 //        + sum_{q=1}^{n-1} sum_{p=1}^{n-q} sum c_pq(k) z_{n-q+1}^-k_{p+1} .. z_n^-k_{p+q} H_{n-q,p}(z_1..z_{n-q})
 //        + sum_{p=2}^{n} sum c_p0(k) H_{n,p}(z_1..z_n) },

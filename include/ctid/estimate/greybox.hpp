@@ -1,4 +1,4 @@
-// ctid — nonlinear continuous-time grey-box identification (issue 15): the parameters and the estimated initial
+// ctid — nonlinear continuous-time grey-box identification: the parameters and the estimated initial
 // states of a GreyboxModel (model/greybox.hpp) that minimise the simulation (output) error
 //     V(theta, x0_1..x0_E) = sum_e sum_k sum_j w_j^2 (y_j,e(t_k) - yhat_j,e(t_k; theta, x0_e))^2
 // over one record or several experiments of one system (one parameter set, an initial state per experiment),

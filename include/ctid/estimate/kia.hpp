@@ -1,13 +1,13 @@
 // ctid — the Kernel Invariance Algorithm of Billings & Li (1999): continuous-time NDE coefficients from
 // the GFRFs of an identified NARX model, order by order, by linear least squares on kernel values at
 // chosen s-points, with generalised least squares (GLS) whitening and ERR term selection.
-//   linear stage     BL 15-25 (SEEDS-SPEC BL-D4): H_1(s) A(s) = B(s), A(s) = 1 + sum alpha_l s^l
+//   linear stage     BL 15-25 (BL 15-25): H_1(s) A(s) = B(s), A(s) = 1 + sum alpha_l s^l
 //   quadratic stage  BL 26-27 (BL-D5): 2 A(s_1+s_2) H_2(s_1,s_2) = - sum gamma (probing expression)
 //   ERR selection    BL 28-32 (BL-D6): forward orthogonal selection on the stacked real system; the
 //                    over-parameterise -> converge -> prune -> re-estimate workflow; ERR-chosen filter order.
 // Kernel invariance: H_n^{NDE}(s_1..s_n) = H_n^{NARX}(e^{s_1 T}..e^{s_n T}), divided by prod Z(s_i) for data
 // sampled with a held input (narx_gfrf_ct). Points on the real and imaginary axes (the reading of the
-// paper that reproduces its tables; SEEDS-SPEC BL.3).
+// paper that reproduces its tables; Billings & Li 1999, eqs 33-34 and Tables 1-3).
 #pragma once
 
 #include <complex>

@@ -7,7 +7,7 @@
 // (RJ 24-25), LS criterion with Riemann or trapezoidal weights (RJ 44, 59-61),
 // exponential weighting e^{2 alpha t} (RJ 52-55), B(-1/tau) != 0 identifiability
 // condition (RJ 26-41); the frequency-domain criterion (RJ 45) on frequency-response data and
-// the information matrix of an input spectrum (RJ 47-50). SEEDS-SPEC Part RJ.
+// the information matrix of an input spectrum (RJ 47-50).
 //
 // Model: G(s) = e^{-s nk Ts} (b_0 s^{nb-1} + .. + b_{nb-1}) / (s^nf + a_1 s^{nf-1} + .. + a_nf).
 // Parameter names: "a1".."a<nf>", "b0".."b<nb-1>" (b0 multiplies the highest power).
@@ -77,7 +77,7 @@ Result<TransferFunction> lssvf(const IdData& data, const TfOrders& orders, const
 /// iterated to convergence (Young's IV idea applied to Johansson's regression).
 Result<TransferFunction> ivsvf(const IdData& data, const TfOrders& orders, const IvsvfOptions& options = {});
 
-/// Several experiments of one system (issue 14, item 2): the normal equations (LSSVF) or IV equations (IVSVF)
+/// Several experiments of one system: the normal equations (LSSVF) or IV equations (IVSVF)
 /// summed over the records, each filtered from rest (transient_time leaves out the start of each); tau chosen on
 /// the pooled simulation fit; fit over all records; diagnostics.scalars "experiments". Throws as the one-record
 /// functions, naming the record.

@@ -1,4 +1,4 @@
-// ctid — the registry of estimation methods and their settings (issue 14, item 3).
+// ctid — the registry of estimation methods and their settings.
 //
 // One entry per estimator function: its name (the C++/Python function name; the CLI's --method, where the CLI
 // offers it), a one-line summary and its settings, read from the options tables (estimate/options.hpp). The CLI's

@@ -1,5 +1,5 @@
 // ctid — El-Shafey (1987), "Identification of linear continuous-time systems using modal functions":
-// estimation of modal parameters and what is derived from them. SEEDS-SPEC Part ES:
+// estimation of modal parameters and what is derived from them (labels of docs/methods/el-shafey.md):
 //   ES-C3  discrete samples, least squares and instrumental variables (ES 3.1-3.10, 3.19-3.20)
 //   ES-C4  Fourier modulating functions with the c_{j-1} recursion (ES 3.11-3.30; Omega of ES 3.25)
 //   ES-C5  Walsh (block-pulse) functions with the edge recursion (ES 3.18, 3.31-3.37)
@@ -131,7 +131,7 @@ Result<TransferFunction> modal_fit(const std::vector<IdData>& data, int nb, Moda
 InputGenerator generator_fitted_to_input(const std::vector<double>& frequencies, const IdData& data);
 
 /// Characteristic polynomial det(sI - M) by Newton's identities with T_k = trace(M^k) (ES 4.50 with
-/// the index fix of SEEDS-SPEC ES-C9): a_{n-1} = -T_1, a_{n-k} = -(a_{n-k+1} T_1 + ... + a_{n-1} T_{k-1} + T_k)/k.
+/// the index fix of ES 4.37-4.63): a_{n-1} = -T_1, a_{n-k} = -(a_{n-k+1} T_1 + ... + a_{n-1} T_{k-1} + T_k)/k.
 Polynomial newton_characteristic_polynomial(const Eigen::MatrixXd& M);
 
 struct FreeResponseOptions {

@@ -1,5 +1,5 @@
 // ctid — El-Shafey (1987) chapter 6: the minimum-time (dead-beat) state observer for piecewise-
-// constant inputs (ES 6.1-6.36, SEEDS-SPEC ES-C13 with the RECONSTRUCTED signs: r_m(s) = int_0^{s-mT} h~
+// constant inputs (ES 6.1-6.36, ES 6.1-6.36 with the RECONSTRUCTED signs: r_m(s) = int_0^{s-mT} h~
 // and x~ = -P y + Qbar(s) u), and the estimate of the Markov parameters b~ (ES 6.37-6.43, ES-C14;
 // ES 6.39's b~_j read as b~_n).
 //

@@ -59,7 +59,7 @@ Result<TransferFunction> oe(const IdData& data, const TfOrders& orders, const Oe
 /// SRIVC (with delay search when estimate_delay) followed by output-error refinement.
 Result<TransferFunction> tfest(const IdData& data, const TfOrders& orders, const OeOptions& options = {});
 
-/// Several experiments of one system (issue 14, item 2): one parameter set minimising the output error summed
+/// Several experiments of one system: one parameter set minimising the output error summed
 /// over the records, each simulated from rest (after transient_time); sensitivities stacked; the records may
 /// differ in length, input and sampling (nk needs one sampling period). tfest starts from the joint SRIVC
 /// estimate. diagnostics.scalars "experiments". Throws as oe/tfest, naming the record.

@@ -1,4 +1,4 @@
-// ctid — one table of settings per method (issue 14, item 3).
+// ctid — one table of settings per method.
 //
 // Each options struct declares its fields once, in an OptionTable: name (the C++ member's name, the Python
 // keyword and the CLI key of `--set NAME=VALUE`), unit, admissible range, default and one line of doc. The

@@ -1,4 +1,4 @@
-// ctid — transfer-function structure [nb nf nk] in CONTSID's convention (DESIGN.md §8).
+// ctid — transfer-function structure [nb nf nk] in CONTSID's convention.
 #pragma once
 
 namespace ctid {

@@ -2,7 +2,7 @@
 // parameters Theta of a partially known model (GW 22-23, time domain; GW 30, frequency
 // domain), with the exponential shift s -> s + a of the unstable case (GW §3.2); and the
 // direct output-error route on raw data for comparison. Sensitivities are exact
-// (PhysicalModel::sensitivities, simulated exactly). SEEDS-SPEC GW-A3, GW-A4.
+// (PhysicalModel::sensitivities, simulated exactly). Gawthrop & Wang 2005, §§3-4.
 #pragma once
 
 #include <limits>

@@ -4,7 +4,7 @@
 // y = theta_tau^T phi_tau (RJ 11), sampled (RJ 59-60) or continuous-time (RJ 56-58), with
 // exponential weighting of rate alpha (RJ 52-53; per sampled update the forgetting factor is
 // e^{-2 alpha dt}) or a plain forgetting factor; and the single-unknown-coefficient tracker of a
-// partially known system (RJ 74-79, sign of RJ 78 corrected as in SEEDS-SPEC RJ-A7).
+// partially known system (RJ 74-79, sign of RJ 78 corrected as in RJ 74-79).
 //
 // The continuous-time recursion dtheta/dt = P phi (y_f - theta^T phi), dP/dt = 2 alpha P - P phi phi^T P
 // (RJ 56-57 with the weighting of RJ 53) is integrated exactly between regression instants for a
@@ -14,7 +14,7 @@
 //   W_ij = int_0^h e^{-2 alpha (h - s)} l_i(s) l_j(s) ds   (l_0 = 1 - s/h, l_1 = s/h),
 // and the same W on the targets; W's two eigen-directions make it two weighted rank-one updates of P.
 // Without noise V = theta~^T P^{-1} theta~ then obeys dV/dt = -2 alpha V - (theta~^T phi)^2 (RJ 58,
-// sign and square as in SEEDS-SPEC RJ-A6).
+// sign and square as in RJ 56-61).
 //
 // The filters run at every sample given to update(); the regression is updated at every
 // sample or at most every `regression_interval` seconds (Johansson's h, which need not be

@@ -55,7 +55,7 @@ const OptionTable<SrivcOptions>& option_table<SrivcOptions>();
 /// back, so the estimate does not depend on the units of the record (docs/guide.md).
 Result<TransferFunction> srivc(const IdData& data, const TfOrders& orders, const SrivcOptions& options = {});
 
-/// SRIVC on several experiments of one system (issue 14, item 2): one parameter set; each record is filtered and
+/// SRIVC on several experiments of one system: one parameter set; each record is filtered and
 /// simulated from rest (its own initial conditions and transient), and the instrumental-variable normal equations
 /// are summed over the records (Young's SRIVC with the sums of (Garnier & Wang 2008, ch. 4) taken over
 /// experiments). The records may differ in length, input and sampling (nk needs one sampling period); units must

@@ -1,4 +1,4 @@
-// ctid — srivc_auto: a transfer function without hand-picked orders (issue 17; the default of `ctid fit`), and
+// ctid — srivc_auto: a transfer function without hand-picked orders (the default of `ctid fit`), and
 // srivc_auto_miso, the same for several inputs.
 //
 // What an expert does first with a new single-input record: SRIVC (Young & Jakeman 1980; estimate/srivc.hpp) for

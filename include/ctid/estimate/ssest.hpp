@@ -1,4 +1,4 @@
-// ctid — multi-input multi-output continuous-time state space by output error (issue 16, item 2): `ssest` =
+// ctid — multi-input multi-output continuous-time state space by output error: `ssest` =
 // the subspace start (estimate/subspace.hpp) refined by prediction-error minimisation for white output noise.
 //
 // Cost: V = 1/2 sum_records sum_k sum_j w_j (y_j(t_k) - yhat_j(t_k))^2, yhat the exact simulation of

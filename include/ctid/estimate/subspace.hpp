@@ -1,4 +1,4 @@
-// ctid — multi-input multi-output continuous-time state space by subspace identification (issue 16, item 1).
+// ctid — multi-input multi-output continuous-time state space by subspace identification.
 //
 // Continuous-time route (the default): Johansson, Verhaegen & Chou (1999), "Stochastic theory of continuous-time
 // state-space identification", IEEE Trans. Signal Processing 47(1), 41-51. With Johansson's operator

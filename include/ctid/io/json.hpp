@@ -1,4 +1,4 @@
-// ctid — JSON model and result files (DESIGN.md §8).
+// ctid — JSON model and result files (docs/guide.md, "Result files").
 //
 // Result envelope: {"ctid_version", "method", "model": {...}, "parameters": [{name, value,
 // std, fixed}], "covariance": [[..]], "fit": {...}, "summary": {...}, "diagnostics": {...}}.
@@ -62,7 +62,7 @@ std::string table_to_json(const std::string& type, const std::vector<std::pair<s
 /// FSF {"type": "fsf", "delta", "N", "n", "shift", "theta": [...], "covariance": [[...]] when known} (real parameterisation); NARX/NARMAX
 /// {"type": "narx", "ts": s, "terms": [{"name": "y(k-1)*u(k-2)", "value": c}, ...]}; NDE {"type": "nde", "terms":
 /// [{"name": "D^2y", "value": 1e-4}, ...]}, written normalised so that the coefficient of y is +1 when the model
-/// has a y term (DESIGN.md §8); grey-box models as parse_greybox_json reads them. write_result_json writes atomically (temporary file, then rename); throws FileError.
+/// has a y term; grey-box models as parse_greybox_json reads them. write_result_json writes atomically (temporary file, then rename); throws FileError.
 std::string result_to_json(const Result<AnyModel>& result, const std::string& method, int indent = 2);
 void write_result_json(const std::string& path, const Result<AnyModel>& result, const std::string& method);
 /// Shorthands for a typed result (Result<TransferFunction>, Result<NarxModel>, ...): the same file.

@@ -1,4 +1,4 @@
-// ctid — one closed set of model types (issue 14, DESIGN.md §3): every front end (CLI, report, Python)
+// ctid — one closed set of model types (docs/architecture.md): every front end (CLI, report, Python)
 // reaches a model through AnyModel and the free functions below and simulate() (simulate/simulate.hpp),
 // never by dispatching on the types itself.
 //

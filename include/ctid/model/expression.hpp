@@ -1,4 +1,4 @@
-// ctid — the grey-box model language (issue 15): a scalar expression of named variables (states, inputs,
+// ctid — the grey-box model language: a scalar expression of named variables (states, inputs,
 // parameters, t), parsed once and compiled to a stack program that evaluates without allocation, with exact first
 // derivatives by forward-mode differentiation of the same program.
 //

@@ -1,6 +1,6 @@
 // ctid — frequency-sampling-filter (FSF) model of Gawthrop & Wang (2005), "Data compression
 // for estimation of the physical parameters of stable and unstable linear systems",
-// Automatica 41(8), eqs (1)-(13); SEEDS-SPEC GW-A1 (reconstructed pole e^{j2 pi k/N}).
+// Automatica 41(8), eqs (1)-(13) (reconstructed pole e^{j2 pi k/N}).
 //
 //   Gbar(z) = sum_{k=-m..m} theta_k Hbar_k(z),  Hbar_k(z) = (1/N)(1 - z^{-N})/(1 - e^{j2 pi k/N} z^{-1}),
 //   N = T/Delta, n = 2m + 1 (odd), theta_{-k} = conj(theta_k) for real data.

@@ -1,4 +1,4 @@
-// ctid — nonlinear continuous-time grey-box models (issue 15): the physics of a machine written as state
+// ctid — nonlinear continuous-time grey-box models: the physics of a machine written as state
 // equations with named parameters,
 //     dx/dt = f(x, u, theta, t),   y = h(x, u, theta, t),   x(t_0) = x0(theta) or estimated,
 // every right-hand side an Expression (model/expression.hpp: + - * / ^, exp log sqrt abs sign tanh sin cos atan

@@ -1,4 +1,4 @@
-// ctid — polynomial NARX / NARMAX models (Billings & Li 1999, eqs 7-10; SEEDS-SPEC BL-D1):
+// ctid — polynomial NARX / NARMAX models (Billings & Li 1999, eqs 7-10):
 //     y(k) = sum_m theta_m prod_{f in term m} x_f(k - lag_f) + e(k),
 // x_f one of the output y, the input u, or the noise e (NARMAX moving-average terms); a term with no
 // factors is the constant. Output and noise lags are >= 1, input lags >= 0.

@@ -1,5 +1,5 @@
 // ctid — polynomial nonlinear differential-equation (NDE) models of Billings & Li (1999), eqs 1-6, in
-// the implicit form of SEEDS-SPEC BL-D3:
+// the implicit form of BL 4-6:
 //     sum_m c_m prod_{f in term m} D^{l_f} x_f(t) = 0,   x_f = y or u,
 // e.g. BL (33): y + 0.002 Dy + 0.0001 D^2y - u + 0.1 y^2 - 0.006 y*Dy = 0. The linear part is
 // A(D) y - B(D) u with A(s) = sum c(D^l y) s^l, B(s) = -sum c(D^l u) s^l; the tables' convention
@@ -61,7 +61,7 @@ class NdeModel {
   Polynomial b() const;
   /// H_1(s) = B(s)/A(s).
   std::complex<double> h1(std::complex<double> s) const;
-  /// Symmetric H_2(s_1, s_2) by harmonic probing of the quadratic terms (SEEDS-SPEC BL-D3):
+  /// Symmetric H_2(s_1, s_2) by harmonic probing of the quadratic terms (BL 4-6):
   /// 2 A(s_1+s_2) H_2 = - sum over y-y, y-u and u-u products of their probing expressions.
   std::complex<double> h2(std::complex<double> s1, std::complex<double> s2) const;
   /// Symmetric H_3(s_1, s_2, s_3) by harmonic probing with three exponentials: the coefficient of

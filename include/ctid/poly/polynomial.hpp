@@ -1,4 +1,4 @@
-// ctid — real polynomials in descending powers (MATLAB's convention, DESIGN.md §4):
+// ctid — real polynomials in descending powers (MATLAB's convention):
 // c = [c0, c1, ..., cn] means c0 s^n + c1 s^(n-1) + ... + cn.
 #pragma once
 

@@ -1,7 +1,7 @@
 // ctid — Johansson's state-variable filter bank and the exact parameter transform.
 //
 // Johansson, R. (1986), "Identification of continuous time dynamic systems",
-// Lund TFRT-7318, eqs (7)-(23); SEEDS-SPEC RJ-A1, RJ-A2 (reconstructed M_tau, G_tau).
+// Lund TFRT-7318, eqs (7)-(23); RJ 7-17, RJ 18-23 (reconstructed M_tau, G_tau).
 //
 // The operator z = 1/(1 + p tau) (p = d/dt) is realised as a chain of n first-order
 // filters tau dx_k/dt = x_{k-1} - x_k, x_0 = the signal, so x_k = [z^k s](t). Between
@@ -14,7 +14,7 @@
 // The filters start at rest; the regression y = theta_tau^T phi_tau is exact when the
 // process also starts at rest.
 //
-// Parameter transform (RJ 18-23, reconstructed in SEEDS-SPEC RJ-A2):
+// Parameter transform (RJ 18-23, reconstructed in RJ 18-23):
 //   theta = [-a_1 .. -a_n, b_1 .. b_n],  A(p) = p^n + a_1 p^{n-1} + .. + a_n,
 //   B(p) = b_1 p^{n-1} + .. + b_n,  theta_tau = [-alpha_1 .. -alpha_n, beta_1 .. beta_n],
 //   theta_tau = F_tau theta + G_tau,  F_tau = diag(M_tau, M_tau),

@@ -1,4 +1,4 @@
-// ctid — exact simulation of linear continuous-time models (DESIGN.md §6).
+// ctid — exact simulation of linear continuous-time models (docs/architecture.md, "Numerics").
 //
 // Between two sample times the input is either held (ZOH) or linear (FOH; BandLimited
 // inputs are treated as FOH). Over an interval of length h the state moves exactly:
@@ -50,7 +50,7 @@ void lsim_into(const StateSpace& sys, const Eigen::Ref<const Eigen::MatrixXd>& u
                const std::vector<Intersample>& intersample, const LsimOptions& options, Eigen::MatrixXd& y);
 /// Same on an experiment: uses its inputs, times and intersample behaviour.
 Eigen::MatrixXd lsim(const StateSpace& sys, const IdData& data, const LsimOptions& options = {});
-/// One-step-ahead predictions (N x ny) of a model with an innovation gain (issue 16): the innovation form
+/// One-step-ahead predictions (N x ny) of a model with an innovation gain: the innovation form
 /// dx/dt = A x + B u + K e(t), y = C x + D u + e, with the innovation held between samples at e_k = y_k - yhat_k,
 /// yhat_k = C x_k + D u_k, x(t_0) = options.x0 (empty: zero) — exact for ZOH/FOH inputs on any sample times, and the
 /// predictor ssest's prediction-error variant minimises. Without K: the simulation (lsim). Throws InvalidArgument
@@ -87,7 +87,7 @@ Eigen::VectorXd step_response(const TransferFunction& tf, const Eigen::VectorXd&
 /// Impulse response g(t) = C e^{A (t - Td)} B for t >= Td, 0 before; a direct term
 /// (Dirac at Td) is not representable on samples and is left out.
 Eigen::VectorXd impulse_response(const TransferFunction& tf, const Eigen::VectorXd& t);
-/// MIMO step responses (issue 16): element i is the response of every output (N x ny) to a unit step on input i at
+/// MIMO step responses: element i is the response of every output (N x ny) to a unit step on input i at
 /// t = 0, from rest, at the times t (t >= 0, increasing): C int_0^t e^{A s} ds B e_i + D e_i, each time by the block
 /// exponential of [[A, B], [0, 0]] t (exact). Throws InvalidArgument for bad times.
 std::vector<Eigen::MatrixXd> step_response(const StateSpace& sys, const Eigen::VectorXd& t);

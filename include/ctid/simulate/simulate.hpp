@@ -1,4 +1,4 @@
-// ctid — simulate any model (model/any_model.hpp) on a record with an explicit initial condition (issue 14).
+// ctid — simulate any model (model/any_model.hpp) on a record with an explicit initial condition.
 // The one simulation the CLI (simulate, validate, report), the HTML report and Python use.
 //
 // Linear models are simulated exactly (simulate/lsim.hpp) with the record's times and intersample
@@ -74,7 +74,7 @@ InitialCondition validation_initial_condition(const AnyModel& model);
 /// count, sampling period, no outputs where the initial condition needs them, an x0 of the wrong size).
 Simulation simulate(const AnyModel& model, const IdData& data, const SimulateOptions& options = {});
 
-/// Responses of any model (issue 14, item 1), one column per input (MISO: the response to that input alone;
+/// Responses of any model, one column per input (MISO: the response to that input alone;
 /// single-input models: one column). Times t in seconds, increasing, >= 0; frequencies w in rad/s.
 ///
 /// Response from rest to the step `amplitude` * 1(t). Linear models: exact (transfer functions with their delay);

@@ -22,7 +22,7 @@ CorrelationTest residual_autocorrelation(const Eigen::VectorXd& e, int max_lag =
 CorrelationTest input_residual_crosscorrelation(const Eigen::VectorXd& u, const Eigen::VectorXd& e, int max_lag = 25);
 
 /// Billings & Voon (1986) correlation validity tests for nonlinear (NARX/NARMAX) models, with 95 %
-/// bounds 1.96/sqrt(N) (SEEDS-SPEC BL-D1). Every signal is mean-removed and each correlation normalised
+/// bounds 1.96/sqrt(N) (Billings & Li 1999, §2). Every signal is mean-removed and each correlation normalised
 /// by the two signals' norms. A model is adequate when all five stay inside the bound (for ee: lags >= 1).
 struct NonlinearCorrelationTests {
   CorrelationTest ee;     ///< phi_ee(k) = delta(k), k = 0..M
