@@ -1,127 +1,16 @@
-// ctid — Billings & Li: `ctid fit --method narx|kia` and `ctid gfrf` (NARX/NARMAX by FROLS, the Kernel
-// Invariance Algorithm, generalised frequency response functions).
+// ctid — Billings & Li: `ctid gfrf`, the generalised frequency response functions of a NARX or NDE model
+// (`ctid fit --method narx|kia` fits them, through the library's registry).
 #include <cmath>
 #include <cstdio>
 #include <algorithm>
 #include <functional>
+#include <limits>
 #include <sstream>
 
 #include "common.hpp"
 
 namespace ctid::cli {
 extern std::function<int()> g_run;
-
-namespace {
-void print_narx(const Result<NarxModel>& r) {
-  if (batch_outcome()) return;
-  std::printf("selected terms (in order of selection) with their error reduction ratio:\n");
-  const Eigen::VectorXd& err = r.diagnostics.get(diagnostic::err);
-  for (int i = 0; i < r.parameters.size(); ++i)
-    std::printf("  %-22s %14.6g +- %-11.3g ERR %8.4f %%\n", r.parameters.names[i].c_str(), r.parameters.values(i),
-                r.parameters.std(i), i < err.size() ? err(i) : NAN);
-  std::printf("1 - sum(ERR) = %.3g   free-run fit %s %%\n", r.diagnostics.get(diagnostic::esr),
-              fit_percent_text(r.fit.fit_percent).c_str());
-}
-}  // namespace
-
-// The library's NARX workflow (narx()) with the settings of its table, on one record or several.
-Result<NarxModel> run_narx(const std::vector<IdData>& ds, const NarxOptions& o) {
-  try {
-    o.validate();
-    if (!batch_outcome())
-      std::printf("candidates: %zu (degree %d, ylag %d, ulag %d)\n",
-                narx_candidates(o.degree, o.ylag, o.ulag, o.constant, o.umin).size(), o.degree, o.ylag, o.ulag);
-    return narx(ds, o);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
-}
-
-int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, const std::vector<std::string>& set_list,
-                    const std::string& narx_file, const std::string& json, const std::string& report,
-                    const std::vector<std::pair<std::string, IdData>>& more_records) {
-  const IdData& d = ds.front();
-  if (d.nu() != 1 || d.ny() != 1) throw UsageError(method + " needs one --input and one --output");
-  NarxOptions no;
-  if (method == "narx") {
-    apply_sets("narx", set_list, no);
-    const Result<NarxModel> r = run_narx(ds, no);
-    if (BatchOutcome* b = batch_outcome()) {
-      b->result = to_any(r);
-      b->method = "narx";
-      return r.usable() ? kOk : kNotUsable;
-    }
-    print_narx(r);
-    if (!json.empty()) {
-      write_result_json(json, r, "narx");
-      std::printf("wrote %s\n", json.c_str());
-    }
-    write_report(report, d, r, "narx", settings_of(no), "", more_records);
-    return r.usable() ? kOk : kNotUsable;
-  }
-  // kia: the NARX model from --narx, or identified here with the narx settings; then the library's workflow (kia()).
-  KiaOptions ko;
-  ko.linear.zoh = ko.quadratic.zoh = ko.cubic.zoh = d.intersample(0) == Intersample::Zoh;
-  if (narx_file.empty()) apply_sets("kia", set_list, ko, no);
-  else apply_sets("kia", set_list, ko);
-  NarxModel narx;
-  if (!narx_file.empty()) {
-    const AnyModel m = read_result(narx_file).result.model;
-    if (!std::holds_alternative<NarxModel>(m))
-      throw InputError(narx_file + ": --narx needs a NARX model; this is a " + model_type_name(m) + " model");
-    narx = std::get<NarxModel>(m).process();
-  } else {
-    const Result<NarxModel> r = run_narx(ds, no);
-    print_narx(r);
-    narx = r.model.process();
-  }
-  KiaRun run;
-  try {
-    run = kia(ds, narx, ko);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
-  if (BatchOutcome* b = batch_outcome()) {
-    b->result = to_any(run.result());
-    b->method = ko.refine ? "kia+oe" : "kia";
-    return run.result().usable() ? kOk : kNotUsable;
-  }
-  const Result<NdeModel>& k = run.reconstructed;
-  for (const auto& c : k.diagnostics.choices) std::printf("chosen: %s\n", c.c_str());
-  std::printf("NDE: %s\n", k.model.to_string(5).c_str());
-  const Eigen::VectorXd& err = k.diagnostics.get(diagnostic::err);
-  for (int i = 0; i < k.parameters.size(); ++i)
-    std::printf("  %-10s %14.6g   ERR %8.4f %%\n", k.parameters.names[i].c_str(), k.parameters.values(i), err(i));
-  std::printf("simulated output fit: %s %%   (hold factor %s)\n", fit_percent_text(k.fit.fit_percent).c_str(), ko.linear.zoh ? "on" : "off");
-  std::printf("NARX model's free-run fit on the same record%s: %s %%\n", ds.size() > 1 ? "s" : "",
-              fit_percent_text(run.narx_fit_percent).c_str());
-  if (run.refined && run.refined->usable()) {
-    const Result<NdeModel>& oe = *run.refined;
-    std::printf("refined by output error (%d iterations): %s\n", oe.summary.iterations, oe.model.to_string(5).c_str());
-    for (int i = 0; i < oe.parameters.size(); ++i)
-      std::printf("  %-10s %14.6g +- %.3g%s\n", oe.parameters.names[i].c_str(), oe.parameters.values(i),
-                  oe.parameters.std(i), oe.parameters.fixed[static_cast<size_t>(i)] ? "  (reference)" : "");
-    for (const auto& w : oe.diagnostics.warnings) std::printf("  note: %s\n", w.c_str());
-    std::printf("simulated output fit: %s %%\n", fit_percent_text(oe.fit.fit_percent).c_str());
-  } else if (run.refined) {
-    std::fprintf(stderr, "ctid: warning: the output-error refinement failed (%s); keeping the KIA model\n",
-                 run.refined->why_not_usable().c_str());
-  }
-  const Result<NdeModel>& r = run.result();
-  if (!json.empty()) {
-    write_result_json(json, r, "kia");
-    std::printf("wrote %s\n", json.c_str());
-  }
-  Settings settings = settings_of(ko);
-  if (narx_file.empty())
-    for (auto& x : settings_of(no)) settings.push_back(x);
-  write_report(report, d, r, ko.refine ? "kia+oe" : "kia", settings, narx_file, more_records);
-  if (!r.usable()) {
-    std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", r.why_not_usable().c_str());
-    return kNotUsable;
-  }
-  return kOk;
-}
 
 namespace {
 struct GfrfArgs {

@@ -32,7 +32,7 @@ Eigen::MatrixXd check_result(const ResultFile& file, const IdData& d, const std:
     if (const std::string why = usability_problem(Summary{}, file.result.parameters, f); !why.empty())
       throw InputError(path + ": " + why + " (its uncertainty bands would be meaningless)");
   }
-  return simulate_result(file.result, d, initial);
+  return simulate_result(file.result, d, SimulationPurpose::OwnFit, initial);
 }
 
 int run(const ReportArgs& a) {
@@ -59,9 +59,8 @@ int run(const ReportArgs& a) {
   o.command_line = g_command_line;
   o.preprocessing = g_preprocessing;
   for (std::size_t e = 1; e < ds.size(); ++e) {
-    // Further records start as ReportOptions::more_records says (a fitted x0 belongs to the first record).
-    const bool narx = std::holds_alternative<NarxModel>(file.result.model);
-    simulate_result(file.result, ds[e], a.initial.empty() ? (narx ? "measured" : "rest") : a.initial);
+    // Further records start as the fit starts a record (a fitted x0 belongs to the first record).
+    simulate_result(file.result, ds[e], SimulationPurpose::OtherRecord, a.initial);
     o.more_records.emplace_back(a.paths[e], ds[e]);
   }
   if (!a.initial.empty()) o.initial = initial_condition_from_string(a.initial);

@@ -15,7 +15,7 @@ struct SimArgs {
   std::string out;
   double snr = std::numeric_limits<double>::quiet_NaN();
   unsigned long long seed = 1;
-  std::string initial;  // "": initial_or_default()
+  std::string initial;  // "": the library's default for a free run (simulate_options, SimulationPurpose::FreeRun)
   int initial_samples = 0;
   bool force = false;
 };
@@ -25,11 +25,9 @@ int run(const SimArgs& a) {
   check_outputs({a.out}, {a.data.path, a.model}, a.force);
   const ResultFile f = read_result(a.model);
   // The record's output is read where the initial condition needs it (a fitted x0 does not).
-  const std::string how = initial_or_default(a.initial, f);
-  const InitialCondition initial = initial_condition_from_string(how);
-  const bool fitted_x0 = initial == InitialCondition::Estimated && a.initial_samples == 0 && f.result.diagnostics.has(diagnostic::x0);
-  const IdData d = columns_of(a.data, f.result.model).load(initial != InitialCondition::Rest && !fitted_x0);
-  Eigen::MatrixXd y = simulate_result(f.result, d, how, a.initial_samples);
+  const SimulateOptions so = simulate_options_of(f.result, SimulationPurpose::FreeRun, a.initial, a.initial_samples);
+  const IdData d = columns_of(a.data, f.result.model).load(so.initial != InitialCondition::Rest && so.x0.size() == 0);
+  Eigen::MatrixXd y = simulate_result(f.result, d, SimulationPurpose::FreeRun, a.initial, a.initial_samples);
   std::vector<std::string> ynames;
   for (Eigen::Index j = 0; j < y.cols(); ++j) ynames.push_back(y.cols() == 1 ? "y" : "y" + std::to_string(j + 1));
   if (!std::isnan(a.snr)) {

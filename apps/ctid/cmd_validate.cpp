@@ -17,7 +17,7 @@ struct ValArgs {
   DataArgs data;
   std::string json;
   int lags = 25;
-  std::string initial;  // "": initial_or_default()
+  std::string initial;  // "": the library's default for a free run (simulate_options, SimulationPurpose::FreeRun)
   int initial_samples = 0;
   bool force = false;
 };
@@ -66,7 +66,7 @@ nlohmann::ordered_json validate_record(const ValArgs& a, const ResultFile& file,
                                     d.ny()));
   if (a.lags < 1 || a.lags >= d.size())
     throw UsageError(detail::format("--lags must be in [1, {}] for {}", d.size() - 1, path));
-  const Eigen::MatrixXd yhat = simulate_result(file.result, d, initial_or_default(a.initial, file), a.initial_samples);
+  const Eigen::MatrixXd yhat = simulate_result(file.result, d, SimulationPurpose::FreeRun, a.initial, a.initial_samples);
   const int n = model_coefficient_count(file.result.model);
   nlohmann::ordered_json j;
   j["data"] = path;
@@ -106,7 +106,7 @@ int run(const ValArgs& a) {
     j.erase("data");
     j["ctid_version"] = version();
     j["model"] = nlohmann::ordered_json::parse(result_to_json(file.result, file.method))["model"];
-    j["initial"] = initial_or_default(a.initial, file);
+    j["initial"] = to_string(simulate_options_of(file.result, SimulationPurpose::FreeRun, a.initial, a.initial_samples).initial);
     j["experiments"] = records;
     write_text_file(a.json, j.dump(2) + "\n");
     std::printf("wrote %s\n", a.json.c_str());

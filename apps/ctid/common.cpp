@@ -253,13 +253,6 @@ DataArgs columns_of(const DataArgs& given, const AnyModel& model) {
   return d;
 }
 
-std::string initial_or_default(const std::string& given, const ResultFile& file) {
-  if (!given.empty()) return given;
-  return std::holds_alternative<GreyboxModel>(file.result.model)
-             ? to_string(fit_initial_condition(file.result.model, file.result.diagnostics))
-             : "rest";
-}
-
 void add_initial_option(CLI::App& app, std::string& initial, int* initial_samples, const char* default_doc) {
   auto* o = app.add_option("--initial", initial,
                            "Initial condition of the simulation: rest (zero state), measured (NARX: the first measured "
@@ -275,22 +268,25 @@ void add_initial_option(CLI::App& app, std::string& initial, int* initial_sample
       ->check(CLI::PositiveNumber);
 }
 
-Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, const std::string& initial, int initial_samples) {
-  SimulateOptions o;
+SimulateOptions simulate_options_of(const Result<AnyModel>& r, SimulationPurpose purpose, const std::string& initial,
+                                    int initial_samples) {
+  try {
+    const std::optional<InitialCondition> given =
+        initial.empty() ? std::nullopt : std::optional(initial_condition_from_string(initial));
+    if (initial_samples > 0 &&
+        (simulate_options(r, purpose, given).initial != InitialCondition::Estimated || !std::holds_alternative<GreyboxModel>(r.model)))
+      throw UsageError("--initial-samples needs --initial estimated and a grey-box model");
+    return simulate_options(r, purpose, given, initial_samples);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+}
+
+Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, SimulationPurpose purpose,
+                                const std::string& initial, int initial_samples) {
+  const SimulateOptions o = simulate_options_of(r, purpose, initial, initial_samples);
   Simulation s;
   try {
-    o.initial = initial.empty() ? fit_initial_condition(r.model, r.diagnostics) : initial_condition_from_string(initial);
-    if (initial_samples > 0) {
-      if (o.initial != InitialCondition::Estimated || !std::holds_alternative<GreyboxModel>(r.model))
-        throw UsageError("--initial-samples needs --initial estimated and a grey-box model");
-      o.initial_samples = initial_samples;
-    } else if (o.initial == InitialCondition::Estimated && r.diagnostics.has(diagnostic::x0) &&
-               !std::holds_alternative<TransferFunction>(r.model) && !std::holds_alternative<StateSpace>(r.model) &&
-               !std::holds_alternative<MisoModel>(r.model)) {
-      // A nonlinear model's fitted x0 (its own record's); a linear model's initial state is estimated by least squares
-      // on the record being simulated (the fitted x0 belongs to the estimation record, not to another one).
-      o.x0 = r.diagnostics.get(diagnostic::x0);
-    }
     s = simulate(r.model, d, o);
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
@@ -315,144 +311,6 @@ int to_int(const std::string& key, const std::string& value) {
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }
-}
-
-namespace {
-// The automatic choices, the summary's note and the warnings: the lines after every result.
-void print_notes(const Summary& s, const Diagnostics& dg) {
-  for (const auto& c : dg.choices) std::printf("chosen: %s\n", c.c_str());
-  if (!s.message.empty()) std::printf("note: %s\n", s.message.c_str());
-  for (const auto& w : dg.warnings) std::printf("warning: %s\n", w.c_str());
-}
-
-template <class M>
-void print_any(const Result<M>& r, const std::string& method, const IdData& d, const std::string& model) {
-  std::printf("method: %s   samples: %d   %s\n", method.c_str(), d.size(),
-              d.is_uniform() ? ("Ts = " + detail::format("{}", d.ts()) + " s").c_str() : "irregular sampling");
-  std::printf("model:  %s\n", model.c_str());
-  std::printf("parameters (value +- one standard deviation):\n");
-  for (int i = 0; i < r.parameters.size(); ++i) {
-    const bool fixed = r.parameters.fixed[i];
-    const double sd = i < r.parameters.std.size() ? r.parameters.std(i) : NAN;
-    if (fixed)
-      std::printf("  %-4s = %14.6g   (fixed)\n", r.parameters.names[i].c_str(), r.parameters.values(i));
-    else if (std::isfinite(sd))
-      std::printf("  %-4s = %14.6g +- %-12.4g\n", r.parameters.names[i].c_str(), r.parameters.values(i), sd);
-    else
-      std::printf("  %-4s = %14.6g\n", r.parameters.names[i].c_str(), r.parameters.values(i));
-  }
-  if (r.diagnostics.has(diagnostic::tau))
-    std::printf("filter time constant tau = %.6g s\n", r.diagnostics.get(diagnostic::tau));
-  std::printf("fit: %s %%   NRMSE %.4g   MSE %.4g   AIC %.6g   BIC %.6g\n", fit_percent_text(r.fit.fit_percent).c_str(), r.fit.nrmse, r.fit.mse,
-              r.fit.aic, r.fit.bic);
-  if (r.diagnostics.condition_number > 0) std::printf("condition number %.3g   ", r.diagnostics.condition_number);
-  std::printf("termination: %s   %.3g s\n", to_string(r.summary.termination), r.summary.seconds);
-  print_notes(r.summary, r.diagnostics);
-}
-}  // namespace
-
-void print_result(const Result<TransferFunction>& r, const std::string& method, const IdData& d) {
-  print_any(r, method, d, "G(s) = " + r.model.to_string(6));
-}
-void print_result(const Result<MisoModel>& r, const std::string& method, const IdData& d) {
-  print_any(r, method, d, "y = " + r.model.to_string(6));
-}
-void print_result(const Result<GreyboxModel>& r, const std::string& method, const IdData& d) {
-  std::string text = r.model.to_string();
-  for (std::size_t i = text.find('\n'); i != std::string::npos && i + 1 < text.size(); i = text.find('\n', i + 1))
-    text.insert(i + 1, "        ");
-  print_any(r, method, d, text.substr(0, text.size() - 1));
-}
-
-void print_result(const Result<StateSpace>& r, const std::string& method, const IdData& d) {
-  const StateSpace& m = r.model;
-  std::printf("method: %s   samples: %d   %s   %d inputs, %d outputs, %d states\n", method.c_str(), d.size(),
-              d.is_uniform() ? ("Ts = " + detail::format("{}", d.ts()) + " s").c_str() : "irregular sampling", m.nu(),
-              m.ny(), m.nx());
-  if (r.diagnostics.has(diagnostic::singular_values)) {
-    const Eigen::VectorXd& sv = r.diagnostics.get(diagnostic::singular_values);
-    std::printf("singular values (the order is where they drop):");
-    for (Eigen::Index i = 0; i < std::min<Eigen::Index>(sv.size(), 12); ++i) std::printf(" %.3g", sv(i) / sv(0));
-    std::printf("\n");
-  }
-  if (m.nx() == 0) {
-    std::printf("termination: %s\nnote: %s\n", to_string(r.summary.termination), r.summary.message.c_str());
-    return;
-  }
-  auto matrix = [](const char* name, const Eigen::MatrixXd& M) {
-    for (Eigen::Index i = 0; i < M.rows(); ++i) {
-      std::printf("  %s%s", i == 0 ? name : " ", i == 0 ? " = [" : "     ");
-      for (Eigen::Index j = 0; j < M.cols(); ++j) std::printf(" %11.5g", M(i, j));
-      std::printf("%s\n", i + 1 == M.rows() ? " ]" : "");
-    }
-  };
-  std::printf("model:  dx/dt = A x + B u,  y = C x + D u\n");
-  matrix("A", m.A());
-  matrix("B", m.B());
-  matrix("C", m.C());
-  matrix("D", m.D());
-  std::printf("modes: pole, natural frequency, damping ratio; shape = |C v| per output (phase, degrees)\n");
-  const std::vector<Mode> modes = m.modes();
-  const bool with_std = r.diagnostics.has(diagnostic::mode_wn_std) &&
-                        r.diagnostics.get(diagnostic::mode_wn_std).size() == static_cast<Eigen::Index>(modes.size()) &&
-                        r.diagnostics.get(diagnostic::mode_wn_std).allFinite();
-  for (size_t k = 0; k < modes.size(); ++k) {
-    const Mode& mode = modes[k];
-    if (with_std)
-      std::printf("  %12.6g %+12.6gj   wn = %.6g +- %.2g rad/s (%.6g Hz)   zeta = %.4g +- %.2g   shape", mode.pole.real(),
-                  mode.pole.imag(), mode.wn, r.diagnostics.get(diagnostic::mode_wn_std)(static_cast<Eigen::Index>(k)),
-                  mode.wn / (2 * std::numbers::pi), mode.zeta,
-                  r.diagnostics.get(diagnostic::mode_zeta_std)(static_cast<Eigen::Index>(k)));
-    else
-      std::printf("  %12.6g %+12.6gj   wn = %.6g rad/s (%.6g Hz)   zeta = %.4g   shape", mode.pole.real(), mode.pole.imag(),
-                  mode.wn, mode.wn / (2 * std::numbers::pi), mode.zeta);
-    for (Eigen::Index j = 0; j < mode.shape.size(); ++j) {
-      // Whole degrees in (-180, 180], without a "-0".
-      double deg = std::round(std::arg(mode.shape(j)) * 180 / std::numbers::pi);
-      if (deg == 0.0 || deg == -180.0) deg = std::abs(deg);
-      std::printf(" %.3f (%.0f)", std::abs(mode.shape(j)), deg);
-    }
-    std::printf("\n");
-  }
-  if (r.diagnostics.has(diagnostic::tau)) std::printf("filter time constant tau = %.6g s\n", r.diagnostics.get(diagnostic::tau));
-  if (r.diagnostics.has(diagnostic::start_fit_percent))
-    std::printf("subspace start: fit %s %%; ", fit_percent_text(r.diagnostics.get(diagnostic::start_fit_percent)).c_str());
-  if (r.diagnostics.has(diagnostic::cost)) std::printf("output-error refinement: %d iterations\n", r.summary.iterations);
-  if (r.diagnostics.has(diagnostic::nx_grid)) {
-    const Eigen::VectorXd& g = r.diagnostics.get(diagnostic::nx_grid);
-    const Eigen::VectorXd& b = r.diagnostics.get(diagnostic::nx_grid_bic);
-    std::printf("order search (BIC):");
-    for (Eigen::Index i = 0; i < g.size(); ++i) std::printf("  nx = %.0f: %.6g", g(i), b(i));
-    std::printf("\n");
-  }
-  std::printf("fit: %s %% (every output scaled alike)", fit_percent_text(r.fit.fit_percent).c_str());
-  if (r.diagnostics.has(diagnostic::output_fit_percent)) {
-    const Eigen::VectorXd& f = r.diagnostics.get(diagnostic::output_fit_percent);
-    for (Eigen::Index j = 0; j < f.size(); ++j)
-      std::printf("   %s %s %%",
-                  j < static_cast<Eigen::Index>(d.output_names().size()) ? d.output_names()[static_cast<size_t>(j)].c_str()
-                                                                          : "y",
-                  fit_percent_text(f(j)).c_str());
-  }
-  std::printf("\ntermination: %s   %.3g s\n", to_string(r.summary.termination), r.summary.seconds);
-  print_notes(r.summary, r.diagnostics);
-}
-
-void print_result(const Result<FsfModel>& r, const std::string& method, const IdData& d) {
-  const FsfModel& f = r.model;
-  std::printf("method: %s   samples: %d   Ts = %g s   T = %g s (N = %d)   n = %d filters   window a = %g\n", method.c_str(),
-              d.size(), f.delta(), f.T(), f.N(), f.n(), f.shift());
-  std::printf("steady-state gain theta0 = %.6g +- %.3g   residual RMS %.4g   condition number %.3g\n", f.theta()(0),
-              r.parameters.std(0), r.diagnostics.has(diagnostic::residual_rms) ? r.diagnostics.get(diagnostic::residual_rms) : NAN,
-              r.diagnostics.condition_number);
-  std::printf("compressed step response%s:\n", f.shift() > 0 ? " (of the shifted system G(s + a))" : "");
-  for (int i = 0; i <= 10; ++i) {
-    const double t = f.T() * i / 10.0;
-    const Eigen::VectorXd tv{{t}};
-    std::printf("  t = %8.4g s   y = %10.5g +- %.3g\n", t, f.step_response(tv)(0), f.step_response_std(tv)(0));
-  }
-  std::printf("termination: %s   %.3g s\n", to_string(r.summary.termination), r.summary.seconds);
-  print_notes(r.summary, r.diagnostics);
 }
 
 void warn_offsets(const IdData& d) {

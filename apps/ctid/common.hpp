@@ -80,37 +80,35 @@ ResultFile read_result(const std::string& path);
 /// With `initial` empty the help states `default_doc` (what the command does without --initial).
 void add_initial_option(CLI::App& app, std::string& initial, int* initial_samples = nullptr,
                         const char* default_doc = "the one the result's own fit used");
-/// The initial condition simulate and validate use without --initial: rest, except for a grey-box result: the one its
-/// fit used (the fitted initial state of its first record). `given` (non-empty) wins.
-std::string initial_or_default(const std::string& given, const ResultFile& file);
 /// A grey-box model's inputs and outputs are data columns of the same names unless --input/--output map them.
 DataArgs columns_of(const DataArgs& given, const AnyModel& model);
-/// The result's model simulated on d from `initial` ("" = fit_initial_condition(); Estimated takes the result's diagnostics "x0" where it
-/// has one). Data that do not fit the model throw UsageError; a simulation that stops being finite throws
-/// NotUsable naming where and why (e.g. the unstable poles): a diverging simulation is never written or scored.
-Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, const std::string& initial,
-                                int initial_samples = 0);
+/// The library's simulation options of `r` for `purpose` (simulate/simulate.hpp: the one rule for the initial state)
+/// with --initial ("" = the purpose's default) and --initial-samples; UsageError for flags that do not fit the model.
+SimulateOptions simulate_options_of(const Result<AnyModel>& r, SimulationPurpose purpose, const std::string& initial,
+                                    int initial_samples = 0);
+/// The result's model simulated on d for `purpose` (simulate_options_of). Data that do not fit the model throw
+/// UsageError; a simulation that stops being finite throws NotUsable naming where and why (e.g. the unstable poles):
+/// a diverging simulation is never written or scored.
+Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, SimulationPurpose purpose,
+                                const std::string& initial, int initial_samples = 0);
 
 /// A --set value as a finite number / a whole number, parsed by the library's option parsers; UsageError otherwise.
 double to_double(const std::string& key, const std::string& value);
 int to_int(const std::string& key, const std::string& value);
 
-/// Print a result (model, parameters with std, fit, summary, warnings).
-void print_result(const Result<TransferFunction>& r, const std::string& method, const IdData& data);
-void print_result(const Result<MisoModel>& r, const std::string& method, const IdData& data);
-void print_result(const Result<FsfModel>& r, const std::string& method, const IdData& data);
-void print_result(const Result<GreyboxModel>& r, const std::string& method, const IdData& data);
-void print_result(const Result<StateSpace>& r, const std::string& method, const IdData& data);
 
 /// Method settings as NAME/VALUE text pairs (the report's "settings" section).
 using Settings = std::vector<std::pair<std::string, std::string>>;
 
-/// Where a method's settings are listed: "ctid poles --help", "ctid response --help" or "ctid fit --method M --help".
-inline std::string settings_hint(const std::string& method) {
-  if (method == "poles") return "ctid poles --help";
-  if (method == "modal_response") return "ctid response --help";
-  return "ctid fit --method " + method + " --help";
+/// Where a method's settings are listed: "ctid fit --method M --help" for a fit, the help of the command that runs
+/// a tool ("ctid poles --help"), the help of the fit it belongs to otherwise (registry: estimate/methods.hpp).
+inline std::string settings_hint(const MethodInfo& m) {
+  if (m.capabilities.records) return "ctid fit --method " + m.name + " --help";
+  const std::string& by = m.reached_by;
+  if (by.rfind("ctid ", 0) == 0) return by.substr(0, by.find(' ', 5)) + " --help";
+  return "ctid fit --method " + by.substr(0, by.find(' ')) + " --help";
 }
+inline std::string settings_hint(const std::string& method) { return settings_hint(method_info(method)); }
 
 /// Applies --set KEY=VALUE pairs to options structs through their tables (estimate/options.hpp): each key goes
 /// to the first struct whose table has it. An unknown key, or a value that does not parse, is a UsageError naming
@@ -197,10 +195,6 @@ void write_report(const std::string& path, const IdData& d, const Result<M>& r, 
 ModalOptions modal_options(const std::string& method, const std::vector<std::string>& sets, double Ts,
                            const std::vector<std::string>& own, std::map<std::string, std::string>& own_values);
 
-/// Billings & Li: fit --method narx | kia (cmd_nonlinear.cpp); narx on one record or several (jointly).
-int run_narx_or_kia(const std::string& method, const std::vector<IdData>& ds, const std::vector<std::string>& sets,
-                    const std::string& narx_file, const std::string& json, const std::string& report,
-                    const std::vector<std::pair<std::string, IdData>>& more_records);
 
 void setup_fit(CLI::App& app);
 /// `ctid fit ARGS...` run from inside another command (ctid demo): the same parsing, defaults, output and exit code.

@@ -20,7 +20,7 @@ from ._ctid import (  # noqa: F401  (re-exported)
     NonlinearCorrelationTests, PhysicalModel, ResultFile, Simulation, StateSpace, TransferFunction, add_noise_snr, crlb, fit_percent, frequency_grid,
     example_data, example_data_names, generator_fitted_to_input, html_report, kia_product_candidates,
     input_residual_crosscorrelation, load, magnitude_band, response_band, drawn_models, compare_models,
-    html_comparison_report, ModelComparison, mode_uncertainty, frequency_response_std, methods, settings, diagnostics, narx_candidates, narx_noise_candidates,
+    html_comparison_report, ModelComparison, mode_uncertainty, frequency_response_std, methods, settings, diagnostics, fit_methods, method_capabilities, narx_candidates, narx_noise_candidates,
     nonlinear_correlation_tests, one_sided_dft, piecewise_constant_windows, prbs, random_binary, multisine, steps, white_noise, read_narx_json, read_nde_json,
     greybox_initial_state, read_result, residual_autocorrelation, response_horizon, time_grid, write_result,
     svf_gamma, svf_information, SvfInformation, RstController, simulate_closed_loop,
@@ -213,27 +213,6 @@ def _parameters_repr(p):
     return "\n".join(rows)
 
 
-def _report(result):
-    """Brief text report of a result (what repr() shows)."""
-    s = result.summary
-    lines = [f"{type(result.model).__name__}: {result.model!r}",
-             f"termination: {s.termination}" + (f" ({s.message})" if s.message else "")
-             + f", {s.iterations} iteration(s), {s.seconds:.3g} s, usable: {result.usable()}"]
-    if len(result.parameters):
-        lines.append(_parameters_repr(result.parameters))
-    f = result.fit
-    lines.append(f"fit: {_ctid.fit_percent_text(f.fit_percent)} %  (mse {f.mse:.4g}, aic {f.aic:.4g}, "
-                 f"{f.n_samples} samples)")
-    lines += [f"warning: {w}" for w in result.diagnostics.warnings]
-    return "\n".join(lines)
-
-
-for _cls in (_ctid.TransferFunctionResult, _ctid.MisoResult, _ctid.ModalResult, _ctid.FsfResult, _ctid.NarxResult,
-             _ctid.NdeResult, _ctid.GreyboxResult):
-    _cls.__repr__ = _report
-    _cls.report = _report
-
-
 def _fit_repr(f):
     return (f"FitReport(fit {_ctid.fit_percent_text(f.fit_percent)} %, nrmse {f.nrmse:.4g}, mse {f.mse:.4g}, "
             f"aic {f.aic:.6g}, bic {f.bic:.6g}, {f.n_samples} samples)")
@@ -263,9 +242,9 @@ _ctid.ParameterSet.__repr__ = _parameters_repr
 _ctid.FitReport.__repr__ = _fit_repr
 _ctid.Summary.__repr__ = _summary_repr
 _ctid.Diagnostics.__repr__ = _diagnostics_repr
+# Results print their library text (brief_text) in repr() and notebooks, every result class alike (bound in C++).
 for _cls in (IdData, _ctid.ParameterSet, _ctid.FitReport, _ctid.Summary, _ctid.Diagnostics, TransferFunction,
-             StateSpace, MisoModel, FsfModel, NarxModel, NdeModel, GreyboxModel, _ctid.TransferFunctionResult,
-             _ctid.MisoResult, _ctid.ModalResult, _ctid.FsfResult, _ctid.NarxResult, _ctid.NdeResult, _ctid.GreyboxResult):
+             StateSpace, MisoModel, FsfModel, NarxModel, NdeModel, GreyboxModel):
     _cls._repr_html_ = _html_pre
 
 
@@ -310,6 +289,58 @@ def _narx_step(self, t, amplitude=1.0):
 
 NdeModel.freqresp, NdeModel.step = _nde_freqresp, _nde_step
 NarxModel.freqresp, NarxModel.step = _narx_freqresp, _narx_step
+
+
+# ---- one entry point for every fit of records (the library's registry) ----
+
+def _fit(data, method=None, *, nb=None, nf=None, nk=0, orders=None, model=None, parameters=None, route="fsf",
+         initial=None, narx=None, reference=None, **settings):
+    """ctid.fit's work: (typed result, the registry name of the method that ran, its settings as (name, text))."""
+    if orders is None and (nb is not None or nf is not None):
+        if nf is None:
+            raise TypeError("fit: nb needs nf (the model order)")
+        orders = [(nf if nb is None else nb, nf, nk)]
+    elif orders is not None:
+        orders = [tuple(orders)] if len(orders) == 3 and all(isinstance(x, int) for x in orders) else \
+            [tuple(o) for o in orders]
+    orders = orders or []
+    if method is None:
+        method = _ctid.default_method(bool(orders), isinstance(data, FrequencyData))
+    if not isinstance(method, str):
+        raise TypeError(f"fit: method must be a method's name (ctid.fit_methods() lists them), got {method!r}")
+    if isinstance(data, (list, tuple)):
+        data = list(data)
+    caps = _ctid.method_capabilities(method)
+    greybox_, expression = None, None
+    if model is not None:
+        if caps["greybox_model"]:
+            greybox_ = greybox_model(model)
+        elif caps["physical_model"]:
+            expression = str(model)
+        else:
+            raise TypeError(f"fit: {method} takes no model (greybox and physical do)")
+    references = []
+    if reference is not None:
+        refs = reference if isinstance(reference, (list, tuple)) else [reference]
+        references = [_np.asarray(r, dtype=float) for r in refs]
+    return _ctid.fit(method, data, orders, settings, initial, greybox_, expression, parameters or {}, route,
+                     references, narx)
+
+
+def fit(data, method=None, **kwargs):
+    """Fit a model to records by any registered method, by its name: the library's registry runs it, as
+    ``ctid fit --method`` does (ctid.fit_methods() lists the names, ctid.method_capabilities(name) what each takes,
+    ctid.settings(name) its settings). data: an IdData, a list of IdData (several experiments of one system, fitted
+    jointly) or a FrequencyData. method: default srivc when orders are given, srivc_auto otherwise.
+
+    Structure keywords: nb, nf, nk (nb defaults to nf) or orders=[(nb, nf, nk), ...] one per input; model= the
+    grey-box model (dict, file or GreyboxModel) or the physical expression ("k1/(s^2 - k2)") with parameters=
+    {"k1": 1, ...} and route= fsf | frequency | raw; initial= a StateSpace (ssest); narx= a NarxModel (kia);
+    reference= one reference per record (srivc in closed loop; its controller is the setting controller=).
+    Every other keyword is a setting of the method, by the names of ctid.settings(method).
+
+    Returns the typed result (TransferFunctionResult, MisoResult, StateSpaceResult, ...)."""
+    return _fit(data, method, **kwargs)[0]
 
 
 # ---- estimators with keyword options (names as in C++) ----
@@ -652,21 +683,20 @@ def frequency_response(model, w):
     return _one_column(_ctid.model_frequency_response(getattr(model, "model", model), _np.asarray(w, dtype=float)))
 
 
-def simulate(model, data, initial="rest", x0=None, initial_samples=0):
+def simulate(model, data, initial=None, x0=None, initial_samples=0):
     """Simulated output of any model (or result) driven by the inputs of `data` — the library's one
     simulate() (the CLI's simulate, validate and report use it too). initial: "rest" (zero state),
     "measured" (NARX: the first measured outputs; NDE: y(0)) or "estimated" (linear models: the
-    least-squares initial state; NARX: the measured history; NDE and grey box: x0, by default the x0 an
+    least-squares initial state on `data`; NARX: the measured history; NDE and grey box: x0, by default the x0 an
     output-error fit estimated; grey box with initial_samples=N: the state from the record's first N samples
-    only). Returns a 1-D array for a single-output model (N x ny otherwise); a simulation that
-    stops being finite warns with the reason and returns NaN from there."""
-    diagnostics = getattr(model, "diagnostics", None)
-    model = getattr(model, "model", model)
-    if x0 is None:
-        vectors = diagnostics.vectors if diagnostics is not None else {}
-        use_fit = initial == "estimated" and "x0" in vectors and not initial_samples
-        x0 = vectors["x0"] if use_fit else _np.zeros(0)
-    s = _ctid.simulate_model(model, data, initial, _np.asarray(x0, dtype=float), int(initial_samples))
+    only); None: for a result, the library's default for a free run (as ``ctid simulate``: rest, a grey-box model
+    from its fit's initial state), for a bare model rest. Returns a 1-D array for a single-output model (N x ny
+    otherwise); a simulation that stops being finite warns with the reason and returns NaN from there."""
+    if hasattr(model, "diagnostics") and x0 is None:
+        s = _ctid.simulate_result(model, data, "free_run", initial or "", int(initial_samples))
+    else:
+        s = _ctid.simulate_model(getattr(model, "model", model), data, initial or "rest",
+                                 _np.zeros(0) if x0 is None else _np.asarray(x0, dtype=float), int(initial_samples))
     if not s.ok():
         import warnings
         warnings.warn(s.problem, RuntimeWarning, stacklevel=2)

@@ -1,7 +1,7 @@
 """ctid.batch — one identification method over many records, on threads or a Dask cluster.
 
-``fit_many(records, method="srivc", client=None, **options)`` fits every record with the single-record function
-``ctid.<method>`` and the same keyword arguments (``fit_many(paths, method="srivc", nb=1, nf=1)`` is
+``fit_many(records, method=None, client=None, **options)`` fits every record with ``ctid.fit(record, method,
+**options)`` (the library's registry: the method's name, its structure keywords and settings) (``fit_many(paths, method="srivc", nb=1, nf=1)`` is
 ``ctid.srivc(data, nb=1, nf=1)`` per record) and returns a pandas DataFrame, one row per record. It runs on the
 ``dask.distributed`` client given (a cluster of several machines unchanged), or with ``client=None`` on a pool of
 threads in this process (the fits release the GIL, so threads use every core without copying the records). A record that cannot be read or fitted, or whose fit is not usable, is a row with its error; a task lost
@@ -57,7 +57,7 @@ def _row(rid, method, result=None, error="", seconds=0.0):
 
 
 def fit_one(rid, record, method, options, file_options):
-    """One row: the record (an IdData or a file path) read and fitted by ctid.<method>(record, **options). Every
+    """One row: the record (an IdData or a file path) read and fitted by ctid.fit(record, method, **options). Every
     failure is the row's error, never an exception (Dask would retry a task that raises)."""
     import ctid
     t0 = _time.perf_counter()
@@ -70,8 +70,8 @@ def fit_one(rid, record, method, options, file_options):
             fo["inputs"] = [str(c) for c in _as_list(fo["inputs"])]
             fo["outputs"] = [str(c) for c in _as_list(fo["outputs"])]
             record = ctid.load(_os.fspath(record), **fo)
-        result = getattr(ctid, method)(record, **options)
-        return _row(rid, method, result)
+        result, ran, _ = ctid._fit(record, method, **options)
+        return _row(rid, ran, result)
     except Exception as e:  # noqa: BLE001 -- every failure becomes the row's error
         return _row(rid, method, error=f"{type(e).__name__}: {e}", seconds=_time.perf_counter() - t0)
 
@@ -259,14 +259,31 @@ def local_cluster(workers=None, **kwargs):
         return distributed.LocalCluster(n_workers=workers or _os.cpu_count() or 1, config=whole, **kwargs)
 
 
-def fit_many(records, method="srivc", client=None, *, out=None, resume=False, progress=True, retries=2, jobs=None,
+def _check_method(who, method, options):
+    """The registry name of `method` (None: ctid fit's default for these options); ValueError for a name that is not
+    a fit of records."""
+    import ctid
+    if method is None:
+        return ctid._ctid.default_method(any(k in options for k in ("nb", "nf", "orders")))
+    try:
+        caps = ctid.method_capabilities(method) if isinstance(method, str) else None
+    except ctid.InvalidOptions:
+        caps = None
+    if caps is None or not caps["records"]:
+        raise ValueError(f"{who}: '{method}' is not an estimator of ctid (ctid.fit_methods() lists them)")
+    return method
+
+
+def fit_many(records, method=None, client=None, *, out=None, resume=False, progress=True, retries=2, jobs=None,
              chunk=None,
              inputs=None, outputs=None, time=None, ts=None, intersample=None, **options):
-    """Fit every record with ``ctid.<method>(record, **options)``; a pandas DataFrame, one row per record.
+    """Fit every record with ``ctid.fit(record, method, **options)``; a pandas DataFrame, one row per record.
 
     records: file paths (read by ctid.load with inputs=, outputs= and time=/ts=/intersample=), IdData objects (id =
-    position) or (id, IdData) pairs. method: the name of a single-record estimator of ctid ("srivc", "srivc_auto",
-    "oe", "tfest", "ssest", "fsf", "greybox", ...); options: its keyword arguments, as for one record.
+    position) or (id, IdData) pairs. method: the name of a fit of the registry (ctid.fit_methods(): "srivc",
+    "srivc_auto", "oe", "tfest", "ssest", "fsf", "greybox", ...); None: ctid fit's default, srivc with orders
+    (nb=, nf=) and srivc_auto without; options: ctid.fit's keywords, as for one record. The rows' method is the
+    registry name of the method that ran.
     client: a dask.distributed.Client (its cluster runs the fits: records and options are sent to the workers, the
     library is not); None: a pool of ``jobs`` threads (default: every core) in this process.
     out: a .csv or .jsonl file the rows are written to as they arrive; resume=True continues a batch that stopped
@@ -283,8 +300,7 @@ def fit_many(records, method="srivc", client=None, *, out=None, resume=False, pr
     import pandas as pd
     import ctid
 
-    if not isinstance(method, str) or not callable(getattr(ctid, method, None)) or method.startswith("_"):
-        raise ValueError(f"fit_many: '{method}' is not an estimator of ctid (ctid.methods() lists them)")
+    method = _check_method("fit_many", method, options)
     if chunk is not None and not (isinstance(chunk, int) and chunk >= 1):
         raise ValueError(f"fit_many: chunk must be a whole number >= 1 (got {chunk!r})")
     pairs = _records(records)
@@ -335,7 +351,7 @@ def _experiment(model, u, ts, t, intersample):
 def monte_carlo_chunk(model, u, ts, t, intersample, runs, snr_db, noise_std, method, options):
     """The rows of some runs of a Monte Carlo (run, seed pairs): the model's noise-free response computed once, the
     noise of each run drawn from its seed (ctid.add_noise_snr or ctid.white_noise, the same numbers on any machine),
-    the record fitted by ctid.<method>(record, **options)."""
+    the record fitted by ctid.fit(record, method, **options)."""
     import numpy as np
     import ctid
     clean = _experiment(model, u, ts, t, intersample)
@@ -350,7 +366,8 @@ def monte_carlo_chunk(model, u, ts, t, intersample, runs, snr_db, noise_std, met
                 record = ctid.IdData.from_arrays(clean.u, y, ts=ts, intersample=intersample)
             else:
                 record = ctid.IdData.from_arrays(clean.u, y, t=clean.t, intersample=intersample)
-            row = _row(rid, method, getattr(ctid, method)(record, **options))
+            result, ran, _ = ctid._fit(record, method, **options)
+            row = _row(rid, ran, result)
         except Exception as e:  # noqa: BLE001 -- every failure becomes the row's error
             row = _row(rid, method, error=f"{type(e).__name__}: {e}", seconds=_time.perf_counter() - t0)
         row["run"], row["seed"] = run, seed
@@ -404,8 +421,7 @@ def monte_carlo(model, u, ts=None, *, t=None, intersample="zoh", runs=100, snr_d
     per_method = {methods: {}} if isinstance(methods, str) else \
         dict(methods) if isinstance(methods, dict) else {m: {} for m in methods}
     for m in per_method:
-        if not isinstance(m, str) or not callable(getattr(ctid, m, None)) or m.startswith("_"):
-            raise ValueError(f"monte_carlo: '{m}' is not an estimator of ctid (ctid.methods() lists them)")
+        _check_method("monte_carlo", m, {})
     clean = _experiment(model, u, ts, t, intersample)  # checks the design here, before any task is sent
     x = np.asarray(clean.y)[:, 0]
     sigma2 = noise_std ** 2 if noise_std is not None else float(np.mean((x - x.mean()) ** 2)) / 10 ** (snr_db / 10)

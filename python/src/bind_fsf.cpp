@@ -7,6 +7,7 @@ namespace ctid::python {
 void bind_fsf(py::module_& m) {
   bind_options<FsfOptions>(m, "FsfOptions");
   py::class_<FsfModel>(m, "FsfModel", "Frequency-sampling-filter model (GW 2005): N samples per window, n filters.")
+      .def("__repr__", [](const FsfModel& f) { return describe(AnyModel(f)); })
       .def_property_readonly("delta", &FsfModel::delta)
       .def_property_readonly("N", &FsfModel::N)
       .def_property_readonly("n", &FsfModel::n)

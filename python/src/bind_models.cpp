@@ -4,8 +4,6 @@
 
 namespace ctid::python {
 
-namespace {
-// The typed Python result (TransferFunctionResult, MisoResult, ...) of a Result<AnyModel>.
 py::object typed(const Result<AnyModel>& r) {
   return std::visit(
       [&r](const auto& m) {
@@ -15,6 +13,7 @@ py::object typed(const Result<AnyModel>& r) {
       r.model);
 }
 
+namespace {
 template <class M>
 void def_write_result(py::module_& m) {
   m.def(
@@ -91,6 +90,31 @@ void bind_models(py::module_& m) {
       py::arg("model"), py::arg("data"), py::arg("initial") = "rest", py::arg("x0") = Eigen::VectorXd(),
       py::arg("initial_samples") = 0,
       "Simulate any model on a record (simulate/simulate.hpp): initial 'rest', 'measured' or 'estimated'.");
+  // A result simulated for a purpose: the library's one rule for its initial state (simulate_options).
+  const auto purpose_of = [](const std::string& p) {
+    if (p == "own_fit") return SimulationPurpose::OwnFit;
+    if (p == "other_record") return SimulationPurpose::OtherRecord;
+    if (p == "validation") return SimulationPurpose::Validation;
+    if (p == "free_run") return SimulationPurpose::FreeRun;
+    throw InvalidArgument("simulate: purpose must be own_fit, other_record, validation or free_run (got '" + p + "')");
+  };
+  std::apply(
+      [&](auto... model) {
+        (m.def(
+             "simulate_result",
+             [purpose_of](const Result<decltype(model)>& r, const IdData& d, const std::string& purpose,
+                          const std::string& initial, int initial_samples) {
+               const std::optional<InitialCondition> given =
+                   initial.empty() ? std::nullopt : std::optional(initial_condition_from_string(initial));
+               return simulate(to_any(r), d, purpose_of(purpose), given, initial_samples);
+             },
+             py::arg("result"), py::arg("data"), py::arg("purpose") = "free_run", py::arg("initial") = "",
+             py::arg("initial_samples") = 0,
+             "A result's model simulated on a record for a purpose (own_fit, other_record, validation, free_run): the "
+             "library's rule for the initial state; initial '' is the purpose's default."),
+         ...);
+      },
+      std::tuple<TransferFunction, MisoModel, StateSpace, FsfModel, NarxModel, NdeModel, GreyboxModel>{});
   py::class_<ModelComparison>(m, "ModelComparison",
                               "One model scored on a record (compare_models): name, model, initial (the initial "
                               "condition it was simulated from), simulation, fits (a FitReport per output), whiteness "

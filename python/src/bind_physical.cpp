@@ -6,7 +6,6 @@
 
 namespace ctid::python {
 
-namespace {
 std::vector<PhysicalParameter> parameters_of(const py::dict& spec) {
   // {"name": initial} or {"name": {"initial": .., "lower": .., "upper": .., "fixed": ..}}
   std::vector<PhysicalParameter> v;
@@ -30,7 +29,6 @@ std::vector<PhysicalParameter> parameters_of(const py::dict& spec) {
   }
   return v;
 }
-}  // namespace
 
 void bind_physical(py::module_& m) {
   py::class_<PhysicalModel>(m, "PhysicalModel", "G(s; Theta) from an expression such as 'k/(s*(J*s + b))'.")

@@ -44,6 +44,10 @@ auto interruptible(F&& f, OnInterrupt on = OnInterrupt::ReturnResult) {
   return result;
 }
 
+/// The typed Python result (TransferFunctionResult, MisoResult, ...) of a Result<AnyModel>.
+py::object typed(const Result<AnyModel>& r);
+/// Physical parameters from {"name": initial} or {"name": {"initial": .., "lower": .., "upper": .., "fixed": ..}}.
+std::vector<PhysicalParameter> parameters_of(const py::dict& spec);
 /// Binds Result<Model> as a Python class `name` (model, parameters, fit, summary, diagnostics, usable()).
 template <class Model>
 void bind_result(py::module_& m, const char* name) {
@@ -54,6 +58,24 @@ void bind_result(py::module_& m, const char* name) {
       .def_readonly("fit", &R::fit)
       .def_readonly("summary", &R::summary)
       .def_readonly("diagnostics", &R::diagnostics)
+      .def(
+          "__repr__",
+          [](const R& r) {
+            // The model as the library describes it (a model outside AnyModel, e.g. ModalModel: its Python repr).
+            const py::object m = py::cast(r.model);
+            std::string text;
+            if constexpr (std::is_constructible_v<AnyModel, Model>) text = describe(AnyModel(r.model));
+            else text = std::string(py::repr(m));
+            return brief_text(r, std::string(py::str(m.get_type().attr("__name__"))) + ": " + text);
+          })
+      .def("report", [](const R& r) { return std::string(py::repr(py::cast(r))); },
+           "A brief text report: the model, termination, parameters, fit and warnings (the library's brief_text).")
+      .def("_repr_html_",
+           [](const R& r) {
+             std::string text = std::string(py::repr(py::cast(r))), html = "<pre>";
+             for (char c : text) html += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : std::string(1, c);
+             return html + "</pre>";
+           })
       .def("usable", &R::usable, "Whether the estimate can be trusted (the rules of why_not_usable).")
       .def("why_not_usable", &R::why_not_usable,
            "Why the estimate cannot be trusted ('' when it can): the estimator failed, a parameter is not finite, "

@@ -11,6 +11,11 @@ PYBIND11_MODULE(_ctid, m) {
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
+    } catch (const ctid::UnknownSetting& e) {
+      // An unknown keyword is a TypeError in Python, worded as the keyword layer words it.
+      const std::string hint = e.closest.empty() ? "" : "; did you mean '" + e.closest + "'?";
+      PyErr_SetString(PyExc_TypeError, (e.method + ": unknown option '" + e.key + "'" + hint + " (ctid.settings('" +
+                                        e.method + "') lists them)").c_str());
     } catch (const ctid::InvalidOptions& e) {
       PyErr_SetString(invalid_options.ptr(), e.what());
     } catch (const ctid::InvalidArgument& e) {

@@ -55,6 +55,7 @@ const std::vector<DiagnosticInfo>& diagnostic_catalogue() {
       info(diagnostic::gls_iterations),
       info(diagnostic::gls_order),
       info(diagnostic::err_sum),
+      info(diagnostic::narx_fit_percent),
       info(diagnostic::x0),
       info(diagnostic::start_scale),
       info(diagnostic::starts_cost), info(diagnostic::segments), info(diagnostic::continuity_defect),

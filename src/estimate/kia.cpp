@@ -602,8 +602,11 @@ KiaRun kia_records(const internal::RecordRefs& ds, const NarxModel& narx, const 
         "or the sampling is too slow for kernel invariance",
         std::round(r.fit.fit_percent * 100) / 100, std::round(run.narx_fit_percent * 100) / 100);
   }
+  const bool narx_fit_known = std::isfinite(run.narx_fit_percent);
+  if (narx_fit_known) r.diagnostics.set(diagnostic::narx_fit_percent, run.narx_fit_percent);
   if (o.refine) {
     run.refined = refine(r.model);
+    if (narx_fit_known) run.refined->diagnostics.set(diagnostic::narx_fit_percent, run.narx_fit_percent);
     run.refined->diagnostics.choices.insert(run.refined->diagnostics.choices.begin(), choices.begin(), choices.end());
   }
   return run;

@@ -605,21 +605,22 @@ void time_responses(Page& page, const AnyModel& model, const std::vector<std::st
 
 double nyquist_or_zero(const IdData& d) { return d.is_uniform() ? std::numbers::pi / d.ts() : 0.0; }
 
-// The model simulated on the record with the report's initial condition (Estimated takes the initial state a
-// fit estimated, its diagnostics "x0", where the result has one); a diverging simulation is drawn up to
-// where it stops being finite, with the reason.
-Eigen::MatrixXd simulated(Page& page, const IdData& d, const AnyModel& m, const Diagnostics& g, const ReportOptions& o) {
-  SimulateOptions so;
-  so.initial = o.initial ? *o.initial : fit_initial_condition(m, g);
-  if (so.initial == InitialCondition::Estimated && g.has(diagnostic::x0)) so.x0 = g.get(diagnostic::x0);
-  const Simulation s = simulate(m, d, so);
+// The model simulated on a record for `purpose` (simulate/simulate.hpp: the library's one rule for the initial
+// state), from the report's initial condition when it sets one; a diverging simulation is drawn up to where it
+// stops being finite, with the reason.
+Eigen::MatrixXd simulated(Page& page, const IdData& d, const Result<AnyModel>& r, SimulationPurpose purpose,
+                          std::optional<InitialCondition> initial) {
+  const SimulateOptions so = simulate_options(r, purpose, initial);
+  const Simulation s = simulate(r.model, d, so);
   page.text("Simulated from the initial condition: " + std::string(to_string(so.initial)) + ".");
   if (!s.ok()) page.text("<span class=\"warn\">" + escape(s.problem) + "</span>");
   return s.y;
 }
 
-// The further records of ReportOptions::more_records, each in its own section.
-void more_records(Page& page, const AnyModel& m, const ReportOptions& o) {
+// The further records of ReportOptions::more_records, each in its own section: held-out records (more_records_initial
+// set) as validation, the other records of a joint fit as the fit starts a record.
+void more_records(Page& page, const Result<AnyModel>& r, const ReportOptions& o) {
+  const AnyModel& m = r.model;
   for (size_t i = 0; i < o.more_records.size(); ++i) {
     const auto& [name, d] = o.more_records[i];
     CTID_REQUIRE(d.nu() == model_inputs(m) && d.ny() == model_outputs(m),
@@ -627,9 +628,9 @@ void more_records(Page& page, const AnyModel& m, const ReportOptions& o) {
                  d.nu(), d.ny(), model_inputs(m), model_outputs(m));
     page.section("Record " + std::to_string(i + 2) + ": " + name);
     page.text(std::to_string(d.size()) + " samples, " + fmt(d.duration()) + " s.");
-    ReportOptions ro = o;
-    if (o.more_records_initial) ro.initial = o.more_records_initial;
-    validations(page, d, simulated(page, d, m, Diagnostics{}, ro), o);
+    const auto y = o.more_records_initial ? simulated(page, d, r, SimulationPurpose::Validation, o.more_records_initial)
+                                          : simulated(page, d, r, SimulationPurpose::OtherRecord, o.initial);
+    validations(page, d, y, o);
   }
 }
 
@@ -643,8 +644,9 @@ template <class M>
 void opening(Page& page, const IdData& d, const Result<M>& r, const ReportOptions& o, bool simulate_on_records = true) {
   overview(page, d, r, o, describe(r.model));
   if (!simulate_on_records) return;
-  validations(page, d, simulated(page, d, r.model, r.diagnostics, o), o);
-  more_records(page, r.model, o);
+  const Result<AnyModel> any{AnyModel(r.model), {}, {}, {}, r.diagnostics};
+  validations(page, d, simulated(page, d, any, SimulationPurpose::OwnFit, o.initial), o);
+  more_records(page, any, o);
 }
 
 // A nonlinear model's response from rest to a step of the input's RMS level (it depends on the amplitude).

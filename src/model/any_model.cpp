@@ -48,6 +48,10 @@ bool is_linear(const AnyModel& model) {
          !std::holds_alternative<GreyboxModel>(model);
 }
 
+bool is_linear_model_type(const std::string& type) {
+  return type == "transfer_function" || type == "miso" || type == "state_space" || type == "fsf";
+}
+
 int model_coefficient_count(const AnyModel& model) {
   const auto tf = [](const TransferFunction& g) { return g.num().degree() + 1 + g.order(); };
   return std::visit(Overloads{[&](const TransferFunction& m) { return tf(m); },

@@ -35,6 +35,37 @@ InitialCondition validation_initial_condition(const AnyModel& model) {
   return InitialCondition::Estimated;
 }
 
+SimulateOptions simulate_options(const Result<AnyModel>& result, SimulationPurpose purpose,
+                                 std::optional<InitialCondition> initial, int initial_samples) {
+  const AnyModel& m = result.model;
+  const Diagnostics& g = result.diagnostics;
+  SimulateOptions o;
+  if (initial) o.initial = *initial;
+  else
+    switch (purpose) {
+      case SimulationPurpose::OwnFit: o.initial = fit_initial_condition(m, g); break;
+      case SimulationPurpose::OtherRecord: o.initial = fit_initial_condition(m, Diagnostics{}); break;
+      case SimulationPurpose::Validation: o.initial = validation_initial_condition(m); break;
+      case SimulationPurpose::FreeRun:
+        o.initial = std::holds_alternative<GreyboxModel>(m) ? fit_initial_condition(m, g) : InitialCondition::Rest;
+        break;
+    }
+  CTID_REQUIRE(initial_samples == 0 || (o.initial == InitialCondition::Estimated && std::holds_alternative<GreyboxModel>(m)),
+               "simulate: initial_samples needs the initial condition estimated and a grey-box model (got {} and a {} "
+               "model)",
+               to_string(o.initial), model_type_name(m));
+  o.initial_samples = initial_samples;
+  const bool fitted_x0 = o.initial == InitialCondition::Estimated && initial_samples == 0 && g.has(diagnostic::x0) &&
+                         (purpose == SimulationPurpose::OwnFit || (purpose == SimulationPurpose::FreeRun && !is_linear(m)));
+  if (fitted_x0) o.x0 = g.get(diagnostic::x0);
+  return o;
+}
+
+Simulation simulate(const Result<AnyModel>& result, const IdData& data, SimulationPurpose purpose,
+                    std::optional<InitialCondition> initial, int initial_samples) {
+  return simulate(result.model, data, simulate_options(result, purpose, initial, initial_samples));
+}
+
 namespace {
 
 // One linear state-space block of a model: its realisation, the input column that drives it and its delay.

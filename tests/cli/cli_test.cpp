@@ -1528,10 +1528,13 @@ TEST(Cli, SeveralDataFilesAreFittedJointly) {
                 1e-9 * std::abs(lib_t.parameters.values(i)));
   const CliRun o = ctid_run("fit " + files[0] + " " + files[1] + " --time time --input force --output position --method fsf");
   EXPECT_EQ(o.code, 2);
-  EXPECT_NE(o.err.find("2 DATA files are several experiments: fitted jointly by --method srivc, oe, tfest, lssvf, "
-                       "ivsvf, rls-svf, narx, kia, modal, ssest, physical --via raw or srivc with --closed-loop-controller (got fsf"),
+  // The list is the registry's: every method whose capabilities take several records.
+  EXPECT_NE(o.err.find("2 DATA files are several experiments: fitted jointly by --method lssvf, ivsvf, rls_svf, srivc, "
+                       "oe, tfest, physical, modal, narx, kia, greybox or ssest (got fsf"),
             std::string::npos)
       << o.err;
+  for (const auto& m : methods())
+    if (m.capabilities.records && m.capabilities.several_records) EXPECT_NE(o.err.find(m.name), std::string::npos) << m.name;
   // NARX on both records (resampled NARX at Ts = 0.02 s): the CLI's file equals the library's joint fit.
   const CliRun n = ctid_run("fit " + files[0] + " " + files[1] +
                             " --time time --input force --output position --method narx --set degree=1 --json " + json +
@@ -2114,4 +2117,115 @@ TEST(Cli, BatchRefusesBadOptionsOnce) {
   EXPECT_EQ(rest.code, 0) << rest.err;
   EXPECT_NE(rest.out.find(std::to_string(3 - kept) + " fitted now"), std::string::npos) << rest.out;
   EXPECT_EQ(csv_ids(out).size(), 3u);
+}
+
+// The registry walked from the command line: every method that fits records (estimate/methods.hpp) runs from
+// `ctid fit --method NAME` on a small record of its kind with the flags its capabilities call for, writes its
+// registry name into the result file, is listed by `ctid fit --help` and has a page in docs/methods/ that names it.
+TEST(Cli, EveryRegisteredFitRunsFromTheCommandLine) {
+  const std::string dir = test::temp_path("registry");
+  fs::create_directories(dir);
+  for (const char* name : {"second", "bl", "spring"})
+    ASSERT_EQ(ctid_run(std::string("example-data ") + name + " " + dir + "/" + name + ".csv --force").code, 0) << name;
+  const CliRun help = ctid_run("fit --help");
+  ASSERT_EQ(help.code, 0) << help.err;
+  std::string pages;
+  for (const auto& page : fs::directory_iterator(std::string(CTID_EXAMPLES_DATA_DIR) + "/../../docs/methods")) {
+    std::ifstream f(page.path());
+    pages.append(std::istreambuf_iterator<char>(f), {});
+  }
+  const std::vector<std::string> fits = fit_method_names();
+  ASSERT_GE(fits.size(), 15u);
+  for (const auto& name : fits) {
+    const MethodCapabilities& c = method_info(name).capabilities;
+    std::string args;
+    if (c.greybox_model) {
+      args = dir + "/spring.csv --model " + std::string(CTID_EXAMPLES_DATA_DIR) + "/spring_greybox.json";
+    } else if (c.narx_model || name == "narx") {
+      args = dir + "/bl.csv --ts 0.0025 --input u --output y --set degree=2 --set ylag=2 --set ulag=2";
+    } else {
+      args = dir + "/second.csv --time t --input u --output y";
+      if (c.needs_orders) args += " --nf 2 --nb 1";
+      if (c.physical_model)
+        args += " --via raw --model \"k*(s + z)/(s^2 + a*s + b)\" --param k=0.8 --param z=2.5 --param a=1 --param b=3.5";
+      if (c.nx) args += " --nx 2";
+    }
+    const std::string json = dir + "/" + name + ".json";
+    const CliRun r = ctid_run("fit " + args + " --method " + name + " --json " + json + " --force", "timeout 300 ");
+    EXPECT_TRUE(r.code == 0 || r.code == 1) << name << ": exit " << r.code << "\n" << r.err;
+    EXPECT_EQ(read_result_file(json).method, name) << name;
+    EXPECT_NE(help.out.find(name), std::string::npos) << name << " is not in ctid fit --help";
+    EXPECT_TRUE(pages.find("--method " + name) != std::string::npos || pages.find("`" + name + "`") != std::string::npos ||
+                pages.find(name + "(") != std::string::npos)
+        << name << " is named in no page of docs/methods/";
+  }
+}
+
+// One rule for the initial state of a simulation (simulate/simulate.hpp, SimulationPurpose): `ctid simulate RESULT
+// RECORD --initial X` gives, on a record the result was not fitted to, the library's simulate(result, record,
+// FreeRun, X) to 1e-12 of the output's scale, for a result of every model type and each initial condition (and the
+// default, without --initial); where the library refuses the initial condition, the command exits 2 naming it.
+// Python's ctid.simulate is compared with the same command in python/tests/test_registry.py.
+TEST(Cli, SimulateFollowsTheLibrarysInitialStateRuleForEveryModelType) {
+  const std::string dir = test::temp_path("initial_rule");
+  fs::create_directories(dir);
+  // Each example record split in two: the fit on the first part, the simulations on the second.
+  auto split = [&](const std::string& name, int first) {
+    const ExampleData e = example_data(name);
+    const int n = static_cast<int>(e.values.rows());
+    write_csv(dir + "/" + name + "1.csv", e.columns, e.values.topRows(first));
+    write_csv(dir + "/" + name + "2.csv", e.columns, e.values.bottomRows(n - first));
+  };
+  split("second", 1000);
+  split("miso", 1000);
+  split("bl", 600);
+  split("spring", 900);
+  struct Case {
+    std::string type, record, columns, fit;
+    DataSpec spec;
+  };
+  const std::string grey = std::string(CTID_EXAMPLES_DATA_DIR) + "/spring_greybox.json";
+  const DataSpec siso{{"u"}, {"y"}, "t"}, bl{{"u"}, {"y"}, "", 0.0025}, spring{{"force"}, {"position"}, "t"};
+  const std::vector<Case> cases = {
+      {"transfer_function", "second", "--time t --input u --output y", "--method oe --nf 2 --nb 1", siso},
+      {"miso", "miso", "--time t --input u1 --input u2 --output y", "--method srivc --nf 2 --nb 1",
+       DataSpec{{"u1", "u2"}, {"y"}, "t"}},
+      {"state_space", "second", "--time t --input u --output y", "--method ssest --nx 2", siso},
+      {"fsf", "second", "--time t --input u --output y", "--method fsf", siso},
+      {"narx", "bl", "--ts 0.0025 --input u --output y", "--method narx --set degree=2 --set ylag=2 --set ulag=2", bl},
+      {"nde", "bl", "--ts 0.0025 --input u --output y", "--method kia --set degree=2 --set ylag=2 --set ulag=2", bl},
+      {"greybox", "spring", "--time t --input force --output position", "--method greybox --model " + grey, spring},
+  };
+  for (const Case& c : cases) {
+    const std::string json = dir + "/" + c.type + ".json";
+    const CliRun f = ctid_run("fit " + dir + "/" + c.record + "1.csv " + c.columns + " " + c.fit + " --json " + json +
+                              " --force", "timeout 300 ");
+    ASSERT_TRUE(f.code == 0 || f.code == 1) << c.type << "\n" << f.err;
+    const Result<AnyModel> r = read_result_file(json).result;
+    ASSERT_EQ(model_type_name(r.model), c.type);
+    const IdData d2 = load_iddata(dir + "/" + c.record + "2.csv", c.spec);
+    for (const std::string initial : {"", "rest", "measured", "estimated"}) {
+      const std::string out = dir + "/" + c.type + "_" + initial + ".csv";
+      const CliRun s = ctid_run("simulate " + json + " " + dir + "/" + c.record + "2.csv " + c.columns +
+                                (initial.empty() ? "" : " --initial " + initial) + " --out " + out + " --force");
+      Simulation lib;
+      try {
+        lib = simulate(r, d2, SimulationPurpose::FreeRun,
+                       initial.empty() ? std::nullopt : std::optional(initial_condition_from_string(initial)));
+      } catch (const InvalidArgument& e) {
+        EXPECT_EQ(s.code, 2) << c.type << " --initial " << initial << ": the library refuses (" << e.what() << ")";
+        continue;
+      }
+      if (!lib.ok()) {
+        EXPECT_EQ(s.code, 1) << c.type << " --initial " << initial << ": " << lib.problem;
+        continue;
+      }
+      ASSERT_EQ(s.code, 0) << c.type << " --initial " << initial << "\n" << s.err;
+      const CsvTable t = read_csv(out);
+      const Eigen::MatrixXd y = t.values.rightCols(lib.y.cols());
+      ASSERT_EQ(y.rows(), lib.y.rows());
+      const double scale = std::max(1.0, lib.y.cwiseAbs().maxCoeff());
+      EXPECT_LE((y - lib.y).cwiseAbs().maxCoeff(), 1e-12 * scale) << c.type << " --initial " << initial;
+    }
+  }
 }

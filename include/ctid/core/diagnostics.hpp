@@ -90,6 +90,9 @@ inline constexpr VectorDiagnostic first_iteration{"first_iteration", "", "KIA st
 inline constexpr ScalarDiagnostic gls_iterations{"gls_iterations", "", "generalised least-squares iterations of a KIA stage"};
 inline constexpr ScalarDiagnostic gls_order{"gls_order", "", "order of the GLS noise model of a KIA stage"};
 inline constexpr ScalarDiagnostic err_sum{"err_sum", "%", "sum of the ERR of a KIA stage's terms"};
+inline constexpr ScalarDiagnostic narx_fit_percent{"narx_fit_percent", "%",
+                                                   "free-run fit of the NARX model KIA reconstructed from, on the same "
+                                                   "records (a KIA equation below half of it is not usable)"};
 // NDE output error.
 // Subspace identification.
 inline constexpr VectorDiagnostic singular_values{"singular_values", "",

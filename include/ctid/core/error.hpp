@@ -14,6 +14,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace ctid {
 
@@ -29,6 +30,15 @@ class InvalidOptions : public InvalidArgument {
   explicit InvalidOptions(const std::string& what) : InvalidArgument(what) {}
 };
 
+/// A setting name that the method does not have (a typo, or a setting of another method).
+class UnknownSetting : public InvalidOptions {
+ public:
+  UnknownSetting(const std::string& what, std::string method, std::string key, std::string closest)
+      : InvalidOptions(what), method(std::move(method)), key(std::move(key)), closest(std::move(closest)) {}
+  std::string method;   ///< the method asked
+  std::string key;      ///< the name given
+  std::string closest;  ///< the closest setting name of the method, "" when none is close
+};
 /// A file could not be opened, read, parsed or written.
 class FileError : public std::runtime_error {
  public:

@@ -40,6 +40,8 @@ int model_inputs(const AnyModel& model);
 int model_outputs(const AnyModel& model);
 /// Whether the model is linear (transfer function, MISO, state space, FSF).
 bool is_linear(const AnyModel& model);
+/// Whether models of the JSON type `type` (model_type_name) are linear: transfer_function, miso, state_space, fsf.
+bool is_linear_model_type(const std::string& type);
 /// Number of coefficients of the model (the parameter count of fit criteria such as AIC): transfer
 /// functions num + den without the leading 1 (summed over MISO channels), all entries of A, B, C, D, FSF
 /// parameters, NARX/NDE terms, grey-box parameters (held ones included).

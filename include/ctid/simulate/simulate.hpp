@@ -20,6 +20,7 @@
 //    that an output reads alone taken from its first sample.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include <Eigen/Dense>
@@ -68,6 +69,27 @@ InitialCondition fit_initial_condition(const AnyModel& model, const Diagnostics&
 /// not start at rest): Estimated — the state that fits the record best, as MATLAB's compare — for linear and grey-box
 /// models, Measured (the record's own history) for NARX and NDE models, Rest for FSF models (simulated from rest only).
 InitialCondition validation_initial_condition(const AnyModel& model);
+
+/// What a simulation of a fitted result is for. It decides the initial condition when none is asked for, and
+/// whether the initial state the fit estimated (diagnostics x0, that of its first record) is used: the one rule of
+/// `ctid fit --validate`, `ctid simulate`, `ctid validate`, `ctid report`, the HTML report and Python's simulate().
+enum class SimulationPurpose {
+  OwnFit,       ///< the record the result was fitted to: the fit's own initial condition (fit_initial_condition), its x0
+  OtherRecord,  ///< a further record of the same joint fit: as the fit starts a record, without the first one's x0
+  Validation,   ///< a held-out record: the state that fits it best (validation_initial_condition)
+  FreeRun,      ///< a record the result is simulated on: rest; a grey-box model from its fit's initial state
+};
+
+/// The options of a simulation of `result` for `purpose`; `initial`, when given, wins over the purpose's default.
+/// Estimated takes the fitted x0 (diagnostics x0) on the result's own record, and for a nonlinear model (NDE, grey
+/// box) in a free run; otherwise the state is estimated on the record simulated (a linear model's by least squares,
+/// a grey-box model's by greybox_initial_state), never taken from another record. initial_samples > 0 (grey-box
+/// models, Estimated): the state from the record's first initial_samples samples instead of the fitted x0.
+SimulateOptions simulate_options(const Result<AnyModel>& result, SimulationPurpose purpose,
+                                 std::optional<InitialCondition> initial = std::nullopt, int initial_samples = 0);
+/// The result's model simulated on `data` for `purpose`: simulate(result.model, data, simulate_options(...)).
+Simulation simulate(const Result<AnyModel>& result, const IdData& data, SimulationPurpose purpose,
+                    std::optional<InitialCondition> initial = std::nullopt, int initial_samples = 0);
 
 /// Simulate `model` driven by the inputs of `data` (its outputs are read only for the Measured and
 /// Estimated initial conditions). Throws InvalidArgument when the data do not match the model (input
