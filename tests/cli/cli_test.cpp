@@ -2229,3 +2229,30 @@ TEST(Cli, SimulateFollowsTheLibrarysInitialStateRuleForEveryModelType) {
     }
   }
 }
+
+// The output policy of a failed run (docs/guide.md, "What the CLI never does to your files"): a run refused before
+// it computes (exit 2 usage, 3 input file) writes nothing; a fit that ran but cannot be trusted (exit 1) writes the
+// files it was asked for, marked so — "usable": false and the reason in the result file, the reason in the report —
+// so that what went wrong can be looked at; a simulation that diverges writes nothing.
+TEST(Cli, AFitThatIsNotUsableWritesItsFilesMarkedSo) {
+  std::string noise = "time,force,position\n";
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n01;
+  for (int i = 0; i < 1000; ++i) noise += detail::format("{},{},{}\n", 0.01 * i, n01(rng) > 0 ? 1 : -1, n01(rng));
+  const std::string data = write("policy_noise.csv", noise);
+  const std::string json = test::temp_path("policy.json"), html = test::temp_path("policy.html");
+  fs::remove(json);
+  fs::remove(html);
+  const std::string base = "fit " + data + " --time time --input force --output position --method tfest --nf 2";
+  const CliRun r = ctid_run(base + " --json " + json + " --report " + html);
+  ASSERT_EQ(r.code, 1) << r.err;
+  const auto j = nlohmann::json::parse(std::ifstream(json));
+  EXPECT_FALSE(j.at("summary").at("usable").get<bool>());
+  EXPECT_NE(j.at("summary").at("not_usable_because").get<std::string>().find("the data cannot tell this model from no model"),
+            std::string::npos);
+  EXPECT_NE(read_text_file(html).find("the data cannot tell this model from no model"), std::string::npos);
+  // Refused before computing: nothing written.
+  fs::remove(json);
+  EXPECT_EQ(ctid_run(base + " --set max_iteration=3 --json " + json).code, 2);
+  EXPECT_FALSE(fs::exists(json));
+}
