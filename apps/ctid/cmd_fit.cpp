@@ -423,12 +423,10 @@ void write_fsf_responses(const std::string& prefix, const FsfModel& f) {
         f.impulse_response_std(t)(0);
   }
   write_csv(prefix + "_time.csv", {"t", "step", "step_std", "impulse", "impulse_std"}, tm);
-  Eigen::VectorXd w(200);
-  const double wmax = std::min(3.14159 / f.delta(), 10.0 * f.m() * f.omega() + f.omega());
-  for (int i = 0; i < 200; ++i) w(i) = f.omega() * 0.01 * std::pow(wmax / (0.01 * f.omega()), i / 199.0);
+  const Eigen::VectorXd w = model_frequency_grid(f);  // the report's grid
   const Eigen::VectorXcd g = f.frequency_response(w), gs = f.frequency_response_std(w);
-  Eigen::MatrixXd fm(200, 7);
-  for (int i = 0; i < 200; ++i)
+  Eigen::MatrixXd fm(w.size(), 7);
+  for (Eigen::Index i = 0; i < w.size(); ++i)
     fm.row(i) << w(i), g(i).real(), g(i).imag(), gs(i).real(), gs(i).imag(), std::abs(g(i)),
         std::arg(g(i)) * 180.0 / 3.14159265358979;
   write_csv(prefix + "_freq.csv", {"w", "re", "im", "re_std", "im_std", "mag", "phase_deg"}, fm);

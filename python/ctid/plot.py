@@ -7,7 +7,7 @@ library's, the same the HTML report and ``ctid compare`` show.
 """
 import numpy as np
 
-from . import FsfModel, InvalidArgument, MisoModel, StateSpace, TransferFunction, drawn_models, frequency_grid, \
+from . import FsfModel, InvalidArgument, MisoModel, StateSpace, TransferFunction, _ctid, drawn_models, \
     frequency_response, impulse_response, magnitude_band, response_band, response_horizon, step_response
 
 
@@ -85,13 +85,9 @@ def bode(model, w=None, data=None, confidence=True, ax=None):
     m = getattr(model, "model", model)
     if w is None:
         w_max = np.pi / data.ts if data is not None and data.is_uniform else 0.0
-        if isinstance(m, (TransferFunction, MisoModel, StateSpace)):
-            poles = np.concatenate([g.poles() for g in m.channels]) if isinstance(m, MisoModel) else m.poles()
-            w = frequency_grid(poles, w_max, 400)  # the report's grid
-        elif isinstance(m, FsfModel):
-            w = np.linspace(0.5 * 2 * np.pi / m.T, np.pi / m.delta * 0.95, 400)
-        else:
+        if not isinstance(m, (TransferFunction, MisoModel, StateSpace, FsfModel)):
             raise InvalidArgument(f"bode: give w for a {type(m).__name__}")
+        w = _ctid.model_frequency_grid(m, w_max)  # the library's default grid (the report's)
     w = np.asarray(w, dtype=float)
     h = frequency_response(m, w)  # the library's (the report's): a multi-input model gives a curve per input
     ph = _phase_deg(h)

@@ -90,6 +90,9 @@ void bind_models(py::module_& m) {
       py::arg("model"), py::arg("data"), py::arg("initial") = "rest", py::arg("x0") = Eigen::VectorXd(),
       py::arg("initial_samples") = 0,
       "Simulate any model on a record (simulate/simulate.hpp): initial 'rest', 'measured' or 'estimated'.");
+  m.def("model_frequency_grid", &model_frequency_grid, py::arg("model"), py::arg("w_max") = 0.0, py::arg("n") = 300,
+        "The default frequency grid (rad/s) of a model's frequency response, the report's: frequency_grid of its poles "
+        "up to w_max (linear models), an FSF model's own band (log-spaced, 2 pi / (2 T) to 0.95 pi / Delta).");
   // A result simulated for a purpose: the library's one rule for its initial state (simulate_options).
   const auto purpose_of = [](const std::string& p) {
     if (p == "own_fit") return SimulationPurpose::OwnFit;

@@ -883,9 +883,7 @@ std::string report_of(const IdData& d, const Result<FsfModel>& r, const ReportOp
   }
   page.plot({"Step response", "time (s)", "y", t, sv});
   page.plot({"Impulse response", "time (s)", "y", t, gv});
-  const double wmax = std::numbers::pi / m.delta() * 0.95, w0 = 2 * std::numbers::pi / m.T();
-  Eigen::VectorXd w(300);
-  for (int i = 0; i < 300; ++i) w(i) = std::pow(10.0, std::log10(0.5 * w0) + (std::log10(wmax) - std::log10(0.5 * w0)) * i / 299);
+  const Eigen::VectorXd w = model_frequency_grid(m);
   bode(page, w, {{"Gbar(e^{jw Delta})", m.frequency_response(w)}});
   return page.render(o.title.empty() ? o.method + " fit" : o.title);
 }

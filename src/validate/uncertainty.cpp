@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "ctid/core/check.hpp"
@@ -33,6 +34,19 @@ TransferFunction with_coefficients(const TransferFunction& g, const std::vector<
   for (size_t i = 0; i < map.size(); ++i)
     if (map[i].poly) (map[i].poly == 'a' ? den : num)(map[i].index) = v(static_cast<Eigen::Index>(i));
   return TransferFunction(num, den, g.io_delay());
+}
+
+Eigen::VectorXd model_frequency_grid(const AnyModel& model, double w_max, int n) {
+  if (const auto* f = std::get_if<FsfModel>(&model)) {
+    CTID_REQUIRE(n >= 2, "model_frequency_grid: need at least 2 points (got {})", n);
+    const double lo = std::log10(0.5 * 2 * std::numbers::pi / f->T()), hi = std::log10(std::numbers::pi / f->delta() * 0.95);
+    Eigen::VectorXd w(n);
+    for (int i = 0; i < n; ++i) w(i) = std::pow(10.0, lo + (hi - lo) * i / (n - 1));
+    return w;
+  }
+  CTID_REQUIRE(is_linear(model), "model_frequency_grid: a {} model has no frequency response (its GFRFs describe it)",
+               model_type_name(model));
+  return frequency_grid(model_poles(model), w_max, n);
 }
 
 Eigen::VectorXd frequency_grid(const Eigen::VectorXcd& poles, double w_max, int n) {

@@ -2,6 +2,7 @@
 // report and ctid.plot). The band is checked against the delta method, which is exact to first order for small
 // parameter uncertainty.
 #include <cmath>
+#include <numbers>
 
 #include <gtest/gtest.h>
 
@@ -124,6 +125,17 @@ TEST(Uncertainty, GridAndHorizon) {
   EXPECT_NEAR(none(0), 1e-2, 1e-15);
   EXPECT_NEAR(none(4), 1e2, 1e-12);
   EXPECT_THROW(frequency_grid(Eigen::VectorXcd(), 0.0, 1), InvalidArgument);
+  // The default grid of a model: a linear model's is frequency_grid of its poles; an FSF model's its own band, from
+  // half its first filter frequency 2 pi / T to 0.95 of its Nyquist frequency pi / Delta (T = N Delta = 8 s here).
+  const TransferFunction g(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 101.0, 100.0}});
+  EXPECT_EQ(model_frequency_grid(g, 50.0), frequency_grid(g.poles(), 50.0));
+  const FsfModel f(0.01, 800, 21, Eigen::VectorXd::Zero(21));
+  const Eigen::VectorXd wf = model_frequency_grid(f);
+  ASSERT_EQ(wf.size(), 300);
+  EXPECT_NEAR(wf(0), std::numbers::pi / 8.0, 1e-12);
+  EXPECT_NEAR(wf(299), 0.95 * std::numbers::pi / 0.01, 1e-9);
+  EXPECT_NEAR(wf(1) / wf(0), wf(299) / wf(298), 1e-12);  // log-spaced
+  EXPECT_THROW(model_frequency_grid(NarxModel()), InvalidArgument);
   // 8 / 0.5 + 0.3 s; an unstable model alone gives the fallback.
   const TransferFunction slow(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 0.5}}, 0.3);
   const TransferFunction fast(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, 10.0}});

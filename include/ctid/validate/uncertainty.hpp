@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "ctid/core/types.hpp"
+#include "ctid/model/any_model.hpp"
 #include "ctid/model/state_space.hpp"
 #include "ctid/model/transfer_function.hpp"
 
@@ -33,6 +34,11 @@ TransferFunction with_coefficients(const TransferFunction& g, const std::vector<
 /// nonzero pole magnitude (1 rad/s when there is none), ending at w_max when w_max > 0 (e.g. the Nyquist
 /// frequency of the data). Throws InvalidArgument for n < 2.
 Eigen::VectorXd frequency_grid(const Eigen::VectorXcd& poles, double w_max = 0.0, int n = 300);
+/// The default frequency grid (rad/s) of a model's frequency response: frequency_grid of its poles up to w_max for
+/// linear models (transfer function, MISO, state space); an FSF model's own band, n log-spaced points from half its
+/// first filter frequency 2 pi / T to 0.95 of its Nyquist frequency pi / Delta. The report, `ctid fit --responses`
+/// and Python's plots use it. Throws InvalidArgument for a nonlinear model (its frequency description is the GFRFs).
+Eigen::VectorXd model_frequency_grid(const AnyModel& model, double w_max = 0.0, int n = 300);
 
 /// Time horizon (s) of step and impulse plots: 8 times the slowest stable time constant of the models plus their
 /// largest delay; `fallback` when none has a stable pole.
