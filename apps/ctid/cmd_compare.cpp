@@ -12,7 +12,6 @@
 #include "common.hpp"
 
 namespace ctid::cli {
-extern std::function<int()> g_run;
 
 namespace {
 struct CompareArgs {
@@ -112,8 +111,7 @@ int run(const CompareArgs& a) {
     ReportOptions o;
     o.title = a.title.empty() ? "ctid compare: " + path : a.title;
     o.data_source = path;
-    o.command_line = g_command_line;
-    o.preprocessing = g_preprocessing;
+    if (a.data.provenance) o.provenance = *a.data.provenance;
     o.max_lag = a.lags;
     try {
       write_text_file(a.report, html_comparison_report(d, cs, o));
@@ -130,7 +128,7 @@ int run(const CompareArgs& a) {
 }
 }  // namespace
 
-void setup_compare(CLI::App& app) {
+void setup_compare(CLI::App& app, Command& command) {
   auto a = std::make_shared<CompareArgs>();
   app.add_option("FILES", a->files,
                  "Model or result files (any type ctid writes), then the record to compare them on (CSV/.dat or .mat)")
@@ -145,7 +143,12 @@ void setup_compare(CLI::App& app) {
   app.add_option("--title", a->title, "Report title");
   app.add_option("--lags", a->lags, "Lags of the residual correlation tests")->capture_default_str();
   app.add_flag("--force", a->force, "Overwrite an existing output file");
-  app.callback([a] { g_run = [a] { return run(*a); }; });
+  app.callback([a, &command] {
+    command = [a](Provenance& prov) {
+      a->data.provenance = &prov;
+      return run(*a);
+    };
+  });
 }
 
 }  // namespace ctid::cli

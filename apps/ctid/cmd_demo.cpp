@@ -6,7 +6,6 @@
 #include "common.hpp"
 
 namespace ctid::cli {
-extern std::function<int()> g_run;
 
 namespace {
 struct DemoArgs {
@@ -30,7 +29,7 @@ std::string find_dryer(const std::string& given) {
 
 // The demo is `ctid fit` with its defaults on the bundled record (run_fit: the same parsing and output), the first
 // half to estimate and the second held out; the command is printed so that the user can run it.
-int run(const DemoArgs& a) {
+int run(const DemoArgs& a, Provenance& prov) {
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::path found = find_dryer(a.data);
@@ -46,7 +45,7 @@ int run(const DemoArgs& a) {
   std::printf("heater voltage (column 1) -> outlet air temperature (column 2); samples 1..500 estimate the model, "
               "501..1000 are held out to validate it\n\n");
   std::fflush(stdout);
-  const int code = run_fit(args);
+  const int code = run_fit(args, prov);
   std::string command = "ctid fit";
   for (const auto& s : args) command += " " + (s.find(' ') == std::string::npos ? s : "'" + s + "'");
   std::printf("\nthe same fit from the command line:\n  %s\n", command.c_str());
@@ -58,12 +57,12 @@ int run(const DemoArgs& a) {
 }
 }  // namespace
 
-void setup_demo(CLI::App& app) {
+void setup_demo(CLI::App& app, Command& command) {
   auto a = std::make_shared<DemoArgs>();
   app.add_option("--json", a->json, "Also write the result to this JSON file (passed on to ctid fit)");
   app.add_option("--data", a->data, "Path of dryer.dat (default: the bundled copy)");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
-  app.callback([a] { g_run = [a] { return run(*a); }; });
+  app.callback([a, &command] { command = [a](Provenance& prov) { return run(*a, prov); }; });
 }
 
 }  // namespace ctid::cli

@@ -7,7 +7,6 @@
 #include "ctid/simulate/example_data.hpp"
 
 namespace ctid::cli {
-extern std::function<int()> g_run;
 
 namespace {
 struct ExampleArgs {
@@ -37,13 +36,13 @@ int run(const ExampleArgs& a) {
 }
 }  // namespace
 
-void setup_example_data(CLI::App& app) {
+void setup_example_data(CLI::App& app, Command& command) {
   auto a = std::make_shared<ExampleArgs>();
   app.add_option("NAME", a->name, "Example record (--list names them all)");
   app.add_option("OUT", a->out, "CSV file to write (header row of column names)");
   app.add_flag("--list", a->list, "List the example records with what each one is");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
-  app.callback([a] { g_run = [a] { return run(*a); }; });
+  app.callback([a, &command] { command = [a](Provenance&) { return run(*a); }; });
 }
 
 }  // namespace ctid::cli

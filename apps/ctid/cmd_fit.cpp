@@ -14,7 +14,6 @@
 #include "common.hpp"
 
 namespace ctid::cli {
-extern std::function<int()> g_run;
 
 namespace {
 
@@ -40,6 +39,13 @@ struct FitArgs {
   /// same columns and with the estimation record's trend removed; set by run() as (description, record).
   std::string validate, validate_samples;
   std::optional<std::pair<std::string, IdData>> validation;
+};
+
+// A fit done: the library's outcome and the records it was computed on (for frequency data, the data instead).
+struct Fitted {
+  FitOutcome out;
+  std::vector<IdData> records;
+  std::optional<FrequencyData> frequency;
 };
 
 using Capability = bool MethodCapabilities::*;
@@ -290,15 +296,43 @@ void print_experiments(const FitArgs& a, const std::vector<IdData>& ds) {
 
 void write_fsf_responses(const std::string& prefix, const FsfModel& f);
 
+// --json: the result file, with where it came from.
+void write_json(const FitArgs& a, const FitOutcome& out, const Provenance& prov) {
+  if (a.json.empty()) return;
+  write_result_json(a.json, out.result, out.method, &prov);
+  std::printf("wrote %s\n", a.json.c_str());
+}
+
+int exit_code(const Result<AnyModel>& r) {
+  if (r.usable()) return kOk;
+  std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", r.why_not_usable().c_str());
+  return kNotUsable;
+}
+
+// A fit to frequency-response data: the method, the band, the model and its parameters, the fit of the complex
+// response.
+int present_frequency(const Fitted& f, const FitArgs& a, const Provenance& prov) {
+  const FrequencyData& fd = *f.frequency;
+  const Result<AnyModel>& res = f.out.result;
+  const auto& g = std::get<TransferFunction>(res.model);
+  std::printf("method: %s (frequency data)   frequencies: %d   from %.4g to %.4g rad/s\n", f.out.method.c_str(),
+              fd.size(), fd.w()(0), fd.w()(fd.size() - 1));
+  std::printf("model:  G(s) = %s\n", g.to_string(6).c_str());
+  for (int i = 0; i < res.parameters.size(); ++i)
+    std::printf("  %-5s = %14.6g +- %-12.4g\n", res.parameters.names[i].c_str(), res.parameters.values(i), res.parameters.std(i));
+  std::printf("fit (complex response): %s %%   termination: %s\n", fit_percent_text(res.fit.fit_percent).c_str(),
+              to_string(res.summary.termination));
+  write_json(a, f.out, prov);
+  return exit_code(res);
+}
+
 // Print, write the JSON file and the HTML report if asked, and map usability to the exit code. The printed samples
 // are those of the first record; the fit is over all of them; the report shows each record.
-int finish(const FitOutcome& out, const std::vector<IdData>& ds, const FitArgs& a) {
+int present(const Fitted& f, const FitArgs& a, const Provenance& prov) {
+  const FitOutcome& out = f.out;
   const Result<AnyModel>& r = out.result;
-  if (BatchOutcome* b = batch_outcome()) {  // ctid batch: the row is written by the batch
-    b->result = r;
-    b->method = out.method;
-    return r.usable() ? kOk : kNotUsable;
-  }
+  if (f.frequency) return present_frequency(f, a, prov);
+  const std::vector<IdData>& ds = f.records;
   const IdData& d = ds.front();
   print_experiments(a, ds);
   std::fputs(fit_text(out, d).c_str(), stdout);
@@ -309,34 +343,27 @@ int finish(const FitOutcome& out, const std::vector<IdData>& ds, const FitArgs& 
     print_validation(r, *a.validation);
     more.insert(more.begin(), {"validation, " + a.validation->first, a.validation->second});
   }
-  if (!a.json.empty()) {
-    write_result_json(a.json, r, out.method);
-    std::printf("wrote %s\n", a.json.c_str());
-  }
-  if (const auto* f = std::get_if<FsfModel>(&r.model); f && !a.responses.empty()) write_fsf_responses(a.responses, *f);
-  write_report(a.report, d, r, out.method, out.settings, a.paths.empty() ? a.data.path : a.paths.front(), more,
+  write_json(a, out, prov);
+  if (const auto* fsf = std::get_if<FsfModel>(&r.model); fsf && !a.responses.empty()) write_fsf_responses(a.responses, *fsf);
+  write_report(a.report, d, r, out.method, out.settings, a.paths.empty() ? a.data.path : a.paths.front(), prov, more,
                a.validation ? std::optional(validation_initial_condition(r.model)) : std::nullopt);
-  if (!r.usable()) {
-    std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", r.why_not_usable().c_str());
-    return kNotUsable;
-  }
-  return kOk;
+  return exit_code(r);
 }
 
 // Time-domain records (one, or several experiments of one system) fitted by the method.
-int fit_records(const FitArgs& a, std::vector<IdData> ds) {
+Fitted fit_records(const FitArgs& a, std::vector<IdData> ds) {
   const MethodInfo& m = method_info(a.method);
   FitRequest r;
   r.structure = structure_of(a, m, ds.front().nu());
   r.settings = settings_of(a);
   r.records = std::move(ds);
-  const FitOutcome out = fit_request(a, r);
-  return finish(out, r.records, a);
+  FitOutcome out = fit_request(a, r);
+  return {std::move(out), std::move(r.records), std::nullopt};
 }
 
 // Closed-loop SRIVC on one record or several (jointly, one controller): each record's reference column is loaded
 // with its data and split off; the controller and the reference's intersample behaviour are settings.
-int run_closed_loop(const FitArgs& a) {
+Fitted run_closed_loop(const FitArgs& a) {
   if (a.reference.empty()) throw UsageError("--closed-loop-controller needs --reference COLUMN");
   if (a.data.inputs.size() != 1) throw UsageError("closed-loop identification needs exactly one --input (the plant input)");
   LinearModel c;
@@ -359,15 +386,16 @@ int run_closed_loop(const FitArgs& a) {
   }
   r.structure.orders = orders_of(a, 1);
   for (auto& s : settings_of(a)) r.settings.push_back(std::move(s));
-  const FitOutcome out = fit_request(a, r);
-  return finish(out, r.records, a);
+  FitOutcome out = fit_request(a, r);
+  return {std::move(out), std::move(r.records), std::nullopt};
 }
 
 // Frequency-response data: columns w, re, im (G) or the spectra U and Y.
-int run_frequency(const FitArgs& a) {
+Fitted run_frequency(const FitArgs& a) {
   FitRequest r;
   try {
     const CsvTable t = read_csv(a.data.path);
+    if (a.data.provenance) a.data.provenance->add_data_file(a.data.path, static_cast<int>(t.values.rows()));
     auto col = [&](const std::string& name) { return Eigen::VectorXd(t.values.col(t.column(name))); };
     const Eigen::VectorXd w = col(a.w);
     try {
@@ -395,23 +423,8 @@ int run_frequency(const FitArgs& a) {
                      " (got " + m.name + "; --period gives subspace and ssest the FRF matrix of periodic records)");
   r.structure = structure_of(a, m, 1);
   r.settings = settings_of(a);
-  const FitOutcome out = fit_request(a, r);
-  const FrequencyData& fd = *r.frequency;
-  const auto& g = std::get<TransferFunction>(out.result.model);
-  const Result<AnyModel>& res = out.result;
-  std::printf("method: %s (frequency data)   frequencies: %d   from %.4g to %.4g rad/s\n", out.method.c_str(),
-              fd.size(), fd.w()(0), fd.w()(fd.size() - 1));
-  std::printf("model:  G(s) = %s\n", g.to_string(6).c_str());
-  for (int i = 0; i < res.parameters.size(); ++i)
-    std::printf("  %-5s = %14.6g +- %-12.4g\n", res.parameters.names[i].c_str(), res.parameters.values(i), res.parameters.std(i));
-  std::printf("fit (complex response): %s %%   termination: %s\n", fit_percent_text(res.fit.fit_percent).c_str(),
-              to_string(res.summary.termination));
-  if (!a.json.empty()) {
-    write_result_json(a.json, res, out.method);
-    std::printf("wrote %s\n", a.json.c_str());
-  }
-  if (!res.usable()) std::fprintf(stderr, "ctid: the estimate is not usable: %s\n", res.why_not_usable().c_str());
-  return res.usable() ? kOk : kNotUsable;
+  FitOutcome out = fit_request(a, r);
+  return {std::move(out), {}, std::move(r.frequency)};
 }
 
 void write_fsf_responses(const std::string& prefix, const FsfModel& f) {
@@ -435,7 +448,7 @@ void write_fsf_responses(const std::string& prefix, const FsfModel& f) {
 
 // A grey-box model file fitted to one record or several (one parameter set, an initial state per record). The
 // model's input and output names are the data columns unless --input/--output map them (in the model's order).
-int run_greybox(const FitArgs& a) {
+Fitted run_greybox(const FitArgs& a) {
   if (a.model_expr.empty()) throw UsageError("--method greybox needs --model FILE.json (the grey-box model file)");
   if (a.frequency) throw UsageError("--method greybox fits time-domain records (not --frequency)");
   FitRequest r;
@@ -453,12 +466,12 @@ int run_greybox(const FitArgs& a) {
                                     options_detail::format_names(model.output_names())));
   r.records = a.paths.size() > 1 ? da.load_each(a.paths, true) : std::vector<IdData>{da.load(true)};
   r.settings = settings_of(a);
-  const FitOutcome out = fit_request(a, r);
-  return finish(out, r.records, a);
+  FitOutcome out = fit_request(a, r);
+  return {std::move(out), std::move(r.records), std::nullopt};
 }
 
 // Several DATA files: several experiments of one system, the same columns in each, fitted jointly.
-int run_experiments(const FitArgs& a) {
+Fitted run_experiments(const FitArgs& a) {
   const MethodInfo& m = method_info(a.method);
   if (!m.capabilities.several_records)
     throw UsageError(detail::format("{} DATA files are several experiments: fitted jointly by --method {} (got {}; the "
@@ -469,7 +482,7 @@ int run_experiments(const FitArgs& a) {
 }
 
 // --period N: periodic records (one per input) -> their FRF matrix with variances -> subspace or ssest on it.
-int run_periodic(const FitArgs& a) {
+Fitted run_periodic(const FitArgs& a) {
   if (!a.report.empty()) throw UsageError("--report needs time-domain records (not --period: a fit to frequency data)");
   const std::vector<IdData> ds = a.paths.size() > 1 ? a.data.load_each(a.paths, true) : std::vector<IdData>{a.data.load(true)};
   FitRequest r;
@@ -480,7 +493,8 @@ int run_periodic(const FitArgs& a) {
   }
   const FrequencyData& fd = *r.frequency;
   const int periods = ds.front().size() / a.period - a.skip;
-  std::printf("FRF matrix of the periodic records: %d excited frequencies from %.6g to %.6g Hz, %d period(s) of %d "
+  if (!a.data.quiet)
+    std::printf("FRF matrix of the periodic records: %d excited frequencies from %.6g to %.6g Hz, %d period(s) of %d "
               "samples averaged (%d skipped)\n", fd.size(), fd.w()(0) / (2 * std::numbers::pi),
               fd.w()(fd.size() - 1) / (2 * std::numbers::pi), periods, a.period, a.skip);
   const MethodInfo& m = method_info(a.method);
@@ -489,8 +503,8 @@ int run_periodic(const FitArgs& a) {
                      fits_that([](const MethodInfo& x) { return has_setting(x, "nx_max"); }) + "; " + m.name + " takes one N");
   r.structure = structure_of(a, m, ds.front().nu());
   r.settings = settings_of(a);
-  const FitOutcome out = fit_request(a, r);
-  return finish(out, {ds.front()}, a);
+  FitOutcome out = fit_request(a, r);
+  return {std::move(out), {ds.front()}, std::nullopt};
 }
 
 // --validate / --validate-samples: the held-out record, with the estimation record's trend (none with --detrend
@@ -504,20 +518,24 @@ std::pair<std::string, IdData> validation_record(const FitArgs& a, const TrendIn
   v.announce_means = false;
   std::pair<int, int> rows;
   IdData d = v.load(true, nullptr, &rows);
-  if (a.data.detrend != "none") d = d.remove_trend(trend);
+  if (a.data.detrend != "none") {
+    d = d.remove_trend(trend);
+    if (v.provenance) {
+      std::string& done = v.provenance->preprocessing.back();
+      done = "validation " + done.substr(0, done.rfind("; no detrending")) + "; the estimation record's " +
+             (a.data.detrend == "mean" ? "means" : "linear trends") + " removed";
+    }
+  } else if (v.provenance) {
+    v.provenance->preprocessing.back().insert(0, "validation ");
+  }
   std::string name = v.path;
   if (!v.samples.empty()) name += detail::format(" rows {}..{}", rows.first, rows.second);
   return {name, d};
 }
 
-int run(FitArgs a) {
-  reject_flags_that_do_not_apply(a);
+// Parse -> library request -> fit: what `ctid fit` computes (and `ctid batch` per record), nothing shown.
+Fitted fit_of(FitArgs& a) {
   const MethodInfo& m = method_info(a.method);
-  std::vector<std::string> inputs = a.paths;
-  inputs.insert(inputs.end(), {a.narx, a.controller, a.initial, a.validate, m.capabilities.greybox_model ? a.model_expr : ""});
-  check_outputs({a.json, a.report, a.responses.empty() ? "" : a.responses + "_time.csv",
-                 a.responses.empty() ? "" : a.responses + "_freq.csv"},
-                inputs, a.force);
   if (!a.controller.empty()) return run_closed_loop(a);
   if (m.capabilities.greybox_model) return run_greybox(a);
   if (a.period > 0) return run_periodic(a);
@@ -540,18 +558,33 @@ int run(FitArgs a) {
   return fit_records(a, {d});
 }
 
+int run(FitArgs a, Provenance& prov) {
+  reject_flags_that_do_not_apply(a);
+  const MethodInfo& m = method_info(a.method);
+  std::vector<std::string> inputs = a.paths;
+  inputs.insert(inputs.end(), {a.narx, a.controller, a.initial, a.validate, m.capabilities.greybox_model ? a.model_expr : ""});
+  check_outputs({a.json, a.report, a.responses.empty() ? "" : a.responses + "_time.csv",
+                 a.responses.empty() ? "" : a.responses + "_freq.csv"},
+                inputs, a.force);
+  a.data.provenance = &prov;
+  const Fitted f = fit_of(a);
+  return present(f, a, prov);
+}
+
 }  // namespace
 
 namespace {
-std::shared_ptr<FitArgs> g_fit_args;  // read by fit_method_help after a --help
 std::vector<std::string> method_choices();
 }  // namespace
 
 std::string fit_method_help(const CLI::App& fit) {
-  if (!g_fit_args || fit.count("--method") == 0) return "";
+  // The --method value parsed before the --help (the option keeps it).
+  const CLI::Option* opt = fit.get_option_no_throw("--method");
+  if (!opt || opt->results().empty()) return "";
+  const std::string& given = opt->results().front();
   const auto names = method_choices();
-  if (std::find(names.begin(), names.end(), g_fit_args->method) == names.end()) return "";
-  const MethodInfo& m = method_info(g_fit_args->method);
+  if (std::find(names.begin(), names.end(), given) == names.end()) return "";
+  const MethodInfo& m = method_info(given);
   std::string out = "\n" + m.name + ": " + m.summary + "\n" + settings_help(m);
   for (const auto& name : m.variants) {
     const MethodInfo& v = method_info(name);
@@ -667,16 +700,15 @@ void resolve_fit_args(FitArgs& a, const CLI::App& app) {
 }
 }  // namespace
 
-void setup_fit(CLI::App& app) {
+void setup_fit(CLI::App& app, Command& command) {
   auto a = add_fit_options(app);
-  g_fit_args = a;
-  app.callback([a, &app] {
+  app.callback([a, &app, &command] {
     resolve_fit_args(*a, app);
-    g_run = [a] { return run(*a); };
+    command = [a](Provenance& prov) { return run(*a, prov); };
   });
 }
 
-void setup_batch(CLI::App& app) {
+void setup_batch(CLI::App& app, Command& command) {
   auto a = add_fit_options(app);
   auto job = std::make_shared<BatchJob>();
   app.get_option("DATA")->description(
@@ -689,12 +721,12 @@ void setup_batch(CLI::App& app) {
       ->required();
   app.add_option("--jobs", job->jobs, "Threads fitting records at once (default: one per core)")->check(CLI::Range(1, 4096));
   app.add_flag("--resume", job->resume, "Continue an interrupted batch: fit only the records whose id is not in --out");
-  app.callback([a, job, &app] {
+  app.callback([a, job, &app, &command] {
     resolve_fit_args(*a, app);
     job->patterns = a->paths;
     job->method = a->method;
     job->force = a->force;
-    g_run = [a, job] {
+    command = [a, job](Provenance&) {
       for (const char* f : {"json", "report", "validate", "validate-samples", "responses", "frequency", "period"})
         if (a->given.count(f))
           throw UsageError("--" + std::string(f) + " is an option of ctid fit on one record, not of ctid batch (one "
@@ -704,14 +736,15 @@ void setup_batch(CLI::App& app) {
         FitArgs b = *a;
         b.paths = {path};
         b.data.path = path;
-        return run(std::move(b));
+        b.data.quiet = true;
+        return fit_of(b).out;
       };
       return run_batch(*job);
     };
   });
 }
 
-int run_fit(std::vector<std::string> args) {
+int run_fit(std::vector<std::string> args, Provenance& provenance) {
   CLI::App app{"ctid fit"};
   const auto a = add_fit_options(app);
   std::reverse(args.begin(), args.end());  // CLI11 parses a vector from its back
@@ -721,7 +754,7 @@ int run_fit(std::vector<std::string> args) {
     throw UsageError(e.what());
   }
   resolve_fit_args(*a, app);
-  return run(*a);
+  return run(*a, provenance);
 }
 
 }  // namespace ctid::cli

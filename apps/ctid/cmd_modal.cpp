@@ -7,7 +7,6 @@
 #include "common.hpp"
 
 namespace ctid::cli {
-extern std::function<int()> g_run;
 
 namespace {
 // A comma-separated list, parsed by the library's option parser.
@@ -199,7 +198,7 @@ int run_response(const ResponseArgs& a) {
 
 }  // namespace
 
-void setup_poles(CLI::App& app) {
+void setup_poles(CLI::App& app, Command& command) {
   auto a = std::make_shared<PolesArgs>();
   app.add_option("DATA", a->data.path, "CSV/.dat table or .mat file holding a free (or generated-input) response")
       ->required();
@@ -214,10 +213,15 @@ void setup_poles(CLI::App& app) {
                      "  shift_samples  the shifts counted in samples (instead of shifts)");
   app.add_option("--json", a->json, "Write both estimates (poles, characteristic polynomials, conditions) to this JSON file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
-  app.callback([a] { g_run = [a] { return run_poles(*a); }; });
+  app.callback([a, &command] {
+    command = [a](Provenance& prov) {
+      a->data.provenance = &prov;
+      return run_poles(*a);
+    };
+  });
 }
 
-void setup_response(CLI::App& app) {
+void setup_response(CLI::App& app, Command& command) {
   auto a = std::make_shared<ResponseArgs>();
   app.add_option("DATA", a->data.path, "CSV/.dat table or .mat file")->required();
   app.add_option("--method", a->method, "Estimator of the response: modal (El-Shafey)")
@@ -234,7 +238,12 @@ void setup_response(CLI::App& app) {
   app.add_option("--out", a->out, "Write the response to this CSV file");
   app.add_option("--json", a->json, "Write the response to this JSON file (the --out columns, with kind and order)");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
-  app.callback([a] { g_run = [a] { return run_response(*a); }; });
+  app.callback([a, &command] {
+    command = [a](Provenance& prov) {
+      a->data.provenance = &prov;
+      return run_response(*a);
+    };
+  });
 }
 
 }  // namespace ctid::cli

@@ -10,7 +10,6 @@
 #include "common.hpp"
 
 namespace ctid::cli {
-extern std::function<int()> g_run;
 
 namespace {
 struct GfrfArgs {
@@ -113,7 +112,7 @@ int run_gfrf(const GfrfArgs& a) {
 }
 }  // namespace
 
-void setup_gfrf(CLI::App& app) {
+void setup_gfrf(CLI::App& app, Command& command) {
   auto a = std::make_shared<GfrfArgs>();
   app.add_option("MODEL", a->model, "NARX or NDE model JSON (result of fit --method narx or kia)")->required();
   app.add_option("--order", a->order, "Kernel order n (1..3)")->capture_default_str();
@@ -125,7 +124,7 @@ void setup_gfrf(CLI::App& app) {
   app.add_option("--out", a->out, "Write the kernel values to this CSV file");
   app.add_option("--json", a->json, "Write the kernel values to this JSON file (the --out columns, with model and order)");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
-  app.callback([a] { g_run = [a] { return run_gfrf(*a); }; });
+  app.callback([a, &command] { command = [a](Provenance&) { return run_gfrf(*a); }; });
 }
 
 }  // namespace ctid::cli

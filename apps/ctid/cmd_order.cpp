@@ -5,7 +5,6 @@
 #include "common.hpp"
 
 namespace ctid::cli {
-extern std::function<int()> g_run;
 
 namespace {
 struct OrderArgs {
@@ -69,7 +68,7 @@ int run(const OrderArgs& a) {
 }
 }  // namespace
 
-void setup_order(CLI::App& app) {
+void setup_order(CLI::App& app, Command& command) {
   auto a = std::make_shared<OrderArgs>();
   app.add_option("DATA", a->data.path, "CSV/.dat table or .mat file")->required();
   a->data.add_to(app, true);
@@ -79,7 +78,12 @@ void setup_order(CLI::App& app) {
   app.add_option("--rank", a->rank, "Ranking criterion: yic, rt2, aic or bic")->capture_default_str();
   app.add_option("--json", a->json, "Write the ranked candidates to this JSON file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
-  app.callback([a] { g_run = [a] { return run(*a); }; });
+  app.callback([a, &command] {
+    command = [a](Provenance& prov) {
+      a->data.provenance = &prov;
+      return run(*a);
+    };
+  });
 }
 
 }  // namespace ctid::cli

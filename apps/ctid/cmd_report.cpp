@@ -6,7 +6,6 @@
 #include "common.hpp"
 
 namespace ctid::cli {
-extern std::function<int()> g_run;
 
 namespace {
 struct ReportArgs {
@@ -56,8 +55,7 @@ int run(const ReportArgs& a) {
   o.method = file.method.empty() ? model_type_name(file.result.model) : file.method;
   o.title = a.title.empty() ? "ctid report: " + a.result : a.title;
   o.data_source = a.paths.front();
-  o.command_line = g_command_line;
-  o.preprocessing = g_preprocessing;
+  if (a.data.provenance) o.provenance = *a.data.provenance;
   for (std::size_t e = 1; e < ds.size(); ++e) {
     // Further records start as the fit starts a record (a fitted x0 belongs to the first record).
     simulate_result(file.result, ds[e], SimulationPurpose::OtherRecord, a.initial);
@@ -80,7 +78,7 @@ int run(const ReportArgs& a) {
 }
 }  // namespace
 
-void setup_report(CLI::App& app) {
+void setup_report(CLI::App& app, Command& command) {
   auto a = std::make_shared<ReportArgs>();
   app.add_option("RESULT", a->result, "Result or model JSON (ctid fit --json)")->required();
   app.add_option("DATA", a->paths, "The record(s) to report on (CSV/.dat or .mat; several: a section each)")->required();
@@ -89,7 +87,12 @@ void setup_report(CLI::App& app) {
   app.add_option("--title", a->title, "Report title");
   add_initial_option(app, a->initial);
   app.add_flag("--force", a->force, "Overwrite an existing output file");
-  app.callback([a] { g_run = [a] { return run(*a); }; });
+  app.callback([a, &command] {
+    command = [a](Provenance& prov) {
+      a->data.provenance = &prov;
+      return run(*a);
+    };
+  });
 }
 
 }  // namespace ctid::cli

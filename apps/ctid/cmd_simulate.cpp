@@ -6,7 +6,6 @@
 #include "common.hpp"
 
 namespace ctid::cli {
-extern std::function<int()> g_run;
 
 namespace {
 struct SimArgs {
@@ -55,7 +54,7 @@ int run(const SimArgs& a) {
 }
 }  // namespace
 
-void setup_simulate(CLI::App& app) {
+void setup_simulate(CLI::App& app, Command& command) {
   auto a = std::make_shared<SimArgs>();
   app.add_option("MODEL", a->model, "Model JSON (a result file or a bare model)")->required();
   app.add_option("DATA", a->data.path, "Table with the input column(s) and a time axis")->required();
@@ -65,7 +64,12 @@ void setup_simulate(CLI::App& app) {
   add_initial_option(app, a->initial, &a->initial_samples, "rest; a grey-box result: its fitted initial state");
   app.add_option("--seed", a->seed, "Seed of the noise")->capture_default_str();
   app.add_flag("--force", a->force, "Overwrite an existing output file");
-  app.callback([a] { g_run = [a] { return run(*a); }; });
+  app.callback([a, &command] {
+    command = [a](Provenance& prov) {
+      a->data.provenance = &prov;
+      return run(*a);
+    };
+  });
 }
 
 }  // namespace ctid::cli

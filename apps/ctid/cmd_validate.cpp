@@ -8,7 +8,6 @@
 #include "common.hpp"
 
 namespace ctid::cli {
-extern std::function<int()> g_run;
 
 namespace {
 struct ValArgs {
@@ -115,7 +114,7 @@ int run(const ValArgs& a) {
 }
 }  // namespace
 
-void setup_validate(CLI::App& app) {
+void setup_validate(CLI::App& app, Command& command) {
   auto a = std::make_shared<ValArgs>();
   app.add_option("MODEL", a->model, "Model JSON (a result file or a bare model)")->required();
   app.add_option("DATA", a->paths, "Measured data table(s) or .mat file(s); several: each validated")->required();
@@ -124,7 +123,12 @@ void setup_validate(CLI::App& app) {
   app.add_option("--lags", a->lags, "Lags of the residual correlation tests")->capture_default_str();
   app.add_option("--json", a->json, "Write fit and residual tests to this JSON file");
   app.add_flag("--force", a->force, "Overwrite an existing output file");
-  app.callback([a] { g_run = [a] { return run(*a); }; });
+  app.callback([a, &command] {
+    command = [a](Provenance& prov) {
+      a->data.provenance = &prov;
+      return run(*a);
+    };
+  });
 }
 
 }  // namespace ctid::cli

@@ -91,7 +91,7 @@ IdData DataArgs::load(bool need_output, TrendInfo* removed_trend, std::pair<int,
       }
       if (time_col.empty())
         throw UsageError("give the time axis: --time COLUMN or --ts SECONDS (no column is named t or time)");
-      if (!batch_outcome())
+      if (!quiet)
         std::fprintf(stderr, "note: column '%s' is the time axis (no --time or --ts given)\n", time_col.c_str());
     }
     spec.time = time_col;
@@ -133,16 +133,21 @@ IdData DataArgs::load(bool need_output, TrendInfo* removed_trend, std::pair<int,
       used = {begin + 1, end};
     }
     if (rows) *rows = used;
-    if (d.uniform_time_deviation() > 1e-9 && !batch_outcome())
+    if (d.uniform_time_deviation() > 1e-9 && !quiet)
       std::fprintf(stderr, "note: %s: the sample times are within %.2g Ts of a uniform grid (threshold %g Ts): read as "
                    "uniform, Ts = %.10g s\n", path.c_str(), d.uniform_time_deviation(), IdData::kUniformTimeTolerance,
                    d.ts());
-    const bool first = g_preprocessing.empty() && !batch_outcome();  // (batch threads: no report, no shared text)
-    if (first)
-      g_preprocessing = path + ": " +
-                        (samples.empty() ? "all " + std::to_string(n_rows) + " rows"
-                                         : detail::format("rows {}..{} of {}", used.first, used.second, n_rows)) +
-                        (detrend == "none" ? "; no detrending" : "");
+    // What was done to this record, for the report and the result file.
+    std::string* done = nullptr;
+    if (provenance) {
+      provenance->add_data_file(path, n_rows);
+      provenance->preprocessing.push_back(
+          path + ": " +
+          (samples.empty() ? "all " + std::to_string(n_rows) + " rows"
+                           : detail::format("rows {}..{} of {}", used.first, used.second, n_rows)) +
+          (detrend == "none" ? "; no detrending" : ""));
+      done = &provenance->preprocessing.back();
+    }
     if (detrend == "none") return d;
     TrendInfo removed;
     IdData out = d.detrend(detrend == "mean" ? Detrend::Mean : Detrend::Linear, &removed);
@@ -161,20 +166,16 @@ IdData DataArgs::load(bool need_output, TrendInfo* removed_trend, std::pair<int,
       what += detail::format("{}{} {} {}", j > 0 ? ", " : "", in ? "input" : "output",
                              channel_name(in ? d.input_names() : d.output_names(), k), value);
     }
-    if (first) g_preprocessing += detail::format("; {} removed ({})", detrend == "mean" ? "means" : "linear trends", what);
-    if (announce_means && detrend == "mean" && !batch_outcome())
+    if (done) *done += detail::format("; {} removed ({})", detrend == "mean" ? "means" : "linear trends", what);
+    if (announce_means && detrend == "mean" && !quiet)
       std::fprintf(stderr, "note: the means were removed (%s); --detrend none keeps them\n", what.c_str());
     return out;
   } catch (const FileError& e) {
     throw InputError(e.what());
+  } catch (const ColumnSelectionError& e) {
+    throw UsageError(e.what());  // a column the file does not have, or one selected twice: the options' problem
   } catch (const InvalidArgument& e) {
-    const std::string what = e.what();
-    // An unknown column is a usage problem; everything else is about the file's content.
-    if (what.find("no column named") != std::string::npos || what.find("no variable named") != std::string::npos ||
-        what.find("column position") != std::string::npos || what.find("are the same column") != std::string::npos ||
-        what.find("is the time column") != std::string::npos)
-      throw UsageError(what);
-    throw InputError(path + ": " + what);
+    throw InputError(path + ": " + e.what());  // the file's content
   }
 }
 

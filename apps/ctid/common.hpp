@@ -33,10 +33,9 @@ struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The command line as typed (main) and what DataArgs::load did to the first record it loaded (its rows and
-/// detrending, with the removed means): the report's "command" and "preprocessing".
-extern std::string g_command_line;
-extern std::string g_preprocessing;
+/// What a subcommand runs once its options are parsed: its job, given the run's provenance (the command line and the
+/// library build, made by main) to record the data it reads in and to pass to what it writes. Returns the exit code.
+using Command = std::function<int(Provenance&)>;
 
 /// Options that select an experiment from a data file.
 struct DataArgs {
@@ -52,6 +51,10 @@ struct DataArgs {
   std::string samples_option = "--samples";  ///< the option's name in messages (--validate-samples for a validation record)
   /// With detrend "mean": say on stderr which means were removed (a command's own default, not the user's option).
   bool announce_means = false;
+  /// No notes on stderr (ctid batch: many records on threads).
+  bool quiet = false;
+  /// Where each file read is recorded (its content hash and rows) with what was done to it; null: not recorded.
+  Provenance* provenance = nullptr;
   void add_to(CLI::App& app, bool need_output);
   /// Load, select the columns and the rows (--samples), detrend (the removed trend in `removed`, left empty with
   /// --detrend none); maps every failure to InputError (file/content) or UsageError (inconsistent options).
@@ -163,13 +166,12 @@ std::vector<std::pair<std::string, std::string>> settings_of(const O&... o) {
 template <class M>
 void write_report(const std::string& path, const IdData& d, const Result<M>& r, const std::string& method,
                   const std::vector<std::pair<std::string, std::string>>& settings, const std::string& source,
-                  const std::vector<std::pair<std::string, IdData>>& more_records = {},
+                  const Provenance& provenance, const std::vector<std::pair<std::string, IdData>>& more_records = {},
                   std::optional<InitialCondition> more_records_initial = std::nullopt) {
   if (path.empty()) return;
   ReportOptions o;
   o.more_records_initial = more_records_initial;
-  o.command_line = g_command_line;
-  o.preprocessing = g_preprocessing;
+  o.provenance = provenance;
   o.method = method;
   o.title = "ctid " + method + " fit";
   o.data_source = source;
@@ -196,50 +198,42 @@ ModalOptions modal_options(const std::string& method, const std::vector<std::str
                            const std::vector<std::string>& own, std::map<std::string, std::string>& own_values);
 
 
-void setup_fit(CLI::App& app);
+void setup_fit(CLI::App& app, Command& run);
 /// `ctid fit ARGS...` run from inside another command (ctid demo): the same parsing, defaults, output and exit code.
 /// A parse error is a UsageError.
-int run_fit(std::vector<std::string> args);
+int run_fit(std::vector<std::string> args, Provenance& provenance);
 /// After `ctid fit --method M --help`: M's settings (names, units, ranges, defaults) from the library's registry;
 /// "" without --method.
 std::string fit_method_help(const CLI::App& fit);
-void setup_gfrf(CLI::App& app);
-void setup_poles(CLI::App& app);
-void setup_response(CLI::App& app);
-void setup_simulate(CLI::App& app);
-void setup_validate(CLI::App& app);
+void setup_gfrf(CLI::App& app, Command& run);
+void setup_poles(CLI::App& app, Command& run);
+void setup_response(CLI::App& app, Command& run);
+void setup_simulate(CLI::App& app, Command& run);
+void setup_validate(CLI::App& app, Command& run);
 /// A linear model through the origin cannot follow an offset: for each channel of d whose mean is above half its
 /// standard deviation, a warning on stderr naming it, its mean and the ratio, and suggesting --detrend mean.
 void warn_offsets(const IdData& d);
-void setup_compare(CLI::App& app);
+void setup_compare(CLI::App& app, Command& run);
 /// The name of channel j (0-based) of a record: its name, or its 1-based position when it has none.
 std::string channel_name(const std::vector<std::string>& names, int j);
 
-void setup_demo(CLI::App& app);
-void setup_example_data(CLI::App& app);
-void setup_order(CLI::App& app);
-void setup_report(CLI::App& app);
-
-/// ctid batch fits records on worker threads. While a fit runs there, batch_outcome() points at its slot: the
-/// fit's result goes into it and nothing is printed (the commands test it before printing); elsewhere it is null.
-struct BatchOutcome {
-  std::optional<Result<AnyModel>> result;
-  std::string method;
-};
-BatchOutcome*& batch_outcome();
+void setup_demo(CLI::App& app, Command& run);
+void setup_example_data(CLI::App& app, Command& run);
+void setup_order(CLI::App& app, Command& run);
+void setup_report(CLI::App& app, Command& run);
 
 /// One ctid batch run (cmd_batch.cpp): the records matched by `patterns`, each fitted by `fit_one` (ctid fit's
-/// options, one record; it fills batch_outcome() or throws), on `jobs` threads; one row per record written to `out`
-/// (.csv or .jsonl, the columns of Python's ctid.batch.fit_many) as it arrives. `resume` fits only the records whose
+/// options, one record; it returns the library's outcome or throws), on `jobs` threads; one row per record written
+/// to `out` (.csv or .jsonl, the library's batch rows: io/batch_file.hpp) as it arrives. `resume` fits only the records whose
 /// id is not yet in `out`. Exit code: 0 when every record gave a usable fit, 1 otherwise (the rows say why).
 struct BatchJob {
   std::vector<std::string> patterns;
   std::string method, out;
   int jobs = 0;  ///< 0: one per core
   bool resume = false, force = false;
-  std::function<int(const std::string& path)> fit_one;
+  std::function<FitOutcome(const std::string& path)> fit_one;
 };
 int run_batch(const BatchJob& job);
-void setup_batch(CLI::App& app);
+void setup_batch(CLI::App& app, Command& run);
 
 }  // namespace ctid::cli

@@ -10,8 +10,6 @@
 #include "common.hpp"
 
 namespace ctid::cli {
-std::function<int()> g_run;
-std::string g_command_line, g_preprocessing;
 
 namespace {
 volatile std::sig_atomic_t g_sigint = 0;
@@ -56,24 +54,25 @@ class CliProgress {
 int main(int argc, char** argv) {
   using namespace ctid::cli;
   CLI::App app{"ctid — continuous-time system identification"};
+  Command command;  // set by the subcommand parsed
   app.set_version_flag("--version", std::string("ctid ") + ctid::version());
   app.require_subcommand(1);
-  setup_fit(*app.add_subcommand("fit", "Estimate a continuous-time model from input/output data"));
-  setup_batch(*app.add_subcommand("batch", "Fit each of many records with one method (threads); one row per record in a CSV or JSON-lines file"));
-  setup_simulate(*app.add_subcommand("simulate", "Simulate a model file on the inputs of a data file"));
-  setup_validate(*app.add_subcommand("validate", "Compare a model with measured data (fit, residual tests)"));
-  setup_order(*app.add_subcommand("order", "Rank model structures [nb nf nk] by YIC, RT2, AIC or BIC (SRIVC fits)"));
-  setup_poles(*app.add_subcommand("poles", "Poles from a free response: data-matrix method (El-Shafey) against Prony"));
-  setup_response(*app.add_subcommand("response", "Nonparametric step, impulse or frequency response (modal functions)"));
-  setup_gfrf(*app.add_subcommand("gfrf", "Generalised frequency response functions of a NARX or NDE model file"));
-  setup_report(*app.add_subcommand("report", "Self-contained HTML report of a result file on a record"));
-  setup_compare(*app.add_subcommand("compare", "Several models on one record side by side (fits, simulations, Bode, step)"));
-  setup_demo(*app.add_subcommand("demo", "Identify a bundled real data set and print the model"));
-  setup_example_data(*app.add_subcommand("example-data", "Write a simulated example record the README and docs use"));
-  g_command_line = "ctid";
+  setup_fit(*app.add_subcommand("fit", "Estimate a continuous-time model from input/output data"), command);
+  setup_batch(*app.add_subcommand("batch", "Fit each of many records with one method (threads); one row per record in a CSV or JSON-lines file"), command);
+  setup_simulate(*app.add_subcommand("simulate", "Simulate a model file on the inputs of a data file"), command);
+  setup_validate(*app.add_subcommand("validate", "Compare a model with measured data (fit, residual tests)"), command);
+  setup_order(*app.add_subcommand("order", "Rank model structures [nb nf nk] by YIC, RT2, AIC or BIC (SRIVC fits)"), command);
+  setup_poles(*app.add_subcommand("poles", "Poles from a free response: data-matrix method (El-Shafey) against Prony"), command);
+  setup_response(*app.add_subcommand("response", "Nonparametric step, impulse or frequency response (modal functions)"), command);
+  setup_gfrf(*app.add_subcommand("gfrf", "Generalised frequency response functions of a NARX or NDE model file"), command);
+  setup_report(*app.add_subcommand("report", "Self-contained HTML report of a result file on a record"), command);
+  setup_compare(*app.add_subcommand("compare", "Several models on one record side by side (fits, simulations, Bode, step)"), command);
+  setup_demo(*app.add_subcommand("demo", "Identify a bundled real data set and print the model"), command);
+  setup_example_data(*app.add_subcommand("example-data", "Write a simulated example record the README and docs use"), command);
+  std::string typed = "ctid";
   for (int i = 1; i < argc; ++i) {
     const std::string s = argv[i];
-    g_command_line += " " + (s.find_first_of(" \t'\"") == std::string::npos ? s : "'" + s + "'");
+    typed += " " + (s.find_first_of(" \t'\"") == std::string::npos ? s : "'" + s + "'");
   }
   try {
     app.parse(argc, argv);
@@ -91,7 +90,8 @@ int main(int argc, char** argv) {
   }
   try {
     const CliProgress progress;
-    return g_run ? g_run() : kUsage;
+    ctid::Provenance provenance = ctid::make_provenance(typed);
+    return command ? command(provenance) : kUsage;
   } catch (const UsageError& e) {
     std::fprintf(stderr, "ctid: %s\n", e.what());
     return kUsage;

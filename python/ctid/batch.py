@@ -13,47 +13,23 @@ with only the records not yet written.
 estimators on the same executors: only the model, the input and the seeds travel, each worker draws its runs' noise
 from their seeds, and the summary gives bias, std and std over the Cramer-Rao bound per method and parameter.
 """
-import csv as _csv
-import json as _json
-import math as _math
 import os as _os
 import sys as _sys
 import time as _time
 
-#: The columns every row has, in this order; then, per parameter NAME of the model, NAME and NAME_std.
-COLUMNS = ["id", "method", "model", "orders", "fit_percent", "termination", "usable", "seconds", "error"]
+from . import _ctid
 
-
-def _orders(model):
-    """The structure of a fitted linear model in the estimators' terms (nb, nf, delay; nx); '' for the others."""
-    import ctid
-    if isinstance(model, ctid.TransferFunction):
-        s = f"nb={len(model.num)} nf={len(model.den) - 1}"
-        return s + (f" delay={model.delay:.6g}" if model.delay else "")
-    if isinstance(model, ctid.StateSpace):
-        return f"nx={model.A.shape[0]}"
-    if isinstance(model, ctid.MisoModel):
-        return "; ".join(f"nb={len(g.num)} nf={len(g.den) - 1}" for g in model.channels)
-    return ""
+#: The columns every row has, in this order; then, per parameter NAME of the model, NAME and NAME_std (the library's
+#: batch rows, which ctid batch writes too).
+COLUMNS = list(_ctid.BATCH_COLUMNS)
 
 
 def _row(rid, method, result=None, error="", seconds=0.0):
-    row = {"id": rid, "method": method, "model": "", "orders": "", "fit_percent": _math.nan, "termination": "",
-           "usable": False, "seconds": seconds, "error": error}
-    if result is not None:
-        import ctid
-        row["model"] = "modal" if isinstance(result.model, ctid.ModalModel) else ctid._ctid.model_type_name(result.model)
-        row["orders"] = _orders(result.model)
-        row["fit_percent"] = float(result.fit.fit_percent)
-        row["termination"] = result.summary.termination
-        row["usable"] = bool(result.usable())
-        row["seconds"] = float(result.summary.seconds)
-        row["error"] = "" if row["usable"] else result.why_not_usable()
-        p = result.parameters
-        for name, value, std in zip(p.names, p.values, p.std):
-            row[name] = float(value)
-            row[name + "_std"] = float(std)
-    return row
+    """The library's batch row (io/batch_file.hpp): the columns of COLUMNS, then NAME and NAME_std per parameter."""
+    import ctid
+    if result is None:
+        return ctid._ctid.batch_row(rid, method, None, error, seconds)
+    return ctid._ctid.batch_row(rid, method, result)
 
 
 def fit_one(rid, record, method, options, file_options):
@@ -107,59 +83,15 @@ def _records(records):
     return out
 
 
-class _Writer:
-    """Rows appended to a CSV or JSON-lines file as they arrive (one flush per row). A CSV whose columns grow (a
-    record with other parameter names) is rewritten once with the new header (temporary file, then rename)."""
-
-    def __init__(self, path, resume):
-        self.path = _os.fspath(path)
-        self.jsonl = self.path.endswith((".jsonl", ".json", ".ndjson"))
-        if not self.jsonl and not self.path.endswith(".csv"):
-            raise ValueError(f"ctid.batch: out must end in .csv or .jsonl (got '{self.path}')")
-        self.rows = []
-        if _os.path.exists(self.path):
-            if not resume:
-                raise FileExistsError(f"ctid.batch: {self.path} exists; resume=True continues it (only the rows "
-                                      f"not in it are fitted), or remove it")
-            self.rows = self._read()
-        self.columns = list(COLUMNS)
-        for r in self.rows:
-            self._grow(r)
-
-    def _read(self):
-        with open(self.path, newline="") as f:
-            if self.jsonl:
-                return [_json.loads(line) for line in f if line.strip()]
-            rows = list(_csv.DictReader(f))
-        for r in rows:  # numbers back from text
-            for k, v in r.items():
-                if k in ("id", "method", "model", "orders", "termination", "error"):
-                    continue
-                r[k] = (v == "True") if k == "usable" else (float(v) if v != "" else _math.nan)
-        return rows
-
-    def _grow(self, row):
-        new = [k for k in row if k not in self.columns]
-        self.columns += new
-        return bool(new)
-
-    def add(self, row):
-        grew = self._grow(row)
-        self.rows.append(row)
-        if self.jsonl:
-            with open(self.path, "a") as f:
-                f.write(_json.dumps({k: (None if isinstance(v, float) and _math.isnan(v) else v)
-                                     for k, v in row.items()}) + "\n")
-        elif grew or not _os.path.exists(self.path):
-            tmp = self.path + ".tmp"
-            with open(tmp, "w", newline="") as f:
-                w = _csv.DictWriter(f, fieldnames=self.columns, restval="")
-                w.writeheader()
-                w.writerows(self.rows)
-            _os.replace(tmp, self.path)
-        else:
-            with open(self.path, "a", newline="") as f:
-                _csv.DictWriter(f, fieldnames=self.columns, restval="").writerow(row)
+def _writer(out, resume):
+    """The library's rows file (BatchFile: CSV or JSON lines, written row by row), never replacing a file unless
+    resuming it."""
+    import ctid
+    path = _os.fspath(out)
+    if _os.path.exists(path) and not resume:
+        raise FileExistsError(f"ctid.batch: {path} exists; resume=True continues it (only the rows not in it are "
+                              f"fitted), or remove it")
+    return ctid._ctid.BatchFile(path, resume)
 
 
 def _show(label, done, total, errors, final=False):
@@ -306,7 +238,7 @@ def fit_many(records, method=None, client=None, *, out=None, resume=False, progr
     pairs = _records(records)
     file_options = {k: v for k, v in dict(inputs=inputs, outputs=outputs, time=time, ts=ts,
                                           intersample=intersample).items() if v is not None}
-    writer = _Writer(out, resume) if out is not None else None
+    writer = _writer(out, resume) if out is not None else None
     rows = {str(r["id"]): r for r in writer.rows} if writer else {}  # those of an earlier run (resume)
     todo = [(rid, rec) for rid, rec in pairs if rid not in rows]
 
@@ -426,7 +358,7 @@ def monte_carlo(model, u, ts=None, *, t=None, intersample="zoh", runs=100, snr_d
     x = np.asarray(clean.y)[:, 0]
     sigma2 = noise_std ** 2 if noise_std is not None else float(np.mean((x - x.mean()) ** 2)) / 10 ** (snr_db / 10)
 
-    writer = _Writer(out, resume) if out is not None else None
+    writer = _writer(out, resume) if out is not None else None
     rows = {str(r["id"]): r for r in writer.rows} if writer else {}
     threads = _threads(client, jobs)
     tasks, total = [], 0

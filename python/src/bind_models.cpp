@@ -26,6 +26,66 @@ void def_write_result(py::module_& m) {
 }
 }  // namespace
 
+namespace {
+// A batch row as a dict (column -> str, float, int or bool) and back (None and NaN as NaN).
+py::dict row_dict(const BatchRow& row) {
+  py::dict d;
+  for (const auto& [name, cell] : row) d[py::str(name)] = std::visit([](const auto& v) { return py::cast(v); }, cell);
+  return d;
+}
+BatchRow dict_row(const py::dict& d) {
+  BatchRow row;
+  for (const auto& [k, v] : d) {
+    const std::string name = py::str(k);
+    if (py::isinstance<py::bool_>(v)) row.emplace_back(name, v.cast<bool>());
+    else if (py::isinstance<py::str>(v)) row.emplace_back(name, v.cast<std::string>());
+    else if (py::isinstance<py::int_>(v)) row.emplace_back(name, v.cast<std::int64_t>());
+    else if (v.is_none()) row.emplace_back(name, std::numeric_limits<double>::quiet_NaN());
+    else row.emplace_back(name, v.cast<double>());  // float, numpy numbers; anything else: TypeError
+  }
+  return row;
+}
+
+// The library's batch rows and their file (io/batch_file.hpp), for ctid.batch.
+void bind_batch_rows(py::module_& m) {
+  m.attr("BATCH_COLUMNS") = batch_columns();
+  std::apply(
+      [&](auto... model) {
+        (m.def(
+             "batch_row",
+             [](const std::string& id, const std::string& method, const Result<decltype(model)>& r) {
+               const Result<AnyModel> any = to_any(r);
+               return row_dict(batch_row(id, method, &any, "", 0.0));
+             },
+             py::arg("id"), py::arg("method"), py::arg("result"),
+             "The batch row of a fitted record (the columns of batch_columns, then NAME and NAME_std per parameter)."),
+         ...);
+      },
+      std::tuple<TransferFunction, MisoModel, StateSpace, FsfModel, NarxModel, NdeModel, GreyboxModel>{});
+  m.def(
+      "batch_row",
+      [](const std::string& id, const std::string& method, py::none, const std::string& error, double seconds) {
+        return row_dict(batch_row(id, method, nullptr, error, seconds));
+      },
+      py::arg("id"), py::arg("method"), py::arg("result"), py::arg("error"), py::arg("seconds"),
+      "The batch row of a record that could not be read or fitted: its error and the seconds spent.");
+  py::class_<BatchFile>(m, "BatchFile",
+                        "A batch's rows file (.csv or .jsonl), written row by row as rows are added; with resume the "
+                        "rows of an existing file are read first.")
+      .def(py::init<std::string, bool>(), py::arg("path"), py::arg("resume"))
+      .def_property_readonly("path", &BatchFile::path)
+      .def_property_readonly("rows",
+                             [](const BatchFile& f) {
+                               py::list out;
+                               for (const auto& r : f.rows()) out.append(row_dict(r));
+                               return out;
+                             })
+      .def("__contains__", &BatchFile::contains, py::arg("id"))
+      .def("usable", &BatchFile::usable)
+      .def("add", [](BatchFile& f, const py::dict& row) { f.add(dict_row(row)); }, py::arg("row"));
+}
+}  // namespace
+
 void bind_models(py::module_& m) {
   py::class_<StateSpace>(m, "StateSpace",
                          "Continuous-time state-space model x' = A x + B u, y = C x + D u; with an innovation gain K "
@@ -184,6 +244,7 @@ void bind_models(py::module_& m) {
   def_write_result<NarxModel>(m);
   def_write_result<NdeModel>(m);
   def_write_result<GreyboxModel>(m);
+  bind_batch_rows(m);
 }
 
 }  // namespace ctid::python

@@ -216,3 +216,32 @@ def test_monte_carlo_runs_are_the_same_on_threads_and_resume(tmp_path):
         ctid.batch.monte_carlo(runs=2, methods="srivcc", **RAO)
     with pytest.raises(ValueError, match="runs must be"):
         ctid.batch.monte_carlo(runs=0, **RAO)
+
+
+@pytest.mark.skipif(not os.environ.get("CTID_CLI"), reason="needs the ctid command (CTID_CLI, set by ctest)")
+def test_ctid_batch_and_fit_many_resume_each_others_files(records, tmp_path):
+    """Both engines write the library's rows: ctid batch starts a file that fit_many resumes, and the reverse; the
+    rows read back carry the other engine's numbers exactly (to 1e-12 of fresh fits of the same records)."""
+    import subprocess
+    paths = records[0][:6]
+    opts = dict(method="srivc", client=None, inputs=["u"], outputs=["y"], ts=0.02, nb=1, nf=2, progress=False)
+    cli = [os.environ["CTID_CLI"], "batch", "--method", "srivc", "--input", "u", "--output", "y", "--ts", "0.02",
+           "--nb", "1", "--nf", "2", "--jobs", "1"]
+    fresh = ctid.batch.fit_many(paths, **opts)
+    for suffix in ("csv", "jsonl"):
+        out = str(tmp_path / f"cli_first.{suffix}")
+        done = subprocess.run(cli + paths[:3] + ["--out", out], capture_output=True, text=True)
+        assert done.returncode == 0, done.stderr
+        df = ctid.batch.fit_many(paths, out=out, resume=True, **opts)
+        assert df["id"].tolist() == paths and df["method"].eq("srivc").all()
+        assert np.allclose(df["a1"], fresh["a1"], rtol=1e-12, atol=0)
+        assert np.allclose(df["a1_std"], fresh["a1_std"], rtol=1e-12, atol=0)
+        assert df["usable"].astype(bool).all()
+
+        out = str(tmp_path / f"python_first.{suffix}")
+        ctid.batch.fit_many(paths[:3], out=out, **opts)
+        done = subprocess.run(cli + paths + ["--out", out, "--resume"], capture_output=True, text=True)
+        assert done.returncode == 0, done.stderr
+        assert "6 records (3 fitted now" in done.stdout, done.stdout
+        back = ctid.batch.fit_many(paths, out=out, resume=True, **opts)  # every row read back, none fitted
+        assert np.allclose(back["b0"], fresh["b0"], rtol=1e-12, atol=0)

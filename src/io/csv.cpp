@@ -21,11 +21,11 @@ int CsvTable::column(const std::string& key) const {
   const long pos = std::strtol(key.c_str(), &end, 10);
   if (!key.empty() && end && *end == '\0') {
     if (pos >= 1 && pos <= static_cast<long>(names.size())) return static_cast<int>(pos - 1);
-    throw InvalidArgument(detail::format("{}: column position {} is outside 1..{}", source, pos, names.size()));
+    throw ColumnSelectionError(detail::format("{}: column position {} is outside 1..{}", source, pos, names.size()));
   }
   std::string known;
   for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
-  throw InvalidArgument(detail::format("{}: no column named '{}' (columns: {})", source, key, known));
+  throw ColumnSelectionError(detail::format("{}: no column named '{}' (columns: {})", source, key, known));
 }
 
 namespace {

@@ -412,10 +412,16 @@ std::string any_model_to_json(const AnyModel& model, bool exact, int indent) {
 }
 
 namespace {
-std::string result_json(const Result<AnyModel>& r, const std::string& method, int indent) {
+std::string result_json(const Result<AnyModel>& r, const std::string& method, int indent, const Provenance* prov) {
   json j;
   j["ctid_version"] = version();
   j["method"] = method;
+  if (prov) {
+    json files = json::array();
+    for (const auto& f : prov->data) files.push_back({{"path", f.path}, {"content_hash", f.content_hash}, {"rows", f.rows}});
+    j["provenance"] = {{"command_line", prov->command_line}, {"version", prov->version}, {"commit", prov->commit},
+                       {"data", files}, {"preprocessing", prov->preprocessing}};
+  }
   j["model"] = any_model_json(r.model);
   json params = json::array();
   for (int i = 0; i < r.parameters.size(); ++i)
@@ -495,11 +501,12 @@ void read_envelope(const json& j, const Reader& rd, Result<M>& r) {
 }
 }  // namespace
 
-std::string result_to_json(const Result<AnyModel>& r, const std::string& method, int indent) {
-  return result_json(r, method, indent);
+std::string result_to_json(const Result<AnyModel>& r, const std::string& method, int indent, const Provenance* provenance) {
+  return result_json(r, method, indent, provenance);
 }
-void write_result_json(const std::string& path, const Result<AnyModel>& r, const std::string& method) {
-  write_text_file(path, result_to_json(r, method) + "\n");
+void write_result_json(const std::string& path, const Result<AnyModel>& r, const std::string& method,
+                       const Provenance* provenance) {
+  write_text_file(path, result_to_json(r, method, 2, provenance) + "\n");
 }
 
 ResultFile parse_result_file(const std::string& text, const std::string& source) {

@@ -47,15 +47,18 @@ void check_distinct(const DataSpec& s, const std::string& source, Key key) {
   auto twice = [&](const std::vector<std::string>& v, const char* what) {
     for (std::size_t i = 0; i < v.size(); ++i)
       for (std::size_t k = 0; k < i; ++k)
-        CTID_REQUIRE(key(v[i]) != key(v[k]), "{}: {} '{}' and '{}' are the same column; select each once", source, what, v[k],
-                     v[i]);
+        if (key(v[i]) == key(v[k]))
+          throw ColumnSelectionError(
+              detail::format("{}: {} '{}' and '{}' are the same column; select each once", source, what, v[k], v[i]));
   };
   twice(s.inputs, "inputs");
   twice(s.outputs, "outputs");
   if (s.time.empty()) return;
   for (const auto* v : {&s.inputs, &s.outputs})
     for (const auto& n : *v)
-      CTID_REQUIRE(key(n) != key(s.time), "{}: '{}' is the time column; it cannot also be an input or output", source, n);
+      if (key(n) == key(s.time))
+        throw ColumnSelectionError(
+            detail::format("{}: '{}' is the time column; it cannot also be an input or output", source, n));
 }
 }  // namespace
 

@@ -354,16 +354,17 @@ std::string output_name(const IdData& d, int j) {
 
 void data_section(Page& page, const IdData& d, const ReportOptions& o);
 
-// The rows every report's summary ends with: the preprocessing and command line (when given), the ctid version and
-// the UTC time the report was made.
+// The rows every report's summary ends with: the provenance (preprocessing, command line, data files, when given),
+// the ctid version and commit, and the UTC time the report was made.
 void provenance(std::vector<std::vector<std::string>>& rows, const ReportOptions& o) {
-  if (!o.preprocessing.empty()) rows.push_back({"preprocessing", o.preprocessing});
-  if (!o.command_line.empty()) rows.push_back({"command", o.command_line});
+  for (const auto& [name, value] : o.provenance.rows()) rows.push_back({name, value});
   const std::time_t now = std::time(nullptr);
   std::tm utc{};
   char when[32] = "";
   if (gmtime_r(&now, &utc)) std::strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S UTC", &utc);
-  rows.push_back({"made by", std::string("ctid ") + version() + ", " + when});
+  Provenance p = o.provenance;
+  if (p.version.empty()) p = make_provenance();
+  rows.push_back({"made by", p.made_by() + ", " + when});
 }
 
 template <class M>

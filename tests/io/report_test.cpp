@@ -50,8 +50,8 @@ TEST(Report, SaysWhatTheNumbersMean) {
   const IdData d = plant();
   auto r = srivc(d, {.nb = 1, .nf = 2});
   ReportOptions o{.method = "srivc"};
-  o.preprocessing = "rows 1..500 of 1000; means removed";
-  o.command_line = "ctid fit x.csv --method srivc";
+  o.provenance.preprocessing = {"rows 1..500 of 1000; means removed"};
+  o.provenance.command_line = "ctid fit x.csv --method srivc";
   std::string html = html_report(d, r, o);
   for (const char* s : {"<h2>Poles, zeros and gain</h2>", "complex pair", "DC gain G(0)", "<td>preprocessing</td><td>rows "
                         "1..500 of 1000; means removed</td>", "<td>command</td><td>ctid fit x.csv --method srivc</td>",
@@ -85,7 +85,7 @@ TEST(Report, ComparisonPutsModelsSideBySide) {
   const TransferFunction unstable(Eigen::VectorXd{{1.0}}, Eigen::VectorXd{{1.0, -20.0}});
   const auto cs = compare_models(d, {{"srivc <2>", r.model}, {"first", first}, {"unstable", unstable}});
   ReportOptions o;
-  o.command_line = "ctid compare a.json b.json c.json x.csv";
+  o.provenance.command_line = "ctid compare a.json b.json c.json x.csv";
   const std::string html = html_comparison_report(d, cs, o);
   for (const char* s : {"<title>ctid compare</title>", "<h2>Models</h2>", "<td>srivc &lt;2&gt;</td>", "<td>diverges</td>",
                         "<h2>Residual tests</h2>", "Unit step response", "Poles of the linear models",

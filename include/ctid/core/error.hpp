@@ -6,6 +6,8 @@
 //     times, order too high for the data, ...
 //   * InvalidOptions (InvalidArgument): an options field out of range; thrown by
 //     `Options::validate()` and names the field and its value.
+//   * ColumnSelectionError (InvalidArgument): a data column selected that the file does
+//     not have, or selected twice.
 //   * FileError (std::runtime_error): a file cannot be opened, parsed or written;
 //     the message names the path (and line/column where it applies).
 // Tier 2, the algorithm did not succeed: no exception, see Summary (status.hpp).
@@ -38,6 +40,11 @@ class UnknownSetting : public InvalidOptions {
   std::string method;   ///< the method asked
   std::string key;      ///< the name given
   std::string closest;  ///< the closest setting name of the method, "" when none is close
+};
+/// A column selection that names no column of the file, or one column twice (a name or 1-based position).
+class ColumnSelectionError : public InvalidArgument {
+ public:
+  explicit ColumnSelectionError(const std::string& what) : InvalidArgument(what) {}
 };
 /// A file could not be opened, read, parsed or written.
 class FileError : public std::runtime_error {

@@ -15,6 +15,7 @@
 #include "ctid/core/types.hpp"
 #include "ctid/estimate/modal.hpp"
 #include "ctid/estimate/order_selection.hpp"
+#include "ctid/io/provenance.hpp"
 #include "ctid/model/any_model.hpp"
 #include "ctid/model/fsf.hpp"
 #include "ctid/model/miso.hpp"
@@ -63,8 +64,12 @@ std::string table_to_json(const std::string& type, const std::vector<std::pair<s
 /// {"type": "narx", "ts": s, "terms": [{"name": "y(k-1)*u(k-2)", "value": c}, ...]}; NDE {"type": "nde", "terms":
 /// [{"name": "D^2y", "value": 1e-4}, ...]}, written normalised so that the coefficient of y is +1 when the model
 /// has a y term; grey-box models as parse_greybox_json reads them. write_result_json writes atomically (temporary file, then rename); throws FileError.
-std::string result_to_json(const Result<AnyModel>& result, const std::string& method, int indent = 2);
-void write_result_json(const std::string& path, const Result<AnyModel>& result, const std::string& method);
+/// With `provenance` the envelope has a "provenance" member: {"command_line", "version", "commit", "data": [{"path",
+/// "content_hash", "rows"}], "preprocessing": [...]} (io/provenance.hpp); readers ignore it.
+std::string result_to_json(const Result<AnyModel>& result, const std::string& method, int indent = 2,
+                           const Provenance* provenance = nullptr);
+void write_result_json(const std::string& path, const Result<AnyModel>& result, const std::string& method,
+                       const Provenance* provenance = nullptr);
 /// Shorthands for a typed result (Result<TransferFunction>, Result<NarxModel>, ...): the same file.
 template <class M>
 std::string result_to_json(const Result<M>& result, const std::string& method, int indent = 2) {

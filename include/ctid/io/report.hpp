@@ -17,6 +17,7 @@
 #include "ctid/model/any_model.hpp"
 #include "ctid/model/fsf.hpp"
 #include "ctid/model/miso.hpp"
+#include "ctid/io/provenance.hpp"
 #include "ctid/model/narx.hpp"
 #include "ctid/model/nde.hpp"
 #include "ctid/model/transfer_function.hpp"
@@ -30,8 +31,9 @@ struct ReportOptions {
   std::string method;                                       ///< e.g. "srivc"
   std::vector<std::pair<std::string, std::string>> settings;  ///< shown as given (e.g. the CLI's --set values)
   std::string data_source;                                  ///< e.g. the data file name
-  std::string preprocessing;  ///< what was done to the data before the fit (rows, detrending with the removed means)
-  std::string command_line;   ///< the command that made the report (the CLI passes its own); shown as given
+  /// Where the result came from (io/provenance.hpp): the preprocessing, the command line and the data files are
+  /// shown when given; the version is the library's.
+  Provenance provenance;
   int max_lag = 25;                                         ///< residual correlation lags
   int max_points = 4000;                                    ///< time plots are decimated (min/max pairs) above this
   /// Initial condition of the simulation compared with the record (simulate/simulate.hpp); Estimated uses
@@ -47,8 +49,8 @@ struct ReportOptions {
   std::optional<InitialCondition> more_records_initial;
 };
 
-/// Every report states the ctid version and the UTC time it was made, the preprocessing and the command line (when
-/// given), flags parameters within two standard deviations of 0 as not significant, and says under each residual test
+/// Every report states the ctid version (and commit) and the UTC time it was made, the preprocessing, the command
+/// line and the data files with their content hashes (when given), flags parameters within two standard deviations of 0 as not significant, and says under each residual test
 /// what its pass or failure means.
 /// Report of a result on the record `data` (single input and output — for a MisoModel one input per channel,
 /// a state-space model with one input and output as its transfer function; the model is simulated on it): the
