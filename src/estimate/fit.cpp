@@ -30,62 +30,9 @@ namespace ctid {
 
 namespace fit_detail {
 
-// Applies `settings` to the options structs through their tables: each name goes to the first struct whose table
-// has it (NAME.KEY to a named setting NAME). `own` names settings the run handles itself: they are returned, not
-// applied. An unknown name throws UnknownSetting naming the closest setting of the method.
-template <class... O>
-SettingList apply_settings(const std::string& method, const SettingList& settings, const std::vector<std::string>& own,
-                           O&... o) {
-  SettingList rest;
-  for (const auto& [name, value] : settings) {
-    if (std::find(own.begin(), own.end(), name) != own.end()) {
-      rest.emplace_back(name, value);
-      continue;
-    }
-    bool done = false;
-    (
-        [&, &name = name, &value = value] {
-          if (done || !option_table<O>().find(name)) return;
-          if (const auto* text = std::get_if<std::string>(&value))
-            option_table<O>().set(o, name, *text);
-          else
-            option_table<O>().set_value(o, name, std::get<OptionValue>(value));
-          done = true;
-        }(),
-        ...);
-    if (done) continue;
-    std::vector<std::string> names = own;
-    (
-        [&] {
-          for (const auto& n : option_table<O>().names()) names.push_back(n);
-        }(),
-        ...);
-    const std::string near = closest_name(name, names);
-    throw UnknownSetting(detail::format("{}: '{}' is not a setting{}", method, name,
-                                        near.empty() ? std::string() : "; did you mean '" + near + "'?"),
-                         method, name, near);
-  }
-  return rest;
-}
-
-template <class... O>
-SettingsText settings_text(const O&... o) {
-  SettingsText s;
-  (
-      [&] {
-        for (auto& p : option_table<O>().settings(o)) s.push_back(std::move(p));
-      }(),
-      ...);
-  return s;
-}
-
 template <class M>
 FitOutcome outcome(const Result<M>& r, std::string method, SettingsText settings) {
-  FitOutcome out;
-  out.result = to_any(r);
-  out.method = std::move(method);
-  out.settings = std::move(settings);
-  return out;
+  return fit_outcome(r, std::move(method), std::move(settings));
 }
 
 // One input: the single entry of the orders.

@@ -2,6 +2,7 @@
 #include "ctid/estimate/methods.hpp"
 
 #include <algorithm>
+#include <deque>
 #include <map>
 
 #include "ctid/core/check.hpp"
@@ -67,18 +68,18 @@ MethodInfo reached(MethodInfo m, std::string by) {
   return m;
 }
 
-const std::vector<std::string> tf{"transfer_function"};
 
 // The names of diagnostic keys (both types).
 template <class... K>
 std::vector<std::string> reports(const K&... keys) {
   return {std::string(keys.name)...};
 }
-}  // namespace
 
-const std::vector<MethodInfo>& methods() {
+// The library's methods, in the order of docs/methods.
+std::deque<MethodInfo> library_methods() {
   using namespace diagnostic;  // the keys of what each method reports
-  static const std::vector<MethodInfo> all = {
+  const std::vector<std::string> tf{"transfer_function"};
+  return {
       fits(entry<LssvfOptions>("lssvf", "Johansson (1986) least squares on state-variable-filtered signals",
                                {"LssvfOptions"},
                                reports(tau, equation_error_variance, theta_tau, B_at_minus_1_over_tau, tau_grid,
@@ -225,7 +226,33 @@ const std::vector<MethodInfo>& methods() {
             .model_types = {"state_space"}},
            fit_runs::ssest),
   };
+}
+
+// Built on first use, so that a register_method() of another file's static initialiser finds it complete.
+std::deque<MethodInfo>& registry() {
+  static std::deque<MethodInfo> all = library_methods();
   return all;
+}
+}  // namespace
+
+const std::deque<MethodInfo>& methods() { return registry(); }
+
+bool register_method(MethodInfo m) {
+  std::deque<MethodInfo>& all = registry();
+  std::vector<std::string> names = m.aliases;
+  names.push_back(m.name);
+  for (const auto& n : names) {
+    CTID_REQUIRE(!n.empty(), "register_method: a method needs a name");
+    for (const auto& x : all)
+      CTID_REQUIRE(x.name != n && std::find(x.aliases.begin(), x.aliases.end(), n) == x.aliases.end(),
+                   "register_method: '{}' is already a method's name", n);
+  }
+  CTID_REQUIRE(!m.capabilities.records || m.run, "register_method: {} fits records but has no run", m.name);
+  for (const auto& d : m.diagnostics)
+    CTID_REQUIRE(find_diagnostic(d) != nullptr, "register_method: {} reports '{}', which is not a declared diagnostic",
+                 m.name, d);
+  all.push_back(std::move(m));
+  return true;
 }
 
 const MethodInfo& method_info(const std::string& name) {

@@ -5,12 +5,15 @@
 // that walk the registry all call it; none of them dispatches on method names itself.
 #pragma once
 
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <utility>
 #include <variant>
 #include <vector>
 
+#include "ctid/core/error.hpp"
+#include "ctid/core/names.hpp"
 #include "ctid/core/types.hpp"
 #include "ctid/data/frequency_data.hpp"
 #include "ctid/data/iddata.hpp"
@@ -84,5 +87,68 @@ std::string default_method(const FitStructure& structure, bool frequency_data = 
 /// records, inputs or outputs, frequency data: each names the method and what it takes). A fit that ran but cannot
 /// be trusted returns normally with result.usable() false.
 FitOutcome fit(const std::string& method, const FitRequest& request);
+
+// For the run of a method (estimate/methods.hpp: MethodInfo::run): its settings applied to its options structs, the
+// settings it used as text, and the outcome.
+
+/// Applies `settings` to the options structs `o...` through their tables: each name goes to the first struct whose
+/// table has it. `own` names settings the run handles itself: they are returned, not applied. An unknown name throws
+/// UnknownSetting naming the closest setting of the method; a bad value InvalidOptions.
+template <class... O>
+SettingList apply_settings(const std::string& method, const SettingList& settings, const std::vector<std::string>& own,
+                           O&... o) {
+  SettingList rest;
+  for (const auto& [name, value] : settings) {
+    if (std::find(own.begin(), own.end(), name) != own.end()) {
+      rest.emplace_back(name, value);
+      continue;
+    }
+    bool done = false;
+    (
+        [&, &name = name, &value = value] {
+          if (done || !option_table<O>().find(name)) return;
+          if (const auto* text = std::get_if<std::string>(&value))
+            option_table<O>().set(o, name, *text);
+          else
+            option_table<O>().set_value(o, name, std::get<OptionValue>(value));
+          done = true;
+        }(),
+        ...);
+    if (done) continue;
+    std::vector<std::string> names = own;
+    (
+        [&] {
+          for (const auto& n : option_table<O>().names()) names.push_back(n);
+        }(),
+        ...);
+    const std::string near = closest_name(name, names);
+    throw UnknownSetting(method + ": '" + name + "' is not a setting" +
+                             (near.empty() ? std::string() : "; did you mean '" + near + "'?"),
+                         method, name, near);
+  }
+  return rest;
+}
+
+/// Every setting of the options structs `o...` as NAME/VALUE text, defaults included (FitOutcome::settings).
+template <class... O>
+SettingsText settings_text(const O&... o) {
+  SettingsText s;
+  (
+      [&] {
+        for (auto& p : option_table<O>().settings(o)) s.push_back(std::move(p));
+      }(),
+      ...);
+  return s;
+}
+
+/// The outcome of a run: the result as Result<AnyModel>, the registry name of the method that ran, its settings.
+template <class M>
+FitOutcome fit_outcome(const Result<M>& r, std::string method, SettingsText settings) {
+  FitOutcome out;
+  out.result = to_any(r);
+  out.method = std::move(method);
+  out.settings = std::move(settings);
+  return out;
+}
 
 }  // namespace ctid

@@ -4,9 +4,11 @@
 // summary, its settings read from the options tables (estimate/options.hpp), its capabilities and, for the methods
 // that fit records, how it runs (fit(), estimate/fit.hpp). The CLI's method list, flag checks and per-method help,
 // Python's ctid.methods()/ctid.settings()/ctid.fit(), ctid batch and ctid.batch.fit_many all read this list.
-// Adding an estimator: its function, its options table, and one entry in src/estimate/methods.cpp.
+// Adding an estimator: its function, its options table, and one entry in src/estimate/methods.cpp (or, outside
+// the library, one CTID_REGISTER_METHOD line in its own source file).
 #pragma once
 
+#include <deque>
 #include <functional>
 #include <string>
 #include <vector>
@@ -59,8 +61,41 @@ struct MethodInfo {
   std::function<FitOutcome(const FitRequest&)> run;
 };
 
-/// Every registered method, in the order of docs/methods.
-const std::vector<MethodInfo>& methods();
+/// Every registered method: the library's in the order of docs/methods, then those added by register_method.
+/// (A deque: adding a method keeps every reference to an entry valid.)
+const std::deque<MethodInfo>& methods();
+
+/// Adds an estimator from outside the library (an experiment, a plugin, the worked example of
+/// docs/architecture.md) to the registry, after the library's methods: from then on fit(), the CLI's --method,
+/// its help, ctid batch and Python's ctid.fit reach it by its name. Call it before methods run on several threads;
+/// CTID_REGISTER_METHOD calls it from a static initialiser of the method's source file. Throws InvalidArgument when
+/// the name or an alias is taken, when a fit of records has no run, or for an undeclared diagnostic.
+bool register_method(MethodInfo m);
+
+/// The registry entry of an estimator of records whose settings are the tables of its options structs `O...`
+/// (estimate/options.hpp): its name, summary, capabilities (records is set) and run.
+template <class... O>
+MethodInfo fit_method(std::string name, std::string summary, MethodCapabilities capabilities,
+                      std::function<FitOutcome(const FitRequest&)> run) {
+  MethodInfo m;
+  m.name = std::move(name);
+  m.summary = std::move(summary);
+  (
+      [&] {
+        for (auto& i : option_table<O>().info()) m.settings.push_back(std::move(i));
+      }(),
+      ...);
+  capabilities.records = true;
+  m.capabilities = std::move(capabilities);
+  m.run = std::move(run);
+  return m;
+}
+
+/// Registers a method at static initialisation: CTID_REGISTER_METHOD(fit_method<MyOptions>(...)); in its source file.
+#define CTID_REGISTER_METHOD_CAT2(a, b) a##b
+#define CTID_REGISTER_METHOD_CAT(a, b) CTID_REGISTER_METHOD_CAT2(a, b)
+#define CTID_REGISTER_METHOD(...) \
+  [[maybe_unused]] static const bool CTID_REGISTER_METHOD_CAT(ctid_registered_, __LINE__) = ::ctid::register_method(__VA_ARGS__)
 /// The method named `name` or one of its aliases; throws InvalidOptions naming the closest registered name.
 const MethodInfo& method_info(const std::string& name);
 /// The methods that fit records (capabilities.records), in registry order: ctid fit's --method choices.
