@@ -1,6 +1,6 @@
 """The library's registry from Python: ctid.fit runs every method that fits records, by its name, on a small record
 of its kind (the structure keywords its capabilities call for), gives what the method's own function gives, and
-refuses what the method does not take. The same walk from the command line is tests/cli/cli_test.cpp's
+refuses what the method does not take. The same walk from the command line is tests/cli/cli_fit_test.cpp's
 Cli.EveryRegisteredFitRunsFromTheCommandLine."""
 import os
 import subprocess
