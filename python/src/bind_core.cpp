@@ -52,7 +52,8 @@ void bind_core(py::module_& m) {
       .def_readonly("covariance", &ParameterSet::covariance)
       .def_readonly("fixed", &ParameterSet::fixed)
       .def("__len__", &ParameterSet::size)
-      .def("__getitem__", &ParameterSet::value, py::arg("name"), "Value of a parameter by name.");
+      .def("__getitem__", &ParameterSet::value, py::arg("name"), "Value of a parameter by name.")
+      .def("__repr__", &parameters_text);
 
   py::class_<FitReport>(m, "FitReport", "Quality of fit of the simulated output (see validate/metrics.hpp).")
       .def_readonly("fit_percent", &FitReport::fit_percent)
@@ -63,14 +64,16 @@ void bind_core(py::module_& m) {
       .def_readonly("aicc", &FitReport::aicc)
       .def_readonly("bic", &FitReport::bic)
       .def_readonly("n_samples", &FitReport::n_samples)
-      .def_readonly("n_parameters", &FitReport::n_parameters);
+      .def_readonly("n_parameters", &FitReport::n_parameters)
+      .def("__repr__", &fit_report_text);
 
   py::class_<Summary>(m, "Summary", "How the run ended.")
       .def_property_readonly("termination", [](const Summary& s) { return std::string(to_string(s.termination)); })
       .def_readonly("message", &Summary::message)
       .def_readonly("iterations", &Summary::iterations)
       .def_readonly("seconds", &Summary::seconds)
-      .def("succeeded", &Summary::succeeded);
+      .def("succeeded", &Summary::succeeded)
+      .def("__repr__", &summary_text);
 
   py::class_<Diagnostics>(m, "Diagnostics", "Numerical diagnostics: condition number, warnings, method-specific numbers.")
       .def_readonly("condition_number", &Diagnostics::condition_number)
@@ -78,7 +81,8 @@ void bind_core(py::module_& m) {
       .def_readonly("choices", &Diagnostics::choices,
                     "settings the estimator chose itself (left automatic), one line each: 'NAME = VALUE: why'")
       .def_property_readonly("scalars", &Diagnostics::scalars, "method-specific numbers by name (ctid.diagnostics())")
-      .def_property_readonly("vectors", &Diagnostics::vectors, "method-specific vectors by name (ctid.diagnostics())");
+      .def_property_readonly("vectors", &Diagnostics::vectors, "method-specific vectors by name (ctid.diagnostics())")
+      .def("__repr__", &diagnostics_text);
 
   py::class_<TrendInfo>(m, "TrendInfo", "What IdData.detrend_with_trend removed, per channel: offset + slope * (t - t_ref).")
       .def_readonly("u_offset", &TrendInfo::u_offset)

@@ -147,6 +147,12 @@ void bind_linear(py::module_& m) {
       .def("is_stable", &MisoModel::is_stable)
       .def("simulate", [](const MisoModel& g, const IdData& d) { return lsim(g, d); }, py::arg("data"),
            "Exact simulation from rest of the inputs of data (their intersample behaviour).")
+      .def("freqresp", [](const MisoModel& g, const Eigen::VectorXd& w) { return model_frequency_response(g, w); },
+           py::arg("w"), "G_i(jw) at w (rad/s), one column per input channel.")
+      .def("step", [](const MisoModel& g, const Eigen::VectorXd& t) { return model_step_response(g, t); }, py::arg("t"),
+           "Unit-step response of each channel at the times t (s), one column per input channel.")
+      .def("impulse", [](const MisoModel& g, const Eigen::VectorXd& t) { return model_impulse_response(g, t); },
+           py::arg("t"), "Impulse response of each channel at the times t (s), one column per input channel.")
       .def("__repr__", [](const MisoModel& g) { return g.to_string(6); });
   bind_result<MisoModel>(m, "MisoResult");
   def_report<MisoModel>(m);

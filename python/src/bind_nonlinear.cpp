@@ -6,6 +6,16 @@
 namespace ctid::python {
 
 namespace {
+// The step response of a nonlinear model at the times t, counted from t[0] (the library's model_step_response):
+// one input, so one column, returned as a vector.
+template <class M>
+Eigen::VectorXd step_from(const M& model, const Eigen::VectorXd& t, double amplitude) {
+  const Eigen::VectorXd from = t.array() - (t.size() ? t(0) : 0.0);
+  return model_step_response(AnyModel(model), from, amplitude).col(0);
+}
+}  // namespace
+
+namespace {
 template <class Term>
 std::vector<std::string> names(const std::vector<Term>& terms) {
   std::vector<std::string> v;
@@ -48,6 +58,16 @@ void bind_nonlinear(py::module_& m) {
       .def("gfrf_discrete", [](const NarxModel& n, const std::vector<std::complex<double>>& z) {
              return narx_gfrf(n.process(), z);
            }, py::arg("z"))
+      .def("freqresp", [](const NarxModel& n, const Eigen::VectorXd& w, bool zoh) {
+             Eigen::VectorXcd h(w.size());
+             for (Eigen::Index i = 0; i < w.size(); ++i) h(i) = narx_gfrf_ct(n.process(), {{0.0, w(i)}}, zoh);
+             return h;
+           }, py::arg("w"), py::arg("zoh") = true,
+           "The linear part's frequency response H_1(jw) read as continuous-time (zoh: hold factor removed).")
+      .def("step", [](const NarxModel& n, const Eigen::VectorXd& t, double amplitude) {
+             return step_from(n, t, amplitude);
+           }, py::arg("t"), py::arg("amplitude") = 1.0,
+           "Free-run response from rest to the step amplitude * 1(t); t on the model's grid k * ts (from t[0]).")
       .def("__repr__", [](const NarxModel& n) { return n.to_string(6); });
   bind_result<NarxModel>(m, "NarxResult");
   def_report<NarxModel>(m);
@@ -93,6 +113,16 @@ void bind_nonlinear(py::module_& m) {
       .def("coefficient", &NdeModel::coefficient, py::arg("name"))
       .def("normalized", &NdeModel::normalized)
       .def("h1", &NdeModel::h1, py::arg("s"))
+      .def("freqresp", [](const NdeModel& n, const Eigen::VectorXd& w) {
+             Eigen::VectorXcd h(w.size());
+             for (Eigen::Index i = 0; i < w.size(); ++i) h(i) = n.h1({0.0, w(i)});
+             return h;
+           }, py::arg("w"), "The linear part's frequency response H_1(jw) (w in rad/s).")
+      .def("step", [](const NdeModel& n, const Eigen::VectorXd& t, double amplitude) {
+             return step_from(n, t, amplitude);
+           }, py::arg("t"), py::arg("amplitude") = 1.0,
+           "Response from rest to the step amplitude * 1(t) at the times t (from t[0]); the amplitude matters: the "
+           "model is nonlinear.")
       .def("h2", &NdeModel::h2, py::arg("s1"), py::arg("s2"))
       .def("h3", &NdeModel::h3, py::arg("s1"), py::arg("s2"), py::arg("s3"))
       .def("simulate", [](const NdeModel& n, const Eigen::VectorXd& u, const Eigen::VectorXd& t,

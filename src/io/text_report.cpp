@@ -2,6 +2,8 @@
 // written once here from the outcome of fit() and the record it was fitted to.
 #include "ctid/io/text_report.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -268,20 +270,52 @@ void kia_text(std::string& out, const FitOutcome& fo) {
 
 }  // namespace
 
+std::string parameters_text(const ParameterSet& p) {
+  std::string out;
+  appendf(out, "%-16s%14s%12s", "parameter", "value", "std");
+  for (int i = 0; i < p.size(); ++i) {
+    char sd[32] = "-";
+    if (i < static_cast<int>(p.fixed.size()) && p.fixed[static_cast<std::size_t>(i)]) std::snprintf(sd, sizeof sd, "fixed");
+    else if (i < p.std.size()) std::snprintf(sd, sizeof sd, "%.4g", p.std(i));
+    appendf(out, "\n%-16s%14.6g%12s", p.names[static_cast<std::size_t>(i)].c_str(), p.values(i), sd);
+  }
+  return out;
+}
+
+std::string fit_report_text(const FitReport& f) {
+  std::string out;
+  appendf(out, "FitReport(fit %s %%, nrmse %.4g, mse %.4g, aic %.6g, bic %.6g, %d samples)",
+          fit_percent_text(f.fit_percent).c_str(), f.nrmse, f.mse, f.aic, f.bic, f.n_samples);
+  return out;
+}
+
+std::string summary_text(const Summary& s) {
+  std::string out;
+  appendf(out, "Summary(%s, %d iteration(s), %.3g s%s)", to_string(s.termination), s.iterations, s.seconds,
+          s.message.empty() ? "" : (": " + s.message).c_str());
+  return out;
+}
+
+std::string diagnostics_text(const Diagnostics& d) {
+  std::string out;
+  appendf(out, "Diagnostics(condition number %.3g)", d.condition_number);
+  for (const auto& [k, v] : d.scalars()) appendf(out, "\n  %s = %.6g", k.c_str(), v);
+  for (const auto& [k, v] : d.vectors()) {
+    appendf(out, "\n  %s = [", k.c_str());
+    for (Eigen::Index i = 0; i < std::min<Eigen::Index>(v.size(), 8); ++i) appendf(out, "%s%.4g", i ? ", " : "", v(i));
+    appendf(out, "%s]", v.size() > 8 ? ", ..." : "");
+  }
+  for (const auto& c : d.choices) appendf(out, "\n  chosen: %s", c.c_str());
+  for (const auto& w : d.warnings) appendf(out, "\n  warning: %s", w.c_str());
+  return out;
+}
+
 std::string brief_text(const std::string& model, const ParameterSet& p, const FitReport& f, const Summary& s,
                        const Diagnostics& d, bool usable) {
   std::string out = model + "\n";
   appendf(out, "termination: %s%s, %d iteration(s), %.3g s, usable: %s\n", to_string(s.termination),
           s.message.empty() ? "" : (" (" + s.message + ")").c_str(), s.iterations, s.seconds, usable ? "True" : "False");
-  if (p.size() > 0) {
-    appendf(out, "%-16s%14s%12s\n", "parameter", "value", "std");
-    for (int i = 0; i < p.size(); ++i) {
-      char sd[32] = "-";
-      if (i < static_cast<int>(p.fixed.size()) && p.fixed[static_cast<std::size_t>(i)]) std::snprintf(sd, sizeof sd, "fixed");
-      else if (i < p.std.size()) std::snprintf(sd, sizeof sd, "%.4g", p.std(i));
-      appendf(out, "%-16s%14.6g%12s\n", p.names[static_cast<std::size_t>(i)].c_str(), p.values(i), sd);
-    }
-  }
+  if (p.size() > 0) out += parameters_text(p) + "\n";
   appendf(out, "fit: %s %%  (mse %.4g, aic %.4g, %d samples)", fit_percent_text(f.fit_percent).c_str(), f.mse, f.aic,
           f.n_samples);
   for (const auto& w : d.warnings) appendf(out, "\nwarning: %s", w.c_str());

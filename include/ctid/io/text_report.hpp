@@ -18,6 +18,15 @@ namespace ctid {
 /// fitted, the reconstructed equation, the refinement). Lines end in '\n'.
 std::string fit_text(const FitOutcome& outcome, const IdData& data);
 
+/// The parts of a result as text (Python's repr of each): the parameter table (name, value, one standard deviation
+/// or "fixed"), "FitReport(fit F %, nrmse, mse, aic, bic, N samples)", "Summary(termination, iterations, seconds:
+/// message)", and the diagnostics (condition number, each method-specific number and vector (its first 8
+/// values), the automatic choices, the warnings). No trailing newline.
+std::string parameters_text(const ParameterSet& parameters);
+std::string fit_report_text(const FitReport& fit);
+std::string summary_text(const Summary& summary);
+std::string diagnostics_text(const Diagnostics& diagnostics);
+
 /// A brief text report of a result of any model type (what Python's repr of a result shows): `model` (a line naming
 /// the model), the termination with its message, iterations, time and usability, the parameters with one standard
 /// deviation ("fixed" for held ones), the fit with its MSE, AIC and sample count, and the warnings.
