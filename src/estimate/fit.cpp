@@ -30,11 +30,6 @@ namespace ctid {
 
 namespace fit_detail {
 
-template <class M>
-FitOutcome outcome(const Result<M>& r, std::string method, SettingsText settings) {
-  return fit_outcome(r, std::move(method), std::move(settings));
-}
-
 // One input: the single entry of the orders.
 TfOrders siso_orders(const FitRequest& r, const std::string& method) {
   CTID_REQUIRE_OPTION(r.structure.orders.size() == 1, "{}: one set of orders (nb, nf, nk) for its one input (got {})",
@@ -49,7 +44,7 @@ FitOutcome tf_records(const FitRequest& r, const std::string& method, One one, M
   apply_settings(method, r.settings, {}, o);
   const TfOrders orders = siso_orders(r, method);
   const auto res = r.records.size() == 1 ? one(r.records.front(), orders, o) : many(r.records, orders, o);
-  return outcome(res, method, settings_text(o));
+  return fit_outcome(res, method, settings_text(o));
 }
 
 // A string or reals setting as reals (modal's own shift_samples and frequencies).
@@ -71,7 +66,7 @@ FitOutcome lssvf(const FitRequest& r) {
   if (r.frequency) {
     LssvfOptions o;
     apply_settings("lssvf", r.settings, {}, o);
-    return outcome(ctid::lssvf(*r.frequency, siso_orders(r, "lssvf"), o), "lssvf", settings_text(o));
+    return fit_outcome(ctid::lssvf(*r.frequency, siso_orders(r, "lssvf"), o), "lssvf", settings_text(o));
   }
   using F1 = Result<TransferFunction> (*)(const IdData&, const TfOrders&, const LssvfOptions&);
   using FN = Result<TransferFunction> (*)(const std::vector<IdData>&, const TfOrders&, const LssvfOptions&);
@@ -97,7 +92,7 @@ FitOutcome srivc(const FitRequest& r) {
     apply_settings("srivc_closed_loop", r.settings, {}, o);
     const Result<TransferFunction> res =
         srivc_closed_loop(ds, r.structure.references, siso_orders(r, "srivc_closed_loop"), o);
-    return outcome(res, "srivc_closed_loop", settings_text(o));
+    return fit_outcome(res, "srivc_closed_loop", settings_text(o));
   }
   const int nu = ds.front().nu();
   if (nu > 1) {
@@ -109,7 +104,7 @@ FitOutcome srivc(const FitRequest& r) {
     for (int i = 0; i < nu; ++i) orders.push_back(given.size() == 1 ? given[0] : given[static_cast<size_t>(i)]);
     SrivcMisoOptions o;
     apply_settings("srivc_miso", r.settings, {}, o);
-    return outcome(srivc_miso(ds, orders, o), "srivc_miso", settings_text(o));
+    return fit_outcome(srivc_miso(ds, orders, o), "srivc_miso", settings_text(o));
   }
   using F1 = Result<TransferFunction> (*)(const IdData&, const TfOrders&, const SrivcOptions&);
   using FN = Result<TransferFunction> (*)(const std::vector<IdData>&, const TfOrders&, const SrivcOptions&);
@@ -120,8 +115,8 @@ FitOutcome srivc_auto(const FitRequest& r) {
   SrivcAutoOptions o;
   apply_settings("srivc_auto", r.settings, {}, o);
   const IdData& d = r.records.front();
-  if (d.nu() > 1) return outcome(srivc_auto_miso(d, o), "srivc_auto", settings_text(o));
-  return outcome(ctid::srivc_auto(d, o), "srivc_auto", settings_text(o));
+  if (d.nu() > 1) return fit_outcome(srivc_auto_miso(d, o), "srivc_auto", settings_text(o));
+  return fit_outcome(ctid::srivc_auto(d, o), "srivc_auto", settings_text(o));
 }
 
 // oe and tfest: on frequency data both are tf_from_frequency (Sanathanan-Koerner, then output error).
@@ -130,7 +125,7 @@ FitOutcome output_error(const FitRequest& r, const std::string& method, One one,
   if (r.frequency) {
     FrequencyFitOptions o;
     apply_settings("tf_from_frequency", r.settings, {}, o);
-    return outcome(tf_from_frequency(*r.frequency, siso_orders(r, "tf_from_frequency"), o), "tf_from_frequency",
+    return fit_outcome(tf_from_frequency(*r.frequency, siso_orders(r, "tf_from_frequency"), o), "tf_from_frequency",
                    settings_text(o));
   }
   return tf_records<OeOptions>(r, method, one, many);
@@ -151,7 +146,7 @@ FitOutcome tfest(const FitRequest& r) {
 FitOutcome fsf(const FitRequest& r) {
   FsfOptions o;
   apply_settings("fsf", r.settings, {}, o);
-  return outcome(ctid::fsf(r.records.front(), o), "fsf", settings_text(o));
+  return fit_outcome(ctid::fsf(r.records.front(), o), "fsf", settings_text(o));
 }
 
 FitOutcome physical(const FitRequest& r) {
@@ -174,7 +169,7 @@ FitOutcome physical(const FitRequest& r) {
                         "physical: the plant is declared unstable: give a window a > 0 (got a = {})", fo.a);
     SettingsText s{{"route", "raw"}, {"a", options_detail::format_real(fo.a)}};
     for (auto& x : settings_text(po)) s.push_back(std::move(x));
-    return outcome(fit_physical_raw(model, p.parameters, r.records, fo.a, po), "physical", std::move(s));
+    return fit_outcome(fit_physical_raw(model, p.parameters, r.records, fo.a, po), "physical", std::move(s));
   }
   const Result<FsfModel> c = ctid::fsf(d, fo);
   Result<TransferFunction> q = p.route == "frequency" ? fit_physical_frequency(model, p.parameters, c.model, po, &d)
@@ -183,13 +178,13 @@ FitOutcome physical(const FitRequest& r) {
   for (const auto& w : c.diagnostics.choices) q.diagnostics.choices.push_back("fsf: " + w);
   SettingsText s{{"route", p.route}};
   for (auto& x : settings_text(fo, po)) s.push_back(std::move(x));
-  return outcome(q, "physical", std::move(s));
+  return fit_outcome(q, "physical", std::move(s));
 }
 
 FitOutcome greybox(const FitRequest& r) {
   GreyboxOptions o;
   apply_settings("greybox", r.settings, {}, o);
-  return outcome(ctid::greybox(r.records, *r.structure.greybox, o), "greybox", settings_text(o));
+  return fit_outcome(ctid::greybox(r.records, *r.structure.greybox, o), "greybox", settings_text(o));
 }
 
 // El-Shafey's modal_fit: nb from the orders, the order from nf unless shifts are given, nk as the input delay;
@@ -228,16 +223,16 @@ FitOutcome modal(const FitRequest& r) {
     o.delay = orders.nk * d.ts();
   }
   SettingsText s = settings_text(o);
-  if (frequencies.empty()) return outcome(modal_fit(r.records, orders.nb, o), "modal", std::move(s));
+  if (frequencies.empty()) return fit_outcome(modal_fit(r.records, orders.nb, o), "modal", std::move(s));
   const InputGenerator g = generator_fitted_to_input(frequencies, d);
   s.emplace_back("frequencies", text_of(frequencies));
-  return outcome(modal_fit(r.records, orders.nb, o, &g), "modal", std::move(s));
+  return fit_outcome(modal_fit(r.records, orders.nb, o, &g), "modal", std::move(s));
 }
 
 FitOutcome narx(const FitRequest& r) {
   NarxOptions o;
   apply_settings("narx", r.settings, {}, o);
-  return outcome(ctid::narx(r.records, o), "narx", settings_text(o));
+  return fit_outcome(ctid::narx(r.records, o), "narx", settings_text(o));
 }
 
 // KIA from the NARX model given, or from one fitted here with the narx settings; the stages are kept.
@@ -270,7 +265,7 @@ FitOutcome kia(const FitRequest& r) {
 FitOutcome subspace(const FitRequest& r) {
   SubspaceOptions o;
   apply_settings("subspace", r.settings, {}, o);
-  return outcome(r.frequency ? ctid::subspace(*r.frequency, o) : ctid::subspace(r.records.front(), o), "subspace",
+  return fit_outcome(r.frequency ? ctid::subspace(*r.frequency, o) : ctid::subspace(r.records.front(), o), "subspace",
                  settings_text(o));
 }
 
@@ -280,7 +275,7 @@ FitOutcome ssest(const FitRequest& r) {
   const auto& start = r.structure.initial;
   Result<StateSpace> res = r.frequency ? (start ? ctid::ssest(*r.frequency, *start, o) : ctid::ssest(*r.frequency, o))
                                        : (start ? ctid::ssest(r.records, *start, o) : ctid::ssest(r.records, o));
-  return outcome(res, "ssest", settings_text(o));
+  return fit_outcome(res, "ssest", settings_text(o));
 }
 
 }  // namespace fit_runs
