@@ -18,6 +18,7 @@
 #include "estimate/svf_common.hpp"
 #include "estimate/tf_common.hpp"
 #include "internal/least_squares.hpp"
+#include "estimate/search.hpp"
 #include "internal/levenberg_marquardt.hpp"
 #include "signal/filter_bank.hpp"
 
@@ -311,11 +312,7 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
   if (free_response.size()) sim_all += free_response;
   r.fit = fit_report_or_inf(y_all, sim_all, p + E * ni);
   const double sigma2 = 2.0 * lm.cost / double(std::max<Eigen::Index>(1, y_all.size() - p - E * ni));
-  std::vector<std::string> free_names;
-  for (int j : free) free_names.push_back(names[static_cast<size_t>(j)]);
-  const std::string unidentifiable = internal::unidentifiable(lm.jtj, lm.x, free_names);
-  r.parameters.set_covariance(unidentifiable.empty() ? internal::covariance(lm.jtj, sigma2) : Eigen::MatrixXd(), free);
-  r.diagnostics.condition_number = internal::gram_condition(lm.jtj);
+  const std::string unidentifiable = search::set_covariance(r.parameters, r.diagnostics, lm, free, sigma2);
   r.diagnostics.set(diagnostic::noise_variance, sigma2);
   r.diagnostics.set(diagnostic::delay, r.model.io_delay());
   r.diagnostics.set(diagnostic::evaluations, lm.evaluations);

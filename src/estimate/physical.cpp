@@ -13,6 +13,7 @@
 #include "ctid/simulate/simulate.hpp"
 #include "ctid/validate/metrics.hpp"
 #include "internal/least_squares.hpp"
+#include "estimate/search.hpp"
 #include "internal/levenberg_marquardt.hpp"
 
 namespace ctid {
@@ -140,11 +141,7 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
   res.parameters.values = th;
   res.parameters.fixed = fixed;
   const double sigma2 = 2.0 * lm.cost / std::max(1, n_data - p - nuisance);
-  std::vector<std::string> free_names;
-  for (int j : free) free_names.push_back(res.parameters.names[static_cast<size_t>(j)]);
-  const std::string unidentifiable = internal::unidentifiable(lm.jtj, lm.x, free_names);
-  res.parameters.set_covariance(unidentifiable.empty() ? internal::covariance(lm.jtj, sigma2) : Eigen::MatrixXd(), free);
-  res.diagnostics.condition_number = internal::gram_condition(lm.jtj);
+  const std::string unidentifiable = search::set_covariance(res.parameters, res.diagnostics, lm, free, sigma2);
   {
     Eigen::VectorXd r;
     if (std::isfinite(lm.cost) && evaluate(lm.x, r, nullptr)) res.fit = fit_report_or_inf(target, target + r, p + nuisance);

@@ -213,7 +213,7 @@ Simulation simulate_nde(const NdeModel& m, const IdData& d, const SimulateOption
 
 // Grey-box models: rest = zero state; measured = the model's initial state with each state that an output reads
 // alone taken from that output's first sample; estimated = `x0`, else the state that best explains the record's first
-// initial_samples samples (model/greybox.hpp).
+// initial_samples samples (greybox_initial_state, greybox_initial_state.cpp).
 Simulation simulate_greybox(const GreyboxModel& m, const IdData& d, const SimulateOptions& o) {
   Simulation s;
   if (o.initial == InitialCondition::Rest) {

@@ -209,6 +209,38 @@ TEST(NdeOe, FixedTermsAreHeld) {
   EXPECT_NEAR(bounded.model.coefficient("y^2"), 0.05, 1e-12);
 }
 
+// Multi-start (the driver the grey box uses): start 0 is the given model, so its cost is the single-start run's to
+// the last bit; the drawn starts lie within the bounds (+-50 % of the truth here) and the best of four reaches the
+// generating coefficients of the noise-free record (to 1e-5, as from one good start). The run is reproducible
+// (seeded): a second run gives the same costs exactly.
+TEST(NdeOe, MultiStartKeepsTheBestOfTheDrawnStarts) {
+  const NdeModel truth = bl33();
+  const IdData d = record(truth, 600);
+  Eigen::VectorXd c = truth.coefficients();
+  c.tail(5) *= 1.15;
+  const NdeModel start(truth.terms(), c);
+  NdeOeOptions o{.estimate_initial_state = false};
+  for (const char* s : {"Dy", "D^2y", "u", "y^2", "y*Dy"}) {
+    const double v = truth.coefficient(s);
+    o.bounds[s] = {std::min(0.5 * v, 1.5 * v), std::max(0.5 * v, 1.5 * v)};
+  }
+  const auto one = nde_oe(d, start, o);
+  o.starts = 4;
+  const auto four = nde_oe(d, start, o);
+  ASSERT_TRUE(four.usable()) << four.why_not_usable();
+  const Eigen::VectorXd costs = four.diagnostics.get(diagnostic::starts_cost);
+  ASSERT_EQ(costs.size(), 4);
+  EXPECT_FALSE(one.diagnostics.has(diagnostic::starts_cost));
+  // noise_variance = 2 cost / (N - p), N = 600 samples, p = 5 free coefficients: the same expression of the same
+  // cost is the same double.
+  EXPECT_EQ(one.diagnostics.get(diagnostic::noise_variance), 2.0 * costs(0) / 595) << "start 0 is the single-start search";
+  EXPECT_FALSE(costs.hasNaN()) << "every start ran (a drawn start that escapes ends at an infinite cost)";
+  for (const char* s : {"Dy", "D^2y", "u", "y^2", "y*Dy"})
+    EXPECT_NEAR(four.model.coefficient(s), truth.coefficient(s), 1e-5 * std::abs(truth.coefficient(s))) << s;
+  const auto again = nde_oe(d, start, o);
+  EXPECT_EQ(again.diagnostics.get(diagnostic::starts_cost), costs);
+}
+
 TEST(NdeOe, ModelWithoutYIsNormalisedByItsHighestDerivative) {
   // An integrating Duffing-like plant D^2y + 2 Dy + 0.5 Dy^3 = u (no y term): D^2y is the reference.
   const NdeModel truth = model({"Dy", "D^2y", "u", "Dy^3"}, {2.0, 1.0, -1.0, 0.5});

@@ -29,6 +29,10 @@ struct NdeOeOptions {
   /// Bounds [lower, upper] on free coefficients by term name (bounds.y^2=0,inf), in the same scale.
   ParameterBounds bounds;
   double rtol = 1e-10;                 ///< relative tolerance of the simulations
+  /// Multi-start: the starting model plus starts - 1 coefficient sets drawn (seeded) uniformly within finite
+  /// bounds, or log-uniformly within a decade of the start's value where a bound is open; the lowest cost wins.
+  int starts = 1;
+  int seed = 1;  ///< seed of the drawn starts
   void validate() const;
 };
 template <>
@@ -41,7 +45,7 @@ const OptionTable<NdeOeOptions>& option_table<NdeOeOptions>();
 /// are shrunk by halves (down to 0) until it does not; the factor is diagnostics.scalars "start_scale"
 /// (1: none) and a warning says so. parameters: every term's coefficient (reference and `fixed` ones
 /// flagged fixed, with zero variance), then "y(0)", "Dy(0)", .. when estimated. diagnostics: vector "x0"
-/// (initial state), scalars "noise_variance", "start_scale". Termination Converged / MaxIterations, or
+/// (initial state), scalars "noise_variance", "start_scale", vector "starts_cost" (starts > 1). Termination Converged / MaxIterations, or
 /// NumericalFailure (fit infinite) when no shrunk start can be simulated.
 /// Throws InvalidArgument for data that are not SISO, fewer samples than free parameters, a model that
 /// NdeModel::simulate rejects, names in `fixed`/`bounds` that are not terms (the closest named), a bound on a

@@ -157,11 +157,5 @@ class GreyboxModel {
 /// BandLimited, linear otherwise.
 Intersample greybox_intersample(const IdData& data);
 
-/// The initial state that best explains the first `samples` samples of `data` (0: all) from the model's
-/// initial-state guess, estimating the states marked "estimate" (every state when none is marked), by Levenberg-Marquardt on
-/// the sensitivities; also started with the unmeasured estimated states at 0 (together and one at a time), the lowest
-/// cost wins. Used by simulate with InitialCondition::Estimated (the nonlinear-benchmark protocol: the test record's
-/// first samples initialise the state, nothing else of it enters the model). Throws InvalidArgument for sizes.
-Eigen::VectorXd greybox_initial_state(const GreyboxModel& model, const IdData& data, int samples = 0, double rtol = 1e-8);
 
 }  // namespace ctid

@@ -96,6 +96,13 @@ Simulation simulate(const Result<AnyModel>& result, const IdData& data, Simulati
 /// count, sampling period, no outputs where the initial condition needs them, an x0 of the wrong size).
 Simulation simulate(const AnyModel& model, const IdData& data, const SimulateOptions& options = {});
 
+/// The initial state that best explains the first `samples` samples of `data` (0: all) from the model's
+/// initial-state guess, estimating the states marked "estimate" (every state when none is marked), by Levenberg-Marquardt on
+/// the sensitivities; also started with the unmeasured estimated states at 0 (together and one at a time), the lowest
+/// cost wins. Used by simulate with InitialCondition::Estimated (the nonlinear-benchmark protocol: the test record's
+/// first samples initialise the state, nothing else of it enters the model). Throws InvalidArgument for sizes.
+Eigen::VectorXd greybox_initial_state(const GreyboxModel& model, const IdData& data, int samples = 0, double rtol = 1e-8);
+
 /// Responses of any model, one column per input (MISO: the response to that input alone;
 /// single-input models: one column). Times t in seconds, increasing, >= 0; frequencies w in rad/s.
 ///
