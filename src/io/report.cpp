@@ -12,7 +12,7 @@
 #include <sstream>
 
 #include "ctid/core/check.hpp"
-#include "ctid/estimate/gfrf.hpp"
+#include "ctid/estimate/nonlinear/gfrf.hpp"
 #include "ctid/io/json.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/simulate/simulate.hpp"

@@ -7,7 +7,7 @@
 
 #include "ctid/core/error.hpp"
 #include "ctid/data/input_design.hpp"
-#include "ctid/estimate/frols.hpp"
+#include "ctid/estimate/nonlinear/frols.hpp"
 #include "ctid/validate/metrics.hpp"
 #include "ctid/validate/residuals.hpp"
 #include "test_util.hpp"

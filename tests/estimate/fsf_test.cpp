@@ -11,7 +11,7 @@
 
 #include "ctid/core/error.hpp"
 #include "ctid/data/input_design.hpp"
-#include "ctid/estimate/fsf.hpp"
+#include "ctid/estimate/fsf/fsf.hpp"
 #include "ctid/model/state_space.hpp"
 #include "ctid/model/transfer_function.hpp"
 #include "ctid/simulate/closed_loop.hpp"

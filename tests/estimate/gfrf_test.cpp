@@ -9,7 +9,7 @@
 #include "estimate/billings_li_models.hpp"
 #include "ctid/core/error.hpp"
 #include "ctid/io/json.hpp"
-#include "ctid/estimate/gfrf.hpp"
+#include "ctid/estimate/nonlinear/gfrf.hpp"
 #include "ctid/simulate/lsim.hpp"
 
 using namespace ctid;

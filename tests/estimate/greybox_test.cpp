@@ -1,4 +1,4 @@
-// Grey-box models and their output-error fit (model/greybox.hpp, estimate/greybox.hpp). The data are simulations
+// Grey-box models and their output-error fit (model/greybox.hpp, estimate/greybox/greybox.hpp). The data are simulations
 // of the same equations by the model's own integrator at rtol 1e-11; noise-free records must give the generating
 // parameters back to the integration accuracy, and the sensitivities must match central differences of the
 // simulation.
@@ -8,8 +8,8 @@
 #include <gtest/gtest.h>
 
 #include "ctid/core/error.hpp"
-#include "ctid/estimate/greybox.hpp"
-#include "ctid/estimate/srivc.hpp"
+#include "ctid/estimate/greybox/greybox.hpp"
+#include "ctid/estimate/transfer_function/srivc.hpp"
 #include "ctid/io/json.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/simulate/simulate.hpp"

@@ -6,8 +6,8 @@
 #include <gtest/gtest.h>
 
 #include "ctid/data/input_design.hpp"
-#include "ctid/estimate/lssvf.hpp"
-#include "ctid/estimate/rls_svf.hpp"
+#include "ctid/estimate/svf/lssvf.hpp"
+#include "ctid/estimate/svf/rls_svf.hpp"
 #include "ctid/simulate/lsim.hpp"
 
 using namespace ctid;

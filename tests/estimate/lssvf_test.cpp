@@ -16,8 +16,8 @@
 
 #include "ctid/core/error.hpp"
 #include "ctid/data/input_design.hpp"
-#include "ctid/estimate/lssvf.hpp"
-#include "ctid/estimate/rls_svf.hpp"
+#include "ctid/estimate/svf/lssvf.hpp"
+#include "ctid/estimate/svf/rls_svf.hpp"
 #include "ctid/simulate/lsim.hpp"
 
 // Count heap allocations to check that RlsSvf::update allocates nothing.

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "ctid/core/error.hpp"
-#include "ctid/estimate/modal_observer.hpp"
+#include "ctid/estimate/modal/modal_observer.hpp"
 #include "ctid/simulate/lsim.hpp"
 
 using namespace ctid;

@@ -10,8 +10,8 @@
 
 #include "ctid/core/error.hpp"
 #include "ctid/data/input_design.hpp"
-#include "ctid/estimate/lssvf.hpp"
-#include "ctid/estimate/modal.hpp"
+#include "ctid/estimate/svf/lssvf.hpp"
+#include "ctid/estimate/modal/modal.hpp"
 #include "ctid/simulate/lsim.hpp"
 
 using namespace ctid;

@@ -1,4 +1,4 @@
-// Output-error refinement of NDE models (estimate/nde_oe.hpp). The data are simulations of known equations
+// Output-error refinement of NDE models (estimate/nonlinear/nde_oe.hpp). The data are simulations of known equations
 // (Billings & Li (33) and a Duffing equation) by the adaptive NDE integrator at rtol 1e-11; noise-free records
 // must give the generating coefficients back to the integration accuracy.
 #include <random>
@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "ctid/core/error.hpp"
-#include "ctid/estimate/nde_oe.hpp"
+#include "ctid/estimate/nonlinear/nde_oe.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "estimate/billings_li_models.hpp"
 #include "test_util.hpp"

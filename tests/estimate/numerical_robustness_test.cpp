@@ -5,13 +5,13 @@
 #include <gtest/gtest.h>
 
 #include "ctid/data/input_design.hpp"
-#include "ctid/estimate/fsf.hpp"
-#include "ctid/estimate/lssvf.hpp"
-#include "ctid/estimate/modal.hpp"
-#include "ctid/estimate/physical.hpp"
-#include "ctid/estimate/rls_svf.hpp"
-#include "ctid/estimate/oe.hpp"
-#include "ctid/estimate/srivc.hpp"
+#include "ctid/estimate/fsf/fsf.hpp"
+#include "ctid/estimate/svf/lssvf.hpp"
+#include "ctid/estimate/modal/modal.hpp"
+#include "ctid/estimate/fsf/physical.hpp"
+#include "ctid/estimate/svf/rls_svf.hpp"
+#include "ctid/estimate/transfer_function/oe.hpp"
+#include "ctid/estimate/transfer_function/srivc.hpp"
 #include "ctid/simulate/lsim.hpp"
 
 using namespace ctid;
@@ -106,7 +106,7 @@ TEST(NumericalRobustness, NearPoleZeroCancellation) {
 // samples at Ts = 0.05 s of a PRBS with 30 dB output noise; then the same record with time scaled so that Ts is
 // log-uniform in [1e-6, 1e3] s and u, y scaled by factors log-uniform in [1e-30, 1e30]. The estimates, mapped
 // back (a_k c^k, b_j c^(n-nb+1+j) ku/ky), agree with the unscaled fit to 1e-6 relative: the estimators work in
-// normalised units (estimate/tf_common.hpp), so only rounding differs (measured: <= 1e-9).
+// normalised units (estimate/transfer_function/tf_common.hpp), so only rounding differs (measured: <= 1e-9).
 TEST(NumericalRobustness, EstimatesDoNotDependOnUnitsOfTimeAndAmplitude) {
   std::mt19937 rng(13);
   std::uniform_real_distribution<double> U(0.0, 1.0);

@@ -9,8 +9,8 @@
 
 #include "ctid/core/error.hpp"
 #include "ctid/data/input_design.hpp"
-#include "ctid/estimate/fsf.hpp"
-#include "ctid/estimate/physical.hpp"
+#include "ctid/estimate/fsf/fsf.hpp"
+#include "ctid/estimate/fsf/physical.hpp"
 #include "ctid/model/state_space.hpp"
 #include "ctid/simulate/closed_loop.hpp"
 #include "ctid/simulate/lsim.hpp"

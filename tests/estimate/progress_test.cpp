@@ -7,9 +7,9 @@
 
 #include "ctid/core/progress.hpp"
 #include "ctid/data/input_design.hpp"
-#include "ctid/estimate/frols.hpp"
-#include "ctid/estimate/oe.hpp"
-#include "ctid/estimate/srivc.hpp"
+#include "ctid/estimate/nonlinear/frols.hpp"
+#include "ctid/estimate/transfer_function/oe.hpp"
+#include "ctid/estimate/transfer_function/srivc.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "test_util.hpp"
 

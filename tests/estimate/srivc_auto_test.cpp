@@ -6,7 +6,7 @@
 
 #include "ctid/core/error.hpp"
 #include "ctid/data/input_design.hpp"
-#include "ctid/estimate/srivc_auto.hpp"
+#include "ctid/estimate/transfer_function/srivc_auto.hpp"
 #include "ctid/io/csv.hpp"
 #include "ctid/io/load.hpp"
 #include "ctid/simulate/example_data.hpp"

@@ -1,4 +1,4 @@
-// Continuous-time state space from frequency-response data (estimate/ssest_frequency.cpp): the frequency-domain
+// Continuous-time state space from frequency-response data (estimate/state_space/ssest_frequency.cpp): the frequency-domain
 // subspace start, the weighted least-squares refinement and its covariance, the FRF of periodic records.
 #include <cmath>
 #include <complex>
@@ -9,9 +9,9 @@
 
 #include "ctid/core/error.hpp"
 #include "ctid/data/frequency_data.hpp"
-#include "ctid/estimate/frequency.hpp"
-#include "ctid/estimate/ssest.hpp"
-#include "ctid/estimate/subspace.hpp"
+#include "ctid/estimate/transfer_function/frequency.hpp"
+#include "ctid/estimate/state_space/ssest.hpp"
+#include "ctid/estimate/state_space/subspace.hpp"
 #include "estimate/state_space_fixtures.hpp"
 
 namespace ctid {

@@ -1,4 +1,4 @@
-// ssest: output-error refinement of MIMO continuous-time state space (estimate/ssest.hpp), on exactly simulated
+// ssest: output-error refinement of MIMO continuous-time state space (estimate/state_space/ssest.hpp), on exactly simulated
 // records (lsim: exact ZOH between samples). Reference values: the true systems below; the Cramér-Rao bound from
 // ssest_crlb (the information matrix at the truth with the true noise variances).
 #include <array>
@@ -11,7 +11,7 @@
 
 #include "ctid/core/error.hpp"
 #include "ctid/data/frequency_data.hpp"
-#include "ctid/estimate/ssest.hpp"
+#include "ctid/estimate/state_space/ssest.hpp"
 #include "ctid/io/json.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/validate/uncertainty.hpp"

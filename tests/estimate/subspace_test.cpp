@@ -1,4 +1,4 @@
-// Subspace identification of MIMO continuous-time state space (estimate/subspace.hpp; Johansson, Verhaegen & Chou
+// Subspace identification of MIMO continuous-time state space (estimate/state_space/subspace.hpp; Johansson, Verhaegen & Chou
 // 1999 and Verhaegen 1994), on exactly simulated records (lsim: exact ZOH between samples).
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "ctid/core/error.hpp"
-#include "ctid/estimate/subspace.hpp"
+#include "ctid/estimate/state_space/subspace.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "estimate/state_space_fixtures.hpp"
 #include "test_util.hpp"

@@ -12,7 +12,7 @@
 #include "ctid/core/error.hpp"
 #include "ctid/data/frequency_data.hpp"
 #include "ctid/data/input_design.hpp"
-#include "ctid/estimate/lssvf.hpp"
+#include "ctid/estimate/svf/lssvf.hpp"
 #include "ctid/signal/svf.hpp"
 #include "ctid/simulate/lsim.hpp"
 

@@ -94,7 +94,7 @@ def self_test():
     with tempfile.TemporaryDirectory() as d:
         root = pathlib.Path(d)
         for rel, text in {
-            "src/model/a.cpp": '#include "ctid/estimate/srivc.hpp"\n#include "ctid/poly/polynomial.hpp"\n',
+            "src/model/a.cpp": '#include "ctid/estimate/transfer_function/srivc.hpp"\n#include "ctid/poly/polynomial.hpp"\n',
             "include/ctid/core/b.hpp": '#include "internal/ode.hpp"\n',
             "src/simulate/c.cpp": '#include "ctid/ctid.hpp"\n',
             "include/ctid/ctid.hpp": "",

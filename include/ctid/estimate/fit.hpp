@@ -19,7 +19,7 @@
 #include "ctid/data/iddata.hpp"
 #include "ctid/estimate/options.hpp"
 #include "ctid/estimate/orders.hpp"
-#include "ctid/estimate/physical.hpp"
+#include "ctid/estimate/fsf/physical.hpp"
 #include "ctid/model/any_model.hpp"
 
 namespace ctid {
@@ -32,7 +32,7 @@ using SettingList = std::vector<std::pair<std::string, SettingValue>>;
 /// Every setting of the options a fit used, as NAME/VALUE text (the report's "settings"; defaults included).
 using SettingsText = std::vector<std::pair<std::string, std::string>>;
 
-/// A physical-parameter model: a transfer-function expression in s with named parameters (estimate/physical.hpp)
+/// A physical-parameter model: a transfer-function expression in s with named parameters (estimate/fsf/physical.hpp)
 /// and the route of the fit.
 struct PhysicalStructure {
   std::string expression;                     ///< e.g. "k1/(s^2 - k2)"

@@ -13,8 +13,8 @@
 #include <variant>
 
 #include "ctid/core/types.hpp"
-#include "ctid/estimate/modal.hpp"
-#include "ctid/estimate/order_selection.hpp"
+#include "ctid/estimate/modal/modal.hpp"
+#include "ctid/estimate/transfer_function/order_selection.hpp"
 #include "ctid/io/provenance.hpp"
 #include "ctid/model/any_model.hpp"
 #include "ctid/model/fsf.hpp"

@@ -93,7 +93,7 @@ ShiftChoice choose_modal_shifts(const TransferFunction& prior, double Ts, double
 /// x~_{j+1} = D^j y - sum_{i<=j} b~_i D^{j-i} u. Throws InvalidArgument unless strictly proper.
 StateSpace phase_variable_form(const TransferFunction& tf);
 
-/// Modal parameters and modal-function coefficients estimated from data (estimate/modal.hpp) or
+/// Modal parameters and modal-function coefficients estimated from data (estimate/modal/modal.hpp) or
 /// computed from a model: row j of P is p_j^T (n shift weights), row j of Q is q_j^T (coefficients
 /// of y_j(t) = q_j^T x_c(t) in the input basis; may have zero columns when no input modes are used).
 class ModalModel {

@@ -13,7 +13,7 @@ namespace ctid {
 /// Quadrature over uniformly sampled signals. Simpson: composite Simpson, with the 3/8 rule on the
 /// last three intervals when the interval count is odd (exact for cubics; error O(h^4)).
 /// Trapezoid: O(h^2). Exact integration of piecewise-constant (ZOH) signals is offered where the
-/// integrand structure allows it (see estimate/modal.hpp).
+/// integrand structure allows it (see estimate/modal/modal.hpp).
 enum class Quadrature { Simpson, Trapezoid };
 
 /// Weights w (size intervals + 1) with integral over [0, intervals * h] of g ~ sum_i w_i g(i h).

@@ -116,7 +116,7 @@ Eigen::MatrixXd model_step_response(const AnyModel& model, const Eigen::VectorXd
 /// NARX/NDE models (no impulse response; see model_step_response) and windowed FSF models.
 Eigen::MatrixXd model_impulse_response(const AnyModel& model, const Eigen::VectorXd& t);
 /// Frequency response G(jw) of a linear model (with its delay). Throws InvalidArgument for NARX/NDE models (their
-/// frequency-domain description is the GFRFs: estimate/gfrf.hpp) and windowed FSF models.
+/// frequency-domain description is the GFRFs: estimate/nonlinear/gfrf.hpp) and windowed FSF models.
 Eigen::MatrixXcd model_frequency_response(const AnyModel& model, const Eigen::VectorXd& w);
 
 }  // namespace ctid

@@ -1,8 +1,8 @@
 // ctid — nonlinear grey-box identification by output error with exact forward sensitivities (see
-// include/ctid/estimate/greybox.hpp; Ljung 1999 §7.3; Bohlin 2006): the problem (problem.hpp), multiple shooting
+// include/ctid/estimate/greybox/greybox.hpp; Ljung 1999 §7.3; Bohlin 2006): the problem (problem.hpp), multiple shooting
 // where the plant does not run free (multiple_shooting.hpp; Bock & Plitt 1984), the multi-start search
 // (estimate/search.hpp).
-#include "ctid/estimate/greybox.hpp"
+#include "ctid/estimate/greybox/greybox.hpp"
 
 #include <algorithm>
 #include <chrono>

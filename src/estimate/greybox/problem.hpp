@@ -1,4 +1,4 @@
-// ctid — the grey-box output-error problem over a record set (include/ctid/estimate/greybox.hpp): the constraints
+// ctid — the grey-box output-error problem over a record set (include/ctid/estimate/greybox/greybox.hpp): the constraints
 // resolved, the records stacked, the output weights, the search vector
 //     v = [free parameters (pf) | estimated initial states of record 1 (nx0) | of record 2 (nx0) | ..]
 // with its bounds and start, and the weighted residuals w_j (y_j - yhat_j) of a simulation from the start of every
@@ -10,7 +10,7 @@
 
 #include <Eigen/Dense>
 
-#include "ctid/estimate/greybox.hpp"
+#include "ctid/estimate/greybox/greybox.hpp"
 #include "data/record_refs.hpp"
 #include "internal/levenberg_marquardt.hpp"
 
