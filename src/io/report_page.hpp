@@ -58,11 +58,11 @@ inline std::string js_number(double v, int digits = 6) {
   return b;
 }
 
-inline std::string json_array(const Eigen::VectorXd& v) {
+inline std::string json_array(const Eigen::VectorXd& v, int digits = 6) {
   std::string o = "[";
   for (Eigen::Index i = 0; i < v.size(); ++i) {
     if (i) o += ',';
-    o += js_number(v(i));
+    o += js_number(v(i), digits);
   }
   return o + "]";
 }
@@ -73,6 +73,7 @@ struct Series {
   bool dashed = false;
   bool light = false;    // a band edge
   bool neutral = false;  // the measured signal among models (dark grey: the models keep their colours across plots)
+  int digits = 6;        // significant digits written (17: the doubles themselves, for a reader that checks them)
 };
 
 struct Plot {
@@ -128,7 +129,7 @@ class Page {
       s << (i ? "," : "") << "{\"label\":" << json_string(p.series[i].label) << ",\"dashed\":"
         << (p.series[i].dashed ? "true" : "false") << ",\"light\":" << (p.series[i].light ? "true" : "false")
         << ",\"neutral\":" << (p.series[i].neutral ? "true" : "false")
-        << ",\"y\":" << json_array(p.series[i].y) << "}";
+        << ",\"y\":" << json_array(p.series[i].y, p.series[i].digits) << "}";
     s << "]}";
     specs_.push_back(s.str());
   }

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "ctid/core/check.hpp"
-#include "ctid/estimate/gfrf.hpp"
+#include "ctid/estimate/nonlinear/gfrf.hpp"
 #include "ctid/io/json.hpp"
 #include "ctid/simulate/lsim.hpp"
 #include "ctid/simulate/simulate.hpp"
@@ -118,7 +118,7 @@ void validation(Page& page, const IdData& d, const Eigen::VectorXd& yhat, const 
   Eigen::VectorXd e = y - yhat;
   const double fit = fit_report_or_inf(y, yhat, 0).fit_percent;
   page.plot({"Output" + of + ": measured and simulated (fit " + fmt(fit, 4) + " %)", "time (s)", "y", pick(d.times(), k),
-             {{"measured", pick(y, k)}, {"simulated", pick(yhat, k)}}});
+             {{"measured", pick(y, k)}, {"simulated", pick(yhat, k), false, false, false, 17}}});
   if (!std::isfinite(e.squaredNorm())) {  // non-finite, or so large that the squares overflow
     page.text("<span class=\"warn\">The simulation does not stay finite on this record: no residual tests.</span>");
     return;

@@ -170,3 +170,70 @@ TEST(Cli, ReportRefusesUnsoundResults) {
   EXPECT_EQ(r.code, 1) << r.err;
   EXPECT_NE(r.err.find("the model diverges"), std::string::npos) << r.err;
 }
+
+namespace {
+// The "simulated" series of the first plot after the heading `section` in a report: the page's chart specification
+// ({"id":"plotN",...,"series":[...,{"label":"simulated",...,"y":[...]}]}) read back, null as NaN.
+std::vector<double> simulated_series(const std::string& html, const std::string& section) {
+  const auto at = html.find(section);
+  if (at == std::string::npos) return {};
+  const auto div = html.find("<div class=\"plot\" id=\"", at);
+  if (div == std::string::npos) return {};
+  const auto id0 = div + std::string("<div class=\"plot\" id=\"").size();
+  const std::string id = html.substr(id0, html.find('"', id0) - id0);
+  const auto spec = html.find("{\"id\":\"" + id + "\"");
+  const auto label = html.find("\"label\":\"simulated\"", spec);
+  const auto y0 = html.find("\"y\":[", label) + 5, y1 = html.find(']', y0);
+  std::vector<double> y;
+  std::stringstream in(html.substr(y0, y1 - y0));
+  for (std::string v; std::getline(in, v, ',');) y.push_back(v == "null" ? NAN : std::stod(v));
+  return y;
+}
+}  // namespace
+
+// One rule for the initial state of a simulation, also in the report: `ctid report RESULT RECORD1 RECORD2
+// [--initial X]` draws, for the further record, the library's simulate(result, record, OtherRecord, X) — to 1e-12 of
+// the output's scale, read back from the page's chart (the simulated series is written with 17 digits) — for a
+// result of every model type and each initial condition (and the default); where the library refuses the initial
+// condition, the command exits 2.
+TEST(Cli, ReportFollowsTheLibrarysInitialStateRuleForEveryModelType) {
+  const std::string dir = test::temp_path("initial_rule_report");
+  for (const ModelTypeCase& c : model_type_cases(dir)) {
+    const std::string json = dir + "/" + c.type + ".json";
+    const CliRun f = ctid_run("fit " + dir + "/" + c.record + "1.csv " + c.columns + " " + c.fit + " --json " + json +
+                              " --force", "timeout 300 ");
+    ASSERT_TRUE(f.code == 0 || f.code == 1) << c.type << "\n" << f.err;
+    const Result<AnyModel> r = read_result_file(json).result;
+    const IdData d2 = load_iddata(dir + "/" + c.record + "2.csv", c.spec);
+    for (const std::string initial : {"", "rest", "measured", "estimated"}) {
+      const std::string html = dir + "/" + c.type + "_" + initial + ".html";
+      const CliRun s = ctid_run("report " + json + " " + dir + "/" + c.record + "1.csv " + dir + "/" + c.record +
+                                "2.csv " + c.columns + (initial.empty() ? "" : " --initial " + initial) + " --out " +
+                                html + " --force");
+      const std::optional<InitialCondition> ic =
+          initial.empty() ? std::nullopt : std::optional(initial_condition_from_string(initial));
+      Simulation lib;
+      try {
+        simulate(r, load_iddata(dir + "/" + c.record + "1.csv", c.spec), SimulationPurpose::OwnFit, ic);
+        lib = simulate(r, d2, SimulationPurpose::OtherRecord, ic);
+      } catch (const InvalidArgument& e) {
+        EXPECT_EQ(s.code, 2) << c.type << " --initial " << initial << ": the library refuses (" << e.what() << ")";
+        continue;
+      }
+      ASSERT_EQ(s.code, 0) << c.type << " --initial " << initial << "\n" << s.err;
+      std::ifstream in(html);
+      const std::string page((std::istreambuf_iterator<char>(in)), {});
+      const std::vector<double> y = simulated_series(page, "Record 2: ");
+      ASSERT_EQ(static_cast<Eigen::Index>(y.size()), lib.y.rows()) << c.type << " --initial " << initial;
+      const double scale = std::max(1.0, lib.y.cwiseAbs().maxCoeff());
+      for (Eigen::Index k = 0; k < lib.y.rows(); ++k) {
+        if (!std::isfinite(lib.y(k, 0))) {
+          EXPECT_TRUE(std::isnan(y[static_cast<size_t>(k)])) << c.type << " sample " << k;
+          continue;
+        }
+        ASSERT_LE(std::abs(y[static_cast<size_t>(k)] - lib.y(k, 0)), 1e-12 * scale)
+            << c.type << " --initial " << initial << " sample " << k;
+      }
+    }
+  }
+}

@@ -82,35 +82,7 @@ TEST(Cli, EveryResultFileIsReadBackAndTheInitialConditionIsExplicit) {
 // Python's ctid.simulate is compared with the same command in python/tests/test_registry.py.
 TEST(Cli, SimulateFollowsTheLibrarysInitialStateRuleForEveryModelType) {
   const std::string dir = test::temp_path("initial_rule");
-  fs::create_directories(dir);
-  // Each example record split in two: the fit on the first part, the simulations on the second.
-  auto split = [&](const std::string& name, int first) {
-    const ExampleData e = example_data(name);
-    const int n = static_cast<int>(e.values.rows());
-    write_csv(dir + "/" + name + "1.csv", e.columns, e.values.topRows(first));
-    write_csv(dir + "/" + name + "2.csv", e.columns, e.values.bottomRows(n - first));
-  };
-  split("second", 1000);
-  split("miso", 1000);
-  split("bl", 600);
-  split("spring", 900);
-  struct Case {
-    std::string type, record, columns, fit;
-    DataSpec spec;
-  };
-  const std::string grey = std::string(CTID_EXAMPLES_DATA_DIR) + "/spring_greybox.json";
-  const DataSpec siso{{"u"}, {"y"}, "t"}, bl{{"u"}, {"y"}, "", 0.0025}, spring{{"force"}, {"position"}, "t"};
-  const std::vector<Case> cases = {
-      {"transfer_function", "second", "--time t --input u --output y", "--method oe --nf 2 --nb 1", siso},
-      {"miso", "miso", "--time t --input u1 --input u2 --output y", "--method srivc --nf 2 --nb 1",
-       DataSpec{{"u1", "u2"}, {"y"}, "t"}},
-      {"state_space", "second", "--time t --input u --output y", "--method ssest --nx 2", siso},
-      {"fsf", "second", "--time t --input u --output y", "--method fsf", siso},
-      {"narx", "bl", "--ts 0.0025 --input u --output y", "--method narx --set degree=2 --set ylag=2 --set ulag=2", bl},
-      {"nde", "bl", "--ts 0.0025 --input u --output y", "--method kia --set degree=2 --set ylag=2 --set ulag=2", bl},
-      {"greybox", "spring", "--time t --input force --output position", "--method greybox --model " + grey, spring},
-  };
-  for (const Case& c : cases) {
+  for (const ModelTypeCase& c : model_type_cases(dir)) {
     const std::string json = dir + "/" + c.type + ".json";
     const CliRun f = ctid_run("fit " + dir + "/" + c.record + "1.csv " + c.columns + " " + c.fit + " --json " + json +
                               " --force", "timeout 300 ");

@@ -4,10 +4,12 @@
 #include <array>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <optional>
 #include <string>
 #include <sys/wait.h>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -80,6 +82,40 @@ inline std::optional<BrowserRun> open_in_browser(const std::string& html, const 
   const auto at = text.find("id=\"ctid-selfcheck\">");
   if (at != std::string::npos) r.selfcheck = text.substr(at + 20, text.find('<', at + 20) - at - 20);
   return r;
+}
+
+// A result of every model type and a record it was not fitted to: each example record split in two (written to dir
+// as NAME1.csv and NAME2.csv), the fit (`fit`: its method flags) on the first part. The cases of the tests of the
+// initial-state rule (ctid simulate, ctid report).
+struct ModelTypeCase {
+  std::string type, record, columns, fit;
+  DataSpec spec;
+};
+inline std::vector<ModelTypeCase> model_type_cases(const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  // Each example record split in two: the fit on the first part, the simulations on the second.
+  auto split = [&](const std::string& name, int first) {
+    const ExampleData e = example_data(name);
+    const int n = static_cast<int>(e.values.rows());
+    write_csv(dir + "/" + name + "1.csv", e.columns, e.values.topRows(first));
+    write_csv(dir + "/" + name + "2.csv", e.columns, e.values.bottomRows(n - first));
+  };
+  split("second", 1000);
+  split("miso", 1000);
+  split("bl", 600);
+  split("spring", 900);
+  const std::string grey = std::string(CTID_EXAMPLES_DATA_DIR) + "/spring_greybox.json";
+  const DataSpec siso{{"u"}, {"y"}, "t"}, bl{{"u"}, {"y"}, "", 0.0025}, spring{{"force"}, {"position"}, "t"};
+  return {
+      {"transfer_function", "second", "--time t --input u --output y", "--method oe --nf 2 --nb 1", siso},
+      {"miso", "miso", "--time t --input u1 --input u2 --output y", "--method srivc --nf 2 --nb 1",
+       DataSpec{{"u1", "u2"}, {"y"}, "t"}},
+      {"state_space", "second", "--time t --input u --output y", "--method ssest --nx 2", siso},
+      {"fsf", "second", "--time t --input u --output y", "--method fsf", siso},
+      {"narx", "bl", "--ts 0.0025 --input u --output y", "--method narx --set degree=2 --set ylag=2 --set ulag=2", bl},
+      {"nde", "bl", "--ts 0.0025 --input u --output y", "--method kia --set degree=2 --set ylag=2 --set ulag=2", bl},
+      {"greybox", "spring", "--time t --input force --output position", "--method greybox --model " + grey, spring},
+  };
 }
 
 }  // namespace ctid_cli_test
