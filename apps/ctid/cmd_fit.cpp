@@ -268,9 +268,7 @@ FitOutcome fit_request(const FitArgs& a, const FitRequest& r) {
     const std::string flag = e.key == "estimate_delay" && a.delay ? "--delay"
                              : (e.key == "nx" || e.key == "nx_max") && !a.nx.empty() ? "--nx"
                                                                                      : "--set " + e.key;
-    throw UsageError(flag + ": not a setting of " + e.method +
-                     (e.closest.empty() ? std::string() : "; did you mean '" + e.closest + "'?") + " (" +
-                     settings_hint(method_info(a.method)) + " lists them)");
+    throw unknown_setting(flag, e, a.method);
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   } catch (const FileError& e) {

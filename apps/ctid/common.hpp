@@ -113,51 +113,28 @@ inline std::string settings_hint(const MethodInfo& m) {
 }
 inline std::string settings_hint(const std::string& method) { return settings_hint(method_info(method)); }
 
-/// Applies --set KEY=VALUE pairs to options structs through their tables (estimate/options.hpp): each key goes
-/// to the first struct whose table has it. An unknown key, or a value that does not parse, is a UsageError naming
-/// `method` and the closest valid setting. Ranges are checked by the estimator (validate()).
+/// The usage error of a setting the method does not have, given by `flag` ("--set NAME", "--delay", ..): names the
+/// method, the closest setting and where the settings are listed.
+inline UsageError unknown_setting(const std::string& flag, const UnknownSetting& e, const std::string& method) {
+  return UsageError(flag + ": not a setting of " + e.method +
+                    (e.closest.empty() ? std::string() : "; did you mean '" + e.closest + "'?") + " (" +
+                    settings_hint(method) + " lists them)");
+}
+
+/// Applies --set KEY=VALUE pairs to options structs through their tables (the library's apply_settings): an
+/// unknown key, or a value that does not parse, is a UsageError naming `method` and the closest valid setting.
+/// Ranges are checked by the estimator (validate()).
 template <class... O>
 void apply_sets(const std::string& method, const std::vector<std::string>& sets, O&... o) {
-  for (const auto& kv : parse_sets(sets)) {
-    // Named references, not a structured binding: clang before 16 cannot capture a binding in the lambda below.
-    const std::string& key = kv.first;
-    const std::string& value = kv.second;
-    bool done = false;
-    try {
-      (
-          [&] {
-            if (!done && option_table<O>().find(key)) {
-              option_table<O>().set(o, key, value);
-              done = true;
-            }
-          }(),
-          ...);
-    } catch (const InvalidOptions& e) {
-      throw UsageError(e.what());
-    }
-    if (done) continue;
-    std::vector<std::string> names;
-    (
-        [&] {
-          for (const auto& n : option_table<O>().names()) names.push_back(n);
-        }(),
-        ...);
-    const std::string near = closest_name(key, names);
-    throw UsageError("--set " + key + ": not a setting of " + method +
-                     (near.empty() ? std::string() : "; did you mean '" + near + "'?") +
-                     " (" + settings_hint(method) + " lists them)");
+  SettingList list;
+  for (const auto& [key, value] : parse_sets(sets)) list.emplace_back(key, value);
+  try {
+    apply_settings(method, list, {}, o...);
+  } catch (const UnknownSetting& e) {
+    throw unknown_setting("--set " + e.key, e, method);
+  } catch (const InvalidOptions& e) {
+    throw UsageError(e.what());
   }
-}
-/// The settings of options structs as NAME/VALUE text pairs (for the report).
-template <class... O>
-std::vector<std::pair<std::string, std::string>> settings_of(const O&... o) {
-  std::vector<std::pair<std::string, std::string>> s;
-  (
-      [&] {
-        for (auto& p : option_table<O>().settings(o)) s.push_back(std::move(p));
-      }(),
-      ...);
-  return s;
 }
 
 /// --report: write the HTML report of r on d (nothing when path is empty), with `settings` as the method
