@@ -15,6 +15,7 @@
 #include "ctid/data/input_design.hpp"
 #include "ctid/model/transfer_function.hpp"
 #include "ctid/simulate/lsim.hpp"
+#include "test_paths.hpp"
 
 namespace ctid::test {
 

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "ctid/ctid.hpp"
+#include "test_util.hpp"
 
 namespace {
 using namespace ctid;
