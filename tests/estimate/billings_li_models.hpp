@@ -6,6 +6,7 @@
 #include "ctid/io/json.hpp"
 #include "ctid/model/narx.hpp"
 #include "ctid/model/nde.hpp"
+#include "test_paths.hpp"
 
 /// NARX model (34), process part, as printed (examples/data/bl34_narx.json).
 inline ctid::NarxModel bl34() { return ctid::read_narx_json(std::string(CTID_EXAMPLES_DATA_DIR) + "/bl34_narx.json"); }
