@@ -307,21 +307,11 @@ int exit_code(const Result<AnyModel>& r) {
   return kNotUsable;
 }
 
-// A fit to frequency-response data: the method, the band, the model and its parameters, the fit of the complex
-// response.
+// A fit to frequency-response data: the library's text of it, the JSON file.
 int present_frequency(const Fitted& f, const FitArgs& a, const Provenance& prov) {
-  const FrequencyData& fd = *f.frequency;
-  const Result<AnyModel>& res = f.out.result;
-  const auto& g = std::get<TransferFunction>(res.model);
-  std::printf("method: %s (frequency data)   frequencies: %d   from %.4g to %.4g rad/s\n", f.out.method.c_str(),
-              fd.size(), fd.w()(0), fd.w()(fd.size() - 1));
-  std::printf("model:  G(s) = %s\n", g.to_string(6).c_str());
-  for (int i = 0; i < res.parameters.size(); ++i)
-    std::printf("  %-5s = %14.6g +- %-12.4g\n", res.parameters.names[i].c_str(), res.parameters.values(i), res.parameters.std(i));
-  std::printf("fit (complex response): %s %%   termination: %s\n", fit_percent_text(res.fit.fit_percent).c_str(),
-              to_string(res.summary.termination));
+  std::fputs(fit_text(f.out, *f.frequency).c_str(), stdout);
   write_json(a, f.out, prov);
-  return exit_code(res);
+  return exit_code(f.out.result);
 }
 
 // Print, write the JSON file and the HTML report if asked, and map usability to the exit code. The printed samples

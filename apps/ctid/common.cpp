@@ -25,164 +25,53 @@ void DataArgs::add_to(CLI::App& app, bool need_output) {
                  "Use only rows A:B of the file (1-based, inclusive; '1:500' the first 500, '501:' from row 501 on)");
 }
 
-namespace {
-// --samples A:B as [begin, end) of a record of n rows; UsageError naming the option, its value and the record size.
-std::pair<int, int> row_range(const std::string& option, const std::string& text, int n) {
-  const auto colon = text.find(':');
-  auto bad = [&](const std::string& why) {
-    return UsageError(option + " " + text + ": " + why + " (the record has " + std::to_string(n) + " rows)");
-  };
-  if (colon == std::string::npos || text.find(':', colon + 1) != std::string::npos)
-    throw bad("give A:B, the first and last row (1-based; '1:500', '501:')");
-  auto number = [&](const std::string& part, int fallback) {
-    if (part.empty()) return fallback;
-    size_t used = 0;
-    long v = 0;
-    try {
-      v = std::stol(part, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != part.size() || v < 1 || v > n) throw bad("'" + part + "' is not a row number from 1 to " + std::to_string(n));
-    return static_cast<int>(v);
-  };
-  const int first = number(text.substr(0, colon), 1), last = number(text.substr(colon + 1), n);
-  if (last - first + 1 < 2) throw bad("the range holds fewer than 2 rows");
-  return {first - 1, last};
-}
-}  // namespace
-
 IdData DataArgs::load(bool need_output, TrendInfo* removed_trend, std::pair<int, int>* rows) const {
   if (detrend != "none" && detrend != "mean" && detrend != "linear")
     throw UsageError("--detrend must be none, mean or linear (got '" + detrend + "')");
   if (!(ts >= 0) || !std::isfinite(ts)) throw UsageError("--ts must be a positive number of seconds (got " + std::to_string(ts) + ")");
-  DataSpec spec;
-  spec.ts = ts;
+  RecordChoice c;
+  c.inputs = inputs;
+  c.outputs = outputs;
+  c.time = time;
+  c.ts = ts;
+  c.need_output = need_output;
+  c.rows = samples;
+  c.rows_name = samples_option;
+  if (detrend != "none") c.detrend = detrend == "mean" ? Detrend::Mean : Detrend::Linear;
+  ChosenRecord r;
   try {
-    spec.intersample = intersample_from_string(intersample);
+    c.intersample = intersample_from_string(intersample);
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }
-  spec.inputs = inputs;
-  spec.outputs = outputs;
   try {
-    // Column (CSV) or variable (.mat) names; the table is read once.
-    const bool is_mat = is_mat_file(path);
-    std::optional<CsvTable> tab;
-    std::vector<std::string> names;
-    if (is_mat) {
-      names = mat_variable_names(path);
-    } else {
-      tab = read_csv(path);
-      names = tab->names;
-    }
-    // Two selections are the same column when they name the same position (CSV) or variable (.mat).
-    auto same = [&](const std::string& a, const std::string& b) { return tab ? tab->column(a) == tab->column(b) : a == b; };
-    // Without --time and --ts, a column named t or time (any case) is the time axis, said on stderr.
-    std::string time_col = time;
-    if (time_col.empty() && ts == 0.0) {
-      for (const auto& n : names) {
-        std::string lower = n;
-        std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-        if (lower != "t" && lower != "time") continue;
-        if (!time_col.empty())
-          throw UsageError(path + ": columns '" + time_col + "' and '" + n + "' could both be the time axis; give --time");
-        time_col = n;
-      }
-      if (time_col.empty())
-        throw UsageError("give the time axis: --time COLUMN or --ts SECONDS (no column is named t or time)");
-      if (!quiet)
-        std::fprintf(stderr, "note: column '%s' is the time axis (no --time or --ts given)\n", time_col.c_str());
-    }
-    spec.time = time_col;
-    if (inputs.empty() || (need_output && outputs.empty())) {
-      // Default columns (documented in --help and docs/guide.md): everything that is not the time column, inputs
-      // first, output last.
-      std::vector<std::string> rest;
-      for (const auto& n : names)
-        if (time_col.empty() || !same(n, time_col)) rest.push_back(n);
-      if (need_output && outputs.empty()) {
-        if (rest.size() != 2 && inputs.empty()) {
-          std::string cols;
-          for (const auto& n : names) cols += (cols.empty() ? "" : ", ") + n;
-          throw UsageError(path + ": choose columns with --input and --output (" + (is_mat ? "variables: " : "columns: ") +
-                           cols + ")");
-        }
-        if (rest.empty()) throw UsageError(path + ": no column left for the output; use --output");
-        spec.outputs = {rest.back()};
-        rest.pop_back();
-      }
-      if (inputs.empty()) {
-        if (need_output)
-          std::erase_if(rest, [&](const std::string& n) { return same(n, spec.outputs.front()); });
-        if (rest.empty()) throw UsageError(path + ": no column left for the input; use --input");
-        spec.inputs = need_output ? rest : std::vector<std::string>{rest.front()};
-      }
-    }
-    if (need_output)
-      for (const auto& o : spec.outputs)
-        for (const auto& in : spec.inputs)
-          if (same(o, in)) throw UsageError(detail::format("'{}' is selected both as an input and as the output", o));
-    if (!need_output) spec.outputs = {spec.inputs.front()};  // placeholder output for loading only
-    IdData d = tab ? iddata_from_table(*tab, spec) : load_iddata(path, spec);
-    const int n_rows = d.size();
-    std::pair<int, int> used{1, n_rows};
-    if (!samples.empty()) {
-      const auto [begin, end] = row_range(samples_option, samples, d.size());
-      d = d.slice(begin, end);
-      used = {begin + 1, end};
-    }
-    if (rows) *rows = used;
-    if (d.uniform_time_deviation() > 1e-9 && !quiet)
-      std::fprintf(stderr, "note: %s: the sample times are within %.2g Ts of a uniform grid (threshold %g Ts): read as "
-                   "uniform, Ts = %.10g s\n", path.c_str(), d.uniform_time_deviation(), IdData::kUniformTimeTolerance,
-                   d.ts());
-    // What was done to this record, for the report and the result file.
-    std::string* done = nullptr;
-    if (provenance) {
-      provenance->add_data_file(path, n_rows);
-      provenance->preprocessing.push_back(
-          path + ": " +
-          (samples.empty() ? "all " + std::to_string(n_rows) + " rows"
-                           : detail::format("rows {}..{} of {}", used.first, used.second, n_rows)) +
-          (detrend == "none" ? "; no detrending" : ""));
-      done = &provenance->preprocessing.back();
-    }
-    if (detrend == "none") return d;
-    TrendInfo removed;
-    IdData out = d.detrend(detrend == "mean" ? Detrend::Mean : Detrend::Linear, &removed);
-    if (removed_trend) *removed_trend = removed;
-    // What was removed, channel by channel: "input 1 4.994, output 2 4.84337" (linear: offset + slope (t - t_ref)).
-    std::string what;
-    char value[64];
-    for (int j = 0; j < d.nu() + d.ny(); ++j) {
-      const bool in = j < d.nu();
-      const int k = in ? j : j - d.nu();
-      if (detrend == "mean")
-        std::snprintf(value, sizeof value, "%.6g", in ? removed.u_offset(k) : removed.y_offset(k));
-      else
-        std::snprintf(value, sizeof value, "%.6g + %.6g (t - %.6g)", in ? removed.u_offset(k) : removed.y_offset(k),
-                      in ? removed.u_slope(k) : removed.y_slope(k), removed.t_ref);
-      what += detail::format("{}{} {} {}", j > 0 ? ", " : "", in ? "input" : "output",
-                             channel_name(in ? d.input_names() : d.output_names(), k), value);
-    }
-    if (done) *done += detail::format("; {} removed ({})", detrend == "mean" ? "means" : "linear trends", what);
-    if (announce_means && detrend == "mean" && !quiet)
-      std::fprintf(stderr, "note: the means were removed (%s); --detrend none keeps them\n", what.c_str());
-    return out;
+    r = choose_record(path, c);
   } catch (const FileError& e) {
     throw InputError(e.what());
+  } catch (const InvalidOptions& e) {
+    throw UsageError(e.what());  // the rows asked for
   } catch (const ColumnSelectionError& e) {
-    throw UsageError(e.what());  // a column the file does not have, or one selected twice: the options' problem
+    throw UsageError(e.what());  // a column the file does not have, or one chosen twice: the options' problem
   } catch (const InvalidArgument& e) {
     throw InputError(path + ": " + e.what());  // the file's content
   }
+  if (!r.time_column.empty() && !quiet)
+    std::fprintf(stderr, "note: column '%s' is the time axis (no --time or --ts given)\n", r.time_column.c_str());
+  if (r.data.uniform_time_deviation() > 1e-9 && !quiet)
+    std::fprintf(stderr, "note: %s: the sample times are within %.2g Ts of a uniform grid (threshold %g Ts): read as "
+                 "uniform, Ts = %.10g s\n", path.c_str(), r.data.uniform_time_deviation(), IdData::kUniformTimeTolerance,
+                 r.data.ts());
+  if (rows) *rows = {r.first_row, r.last_row};
+  if (removed_trend) *removed_trend = r.removed;
+  if (provenance) {
+    provenance->add_data_file(path, r.file_rows);
+    provenance->preprocessing.push_back(path + ": " + r.preprocessing);
+  }
+  if (announce_means && detrend == "mean" && !quiet)
+    std::fprintf(stderr, "note: the means were removed (%s); --detrend none keeps them\n", r.removed_text.c_str());
+  return r.data;
 }
 
-std::string channel_name(const std::vector<std::string>& names, int j) {
-  const auto k = static_cast<size_t>(j);
-  return k < names.size() && !names[k].empty() ? names[k] : std::to_string(j + 1);
-}
 
 std::vector<IdData> DataArgs::load_each(const std::vector<std::string>& paths, bool need_output) const {
   std::vector<IdData> ds;

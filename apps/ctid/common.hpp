@@ -56,8 +56,9 @@ struct DataArgs {
   /// Where each file read is recorded (its content hash and rows) with what was done to it; null: not recorded.
   Provenance* provenance = nullptr;
   void add_to(CLI::App& app, bool need_output);
-  /// Load, select the columns and the rows (--samples), detrend (the removed trend in `removed`, left empty with
-  /// --detrend none); maps every failure to InputError (file/content) or UsageError (inconsistent options).
+  /// The library's choose_record (io/load.hpp: the default columns, the rows of --samples, the detrending; the
+  /// removed trend in `removed`, left empty with --detrend none) with its notes on stderr and the provenance
+  /// recorded; maps every failure to InputError (file/content) or UsageError (inconsistent options).
   /// With `rows`: the rows used, 1-based first and last.
   IdData load(bool need_output, TrendInfo* removed = nullptr, std::pair<int, int>* rows = nullptr) const;
   /// The same selection loaded from each of `paths` (several records of one system), in order.
@@ -191,8 +192,6 @@ void setup_validate(CLI::App& app, Command& run);
 /// standard deviation, a warning on stderr naming it, its mean and the ratio, and suggesting --detrend mean.
 void warn_offsets(const IdData& d);
 void setup_compare(CLI::App& app, Command& run);
-/// The name of channel j (0-based) of a record: its name, or its 1-based position when it has none.
-std::string channel_name(const std::vector<std::string>& names, int j);
 
 void setup_demo(CLI::App& app, Command& run);
 void setup_example_data(CLI::App& app, Command& run);

@@ -155,17 +155,28 @@ void bind_core(py::module_& m) {
   m.def(
       "load",
       [](const std::string& path, std::vector<std::string> inputs, std::vector<std::string> outputs,
-         const std::string& time, double ts, const std::string& intersample) {
-        DataSpec spec;
-        spec.inputs = std::move(inputs);
-        spec.outputs = std::move(outputs);
-        spec.time = time;
-        spec.ts = ts;
-        spec.intersample = intersample_from_string(intersample);
-        return load_iddata(path, spec);
+         const std::string& time, double ts, const std::string& intersample, const std::string& detrend,
+         const std::string& rows) {
+        RecordChoice c;
+        c.inputs = std::move(inputs);
+        c.outputs = std::move(outputs);
+        c.time = time;
+        c.ts = ts;
+        c.intersample = intersample_from_string(intersample);
+        if (detrend == "mean") c.detrend = Detrend::Mean;
+        else if (detrend == "linear") c.detrend = Detrend::Linear;
+        else if (detrend != "none") throw InvalidOptions("load: detrend must be 'none', 'mean' or 'linear' (got '" + detrend + "')");
+        c.rows = rows;
+        return choose_record(path, c).data;
       },
-      py::arg("path"), py::arg("inputs"), py::arg("outputs"), py::arg("time") = "", py::arg("ts") = 0.0,
-      py::arg("intersample") = "zoh", "Load a CSV or .mat record by column / variable names.");
+      py::arg("path"), py::arg("inputs") = std::vector<std::string>{}, py::arg("outputs") = std::vector<std::string>{},
+      py::arg("time") = "", py::arg("ts") = 0.0, py::arg("intersample") = "zoh", py::arg("detrend") = "none",
+      py::arg("rows") = "",
+      "Load a CSV/.dat or .mat record by column / variable names or 1-based positions, with ctid fit's defaults: "
+      "without time and ts the column named t or time is the time axis; without inputs and outputs a file of two other "
+      "columns gives the input and the output (more: name them); with the outputs named, every other column is an "
+      "input. rows='A:B' takes rows A..B (1-based, inclusive); detrend='mean' or 'linear' removes the trend after "
+      "that.");
 
   py::class_<TransferFunction>(m, "TransferFunction", "G(s) = e^{-s delay} B(s)/A(s), descending powers of s.")
       .def(py::init([](const Eigen::VectorXd& num, const Eigen::VectorXd& den, double delay) {

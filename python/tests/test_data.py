@@ -39,6 +39,27 @@ def test_load_bundled_dryer(tmp_path):
     assert len(d) == 1000 and d.ts == 0.08
 
 
+def test_load_takes_the_command_lines_defaults(tmp_path):
+    """ctid.load without columns chooses as ctid fit does (the library's choose_record): the column named t is the
+    time axis; of two other columns the first is the input and the second the output; with the output named, every
+    other column is an input; rows='2:4' and detrend='mean' as --samples and --detrend."""
+    f = tmp_path / "r.csv"
+    f.write_text("t,u,y\n0,1,2\n0.5,3,4\n1,5,6\n1.5,7,9\n")
+    d = ctid.load(str(f))
+    assert d.nu == 1 and d.ny == 1 and d.ts == pytest.approx(0.5, rel=1e-12)
+    assert list(d.input_names) == ["u"] and list(d.output_names) == ["y"]
+    part = ctid.load(str(f), rows="2:4", detrend="mean")
+    assert len(part) == 3 and part.y.mean() == pytest.approx(0.0, abs=1e-13)
+    assert part.u[:, 0] == pytest.approx([-2.0, 0.0, 2.0], abs=1e-13)  # 3, 5, 7 minus their mean 5
+    with pytest.raises(ctid.InvalidOptions, match="'0' is not a row number"):
+        ctid.load(str(f), rows="0:2")
+    g = tmp_path / "miso.csv"
+    g.write_text("t,u1,u2,y\n0,1,0,2\n0.5,3,1,4\n1,5,0,6\n")
+    with pytest.raises(ctid.InvalidArgument, match="choose the input and output columns"):
+        ctid.load(str(g))  # three columns besides the time: which is the output is not guessed
+    assert list(ctid.load(str(g), outputs=["y"]).input_names) == ["u1", "u2"]
+
+
 def test_from_pandas_when_available():
     # pandas is installed by scripts/install-deps.sh (python3-pandas); elsewhere the test skips.
     pd = pytest.importorskip("pandas")

@@ -1,7 +1,10 @@
 #include "ctid/io/load.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <optional>
 
 #include "ctid/core/check.hpp"
 #include "ctid/io/mat.hpp"
@@ -130,6 +133,149 @@ IdData load_iddata(const std::string& path, const DataSpec& s) {
     return assemble(u, y, &t, s, path, nullptr);
   }
   return assemble(u, y, nullptr, s, path, nullptr);
+}
+
+
+namespace {
+// Rows "A:B" (1-based, inclusive, either end open) of a record of n rows as [begin, end); InvalidOptions naming the
+// rows' name, the text and the record size.
+std::pair<int, int> row_range(const std::string& name, const std::string& text, int n) {
+  const auto colon = text.find(':');
+  auto bad = [&](const std::string& why) {
+    return InvalidOptions(name + " " + text + ": " + why + " (the record has " + std::to_string(n) + " rows)");
+  };
+  if (colon == std::string::npos || text.find(':', colon + 1) != std::string::npos)
+    throw bad("give A:B, the first and last row (1-based; '1:500', '501:')");
+  auto number = [&](const std::string& part, int fallback) {
+    if (part.empty()) return fallback;
+    size_t used = 0;
+    long v = 0;
+    try {
+      v = std::stol(part, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != part.size() || v < 1 || v > n) throw bad("'" + part + "' is not a row number from 1 to " + std::to_string(n));
+    return static_cast<int>(v);
+  };
+  const int first = number(text.substr(0, colon), 1), last = number(text.substr(colon + 1), n);
+  if (last - first + 1 < 2) throw bad("the range holds fewer than 2 rows");
+  return {first - 1, last};
+}
+
+// What detrending removed, channel by channel: "input 1 4.994, output 2 4.84337" (linear: offset + slope (t - t_ref)).
+std::string removed_text(const IdData& d, const TrendInfo& removed, Detrend how) {
+  std::string what;
+  char value[64];
+  for (int j = 0; j < d.nu() + d.ny(); ++j) {
+    const bool in = j < d.nu();
+    const int k = in ? j : j - d.nu();
+    if (how == Detrend::Mean)
+      std::snprintf(value, sizeof value, "%.6g", in ? removed.u_offset(k) : removed.y_offset(k));
+    else
+      std::snprintf(value, sizeof value, "%.6g + %.6g (t - %.6g)", in ? removed.u_offset(k) : removed.y_offset(k),
+                    in ? removed.u_slope(k) : removed.y_slope(k), removed.t_ref);
+    what += detail::format("{}{} {} {}", j > 0 ? ", " : "", in ? "input" : "output",
+                           channel_name(in ? d.input_names() : d.output_names(), k), value);
+  }
+  return what;
+}
+}  // namespace
+
+std::string channel_name(const std::vector<std::string>& names, int j) {
+  const auto k = static_cast<std::size_t>(j);
+  return k < names.size() && !names[k].empty() ? names[k] : std::to_string(j + 1);
+}
+
+ChosenRecord choose_record(const std::string& path, const RecordChoice& choice) {
+  if (!(choice.ts >= 0) || !std::isfinite(choice.ts))
+    throw InvalidOptions(detail::format("the sampling period must be a positive number of seconds (got {})", choice.ts));
+  DataSpec spec;
+  spec.ts = choice.ts;
+  spec.intersample = choice.intersample;
+  spec.inputs = choice.inputs;
+  spec.outputs = choice.outputs;
+  // Column (CSV) or variable (.mat) names; the table is read once.
+  const bool is_mat = is_mat_file(path);
+  std::optional<CsvTable> tab;
+  std::vector<std::string> names;
+  if (is_mat) {
+    names = mat_variable_names(path);
+  } else {
+    tab = read_csv(path);
+    names = tab->names;
+  }
+  // Two selections are the same column when they name the same position (CSV) or variable (.mat).
+  auto same = [&](const std::string& a, const std::string& b) { return tab ? tab->column(a) == tab->column(b) : a == b; };
+  ChosenRecord out;
+  // Without a time column and ts, a column named t or time (any case) is the time axis.
+  std::string time_col = choice.time;
+  if (time_col.empty() && choice.ts == 0.0) {
+    for (const auto& n : names) {
+      std::string lower = n;
+      std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+      if (lower != "t" && lower != "time") continue;
+      if (!time_col.empty())
+        throw ColumnSelectionError(path + ": columns '" + time_col + "' and '" + n +
+                                   "' could both be the time axis; name the time column (ctid: --time)");
+      time_col = n;
+    }
+    if (time_col.empty())
+      throw ColumnSelectionError("give the time axis: a time column or the sampling period (ctid: --time COLUMN or --ts "
+                                 "SECONDS; no column is named t or time)");
+    out.time_column = time_col;
+  }
+  spec.time = time_col;
+  const bool need_output = choice.need_output;
+  if (spec.inputs.empty() || (need_output && spec.outputs.empty())) {
+    // Default columns: everything that is not the time column, inputs first, output last.
+    std::vector<std::string> rest;
+    for (const auto& n : names)
+      if (time_col.empty() || !same(n, time_col)) rest.push_back(n);
+    if (need_output && spec.outputs.empty()) {
+      if (rest.size() != 2 && spec.inputs.empty()) {
+        std::string cols;
+        for (const auto& n : names) cols += (cols.empty() ? "" : ", ") + n;
+        throw ColumnSelectionError(path + ": choose the input and output columns (ctid: --input and --output; " +
+                                   (is_mat ? "variables: " : "columns: ") + cols + ")");
+      }
+      if (rest.empty()) throw ColumnSelectionError(path + ": no column left for the output; choose it (ctid: --output)");
+      spec.outputs = {rest.back()};
+      rest.pop_back();
+    }
+    if (spec.inputs.empty()) {
+      if (need_output) std::erase_if(rest, [&](const std::string& n) { return same(n, spec.outputs.front()); });
+      if (rest.empty()) throw ColumnSelectionError(path + ": no column left for the input; choose it (ctid: --input)");
+      spec.inputs = need_output ? rest : std::vector<std::string>{rest.front()};
+    }
+  }
+  if (need_output)
+    for (const auto& o : spec.outputs)
+      for (const auto& in : spec.inputs)
+        if (same(o, in)) throw ColumnSelectionError(detail::format("'{}' is selected both as an input and as the output", o));
+  if (!need_output) spec.outputs = {spec.inputs.front()};  // placeholder output for loading only
+  IdData d = tab ? iddata_from_table(*tab, spec) : load_iddata(path, spec);
+  out.file_rows = d.size();
+  out.last_row = d.size();
+  if (!choice.rows.empty()) {
+    const auto [begin, end] = row_range(choice.rows_name, choice.rows, d.size());
+    d = d.slice(begin, end);
+    out.first_row = begin + 1;
+    out.last_row = end;
+  }
+  out.preprocessing = choice.rows.empty()
+                          ? "all " + std::to_string(out.file_rows) + " rows"
+                          : detail::format("rows {}..{} of {}", out.first_row, out.last_row, out.file_rows);
+  if (!choice.detrend) {
+    out.preprocessing += "; no detrending";
+    out.data = std::move(d);
+    return out;
+  }
+  out.data = d.detrend(*choice.detrend, &out.removed);
+  out.removed_text = removed_text(d, out.removed, *choice.detrend);
+  out.preprocessing += detail::format("; {} removed ({})", *choice.detrend == Detrend::Mean ? "means" : "linear trends",
+                                      out.removed_text);
+  return out;
 }
 
 }  // namespace ctid

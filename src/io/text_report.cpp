@@ -14,17 +14,12 @@
 #include "ctid/core/diagnostics.hpp"
 #include "ctid/core/names.hpp"
 #include "ctid/estimate/methods.hpp"
+#include "ctid/io/load.hpp"
 #include "ctid/validate/metrics.hpp"
 
 namespace ctid {
 
 namespace {
-// The name of channel j (0-based): its name, or its 1-based position when it has none.
-std::string channel_name(const std::vector<std::string>& names, int j) {
-  const auto k = static_cast<std::size_t>(j);
-  return k < names.size() && !names[k].empty() ? names[k] : std::to_string(j + 1);
-}
-
 // printf into a string.
 [[gnu::format(printf, 2, 3)]] void appendf(std::string& out, const char* format, ...) {
   va_list args;
@@ -334,6 +329,21 @@ std::string fit_text(const FitOutcome& fo, const IdData& data) {
         else result_text(out, Result<M>{m, r.parameters, r.fit, r.summary, r.diagnostics}, fo.method, data);
       },
       fo.result.model);
+  return out;
+}
+
+std::string fit_text(const FitOutcome& fo, const FrequencyData& data) {
+  std::string out;
+  const Result<AnyModel>& r = fo.result;
+  appendf(out, "method: %s (frequency data)   frequencies: %d   from %.4g to %.4g rad/s\n", fo.method.c_str(), data.size(),
+          data.w()(0), data.w()(data.size() - 1));
+  if (const auto* g = std::get_if<TransferFunction>(&r.model)) appendf(out, "model:  G(s) = %s\n", g->to_string(6).c_str());
+  else appendf(out, "model:  %s\n", describe(r.model).c_str());
+  for (int i = 0; i < r.parameters.size(); ++i)
+    appendf(out, "  %-5s = %14.6g +- %-12.4g\n", r.parameters.names[static_cast<size_t>(i)].c_str(),
+            r.parameters.values(i), r.parameters.std(i));
+  appendf(out, "fit (complex response): %s %%   termination: %s\n", fit_percent_text(r.fit.fit_percent).c_str(),
+          to_string(r.summary.termination));
   return out;
 }
 

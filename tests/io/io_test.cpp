@@ -84,6 +84,43 @@ TEST(Load, TimeColumnUniformIrregularAndNonIncreasing) {
   EXPECT_NE(error_of([&] { load_iddata(uni, s); }).find("no column named 'flow'"), std::string::npos);
 }
 
+// choose_record: the defaults ctid fit and ctid.load share. A column named Time is the time axis; the other columns
+// are the inputs, the last the output; rows 2:4 keep rows 2..4; the means removed are those of the rows kept
+// (u: (3 + 5 + 7)/3 = 5, y: (4 + 6 + 9)/3 = 19/3, printed with 6 digits); the choices the file cannot satisfy are
+// ColumnSelectionError, bad rows InvalidOptions.
+TEST(Load, ChooseRecordDefaultsRowsAndDetrending) {
+  const std::string f = write_text("choose.csv", "Time,u,y\n0,1,2\n0.1,3,4\n0.2,5,6\n0.3,7,9\n");
+  RecordChoice c;
+  ChosenRecord r = choose_record(f, c);
+  EXPECT_EQ(r.time_column, "Time");
+  EXPECT_EQ(r.data.input_names(), (std::vector<std::string>{"u"}));
+  EXPECT_EQ(r.data.output_names(), (std::vector<std::string>{"y"}));
+  EXPECT_EQ(r.data.size(), 4);
+  EXPECT_EQ(r.preprocessing, "all 4 rows; no detrending");
+  c.rows = "2:4";
+  c.detrend = Detrend::Mean;
+  r = choose_record(f, c);
+  EXPECT_EQ(r.data.size(), 3);
+  EXPECT_EQ(r.first_row, 2);
+  EXPECT_EQ(r.last_row, 4);
+  EXPECT_NEAR(r.removed.u_offset(0), 5.0, 1e-15);
+  EXPECT_NEAR(r.removed.y_offset(0), 19.0 / 3.0, 1e-14);
+  EXPECT_NEAR(r.data.y().col(0).sum(), 0.0, 1e-13);
+  EXPECT_EQ(r.preprocessing, "rows 2..4 of 4; means removed (input u 5, output y 6.33333)");
+  c.rows = "0:3";
+  EXPECT_THROW(choose_record(f, c), InvalidOptions);
+  EXPECT_NE(error_of([&] { choose_record(f, c); }).find("rows 0:3: '0' is not a row number from 1 to 4"), std::string::npos);
+  const std::string two = write_text("two_times.csv", "T,time,u,y\n0,0,1,2\n1,1,3,4\n");
+  EXPECT_THROW(choose_record(two, {}), ColumnSelectionError);
+  EXPECT_NE(error_of([&] { choose_record(two, {}); }).find("columns 'T' and 'time' could both be the time axis"),
+            std::string::npos);
+  RecordChoice wide;
+  wide.ts = 0.1;
+  EXPECT_THROW(choose_record(write_text("wide.csv", "a,b,c\n1,2,3\n4,5,6\n"), wide), ColumnSelectionError);
+  wide.outputs = {"c"};  // an output given: every other column is an input
+  EXPECT_EQ(choose_record(write_text("wide2.csv", "a,b,c\n1,2,3\n4,5,6\n"), wide).data.nu(), 2);
+}
+
 TEST(Json, ModelAndResultRoundTrip) {
   const TransferFunction g(Eigen::VectorXd{{-6400.0, 1600.0}}, Eigen::VectorXd{{1.0, 5.0, 408.0, 416.0, 1600.0}}, 0.25);
   const LinearModel back = parse_model_json(model_to_json(g));

@@ -1,6 +1,7 @@
 // ctid — load an experiment (IdData) from a CSV/.dat table or a .mat file.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,5 +31,44 @@ bool is_mat_file(const std::string& path);
 IdData load_iddata(const std::string& path, const DataSpec& spec);
 /// Build from an already-read table.
 IdData iddata_from_table(const CsvTable& table, const DataSpec& spec);
+
+/// The name of channel j (0-based) of a record (IdData::input_names / output_names): its name, or its 1-based
+/// position when it has none.
+std::string channel_name(const std::vector<std::string>& names, int j);
+
+/// A record chosen from a file with the defaults `ctid fit` and Python's ctid.load share when columns are left out.
+struct RecordChoice {
+  std::vector<std::string> inputs;   ///< names or 1-based positions; empty: the columns that are not the time axis
+                                     ///< or the output (without an output: the first such column)
+  /// Empty (need_output): the last column that is not the time axis — when the inputs are given, or when the file
+  /// has exactly two such columns (more, with neither given: ColumnSelectionError, the output is not guessed).
+  std::vector<std::string> outputs;
+  std::string time;                  ///< time column; "" with ts = 0: the one column named t or time (any case)
+  double ts = 0.0;                   ///< sampling period (s) when there is no time column
+  Intersample intersample = Intersample::Zoh;
+  bool need_output = true;           ///< false: inputs only (a signal); the record's output is its first input
+  /// Rows "A:B" of the file, 1-based and inclusive, either end may be left out ("1:500", "501:"); "": all.
+  std::string rows;
+  std::string rows_name = "rows";    ///< what the messages call `rows` (the command line: "--samples")
+  std::optional<Detrend> detrend;    ///< removed after the rows are taken; nullopt: nothing removed
+};
+
+struct ChosenRecord {
+  IdData data;                ///< the chosen columns and rows, detrended
+  int file_rows = 0;          ///< the rows of the file
+  int first_row = 1, last_row = 0;  ///< the rows used, 1-based and inclusive
+  std::string time_column;    ///< the time axis when it was found by its name ("" when given, or ts given)
+  TrendInfo removed;          ///< what detrending removed (empty without)
+  std::string removed_text;   ///< the same as text: "input u 4.994, output y 4.84337" (linear: "o + s (t - t_ref)")
+  /// What was done to the file's data: "all 1000 rows; no detrending", "rows 1..500 of 1000; means removed (input u
+  /// 4.994, output y 4.84337)".
+  std::string preprocessing;
+};
+
+/// Loads `path` (load_iddata) with the defaults of RecordChoice, takes the rows and detrends. Throws FileError for
+/// the file, ColumnSelectionError for a choice the file cannot satisfy (a column it does not have, one chosen twice
+/// or as input and output, no column left for the input or the output, two columns or none that could be the time
+/// axis), InvalidOptions for bad rows or a negative or non-finite ts, InvalidArgument for the file's content.
+ChosenRecord choose_record(const std::string& path, const RecordChoice& choice);
 
 }  // namespace ctid

@@ -17,6 +17,9 @@ namespace ctid {
 /// compressed step response; for NARX the selected terms with their ERR; for KIA each stage (the NARX model it
 /// fitted, the reconstructed equation, the refinement). Lines end in '\n'.
 std::string fit_text(const FitOutcome& outcome, const IdData& data);
+/// The text report of a fit to frequency-response data: the method, the band, the model, the parameters with one
+/// standard deviation, the fit of the complex response and the termination.
+std::string fit_text(const FitOutcome& outcome, const FrequencyData& data);
 
 /// The parts of a result as text (Python's repr of each): the parameter table (name, value, one standard deviation
 /// or "fixed"), "FitReport(fit F %, nrmse, mse, aic, bic, N samples)", "Summary(termination, iterations, seconds:

@@ -358,7 +358,6 @@ Result<NarxModel> frols_signals(const Signals& sig, const std::vector<Eigen::Ind
   int L = 0;
   for (const auto& t : cand) L = std::max(L, t.max_lag());
   const auto& y = sig.y;
-  const auto& u = sig.u;
   const Eigen::Index N = y.size(), Ne = N - L;
   const int M = static_cast<int>(cand.size());
   for (size_t r = 0; r < starts.size() && starts.size() > 1; ++r) {  // one record: the row count below says it
