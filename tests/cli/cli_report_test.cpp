@@ -199,9 +199,7 @@ std::vector<double> simulated_series(const std::string& html, const std::string&
 TEST(Cli, ReportFollowsTheLibrarysInitialStateRuleForEveryModelType) {
   const std::string dir = test::temp_path("initial_rule_report");
   for (const ModelTypeCase& c : model_type_cases(dir)) {
-    const std::string json = dir + "/" + c.type + ".json";
-    const CliRun f = ctid_run("fit " + dir + "/" + c.record + "1.csv " + c.columns + " " + c.fit + " --json " + json +
-                              " --force", "timeout 300 ");
+    const auto [json, f] = fit_case(dir, c);
     ASSERT_TRUE(f.code == 0 || f.code == 1) << c.type << "\n" << f.err;
     const Result<AnyModel> r = read_result_file(json).result;
     const IdData d2 = load_iddata(dir + "/" + c.record + "2.csv", c.spec);

@@ -83,9 +83,7 @@ TEST(Cli, EveryResultFileIsReadBackAndTheInitialConditionIsExplicit) {
 TEST(Cli, SimulateFollowsTheLibrarysInitialStateRuleForEveryModelType) {
   const std::string dir = test::temp_path("initial_rule");
   for (const ModelTypeCase& c : model_type_cases(dir)) {
-    const std::string json = dir + "/" + c.type + ".json";
-    const CliRun f = ctid_run("fit " + dir + "/" + c.record + "1.csv " + c.columns + " " + c.fit + " --json " + json +
-                              " --force", "timeout 300 ");
+    const auto [json, f] = fit_case(dir, c);
     ASSERT_TRUE(f.code == 0 || f.code == 1) << c.type << "\n" << f.err;
     const Result<AnyModel> r = read_result_file(json).result;
     ASSERT_EQ(model_type_name(r.model), c.type);

@@ -118,4 +118,11 @@ inline std::vector<ModelTypeCase> model_type_cases(const std::string& dir) {
   };
 }
 
+// The case's fit on the first part of its record by `ctid fit`, written to DIR/TYPE.json (returned with the run).
+inline std::pair<std::string, CliRun> fit_case(const std::string& dir, const ModelTypeCase& c) {
+  const std::string json = dir + "/" + c.type + ".json";
+  return {json, ctid_run("fit " + dir + "/" + c.record + "1.csv " + c.columns + " " + c.fit + " --json " + json +
+                             " --force", "timeout 300 ")};
+}
+
 }  // namespace ctid_cli_test
