@@ -103,6 +103,9 @@ int run_batch(const BatchJob& job) {
           } catch (const UsageError& e) {
             error = e.what();
             usage = true;
+          } catch (const InvalidArgument& e) {  // the library's refusal of an option or of the data's shape
+            error = e.what();
+            usage = true;
           } catch (const std::exception& e) {
             error = e.what();
           }
@@ -133,11 +136,7 @@ int run_batch(const BatchJob& job) {
       for (BatchRow& r : batch) {
         const BatchCell* ok = batch_cell(r, "usable");
         failed += !(ok && std::get<bool>(*ok));
-        try {
-          writer.add(std::move(r));
-        } catch (const FileError& e) {
-          throw InputError(e.what());
-        }
+        writer.add(std::move(r));
         ++written;
       }
       const auto now = std::chrono::steady_clock::now();

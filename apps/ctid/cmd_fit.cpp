@@ -28,7 +28,7 @@ struct FitArgs {
   bool frequency = false;
   std::string model_expr, via = "fsf", responses;
   std::vector<std::string> params;
-  std::string w = "w", re = "re", im = "im", u_re, u_im, y_re, y_im;
+  FrequencyColumns columns;  ///< --w --re --im, or the spectra --u-re --u-im --y-re --y-im
   std::string json, narx, report;
   std::string nx, initial;  ///< subspace/ssest: state dimension N or range A:B; ssest: a starting model (JSON)
   int period = 0, skip = 1;  ///< subspace/ssest: periodic records -> their FRF matrix (frf_from_periodic)
@@ -167,7 +167,7 @@ SettingList settings_of(const FitArgs& a) {
   const auto [nx, nx_max] = nx_of(a);
   if (nx > 0) s.emplace_back("nx", std::to_string(nx));
   if (nx_max > 0) s.emplace_back("nx_max", std::to_string(nx_max));
-  for (const auto& [k, v] : parse_sets(a.sets)) s.emplace_back(k, v);
+  for (auto& kv : setting_list(a.sets)) s.push_back(std::move(kv));
   return s;
 }
 
@@ -222,28 +222,17 @@ PhysicalStructure physical_of(const FitArgs& a) {
     p.parameters.push_back(q);
     names.push_back(q.name);
   }
-  std::vector<std::string> symbols;
   try {
     PhysicalModel check(a.model_expr, names);
-    symbols = PhysicalModel::symbols(a.model_expr);
   } catch (const InvalidArgument& e) {
     throw UsageError(std::string(e.what()) + "; declare every parameter with --param NAME=INITIAL");
   }
-  for (const auto& n : names)
-    if (std::find(symbols.begin(), symbols.end(), n) == symbols.end())
-      throw UsageError(detail::format("--param {}: '{}' does not appear in the model \"{}\"", n, n, a.model_expr));
-  if (a.via == "raw")
-    for (const auto& s : a.sets)
-      for (const char* k : {"T=", "n=", "b=", "weights=", "step_points="})
-        if (s.rfind(k, 0) == 0)
-          throw UsageError("--set " + s + ": --via raw fits the record itself (its settings: a, unstable, max_iterations, "
-                           "tolerance, fixed.NAME, bounds.NAME)");
   return p;
 }
 
 // --narx FILE: the NARX model KIA starts from.
 NarxModel narx_of(const std::string& path) {
-  const AnyModel m = read_result(path).result.model;
+  const AnyModel m = read_result_file(path).result.model;
   if (!std::holds_alternative<NarxModel>(m))
     throw InputError(path + ": --narx needs a NARX model; this is a " + model_type_name(m) + " model");
   return std::get<NarxModel>(m);
@@ -269,10 +258,6 @@ FitOutcome fit_request(const FitArgs& a, const FitRequest& r) {
                              : (e.key == "nx" || e.key == "nx_max") && !a.nx.empty() ? "--nx"
                                                                                      : "--set " + e.key;
     throw unknown_setting(flag, e, a.method);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  } catch (const FileError& e) {
-    throw InputError(e.what());
   }
 }
 
@@ -291,8 +276,6 @@ void print_experiments(const FitArgs& a, const std::vector<IdData>& ds) {
     std::printf("%s%s: %d samples", e ? ", " : "", a.paths[e].c_str(), ds[e].size());
   std::printf(")\n");
 }
-
-void write_fsf_responses(const std::string& prefix, const FsfModel& f);
 
 // --json: the result file, with where it came from.
 void write_json(const FitArgs& a, const FitOutcome& out, const Provenance& prov) {
@@ -332,7 +315,10 @@ int present(const Fitted& f, const FitArgs& a, const Provenance& prov) {
     more.insert(more.begin(), {"validation, " + a.validation->first, a.validation->second});
   }
   write_json(a, out, prov);
-  if (const auto* fsf = std::get_if<FsfModel>(&r.model); fsf && !a.responses.empty()) write_fsf_responses(a.responses, *fsf);
+  if (const auto* fsf = std::get_if<FsfModel>(&r.model); fsf && !a.responses.empty()) {
+    write_fsf_responses(a.responses, *fsf);
+    std::printf("wrote %s_time.csv and %s_freq.csv\n", a.responses.c_str(), a.responses.c_str());
+  }
   write_report(a.report, d, r, out.method, out.settings, a.paths.empty() ? a.data.path : a.paths.front(), prov, more,
                a.validation ? std::optional(validation_initial_condition(r.model)) : std::nullopt);
   return exit_code(r);
@@ -355,11 +341,7 @@ Fitted run_closed_loop(const FitArgs& a) {
   if (a.reference.empty()) throw UsageError("--closed-loop-controller needs --reference COLUMN");
   if (a.data.inputs.size() != 1) throw UsageError("closed-loop identification needs exactly one --input (the plant input)");
   LinearModel c;
-  try {
-    c = read_model_json(a.controller);
-  } catch (const FileError& e) {
-    throw InputError(e.what());
-  }
+  c = read_model_json(a.controller);
   if (!std::holds_alternative<TransferFunction>(c)) throw UsageError(a.controller + ": the controller must be a transfer_function");
   DataArgs da = a.data;
   da.inputs.push_back(a.reference);
@@ -381,29 +363,17 @@ Fitted run_closed_loop(const FitArgs& a) {
 // Frequency-response data: columns w, re, im (G) or the spectra U and Y.
 Fitted run_frequency(const FitArgs& a) {
   FitRequest r;
+  int rows = 0;
   try {
-    const CsvTable t = read_csv(a.data.path);
-    if (a.data.provenance) a.data.provenance->add_data_file(a.data.path, static_cast<int>(t.values.rows()));
-    auto col = [&](const std::string& name) { return Eigen::VectorXd(t.values.col(t.column(name))); };
-    const Eigen::VectorXd w = col(a.w);
-    try {
-      if (!a.u_re.empty() || !a.y_re.empty()) {
-        if (a.u_re.empty() || a.u_im.empty() || a.y_re.empty() || a.y_im.empty())
-          throw UsageError("spectra need all of --u-re --u-im --y-re --y-im");
-        const Eigen::VectorXcd U = col(a.u_re).cast<std::complex<double>>() + std::complex<double>(0, 1) * col(a.u_im);
-        const Eigen::VectorXcd Y = col(a.y_re).cast<std::complex<double>>() + std::complex<double>(0, 1) * col(a.y_im);
-        r.frequency = FrequencyData::from_spectra(w, U, Y);
-      } else {
-        r.frequency = FrequencyData(w, col(a.re).cast<std::complex<double>>() + std::complex<double>(0, 1) * col(a.im));
-      }
-    } catch (const InvalidArgument& e) {
-      throw InputError(a.data.path + ": " + e.what());
-    }
-  } catch (const FileError& e) {
-    throw InputError(e.what());
+    r.frequency = load_frequency_data(a.data.path, a.columns, &rows);
+  } catch (const ColumnSelectionError&) {
+    throw;  // the options' problem (exit 2)
+  } catch (const InvalidOptions&) {
+    throw;
   } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
+    throw InputError(e.what());  // the file's content
   }
+  if (a.data.provenance) a.data.provenance->add_data_file(a.data.path, rows);
   const MethodInfo& m = method_info(a.method);
   if (!m.capabilities.frequency_data || m.capabilities.several_outputs)
     throw UsageError("frequency data are fitted with --method " +
@@ -415,36 +385,13 @@ Fitted run_frequency(const FitArgs& a) {
   return {std::move(out), {}, std::move(r.frequency)};
 }
 
-void write_fsf_responses(const std::string& prefix, const FsfModel& f) {
-  const int K = 501;
-  Eigen::MatrixXd tm(K, 5);
-  for (int i = 0; i < K; ++i) {
-    const Eigen::VectorXd t{{f.T() * i / (K - 1)}};
-    tm.row(i) << t(0), f.step_response(t)(0), f.step_response_std(t)(0), f.impulse_response(t)(0),
-        f.impulse_response_std(t)(0);
-  }
-  write_csv(prefix + "_time.csv", {"t", "step", "step_std", "impulse", "impulse_std"}, tm);
-  const Eigen::VectorXd w = model_frequency_grid(f);  // the report's grid
-  const Eigen::VectorXcd g = f.frequency_response(w), gs = f.frequency_response_std(w);
-  Eigen::MatrixXd fm(w.size(), 7);
-  for (Eigen::Index i = 0; i < w.size(); ++i)
-    fm.row(i) << w(i), g(i).real(), g(i).imag(), gs(i).real(), gs(i).imag(), std::abs(g(i)),
-        std::arg(g(i)) * 180.0 / 3.14159265358979;
-  write_csv(prefix + "_freq.csv", {"w", "re", "im", "re_std", "im_std", "mag", "phase_deg"}, fm);
-  std::printf("wrote %s_time.csv and %s_freq.csv\n", prefix.c_str(), prefix.c_str());
-}
-
 // A grey-box model file fitted to one record or several (one parameter set, an initial state per record). The
 // model's input and output names are the data columns unless --input/--output map them (in the model's order).
 Fitted run_greybox(const FitArgs& a) {
   if (a.model_expr.empty()) throw UsageError("--method greybox needs --model FILE.json (the grey-box model file)");
   if (a.frequency) throw UsageError("--method greybox fits time-domain records (not --frequency)");
   FitRequest r;
-  try {
-    r.structure.greybox = read_greybox_json(a.model_expr);
-  } catch (const FileError& e) {
-    throw InputError(e.what());
-  }
+  r.structure.greybox = read_greybox_json(a.model_expr);
   const GreyboxModel& model = *r.structure.greybox;
   const DataArgs da = columns_of(a.data, model);
   if (static_cast<int>(da.inputs.size()) != model.nu() || static_cast<int>(da.outputs.size()) != model.ny())
@@ -474,11 +421,7 @@ Fitted run_periodic(const FitArgs& a) {
   if (!a.report.empty()) throw UsageError("--report needs time-domain records (not --period: a fit to frequency data)");
   const std::vector<IdData> ds = a.paths.size() > 1 ? a.data.load_each(a.paths, true) : std::vector<IdData>{a.data.load(true)};
   FitRequest r;
-  try {
-    r.frequency = frf_from_periodic(ds, a.period, a.skip, a.excited);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
+  r.frequency = frf_from_periodic(ds, a.period, a.skip, a.excited);
   const FrequencyData& fd = *r.frequency;
   const int periods = ds.front().size() / a.period - a.skip;
   if (!a.data.quiet)
@@ -534,11 +477,7 @@ Fitted fit_of(FitArgs& a) {
   const IdData d = a.data.load(true, &trend);
   if (!a.validate.empty() || !a.validate_samples.empty()) a.validation = validation_record(a, trend);
   // A constant channel carries no information on the dynamics (the library's check, made before any other).
-  try {
-    require_io_data(d, m.name.c_str(), -1, -1);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
+  require_io_data(d, m.name.c_str(), -1, -1);
   if (nx_of(a).second > 0 && !has_setting(m, "nx_max"))
     throw UsageError("--nx A:B (an order range) is for --method " +
                      fits_that([](const MethodInfo& x) { return has_setting(x, "nx_max"); }) + "; " + m.name +
@@ -626,13 +565,13 @@ std::shared_ptr<FitArgs> add_fit_options(CLI::App& app) {
   app.add_flag("--frequency", a->frequency,
                "DATA holds frequency-response data: columns --w (rad/s), --re, --im of G(jw), or the spectra --u-re --u-im "
                "--y-re --y-im");
-  app.add_option("--w", a->w, "Frequency column (rad/s) of frequency data")->capture_default_str();
-  app.add_option("--re", a->re, "Real part of G(jw)")->capture_default_str();
-  app.add_option("--im", a->im, "Imaginary part of G(jw)")->capture_default_str();
-  app.add_option("--u-re", a->u_re, "Input spectrum, real part");
-  app.add_option("--u-im", a->u_im, "Input spectrum, imaginary part");
-  app.add_option("--y-re", a->y_re, "Output spectrum, real part");
-  app.add_option("--y-im", a->y_im, "Output spectrum, imaginary part");
+  app.add_option("--w", a->columns.w, "Frequency column (rad/s) of frequency data")->capture_default_str();
+  app.add_option("--re", a->columns.re, "Real part of G(jw)")->capture_default_str();
+  app.add_option("--im", a->columns.im, "Imaginary part of G(jw)")->capture_default_str();
+  app.add_option("--u-re", a->columns.u_re, "Input spectrum, real part");
+  app.add_option("--u-im", a->columns.u_im, "Input spectrum, imaginary part");
+  app.add_option("--y-re", a->columns.y_re, "Output spectrum, real part");
+  app.add_option("--y-im", a->columns.y_im, "Output spectrum, imaginary part");
   app.add_option("--model", a->model_expr,
                  "physical: transfer-function expression in s, e.g. \"k1/(s^2-k2)\"; greybox: the model file (JSON: inputs, "
                  "states, outputs, parameters, equations, initial; docs/methods/greybox.md)");

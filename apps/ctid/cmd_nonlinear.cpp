@@ -26,7 +26,7 @@ int run_gfrf(const GfrfArgs& a) {
     throw UsageError("give either the frequencies with --w w1,w2,.. (rad/s) or the points with --points FILE");
   std::function<Complex(const std::vector<Complex>&)> kernel;
   std::string kind;
-  const AnyModel model = read_result(a.model).result.model;
+  const AnyModel model = read_result_file(a.model).result.model;
   if (const auto* narx = std::get_if<NarxModel>(&model)) {
     kernel = [m = narx->process(), zoh = !a.no_zoh](const std::vector<Complex>& s) { return narx_gfrf_ct(m, s, zoh); };
     kind = "narx";
@@ -48,11 +48,7 @@ int run_gfrf(const GfrfArgs& a) {
   std::vector<std::vector<Complex>> tuples;
   if (!a.points.empty()) {
     CsvTable in;
-    try {
-      in = read_csv(a.points);
-    } catch (const FileError& e) {
-      throw InputError(e.what());
-    }
+    in = read_csv(a.points);
     std::vector<int> col;
     for (const auto& n : names) {
       const auto it = std::find(in.names.begin(), in.names.end(), n);

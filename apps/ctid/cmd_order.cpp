@@ -35,21 +35,13 @@ OrderRange parse_range(const std::string& flag, const std::string& s) {
 
 int run(const OrderArgs& a) {
   OrderSelectionOptions o;
-  try {
-    o.rank_by = order_criterion_from_string(a.rank);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
+  o.rank_by = order_criterion_from_string(a.rank);
   const OrderRange nb = parse_range("--nb", a.nb), nf = parse_range("--nf", a.nf), nk = parse_range("--nk", a.nk);
   check_outputs({a.json}, {a.data.path}, a.force);
   const IdData d = a.data.load(true);
   if (d.nu() != 1 || d.ny() != 1) throw UsageError("order selection needs one --input and one --output");
   std::vector<OrderCandidate> c;
-  try {
-    c = select_order(d, nb, nf, nk, o);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
+  c = select_order(d, nb, nf, nk, o);
   std::printf("rank  nb nf nk        YIC       RT2         AIC         BIC    fit %%  SRIVC\n");
   int i = 0;
   for (const auto& k : c)

@@ -39,7 +39,7 @@ int run(const ReportArgs& a) {
   std::vector<std::string> inputs = a.paths;
   inputs.push_back(a.result);
   check_outputs({a.out}, inputs, a.force);
-  ResultFile file = read_result(a.result);
+  ResultFile file = read_result_file(a.result);
   const std::vector<IdData> ds = columns_of(a.data, file.result.model).load_each(a.paths, true);
   const IdData& d = ds.front();
   const int nu = model_inputs(file.result.model), ny = model_outputs(file.result.model);
@@ -63,16 +63,8 @@ int run(const ReportArgs& a) {
   }
   if (!a.initial.empty()) o.initial = initial_condition_from_string(a.initial);
   std::string html;
-  try {
-    html = html_report(d, file.result, o);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
-  try {
-    write_text_file(a.out, html);
-  } catch (const FileError& e) {
-    throw InputError(e.what());
-  }
+  html = html_report(d, file.result, o);
+  write_text_file(a.out, html);
   std::printf("wrote %s\n", a.out.c_str());
   return kOk;
 }

@@ -87,7 +87,7 @@ int run(const ValArgs& a) {
   std::vector<std::string> inputs = a.paths;
   inputs.push_back(a.model);
   check_outputs({a.json}, inputs, a.force);
-  const ResultFile file = read_result(a.model);
+  const ResultFile file = read_result_file(a.model);
   const AnyModel& model = file.result.model;
   const std::vector<IdData> ds = columns_of(a.data, model).load_each(a.paths, true);
   std::printf("model:  %s\n", describe(model).c_str());

@@ -39,19 +39,13 @@ IdData DataArgs::load(bool need_output, TrendInfo* removed_trend, std::pair<int,
   c.rows_name = samples_option;
   if (detrend != "none") c.detrend = detrend == "mean" ? Detrend::Mean : Detrend::Linear;
   ChosenRecord r;
-  try {
-    c.intersample = intersample_from_string(intersample);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
+  c.intersample = intersample_from_string(intersample);
   try {
     r = choose_record(path, c);
-  } catch (const FileError& e) {
-    throw InputError(e.what());
-  } catch (const InvalidOptions& e) {
-    throw UsageError(e.what());  // the rows asked for
-  } catch (const ColumnSelectionError& e) {
-    throw UsageError(e.what());  // a column the file does not have, or one chosen twice: the options' problem
+  } catch (const InvalidOptions&) {
+    throw;  // the rows asked for (exit 2)
+  } catch (const ColumnSelectionError&) {
+    throw;  // a column the file does not have, or one chosen twice: the options' problem (exit 2)
   } catch (const InvalidArgument& e) {
     throw InputError(path + ": " + e.what());  // the file's content
   }
@@ -126,12 +120,10 @@ std::map<std::string, std::string> parse_sets(const std::vector<std::string>& se
   return m;
 }
 
-ResultFile read_result(const std::string& path) {
-  try {
-    return read_result_file(path);
-  } catch (const FileError& e) {
-    throw InputError(e.what());
-  }
+SettingList setting_list(const std::vector<std::string>& sets) {
+  SettingList list;
+  for (const auto& [key, value] : parse_sets(sets)) list.emplace_back(key, value);
+  return list;
 }
 
 DataArgs columns_of(const DataArgs& given, const AnyModel& model) {
@@ -160,47 +152,28 @@ void add_initial_option(CLI::App& app, std::string& initial, int* initial_sample
 
 SimulateOptions simulate_options_of(const Result<AnyModel>& r, SimulationPurpose purpose, const std::string& initial,
                                     int initial_samples) {
-  try {
-    const std::optional<InitialCondition> given =
-        initial.empty() ? std::nullopt : std::optional(initial_condition_from_string(initial));
-    if (initial_samples > 0 &&
-        (simulate_options(r, purpose, given).initial != InitialCondition::Estimated || !std::holds_alternative<GreyboxModel>(r.model)))
-      throw UsageError("--initial-samples needs --initial estimated and a grey-box model");
-    return simulate_options(r, purpose, given, initial_samples);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
+  const std::optional<InitialCondition> given =
+      initial.empty() ? std::nullopt : std::optional(initial_condition_from_string(initial));
+  if (initial_samples > 0 &&
+      (simulate_options(r, purpose, given).initial != InitialCondition::Estimated || !std::holds_alternative<GreyboxModel>(r.model)))
+    throw UsageError("--initial-samples needs --initial estimated and a grey-box model");
+  return simulate_options(r, purpose, given, initial_samples);
 }
 
 Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, SimulationPurpose purpose,
                                 const std::string& initial, int initial_samples) {
   const SimulateOptions o = simulate_options_of(r, purpose, initial, initial_samples);
   Simulation s;
-  try {
-    s = simulate(r.model, d, o);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
+  s = simulate(r.model, d, o);
   if (!s.ok()) throw NotUsable(s.problem);
   return s.y;
 }
 
-// The library's parsers of setting values (estimate/options.hpp), with the CLI's exit code for a bad value.
+// The library's parser of setting values (estimate/options.hpp), with the CLI's exit code for a bad value.
 double to_double(const std::string& key, const std::string& value) {
-  try {
-    const double v = options_detail::parse_real("--set", key, value);
-    if (!std::isfinite(v)) throw UsageError("--set " + key + ": '" + value + "' is not a finite number");
-    return v;
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
-}
-int to_int(const std::string& key, const std::string& value) {
-  try {
-    return options_detail::parse_int("--set", key, value);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
+  const double v = options_detail::parse_real("--set", key, value);
+  if (!std::isfinite(v)) throw UsageError("--set " + key + ": '" + value + "' is not a finite number");
+  return v;
 }
 
 void warn_offsets(const IdData& d) {

@@ -14,7 +14,9 @@
 
 namespace ctid::cli {
 
-// Exit codes (docs/guide.md, "Exit codes").
+// Exit codes (docs/guide.md, "Exit codes"). The library's exceptions reach main unchanged and are classified there
+// by type: FileError is exit 3, InvalidArgument (with InvalidOptions and ColumnSelectionError) exit 2. A command
+// converts one only where the exit code differs (a file's content is exit 3) or a flag must be named.
 constexpr int kOk = 0;
 constexpr int kNotUsable = 1;
 constexpr int kUsage = 2;
@@ -58,7 +60,8 @@ struct DataArgs {
   void add_to(CLI::App& app, bool need_output);
   /// The library's choose_record (io/load.hpp: the default columns, the rows of --samples, the detrending; the
   /// removed trend in `removed`, left empty with --detrend none) with its notes on stderr and the provenance
-  /// recorded; maps every failure to InputError (file/content) or UsageError (inconsistent options).
+  /// recorded; a file's content it cannot read is an InputError naming the file (the library's FileError,
+  /// InvalidOptions and ColumnSelectionError pass unchanged).
   /// With `rows`: the rows used, 1-based first and last.
   IdData load(bool need_output, TrendInfo* removed = nullptr, std::pair<int, int>* rows = nullptr) const;
   /// The same selection loaded from each of `paths` (several records of one system), in order.
@@ -72,11 +75,10 @@ struct DataArgs {
 /// Empty names are skipped.
 void check_outputs(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs, bool force);
 
-/// "KEY=VALUE" pairs from --set.
+/// "KEY=VALUE" pairs from --set; UsageError for a pair without '=' or a key given twice.
 std::map<std::string, std::string> parse_sets(const std::vector<std::string>& sets);
-/// The result or model file at `path`, whatever its model type (io/json.hpp); a file that cannot be read
-/// or recognised throws InputError naming it.
-ResultFile read_result(const std::string& path);
+/// The same as the library's settings (text values, parsed by the method's tables).
+SettingList setting_list(const std::vector<std::string>& sets);
 /// `--initial rest|measured|estimated` (simulate/simulate.hpp) on a command, defaulting to `initial`'s value
 /// ("" = fit_initial_condition(): the one the result's own fit used).
 /// With `initial_samples` (not null) also `--initial-samples N`: the estimated initial state of a grey-box model from
@@ -87,18 +89,18 @@ void add_initial_option(CLI::App& app, std::string& initial, int* initial_sample
 /// A grey-box model's inputs and outputs are data columns of the same names unless --input/--output map them.
 DataArgs columns_of(const DataArgs& given, const AnyModel& model);
 /// The library's simulation options of `r` for `purpose` (simulate/simulate.hpp: the one rule for the initial state)
-/// with --initial ("" = the purpose's default) and --initial-samples; UsageError for flags that do not fit the model.
+/// with --initial ("" = the purpose's default) and --initial-samples; UsageError or InvalidArgument for flags that
+/// do not fit the model.
 SimulateOptions simulate_options_of(const Result<AnyModel>& r, SimulationPurpose purpose, const std::string& initial,
                                     int initial_samples = 0);
 /// The result's model simulated on d for `purpose` (simulate_options_of). Data that do not fit the model throw
-/// UsageError; a simulation that stops being finite throws NotUsable naming where and why (e.g. the unstable poles):
+/// InvalidArgument; a simulation that stops being finite throws NotUsable naming where and why (e.g. the unstable poles):
 /// a diverging simulation is never written or scored.
 Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, SimulationPurpose purpose,
                                 const std::string& initial, int initial_samples = 0);
 
-/// A --set value as a finite number / a whole number, parsed by the library's option parsers; UsageError otherwise.
+/// A --param value as a finite number, parsed by the library's option parser; UsageError otherwise.
 double to_double(const std::string& key, const std::string& value);
-int to_int(const std::string& key, const std::string& value);
 
 
 /// Method settings as NAME/VALUE text pairs (the report's "settings" section).
@@ -122,25 +124,8 @@ inline UsageError unknown_setting(const std::string& flag, const UnknownSetting&
                     settings_hint(method) + " lists them)");
 }
 
-/// Applies --set KEY=VALUE pairs to options structs through their tables (the library's apply_settings): an
-/// unknown key, or a value that does not parse, is a UsageError naming `method` and the closest valid setting.
-/// Ranges are checked by the estimator (validate()).
-template <class... O>
-void apply_sets(const std::string& method, const std::vector<std::string>& sets, O&... o) {
-  SettingList list;
-  for (const auto& [key, value] : parse_sets(sets)) list.emplace_back(key, value);
-  try {
-    apply_settings(method, list, {}, o...);
-  } catch (const UnknownSetting& e) {
-    throw unknown_setting("--set " + e.key, e, method);
-  } catch (const InvalidOptions& e) {
-    throw UsageError(e.what());
-  }
-}
-
 /// --report: write the HTML report of r on d (nothing when path is empty), with `settings` as the method
-/// settings. A report that cannot be made (e.g. multi-channel data) is a UsageError; a write failure an
-/// InputError.
+/// settings. A report that cannot be made (e.g. multi-channel data) is a UsageError; a write failure a FileError.
 template <class M>
 void write_report(const std::string& path, const IdData& d, const Result<M>& r, const std::string& method,
                   const std::vector<std::pair<std::string, std::string>>& settings, const std::string& source,
@@ -161,20 +146,9 @@ void write_report(const std::string& path, const IdData& d, const Result<M>& r, 
   } catch (const InvalidArgument& e) {
     throw UsageError(std::string("--report: ") + e.what());
   }
-  try {
-    write_text_file(path, html);
-  } catch (const FileError& e) {
-    throw InputError(e.what());
-  }
+  write_text_file(path, html);
   std::printf("wrote %s\n", path.c_str());
 }
-
-/// Modal-function options (El-Shafey) from --set through their table, plus the CLI's shift_samples (the shifts
-/// counted in sampling periods of Ts; give it or shifts in seconds). Keys listed in `own` are not modal settings
-/// but the command's own: they are returned in `own_values` instead.
-ModalOptions modal_options(const std::string& method, const std::vector<std::string>& sets, double Ts,
-                           const std::vector<std::string>& own, std::map<std::string, std::string>& own_values);
-
 
 void setup_fit(CLI::App& app, Command& run);
 /// `ctid fit ARGS...` run from inside another command (ctid demo): the same parsing, defaults, output and exit code.

@@ -42,6 +42,7 @@
 #include "ctid/io/mat.hpp"
 #include "ctid/io/provenance.hpp"
 #include "ctid/io/text_report.hpp"
+#include "ctid/io/tool_text.hpp"
 #include "ctid/model/any_model.hpp"
 #include "ctid/model/expression.hpp"
 #include "ctid/model/fsf.hpp"

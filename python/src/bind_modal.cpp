@@ -141,7 +141,8 @@ void bind_modal(py::module_& m) {
       .def_readonly("time", &ModalResponse::time)
       .def_readonly("frequency", &ModalResponse::frequency)
       .def_readonly("p0", &ModalResponse::p0)
-      .def_readonly("modal", &ModalResponse::modal);
+      .def_readonly("modal", &ModalResponse::modal)
+      .def("__repr__", &modal_response_text);
   m.def(
       "modal_response",
       [](const IdData& d, int order, ResponseKind kind, const ModalResponseOptions& o, const ModalOptions& mo) {
@@ -156,7 +157,8 @@ void bind_modal(py::module_& m) {
       .def_readonly("prony_problem", &PolesComparison::prony_problem)
       .def_readonly("free_response", &PolesComparison::free_response)
       .def_readonly("prony_options", &PolesComparison::prony_options)
-      .def_readonly("choices", &PolesComparison::choices);
+      .def_readonly("choices", &PolesComparison::choices)
+      .def("__repr__", &poles_text);
   m.def("compare_poles", &compare_poles, py::arg("y"), py::arg("ts"), py::arg("order"), py::arg("options"),
         "El-Shafey's data-matrix poles beside Prony's, instants chosen from the record unless given (ctid poles).");
 }

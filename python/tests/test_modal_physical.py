@@ -69,6 +69,11 @@ def test_compare_poles_is_what_ctid_poles_prints():
     assert max(abs(c.data_matrix.poles.imag)) == pytest.approx(100, abs=0.1)
     assert c.prony is not None and c.prony_options.spacing == 33
     assert max(abs(c.prony.poles.imag)) <= math.pi / (33 * tw) + 1e-9
+    # Its repr is the library's text that ctid poles prints: both estimates, each pole to 6 digits.
+    text = repr(c)
+    assert text.startswith("data-matrix method (Theorem 4.3, El-Shafey 1987):") and "\nProny (order 4, T = 33" in text
+    for p in c.data_matrix.poles:
+        assert "%.6g%+.6gj" % (p.real, p.imag) in text
     with pytest.raises(ctid.InvalidOptions, match="3 shifts; order 4 needs 4"):
         ctid.compare_poles(y, tw, 4, shifts=np.array([33, 66, 99]) * tw)
     # Shifts left out: chosen on Prony's pre-estimate and stated; 100 rad/s still found (C++ test: within 0.1).
@@ -103,6 +108,11 @@ def test_modal_frequency_response_from_a_square_wave():
                               window_start=120 * ts, shifts=shifts)
     np.testing.assert_allclose(one.frequency.response.response, h.response.response, rtol=1e-12)
     assert one.p0.usable() and len(one.modal.windows) > 0
+    # Its repr is the text ctid response prints: the p_0 line, then one line per harmonic with |H| to 6 digits.
+    lines = repr(one).splitlines()
+    assert lines[0].startswith("modal parameters p_0:") and len(lines) == 1 + 6
+    for line, g in zip(lines[1:], one.frequency.response.response):
+        assert "|H| = %.6g " % abs(g) in line
     with pytest.raises(ctid.InvalidOptions, match="give the period"):
         ctid.modal_response(d, 3, "frequency", shifts=shifts)
     # A misspelt keyword names the closest setting of either table (ModalResponseOptions or ModalOptions).

@@ -28,6 +28,13 @@
 
 namespace ctid {
 
+std::vector<double> setting_reals(const std::string& method, const std::string& name, const SettingValue& v) {
+  if (const auto* text = std::get_if<std::string>(&v)) return options_detail::parse_reals(method, name, *text);
+  if (const auto* x = std::get_if<std::vector<double>>(&std::get<OptionValue>(v))) return *x;
+  if (const auto* x = std::get_if<double>(&std::get<OptionValue>(v))) return {*x};
+  throw InvalidOptions(detail::format("{}: {} takes a list of numbers", method, name));
+}
+
 namespace fit_detail {
 
 // One input: the single entry of the orders.
@@ -45,14 +52,6 @@ FitOutcome tf_records(const FitRequest& r, const std::string& method, One one, M
   const TfOrders orders = siso_orders(r, method);
   const auto res = r.records.size() == 1 ? one(r.records.front(), orders, o) : many(r.records, orders, o);
   return fit_outcome(res, method, settings_text(o));
-}
-
-// A string or reals setting as reals (modal's own shift_samples and frequencies).
-std::vector<double> reals_of(const std::string& method, const std::string& name, const SettingValue& v) {
-  if (const auto* text = std::get_if<std::string>(&v)) return options_detail::parse_reals(method, name, *text);
-  if (const auto* x = std::get_if<std::vector<double>>(&std::get<OptionValue>(v))) return *x;
-  if (const auto* x = std::get_if<double>(&std::get<OptionValue>(v))) return {*x};
-  throw InvalidOptions(detail::format("{}: {} takes a list of numbers", method, name));
 }
 
 std::string text_of(const std::vector<double>& v) { return options_detail::format_reals(v); }
@@ -160,6 +159,18 @@ FitOutcome physical(const FitRequest& r) {
   std::vector<std::string> names;
   for (const auto& q : p.parameters) names.push_back(q.name);
   const PhysicalModel model(p.expression, names);
+  const std::vector<std::string> symbols = PhysicalModel::symbols(p.expression);
+  for (const auto& n : names)
+    CTID_REQUIRE_OPTION(std::find(symbols.begin(), symbols.end(), n) != symbols.end(),
+                        "physical: parameter {}: '{}' does not appear in the model \"{}\"", n, n, p.expression);
+  // The raw route fits the record itself: the FSF compression's settings would be ignored, so they are refused.
+  if (p.route == "raw")
+    for (const auto& [name, value] : r.settings)
+      for (const char* k : {"T", "n", "b", "weights", "step_points"})
+        CTID_REQUIRE_OPTION(name != k,
+                            "physical: {}: the raw route fits the record itself (its settings: a, unstable, "
+                            "max_iterations, tolerance, fixed.NAME, bounds.NAME)",
+                            name);
   FsfOptions fo;
   PhysicalFitOptions po;
   apply_settings("physical", r.settings, {}, fo, po);
@@ -198,18 +209,8 @@ FitOutcome modal(const FitRequest& r) {
   const SettingList own = apply_settings("modal", r.settings, {"shift_samples", "frequencies"}, o);
   std::vector<double> frequencies, samples;
   for (const auto& [name, value] : own)
-    (name == "frequencies" ? frequencies : samples) = reals_of("modal", name, value);
-  if (!samples.empty()) {
-    CTID_REQUIRE_OPTION(o.shifts.size() == 0,
-                        "modal: give either shifts (seconds) or shift_samples (samples), not both");
-    o.shifts.resize(static_cast<Eigen::Index>(samples.size()));
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-      const double v = samples[i];
-      CTID_REQUIRE_OPTION(std::abs(v - std::round(v)) <= 1e-9 && v >= 0 && v <= 1e9,
-                          "modal: shift_samples: {} is not a whole number of samples", v);
-      o.shifts(static_cast<Eigen::Index>(i)) = std::round(v) * d.ts();
-    }
-  }
+    (name == "frequencies" ? frequencies : samples) = setting_reals("modal", name, value);
+  if (!samples.empty()) o.shifts = shifts_from_samples("modal", samples, d.ts(), o.shifts);
   const int n = orders.nf;
   if (o.shifts.size() == 0)
     o.order = n;  // the shifts are chosen (and stated)

@@ -11,6 +11,8 @@
 
 #include "ctid/core/check.hpp"
 #include "ctid/io/file.hpp"
+#include "ctid/model/fsf.hpp"
+#include "ctid/validate/uncertainty.hpp"
 
 namespace ctid {
 
@@ -168,6 +170,24 @@ void write_csv(const std::string& path, const std::vector<std::string>& names, c
     os << "\n";
   }
   write_text_file(path, os.str());
+}
+
+void write_fsf_responses(const std::string& prefix, const FsfModel& f) {
+  const int K = 501;
+  Eigen::MatrixXd tm(K, 5);
+  for (int i = 0; i < K; ++i) {
+    const Eigen::VectorXd t{{f.T() * i / (K - 1)}};
+    tm.row(i) << t(0), f.step_response(t)(0), f.step_response_std(t)(0), f.impulse_response(t)(0),
+        f.impulse_response_std(t)(0);
+  }
+  write_csv(prefix + "_time.csv", {"t", "step", "step_std", "impulse", "impulse_std"}, tm);
+  const Eigen::VectorXd w = model_frequency_grid(f);
+  const Eigen::VectorXcd g = f.frequency_response(w), gs = f.frequency_response_std(w);
+  Eigen::MatrixXd fm(w.size(), 7);
+  for (Eigen::Index i = 0; i < w.size(); ++i)
+    fm.row(i) << w(i), g(i).real(), g(i).imag(), gs(i).real(), gs(i).imag(), std::abs(g(i)),
+        std::arg(g(i)) * 180.0 / 3.14159265358979;
+  write_csv(prefix + "_freq.csv", {"w", "re", "im", "re_std", "im_std", "mag", "phase_deg"}, fm);
 }
 
 }  // namespace ctid

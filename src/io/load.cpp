@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <complex>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -276,6 +277,26 @@ ChosenRecord choose_record(const std::string& path, const RecordChoice& choice) 
   out.preprocessing += detail::format("; {} removed ({})", *choice.detrend == Detrend::Mean ? "means" : "linear trends",
                                       out.removed_text);
   return out;
+}
+
+FrequencyData load_frequency_data(const std::string& path, const FrequencyColumns& c, int* rows) {
+  const CsvTable t = read_csv(path);
+  if (rows) *rows = static_cast<int>(t.values.rows());
+  auto col = [&](const std::string& name) { return Eigen::VectorXd(t.values.col(t.column(name))); };
+  auto complex = [&](const std::string& re, const std::string& im) -> Eigen::VectorXcd {
+    return col(re).cast<std::complex<double>>() + std::complex<double>(0, 1) * col(im);
+  };
+  const Eigen::VectorXd w = col(c.w);
+  const bool spectra = !c.u_re.empty() || !c.u_im.empty() || !c.y_re.empty() || !c.y_im.empty();
+  CTID_REQUIRE_OPTION(!spectra || (!c.u_re.empty() && !c.u_im.empty() && !c.y_re.empty() && !c.y_im.empty()),
+                      "{}: frequency data from spectra need all four columns u_re, u_im, y_re and y_im", path);
+  const Eigen::VectorXcd a = spectra ? complex(c.u_re, c.u_im) : complex(c.re, c.im);
+  const Eigen::VectorXcd b = spectra ? complex(c.y_re, c.y_im) : Eigen::VectorXcd();
+  try {
+    return spectra ? FrequencyData::from_spectra(w, a, b) : FrequencyData(w, a);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(path + ": " + e.what());
+  }
 }
 
 }  // namespace ctid

@@ -5,7 +5,6 @@
 #include <algorithm>
 
 #include <cmath>
-#include <cstdarg>
 #include <cstdio>
 #include <limits>
 #include <numbers>
@@ -16,26 +15,12 @@
 #include "ctid/estimate/methods.hpp"
 #include "ctid/io/load.hpp"
 #include "ctid/validate/metrics.hpp"
+#include "io/appendf.hpp"
 
 namespace ctid {
 
 namespace {
-// printf into a string.
-[[gnu::format(printf, 2, 3)]] void appendf(std::string& out, const char* format, ...) {
-  va_list args;
-  va_start(args, format);
-  va_list again;
-  va_copy(again, args);
-  const int n = std::vsnprintf(nullptr, 0, format, args);
-  va_end(args);
-  if (n > 0) {
-    const std::size_t at = out.size();
-    out.resize(at + static_cast<std::size_t>(n) + 1);
-    std::vsnprintf(out.data() + at, static_cast<std::size_t>(n) + 1, format, again);
-    out.resize(at + static_cast<std::size_t>(n));
-  }
-  va_end(again);
-}
+using io_detail::appendf;
 
 // The automatic choices, the summary's note and the warnings: the lines after every result.
 void notes_text(std::string& out, const Summary& s, const Diagnostics& dg) {

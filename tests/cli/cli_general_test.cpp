@@ -274,6 +274,11 @@ TEST(Cli, TrustCampaign) {
       {"fit " + good_csv() + base + "--method srivc --narx " + narx, 2, "--narx gives KIA its NARX model"},
       {"fit " + good_csv() + base + "--method physical --via bogus", 2, "--via must be fsf, frequency or raw (got 'bogus')"},
       {"fit " + good_csv() + base + "--method narx --nf 2", 2, "--nf sets transfer-function orders"},
+      // The library's physical fit refuses a parameter the model lacks, and FSF settings on the raw route.
+      {"fit " + good_csv() + base + "--method physical --model \"k/(s+a)\" --param k=1 --param a=1 --param c=2", 2,
+       "parameter c: 'c' does not appear in the model"},
+      {"fit " + good_csv() + base + "--method physical --via raw --model \"k/(s+a)\" --param k=1 --param a=1 --set T=5",
+       2, "T: the raw route fits the record itself"},
       {"fit " + good_csv() + base + "--method lssvf --set tau=0.3 --set tau=0.4", 2, "--set tau is given twice"},
       {"fit " + good_csv() + base + "--closed-loop-controller " + ctrl + " --method oe", 2, "needs --method srivc"},
       // A fit the data cannot tell from no model.

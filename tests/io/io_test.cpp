@@ -1,4 +1,5 @@
 #include <cmath>
+#include <complex>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -119,6 +120,29 @@ TEST(Load, ChooseRecordDefaultsRowsAndDetrending) {
   EXPECT_THROW(choose_record(write_text("wide.csv", "a,b,c\n1,2,3\n4,5,6\n"), wide), ColumnSelectionError);
   wide.outputs = {"c"};  // an output given: every other column is an input
   EXPECT_EQ(choose_record(write_text("wide2.csv", "a,b,c\n1,2,3\n4,5,6\n"), wide).data.nu(), 2);
+}
+
+TEST(Load, FrequencyDataFromTheResponseOrTheSpectra) {
+  // G(jw) = 1/(1 + jw) at w = 1, 2: from re/im directly, and as Y/U from spectra U = 2, Y = 2 G (exact in binary).
+  const std::string f = write_text("freq.csv", "w,re,im,ur,ui,yr,yi\n1,0.5,-0.5,2,0,1,-1\n2,0.2,-0.4,2,0,0.4,-0.8\n");
+  int rows = 0;
+  const FrequencyData g = load_frequency_data(f, {}, &rows);
+  EXPECT_EQ(rows, 2);
+  EXPECT_EQ(g.response()(1), std::complex<double>(0.2, -0.4));
+  FrequencyColumns spectra;
+  spectra.u_re = "ur";
+  spectra.u_im = "ui";
+  spectra.y_re = "yr";
+  spectra.y_im = "yi";
+  EXPECT_NEAR(std::abs(load_frequency_data(f, spectra).response()(1) - std::complex<double>(0.2, -0.4)), 0.0, 1e-15);
+  // The options' problems (a column the file lacks, spectra named in part) and the file's content are told apart.
+  FrequencyColumns missing;
+  missing.re = "real";
+  EXPECT_THROW(load_frequency_data(f, missing), ColumnSelectionError);
+  spectra.y_im.clear();
+  EXPECT_THROW(load_frequency_data(f, spectra), InvalidOptions);
+  const std::string bad = write_text("freq_bad.csv", "w,re,im\n2,1,0\n1,1,0\n");
+  EXPECT_NE(error_of([&] { load_frequency_data(bad, {}); }).find(bad + ": "), std::string::npos);
 }
 
 TEST(Json, ModelAndResultRoundTrip) {

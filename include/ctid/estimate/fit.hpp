@@ -129,6 +129,10 @@ SettingList apply_settings(const std::string& method, const SettingList& setting
   return rest;
 }
 
+/// A setting's value as a list of numbers: text "1,2,3" (parsed as the tables parse lists), or typed reals or one
+/// real. Throws InvalidOptions naming `method` and `name` otherwise (a method's own settings, apply_settings' `own`).
+std::vector<double> setting_reals(const std::string& method, const std::string& name, const SettingValue& value);
+
 /// Every setting of the options structs `o...` as NAME/VALUE text, defaults included (FitOutcome::settings).
 template <class... O>
 SettingsText settings_text(const O&... o) {

@@ -38,4 +38,10 @@ CsvTable parse_csv(const std::string& text, const std::string& source, const Csv
 /// values at full precision (17 significant digits). Throws FileError.
 void write_csv(const std::string& path, const std::vector<std::string>& names, const Eigen::MatrixXd& values);
 
+class FsfModel;
+/// The responses of an FSF model with their standard deviations (ctid fit --responses PREFIX): PREFIX_time.csv
+/// (t, step, step_std, impulse, impulse_std on 501 points over [0, T]) and PREFIX_freq.csv (w, re, im, re_std,
+/// im_std, mag, phase_deg on the model's default frequency grid, model_frequency_grid). Throws FileError.
+void write_fsf_responses(const std::string& prefix, const FsfModel& model);
+
 }  // namespace ctid

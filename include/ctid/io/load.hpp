@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "ctid/data/frequency_data.hpp"
 #include "ctid/data/iddata.hpp"
 #include "ctid/io/csv.hpp"
 
@@ -70,5 +71,18 @@ struct ChosenRecord {
 /// or as input and output, no column left for the input or the output, two columns or none that could be the time
 /// axis), InvalidOptions for bad rows or a negative or non-finite ts, InvalidArgument for the file's content.
 ChosenRecord choose_record(const std::string& path, const RecordChoice& choice);
+
+/// The columns of a frequency-response table: the frequencies (rad/s) with the real and imaginary parts of G(jw),
+/// or, when any of the spectra columns is named, with the input and output spectra (all four needed).
+struct FrequencyColumns {
+  std::string w = "w", re = "re", im = "im";
+  std::string u_re, u_im, y_re, y_im;
+};
+
+/// A frequency-response table (CSV/.dat) as FrequencyData: G(jw) from re and im, or Y/U from the spectra
+/// (FrequencyData::from_spectra); `rows` (not null) gets the file's rows. Throws FileError for the file,
+/// ColumnSelectionError for a column it does not have, InvalidOptions for spectra named incompletely,
+/// InvalidArgument naming the file for its content (frequencies not positive and increasing, a zero input spectrum).
+FrequencyData load_frequency_data(const std::string& path, const FrequencyColumns& columns, int* rows = nullptr);
 
 }  // namespace ctid

@@ -98,6 +98,19 @@ ModalOptions ModalOptions::resolved(bool piecewise_constant) const {
   return o;
 }
 
+Eigen::VectorXd shifts_from_samples(const std::string& method, const std::vector<double>& samples, double ts,
+                                    const Eigen::VectorXd& given) {
+  CTID_REQUIRE_OPTION(given.size() == 0, "{}: give either shifts (seconds) or shift_samples (samples), not both", method);
+  Eigen::VectorXd shifts(static_cast<Eigen::Index>(samples.size()));
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const double v = samples[i];
+    CTID_REQUIRE_OPTION(std::abs(v - std::round(v)) <= 1e-9 && v >= 0 && v <= 1e9,
+                        "{}: shift_samples: {} is not a whole number of samples", method, v);
+    shifts(static_cast<Eigen::Index>(i)) = std::round(v) * ts;
+  }
+  return shifts;
+}
+
 void ModalOptions::validate() const {
   option_table<ModalOptions>().check(*this);
   CTID_REQUIRE_OPTION(shifts.size() >= 1 || order >= 1,

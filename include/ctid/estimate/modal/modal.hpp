@@ -78,6 +78,12 @@ struct ModalOptions {
 template <>
 const OptionTable<ModalOptions>& option_table<ModalOptions>();
 
+/// Shifts given in samples (the setting shift_samples=S1,..,Sn of modal, poles and modal_response) in seconds,
+/// S_i Ts. Throws InvalidOptions naming `method` when an S_i is not a whole number of samples (0..1e9), or when
+/// shifts in seconds were given as well (`given` not empty).
+Eigen::VectorXd shifts_from_samples(const std::string& method, const std::vector<double>& samples, double ts,
+                                    const Eigen::VectorXd& given);
+
 /// Modal parameters p_j and modal-function coefficients q_j (j = 0..max_order) from one record.
 /// input_basis: N x n_c samples of the input generator basis x_c(t) (InputGenerator::basis at the
 /// sample times, or u itself for a piecewise-constant input treated window by window; 0 columns for a
