@@ -3,31 +3,41 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 
 #include "internal/least_squares.hpp"
 
 namespace ctid::search {
 
+StartDraws::StartDraws(const Eigen::VectorXd& v0, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+                       const MultiStart& options)
+    : v0_(v0), lower_(lower), upper_(upper), drawn_(options.drawn), rng_(options.seed) {}
+
+Eigen::VectorXd StartDraws::next() {
+  Eigen::VectorXd v = v0_;
+  if (first_) {
+    first_ = false;
+    return v;
+  }
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int j = 0; j < drawn_; ++j) {
+    if (std::isfinite(lower_(j)) && std::isfinite(upper_(j))) v(j) = lower_(j) + (upper_(j) - lower_(j)) * unit(rng_);
+    else {
+      const double mag = v0_(j) != 0.0 ? std::abs(v0_(j)) : 1.0;
+      const double sign = v0_(j) < 0 ? -1.0 : 1.0;
+      v(j) = std::clamp(sign * mag * std::pow(10.0, 2.0 * unit(rng_) - 1.0), lower_(j), upper_(j));
+    }
+  }
+  return v;
+}
+
 MultiStartResult multi_start(const Search& search, const Eigen::VectorXd& v0, const Eigen::VectorXd& lower,
                              const Eigen::VectorXd& upper, const MultiStart& options) {
-  std::mt19937_64 rng(options.seed);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  StartDraws draws(v0, lower, upper, options);
   MultiStartResult out;
   out.best.cost = INFINITY;
   out.costs = Eigen::VectorXd::Constant(options.starts, NAN);
   for (int s = 0; s < options.starts; ++s) {
-    Eigen::VectorXd v = v0;
-    if (s > 0)
-      for (int j = 0; j < options.drawn; ++j) {
-        if (std::isfinite(lower(j)) && std::isfinite(upper(j))) v(j) = lower(j) + (upper(j) - lower(j)) * unit(rng);
-        else {
-          const double mag = v0(j) != 0.0 ? std::abs(v0(j)) : 1.0;
-          const double sign = v0(j) < 0 ? -1.0 : 1.0;
-          v(j) = std::clamp(sign * mag * std::pow(10.0, 2.0 * unit(rng) - 1.0), lower(j), upper(j));
-        }
-      }
-    internal::LmResult lm = search(v);
+    internal::LmResult lm = search(draws.next());
     out.costs(s) = lm.cost;
     const bool interrupted = lm.interrupted;
     const std::string message = lm.message;

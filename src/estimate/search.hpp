@@ -1,9 +1,10 @@
-// ctid — what the output-error searches share (greybox, nde_oe, oe, physical): the multi-start driver and the
-// covariance of a search's estimate, sigma^2 (J^T J)^{-1} (Ljung 1999 §9.3), with its identifiability check.
+// ctid — what the output-error searches share (greybox, nde_oe, oe, physical; ssest draws its starts): the
+// multi-start driver and the covariance of a search's estimate, sigma^2 (J^T J)^{-1} (Ljung 1999 §9.3), with its identifiability check.
 #pragma once
 
 #include <cstdint>
 #include <functional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,20 @@ struct MultiStart {
   int starts = 1;
   std::uint64_t seed = 1;
   int drawn = 0;
+};
+
+/// The starts of `options` one after the other: the first call of next() returns v0, each later one a new draw.
+class StartDraws {
+ public:
+  StartDraws(const Eigen::VectorXd& v0, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+             const MultiStart& options);
+  Eigen::VectorXd next();
+
+ private:
+  Eigen::VectorXd v0_, lower_, upper_;
+  int drawn_;
+  bool first_ = true;
+  std::mt19937_64 rng_;
 };
 
 struct MultiStartResult {

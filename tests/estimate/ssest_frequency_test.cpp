@@ -206,6 +206,9 @@ TEST(FrequencyData, BadInputIsNamed) {
   o.fixed.clear();
   o.integrators = 1;
   EXPECT_THROW(ssest(mimo, o), InvalidOptions);
+  o.integrators = 0;
+  o.starts = 2;  // multi-start draws around the subspace start of records
+  EXPECT_THROW(ssest(mimo, o), InvalidOptions);
   // Periodic records: one per input, whole periods, two after the transient for a variance.
   const StateSpace truth = test::ss::two_modes();
   const IdData rec = test::ss::periodic_record(truth, 64, 3, 0.05, 0, 1, 0.01);

@@ -124,7 +124,9 @@ inline constexpr ScalarDiagnostic start_scale{"start_scale", "",
                                               "factor the NDE start was shrunk by until its simulation was finite"};
 // Grey-box output error.
 inline constexpr VectorDiagnostic starts_cost{"starts_cost", "",
-                                              "final cost 1/2 sum of squared (weighted) errors of each start of a multi-start search"};
+                                              "final cost of each start of a multi-start search (grey box, NDE: 1/2 sum "
+                                              "of squared weighted errors; ssest: the MSE of the outputs scaled by their "
+                                              "standard deviations)"};
 inline constexpr ScalarDiagnostic segments{"segments", "", "multiple-shooting segments of all records (when used)"};
 inline constexpr ScalarDiagnostic continuity_defect{
     "continuity_defect", "", "largest |x_end - x_start| at a segment boundary relative to the state's RMS (multiple shooting)"};

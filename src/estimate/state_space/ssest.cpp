@@ -19,6 +19,7 @@
 #include "ctid/validate/metrics.hpp"
 #include "ctid/validate/uncertainty.hpp"
 #include "estimate/state_space/state_space_common.hpp"
+#include "estimate/search.hpp"
 #include "internal/levenberg_marquardt.hpp"
 
 namespace ctid {
@@ -49,6 +50,10 @@ const OptionTable<SsestOptions>& option_table<SsestOptions>() {
                 "variance from the residuals)")
           .integer("integrators", &O::integrators, "", at_least(0),
                    "known pure integrators: poles held at 0 (the first states integrate)")
+          .integer("starts", &O::starts, "", at_least(1),
+                   "multi-start: the subspace start plus starts-1 with its poles moved within a decade (the usable fit "
+                   "of least MSE wins)")
+          .integer("seed", &O::seed, "", at_least(0), "seed of the drawn starts")
           .named_reals("fixed", &O::fixed,
                        "entries held at a value by name (fixed.D1_1=0; A, B, C entries with a starting model)")
           .include(&O::start, option_table<SubspaceOptions>(), {"horizon", "route", "tau", "stabilize"},
@@ -685,6 +690,35 @@ void with_integrators(Point& p, int k) {
   p.A.leftCols(k).setZero();
 }
 
+// The start with each pole p moved to p exp(f_i) (f from the multi-start draws; a complex pair by one factor, so its
+// damping is kept): A = V diag(p exp(f)) V^-1 in the start's coordinates, B, C, D and the initial states kept.
+// Returns false when A's eigenvectors are too ill-conditioned to move the poles one by one.
+bool with_poles_moved(Point& p, const Eigen::VectorXd& f) {
+  Eigen::EigenSolver<Eigen::MatrixXd> es(p.A);
+  if (es.info() != Eigen::Success) return false;
+  const Eigen::VectorXcd lambda = es.eigenvalues();
+  const Eigen::MatrixXcd V = es.eigenvectors();
+  Eigen::JacobiSVD<Eigen::MatrixXcd> svd(V);
+  const Eigen::VectorXd sv = svd.singularValues();
+  if (!(sv(sv.size() - 1) > 1e-8 * sv(0))) return false;
+  Eigen::VectorXcd moved = lambda;
+  for (Eigen::Index i = 0; i < lambda.size(); ++i) {
+    Eigen::Index k = i;  // a pair's member of positive imaginary part gives the pair's factor
+    if (lambda(i).imag() < 0)
+      for (Eigen::Index j = 0; j < lambda.size(); ++j)
+        if (lambda(j).imag() > 0 && std::abs(lambda(j) - std::conj(lambda(i))) <= 1e-9 * std::abs(lambda(i))) k = j;
+    moved(i) = lambda(i) * std::exp(f(k));
+  }
+  p.A = (V * moved.asDiagonal() * V.inverse()).real();
+  return true;
+}
+
+// Whether fit a is better than fit b: usable before not usable, then the lower MSE.
+bool better(const Result<StateSpace>& a, const Result<StateSpace>& b) {
+  if (a.usable() != b.usable()) return a.usable();
+  return a.fit.mse < b.fit.mse;
+}
+
 Result<StateSpace> ssest_order(std::span<const IdData> ds, int nx, const SsestOptions& o, Clock::time_point t0) {
   Start s = subspace_start(ds, nx, o);
   if (s.failed) {
@@ -692,10 +726,38 @@ Result<StateSpace> ssest_order(std::span<const IdData> ds, int nx, const SsestOp
     r.summary.message = "ssest: the subspace start failed: " + r.summary.message;
     return r;
   }
-  if (o.integrators > 0) with_integrators(s.point, o.integrators);
-  Result<StateSpace> r = fit_from(ds, s.point, false, s.sigma, o, t0);
-  r.diagnostics.set(diagnostic::start_fit_percent, s.fit);
-  return r;
+  const Eigen::Index n = s.point.A.rows();
+  search::StartDraws draws(Eigen::VectorXd::Zero(n), Eigen::VectorXd::Constant(n, -std::log(10.0)),
+                           Eigen::VectorXd::Constant(n, std::log(10.0)),
+                           {o.starts, static_cast<std::uint64_t>(o.seed), static_cast<int>(n)});
+  Result<StateSpace> best;
+  Eigen::VectorXd costs = Eigen::VectorXd::Constant(o.starts, NAN);
+  int chosen = 0;
+  for (int k = 0; k < o.starts; ++k) {
+    Point p = s.point;
+    if (k > 0 && !with_poles_moved(p, draws.next())) continue;
+    if (o.integrators > 0) with_integrators(p, o.integrators);
+    Result<StateSpace> r = fit_from(ds, p, false, s.sigma, o, t0);
+    costs(k) = r.fit.mse;
+    const bool interrupted = r.summary.termination == Termination::Interrupted;
+    if (k == 0 || better(r, best)) {
+      best = std::move(r);
+      chosen = k;
+    }
+    if (interrupted) {
+      best.summary.termination = Termination::Interrupted;
+      break;
+    }
+  }
+  best.diagnostics.set(diagnostic::start_fit_percent, s.fit);
+  if (o.starts > 1) {
+    best.diagnostics.set(diagnostic::starts_cost, costs);
+    best.diagnostics.choices.push_back(detail::format(
+        "start {} of {} fitted best ({}: poles moved within a decade, seed {})", chosen + 1, o.starts,
+        chosen == 0 ? "the subspace start itself" : "the subspace start", o.seed));
+  }
+  best.summary.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return best;
 }
 
 // ssest of one record (a span of one, not copied) or of several.
@@ -725,6 +787,8 @@ Result<StateSpace> ssest(const std::vector<IdData>& data, const StateSpace& init
   CTID_REQUIRE_OPTION(options.nx == 0 || options.nx == initial.nx(),
                       "ssest: nx = {} differs from the starting model's {} states", options.nx, initial.nx());
   CTID_REQUIRE_OPTION(options.nx_max == 0, "ssest: nx_max needs the subspace start (a starting model has one order)");
+  CTID_REQUIRE_OPTION(options.starts == 1, "ssest: starts = {} draws around the subspace start; a starting model is "
+                                           "searched from itself alone", options.starts);
   CTID_REQUIRE(initial.nu() == data.front().nu() && initial.ny() == data.front().ny(),
                "ssest: the starting model has {} inputs and {} outputs, the data {} and {}", initial.nu(), initial.ny(),
                data.front().nu(), data.front().ny());

@@ -532,6 +532,8 @@ Result<StateSpace> fit_frequency_from(const Fd& f0, Point start, const Eigen::Ve
 void check_frequency_options(const SsestOptions& o) {
   CTID_REQUIRE_OPTION(o.integrators == 0, "ssest: integrators = {} with frequency data: hold the pole at 0 by fitting "
                                           "s G(jw) instead, or use time-domain records", o.integrators);
+  CTID_REQUIRE_OPTION(o.starts == 1, "ssest: starts = {} with frequency data: multi-start searches records only",
+                      o.starts);
   CTID_REQUIRE_OPTION(!o.estimate_k, "ssest: estimate_k with frequency data: an FRF carries no noise sequence to "
                                      "predict (use time-domain records for the prediction-error variant)");
   for (const auto& [name, v] : o.fixed)

@@ -74,6 +74,11 @@ struct SsestOptions {
   int integrators = 0;
   /// Entries held at a value by name: "D1_2" (row 1, column 2), and with a starting model "A1_1", "B2_1", "C1_3".
   FixedValues fixed;
+  /// Multi-start (records, from the subspace start): the subspace start, then starts - 1 starts with each of its poles
+  /// moved by a factor drawn (seeded) log-uniformly within a decade either way (a complex pair keeps its damping);
+  /// each searched fully, the usable fit of least MSE kept (diagnostic starts_cost: each start's MSE).
+  int starts = 1;
+  int seed = 1;  ///< seed of the drawn starts
   /// The subspace start's settings (horizon, route, tau, stabilize: CLI/Python start_horizon ..); its nx, estimate_d and estimate_initial_state are ssest's.
   SubspaceOptions start;
   void validate() const;
