@@ -3,8 +3,6 @@
 #include <cstdio>
 #include <functional>
 
-#include <nlohmann/json.hpp>
-
 #include "common.hpp"
 
 namespace ctid::cli {
@@ -21,44 +19,8 @@ struct ValArgs {
   bool force = false;
 };
 
-nlohmann::ordered_json corr_json(const CorrelationTest& c) {
-  return {{"lags", std::vector<int>(c.lags.begin(), c.lags.end())},
-          {"values", std::vector<double>(c.values.begin(), c.values.end())},
-          {"bound_99", c.bound},
-          {"n_outside", c.n_outside},
-          {"passed", c.passed()}};
-}
-
-// One output's fit and residual tests, printed and as JSON.
-nlohmann::ordered_json validate_output(const ValArgs& a, const IdData& d, const Eigen::VectorXd& y,
-                                       const Eigen::VectorXd& yhat, int n_coefficients, const std::string& path) {
-  FitReport f;
-  try {
-    f = fit_report(y, yhat, n_coefficients);
-  } catch (const InvalidArgument& e) {
-    throw InputError(path + ": " + e.what());
-  }
-  const Eigen::VectorXd e = y - yhat;
-  const CorrelationTest ac = residual_autocorrelation(e, a.lags);
-  std::vector<CorrelationTest> xcs;
-  for (int i = 0; i < d.nu(); ++i) xcs.push_back(input_residual_crosscorrelation(d.u().col(i), e, a.lags));
-  std::printf("fit: %s %%   NRMSE %.4g   MSE %.4g   (%d samples)\n", fit_percent_text(f.fit_percent).c_str(), f.nrmse, f.mse, f.n_samples);
-  std::printf("residual whiteness (lags 1..%d): %d outside the 99 %% bound %.3g -> %s\n", a.lags, ac.n_outside, ac.bound,
-              ac.passed() ? "passed" : "not white");
-  for (int i = 0; i < d.nu(); ++i)
-    std::printf("input %s - residual independence (lags -%d..%d): %d outside -> %s\n", d.input_names()[i].c_str(), a.lags,
-                a.lags, xcs[i].n_outside, xcs[i].passed() ? "passed" : "correlated (unmodelled dynamics)");
-  nlohmann::ordered_json j;
-  j["fit"] = {{"fit_percent", f.fit_percent}, {"nrmse", f.nrmse}, {"mse", f.mse}, {"n_samples", f.n_samples}};
-  j["residual_autocorrelation"] = corr_json(ac);
-  j["input_residual_crosscorrelation"] = nlohmann::ordered_json::array();
-  for (const auto& xc : xcs) j["input_residual_crosscorrelation"].push_back(corr_json(xc));
-  return j;
-}
-
-// One record: each output's fit and residual tests (one output: at the top level of the JSON; several: under
-// "outputs", each with its name).
-nlohmann::ordered_json validate_record(const ValArgs& a, const ResultFile& file, const IdData& d, const std::string& path) {
+// One record: the model simulated on it and each output scored (score_outputs), the library's text printed.
+std::vector<OutputScore> validate_record(const ValArgs& a, const ResultFile& file, const IdData& d, const std::string& path) {
   const int ny = model_outputs(file.result.model);
   if (d.ny() != ny)
     throw UsageError(detail::format("the model has {} output(s) and {} were selected (--output, once per output)", ny,
@@ -66,21 +28,14 @@ nlohmann::ordered_json validate_record(const ValArgs& a, const ResultFile& file,
   if (a.lags < 1 || a.lags >= d.size())
     throw UsageError(detail::format("--lags must be in [1, {}] for {}", d.size() - 1, path));
   const Eigen::MatrixXd yhat = simulate_result(file.result, d, SimulationPurpose::FreeRun, a.initial, a.initial_samples);
-  const int n = model_coefficient_count(file.result.model);
-  nlohmann::ordered_json j;
-  j["data"] = path;
-  if (ny == 1) {
-    j.update(validate_output(a, d, d.y().col(0), yhat.col(0), n, path));
-    return j;
+  std::vector<OutputScore> scores;
+  try {
+    scores = score_outputs(d, yhat, model_coefficient_count(file.result.model), a.lags);
+  } catch (const InvalidArgument& e) {
+    throw InputError(path + ": " + e.what());
   }
-  j["outputs"] = nlohmann::ordered_json::array();
-  for (int o = 0; o < ny; ++o) {
-    std::printf("output %s:\n", d.output_names()[static_cast<size_t>(o)].c_str());
-    nlohmann::ordered_json jo = {{"output", d.output_names()[static_cast<size_t>(o)]}};
-    jo.update(validate_output(a, d, d.y().col(o), yhat.col(o), n, path));
-    j["outputs"].push_back(jo);
-  }
-  return j;
+  std::fputs(validation_text(d, scores).c_str(), stdout);
+  return scores;
 }
 
 int run(const ValArgs& a) {
@@ -94,20 +49,15 @@ int run(const ValArgs& a) {
   // Finite on these records, but growing: the numbers below say little beyond them.
   if (const std::string unstable = unstable_poles_note(model); !unstable.empty())
     std::printf("note: the model is unstable%s\n", unstable.c_str());
-  nlohmann::ordered_json records = nlohmann::ordered_json::array();
+  std::vector<std::pair<std::string, std::vector<OutputScore>>> records;
   for (std::size_t e = 0; e < ds.size(); ++e) {
     if (ds.size() > 1) std::printf("record %zu (%s):\n", e + 1, a.paths[e].c_str());
-    records.push_back(validate_record(a, file, ds[e], a.paths[e]));
+    records.emplace_back(a.paths[e], validate_record(a, file, ds[e], a.paths[e]));
   }
   if (!a.json.empty()) {
-    // The first record's numbers at the top level; every record's under "experiments".
-    nlohmann::ordered_json j = records.front();
-    j.erase("data");
-    j["ctid_version"] = version();
-    j["model"] = nlohmann::ordered_json::parse(result_to_json(file.result, file.method))["model"];
-    j["initial"] = to_string(simulate_options_of(file.result, SimulationPurpose::FreeRun, a.initial, a.initial_samples).initial);
-    j["experiments"] = records;
-    write_text_file(a.json, j.dump(2) + "\n");
+    const InitialCondition initial =
+        simulate_options_of(file.result, SimulationPurpose::FreeRun, a.initial, a.initial_samples).initial;
+    write_text_file(a.json, validation_to_json(file, initial, records));
     std::printf("wrote %s\n", a.json.c_str());
   }
   return kOk;

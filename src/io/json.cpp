@@ -11,7 +11,6 @@
 #include "ctid/core/check.hpp"
 #include "ctid/core/names.hpp"
 #include "ctid/io/file.hpp"
-#include "ctid/io/load.hpp"
 
 namespace ctid {
 
@@ -615,34 +614,6 @@ std::string poles_to_json(const PolesComparison& c, int order, double ts, int in
                   {"prony_error", c.prony_problem},
                   {"shifts", vec(c.free_response.shifts)},
                   {"choices", c.choices}};
-  return j.dump(indent) + "\n";
-}
-
-std::string comparison_to_json(const std::string& data_name, const IdData& d, const std::vector<ModelComparison>& cs,
-                               int indent) {
-  json j;
-  j["ctid_version"] = version();
-  j["data"] = data_name;
-  j["n_samples"] = d.size();
-  j["best"] = cs.empty() ? json(nullptr) : json(cs[best_comparison(cs)].name);
-  j["models"] = json::array();
-  for (const ModelComparison& c : cs) {
-    json m = {{"name", c.name}, {"type", model_type_name(c.model)}, {"initial", to_string(c.initial)}};
-    m["outputs"] = json::array();
-    for (std::size_t o = 0; o < c.fits.size(); ++o) {
-      const FitReport& f = c.fits[o];
-      json jo = {{"output", channel_name(d.output_names(), static_cast<int>(o))},
-                 {"fit_percent", num(f.fit_percent)}, {"nrmse", num(f.nrmse)}, {"mse", num(f.mse)}, {"aic", num(f.aic)}};
-      if (c.whiteness[o].lags.size() > 0) {
-        jo["whiteness_lags_outside"] = c.whiteness[o].n_outside;
-        jo["independence_lags_outside"] = json::array();
-        for (const auto& x : c.independence[o]) jo["independence_lags_outside"].push_back(x.n_outside);
-      }
-      m["outputs"].push_back(jo);
-    }
-    m["problem"] = c.simulation.problem;
-    j["models"].push_back(m);
-  }
   return j.dump(indent) + "\n";
 }
 

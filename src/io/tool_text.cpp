@@ -7,6 +7,7 @@
 
 #include "ctid/core/names.hpp"
 #include "ctid/io/load.hpp"
+#include "ctid/validate/metrics.hpp"
 #include "io/appendf.hpp"
 
 namespace ctid {
@@ -113,6 +114,25 @@ std::string comparison_text(const IdData& d, const std::vector<ModelComparison>&
   const std::size_t best = best_comparison(cs);
   appendf(out, "best: %s (%s %%%s)\n", cs[best].name.c_str(), two_decimals(cs[best].mean_fit()).c_str(),
           d.ny() > 1 ? ", mean over the outputs" : "");
+  return out;
+}
+
+std::string validation_text(const IdData& d, const std::vector<OutputScore>& scores) {
+  std::string out;
+  for (const OutputScore& o : scores) {
+    if (scores.size() > 1) appendf(out, "output %s:\n", o.output.c_str());
+    const FitReport& f = o.fit;
+    const CorrelationTest& ac = o.whiteness;
+    const int lags = ac.lags.size() > 0 ? static_cast<int>(ac.lags(ac.lags.size() - 1)) : 0;
+    appendf(out, "fit: %s %%   NRMSE %.4g   MSE %.4g   (%d samples)\n", fit_percent_text(f.fit_percent).c_str(), f.nrmse,
+            f.mse, f.n_samples);
+    appendf(out, "residual whiteness (lags 1..%d): %d outside the 99 %% bound %.3g -> %s\n", lags, ac.n_outside, ac.bound,
+            ac.passed() ? "passed" : "not white");
+    for (std::size_t i = 0; i < o.independence.size(); ++i)
+      appendf(out, "input %s - residual independence (lags -%d..%d): %d outside -> %s\n",
+              channel_name(d.input_names(), static_cast<int>(i)).c_str(), lags, lags, o.independence[i].n_outside,
+              o.independence[i].passed() ? "passed" : "correlated (unmodelled dynamics)");
+  }
   return out;
 }
 

@@ -75,4 +75,25 @@ std::vector<ModelComparison> compare_models(const IdData& data,
   return out;
 }
 
+std::vector<OutputScore> score_outputs(const IdData& data, const Eigen::MatrixXd& yhat, int n_coefficients,
+                                       int max_lag) {
+  CTID_REQUIRE(max_lag >= 1 && max_lag < data.size(), "score_outputs: max_lag must be in [1, {}] (got {})",
+               data.size() - 1, max_lag);
+  CTID_REQUIRE(yhat.rows() == data.size() && yhat.cols() == data.ny(),
+               "score_outputs: the simulation is {} x {}; the record has {} samples of {} output(s)", yhat.rows(),
+               yhat.cols(), data.size(), data.ny());
+  std::vector<OutputScore> out;
+  for (int j = 0; j < data.ny(); ++j) {
+    OutputScore s;
+    s.output = j < static_cast<int>(data.output_names().size()) ? data.output_names()[static_cast<size_t>(j)]
+                                                                : std::to_string(j + 1);
+    const Eigen::VectorXd y = data.y().col(j), e = y - yhat.col(j);
+    s.fit = fit_report(y, yhat.col(j), n_coefficients);
+    s.whiteness = residual_autocorrelation(e, max_lag);
+    for (int i = 0; i < data.nu(); ++i) s.independence.push_back(input_residual_crosscorrelation(data.u().col(i), e, max_lag));
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
 }  // namespace ctid

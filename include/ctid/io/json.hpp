@@ -23,7 +23,6 @@
 #include "ctid/model/nde.hpp"
 #include "ctid/model/state_space.hpp"
 #include "ctid/model/transfer_function.hpp"
-#include "ctid/validate/compare.hpp"
 
 namespace ctid {
 
@@ -54,12 +53,6 @@ std::string order_selection_to_json(const std::vector<OrderCandidate>& candidate
 /// "choices": [automatic choices]}, E = {"poles": [{"re", "im"}, ...], "characteristic": [descending coefficients],
 /// "augmented": [...], "condition": c, "warnings": [...]}.
 std::string poles_to_json(const PolesComparison& comparison, int order, double ts, int indent = 2);
-/// Models compared on one record (ctid compare --json): {"ctid_version", "data": data_name, "n_samples", "best": the
-/// name of the best by mean fit, "models": [{"name", "type", "initial", "outputs": [{"output", "fit_percent",
-/// "nrmse", "mse", "aic", and where the tests ran "whiteness_lags_outside", "independence_lags_outside": [per
-/// input]}], "problem": "" or why the simulation stopped}]} (non-finite numbers as null).
-std::string comparison_to_json(const std::string& data_name, const IdData& data,
-                               const std::vector<ModelComparison>& comparisons, int indent = 2);
 /// A computed table (ctid response --json, ctid gfrf --json): {"type": type, <each field: name -> text, or a number
 /// when the text is one>, "columns": {name: [values, non-finite as null], ...}} with the columns of `values` named
 /// by `names` in order. Throws InvalidArgument when names and columns differ in number.

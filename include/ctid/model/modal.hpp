@@ -1,5 +1,5 @@
-// ctid — modal functions and modal parameters of El-Shafey (1987), "Identification of linear
-// continuous-time systems using modal functions", chapter 2 (equations "ES n"); docs/methods/el-shafey.md,
+// ctid — modal functions and modal parameters of El-Shafey (1987), "Linear
+// Continuous-time System Identification and State Observer Design by Modal Analysis" (PhD thesis), chapter 2 (equations "ES n"); docs/methods/el-shafey.md,
 // ES-C1 (modal parameters from a known model, ES 2.13-2.30, with the corrected sign e^{-s_k T_i}),
 // ES-C2 (modal functions, ES 2.26-2.45), the phase-variable form (ES 2.11-2.12), input generators
 // (ES 2.35-2.36) and Theorems 4.1 and 4.2 (ES 4.15-4.31).

@@ -1,5 +1,5 @@
 // ctid — modal filtering of sampled signals and the quadrature rules used by the modal-function
-// estimators. El-Shafey (1987): modal functions (ES 2.26-2.45, ES 2.26-2.45) and annihilating
+// estimators. El-Shafey (1987): modal functions (ES 2.26-2.45) and annihilating
 // prefilters L u(t) = u(t) + sum_i l_i u(t - T_Li) with l = -c_c^T psi_c^{-1} (ES 3.38-3.47, ES-C6).
 #pragma once
 

@@ -1,5 +1,5 @@
 // ctid — Walsh functions and the fast Walsh-Hadamard transform, used by the Walsh-function
-// modal-parameter estimator of El-Shafey (1987) (ES 3.18, 3.31-3.37; ES 3.18, 3.31-3.37).
+// modal-parameter estimator of El-Shafey (1987) (ES 3.18, 3.31-3.37).
 #pragma once
 
 #include <Eigen/Dense>

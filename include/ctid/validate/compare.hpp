@@ -49,4 +49,18 @@ std::vector<ModelComparison> compare_models(const IdData& data,
                                             const std::vector<std::pair<std::string, AnyModel>>& models,
                                             std::optional<InitialCondition> initial = std::nullopt, int max_lag = 25);
 
+/// One output of a model's simulation on a record, scored as `ctid validate` scores it.
+struct OutputScore {
+  std::string output;                         ///< the output's name (channel_name)
+  FitReport fit;                              ///< fit_report with the model's coefficient count
+  CorrelationTest whiteness;                  ///< residual autocorrelation at lags 1..max_lag
+  std::vector<CorrelationTest> independence;  ///< per input: input-residual cross-correlation at lags -max_lag..max_lag
+};
+
+/// The simulated outputs `yhat` (N x ny, finite) of a model with `n_coefficients` scored against `data`'s outputs.
+/// Throws InvalidArgument for max_lag outside [1, N - 1], a `yhat` of another size, or an output fit_report refuses
+/// (a constant one).
+std::vector<OutputScore> score_outputs(const IdData& data, const Eigen::MatrixXd& yhat, int n_coefficients,
+                                       int max_lag);
+
 }  // namespace ctid

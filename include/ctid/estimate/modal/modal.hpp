@@ -1,4 +1,5 @@
-// ctid — El-Shafey (1987), "Identification of linear continuous-time systems using modal functions":
+// ctid — El-Shafey (1987), "Linear Continuous-time System Identification and State Observer Design by Modal
+// Analysis" (PhD thesis):
 // estimation of modal parameters and what is derived from them (labels of docs/methods/el-shafey.md):
 //   ES-C3  discrete samples, least squares and instrumental variables (ES 3.1-3.10, 3.19-3.20)
 //   ES-C4  Fourier modulating functions with the c_{j-1} recursion (ES 3.11-3.30; Omega of ES 3.25)
