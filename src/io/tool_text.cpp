@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "ctid/core/check.hpp"
 #include "ctid/core/names.hpp"
 #include "ctid/io/load.hpp"
 #include "ctid/validate/metrics.hpp"
