@@ -34,8 +34,7 @@ int run(const CompareArgs& a) {
   std::optional<InitialCondition> initial;
   if (!a.initial.empty()) initial = initial_condition_from_string(a.initial);
   if (a.lags < 1) throw UsageError(detail::format("--lags must be >= 1 (got {})", a.lags));
-  std::vector<ModelComparison> cs;
-  cs = compare_models(d, named, initial, a.lags);
+  const std::vector<ModelComparison> cs = compare_models(d, named, initial, a.lags);
   std::printf("data: %s (%d samples)\n%s", path.c_str(), d.size(), comparison_text(d, cs).c_str());
   if (!a.json.empty()) {
     write_text_file(a.json, comparison_to_json(path, d, cs));

@@ -340,8 +340,7 @@ Fitted fit_records(const FitArgs& a, std::vector<IdData> ds) {
 Fitted run_closed_loop(const FitArgs& a) {
   if (a.reference.empty()) throw UsageError("--closed-loop-controller needs --reference COLUMN");
   if (a.data.inputs.size() != 1) throw UsageError("closed-loop identification needs exactly one --input (the plant input)");
-  LinearModel c;
-  c = read_model_json(a.controller);
+  const LinearModel c = read_model_json(a.controller);
   if (!std::holds_alternative<TransferFunction>(c)) throw UsageError(a.controller + ": the controller must be a transfer_function");
   DataArgs da = a.data;
   da.inputs.push_back(a.reference);

@@ -53,8 +53,7 @@ int run_poles(PolesArgs a) {
     if (o.generator.size() > 0) throw UsageError("give either --generator or --set generator, not both");
     o.generator = Eigen::Map<const Eigen::VectorXd>(a.generator.data(), static_cast<Eigen::Index>(a.generator.size()));
   }
-  PolesComparison c;
-  c = compare_poles(y, Ts, a.order, o);
+  const PolesComparison c = compare_poles(y, Ts, a.order, o);
   std::printf("free response: %d samples, Ts = %.6g s, order %d\n%s", d.size(), Ts, a.order, poles_text(c).c_str());
   if (!a.json.empty()) {
     write_text_file(a.json, poles_to_json(c, a.order, Ts));
@@ -82,8 +81,7 @@ int run_response(const ResponseArgs& a) {
   const ResponseKind kind = a.kind == "frequency" ? ResponseKind::Frequency
                             : a.kind == "impulse" ? ResponseKind::Impulse
                                                   : ResponseKind::Step;
-  ModalResponse m;
-  m = modal_response(d, a.order, kind, ro, mo);
+  const ModalResponse m = modal_response(d, a.order, kind, ro, mo);
   std::fputs(modal_response_text(m).c_str(), stdout);
   const auto [names, table] = modal_response_table(m);
   if (!a.out.empty()) write_csv(a.out, names, table);

@@ -47,8 +47,7 @@ int run_gfrf(const GfrfArgs& a) {
   // The evaluation points: one n-tuple per row.
   std::vector<std::vector<Complex>> tuples;
   if (!a.points.empty()) {
-    CsvTable in;
-    in = read_csv(a.points);
+    const CsvTable in = read_csv(a.points);
     std::vector<int> col;
     for (const auto& n : names) {
       const auto it = std::find(in.names.begin(), in.names.end(), n);

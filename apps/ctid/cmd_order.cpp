@@ -40,8 +40,7 @@ int run(const OrderArgs& a) {
   check_outputs({a.json}, {a.data.path}, a.force);
   const IdData d = a.data.load(true);
   if (d.nu() != 1 || d.ny() != 1) throw UsageError("order selection needs one --input and one --output");
-  std::vector<OrderCandidate> c;
-  c = select_order(d, nb, nf, nk, o);
+  const std::vector<OrderCandidate> c = select_order(d, nb, nf, nk, o);
   std::printf("rank  nb nf nk        YIC       RT2         AIC         BIC    fit %%  SRIVC\n");
   int i = 0;
   for (const auto& k : c)

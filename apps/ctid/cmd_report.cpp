@@ -62,8 +62,7 @@ int run(const ReportArgs& a) {
     o.more_records.emplace_back(a.paths[e], ds[e]);
   }
   if (!a.initial.empty()) o.initial = initial_condition_from_string(a.initial);
-  std::string html;
-  html = html_report(d, file.result, o);
+  const std::string html = html_report(d, file.result, o);
   write_text_file(a.out, html);
   std::printf("wrote %s\n", a.out.c_str());
   return kOk;

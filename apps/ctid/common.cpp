@@ -163,8 +163,7 @@ SimulateOptions simulate_options_of(const Result<AnyModel>& r, SimulationPurpose
 Eigen::MatrixXd simulate_result(const Result<AnyModel>& r, const IdData& d, SimulationPurpose purpose,
                                 const std::string& initial, int initial_samples) {
   const SimulateOptions o = simulate_options_of(r, purpose, initial, initial_samples);
-  Simulation s;
-  s = simulate(r.model, d, o);
+  const Simulation s = simulate(r.model, d, o);
   if (!s.ok()) throw NotUsable(s.problem);
   return s.y;
 }
