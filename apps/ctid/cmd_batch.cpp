@@ -59,7 +59,7 @@ int run_batch(const BatchJob& job) {
   const std::vector<std::string> files = expand(job.patterns);
   if (std::filesystem::exists(job.out) && !job.resume && !job.force)
     throw UsageError(job.out + " exists: --resume fits only the records not yet in it, --force replaces it");
-  check_outputs({job.out}, files, true);
+  check_output_files({job.out}, files, true);
   if (job.force && !job.resume) std::filesystem::remove(job.out);
   std::optional<BatchFile> opened;
   try {

@@ -24,7 +24,7 @@ int run(const CompareArgs& a) {
   if (a.files.size() < 2) throw UsageError("give one or more model files and then the record: ctid compare MODEL.json... DATA");
   const std::vector<std::string> models(a.files.begin(), a.files.end() - 1);
   const std::string path = a.files.back();
-  check_outputs({a.report, a.json}, a.files, a.force);
+  check_output_files({a.report, a.json}, a.files, a.force);
   std::vector<std::pair<std::string, AnyModel>> named;
   for (const auto& m : models) named.emplace_back(m, read_result_file(m).result.model);
   const IdData d = columns_of(a.data, named.front().second).load_each({path}, true).front();

@@ -26,7 +26,7 @@ int run(const ExampleArgs& a) {
   } catch (const InvalidArgument& err) {
     throw UsageError(err.what());
   }
-  check_outputs({a.out}, {}, a.force);
+  check_output_files({a.out}, {}, a.force);
   write_csv(a.out, e.columns, e.values);
   std::printf("wrote %s: %s (%lld rows; columns", a.out.c_str(), e.description.c_str(),
               static_cast<long long>(e.values.rows()));

@@ -9,6 +9,7 @@
 #include <numbers>
 #include <optional>
 #include <set>
+#include <tuple>
 #include <type_traits>
 
 #include "common.hpp"
@@ -77,26 +78,27 @@ void reject_flags_that_do_not_apply(const FitArgs& a) {
   auto refuse = [&](const char* f, const std::string& why) { throw UsageError("--" + std::string(f) + " " + why); };
   const std::string got = " (got " + m + ")";
   if (has("reference") && a.controller.empty()) refuse("reference", "needs --closed-loop-controller FILE (without it the fit would be open loop)");
-  if (has("closed-loop-controller") && !c.references)
-    refuse("closed-loop-controller", "needs --method " + fits_that(&MethodCapabilities::references) + got);
-  if (has("responses") && !gives(mi, "fsf"))
-    refuse("responses", "writes FSF responses: it needs --method " + fits_that([](const MethodInfo& x) { return gives(x, "fsf"); }) + got);
-  if (has("narx") && !c.narx_model)
-    refuse("narx", "gives KIA its NARX model: it needs --method " + fits_that(&MethodCapabilities::narx_model) + got);
-  if (has("via") && !c.physical_model)
-    refuse("via", "chooses the route of --method " + fits_that(&MethodCapabilities::physical_model) + got);
+  using Takes = std::function<bool(const MethodInfo&)>;
+  const auto cap = [](Capability k) -> Takes { return [k](const MethodInfo& x) { return x.capabilities.*k; }; };
+  const auto setting = [](const char* n) -> Takes { return [n](const MethodInfo& x) { return has_setting(x, n); }; };
+  // A method-specific flag: what it does, and which methods take it.
+  const std::vector<std::tuple<const char*, const char*, Takes>> specific{
+      {"closed-loop-controller", "", cap(&MethodCapabilities::references)},
+      {"responses", "writes FSF responses: it ", [](const MethodInfo& x) { return gives(x, "fsf"); }},
+      {"narx", "gives KIA its NARX model: it ", cap(&MethodCapabilities::narx_model)},
+      {"via", "chooses the route of --method", cap(&MethodCapabilities::physical_model)},
+      {"model", "describes the model of --method",
+       [](const MethodInfo& x) { return x.capabilities.physical_model || x.capabilities.greybox_model; }},
+      {"param", "describes the model of --method", cap(&MethodCapabilities::physical_model)},
+      {"delay", "(delay estimation) ", setting("estimate_delay")},
+      {"nx", "sets a state dimension: it ", cap(&MethodCapabilities::nx)},
+      {"initial", "gives ssest its starting model: it ", cap(&MethodCapabilities::initial_model)}};
+  for (const auto& [flag, what, takes] : specific)
+    if (has(flag) && !takes(mi)) {
+      const std::string w = what;
+      refuse(flag, (w.empty() || w.back() == ' ' ? w + "needs --method " : w + " ") + fits_that(takes) + got);
+    }
   if (a.via != "fsf" && a.via != "frequency" && a.via != "raw") refuse("via", "must be fsf, frequency or raw (got '" + a.via + "')");
-  if (has("model") && !c.physical_model && !c.greybox_model)
-    refuse("model", "describes the model of --method " +
-                        fits_that([](const MethodInfo& x) { return x.capabilities.physical_model || x.capabilities.greybox_model; }) + got);
-  if (has("param") && !c.physical_model)
-    refuse("param", "describes the model of --method " + fits_that(&MethodCapabilities::physical_model) + got);
-  if (has("delay") && !has_setting(mi, "estimate_delay"))
-    refuse("delay", "(delay estimation) needs --method " +
-                        fits_that([](const MethodInfo& x) { return has_setting(x, "estimate_delay"); }) + got);
-  if (has("nx") && !c.nx) refuse("nx", "sets a state dimension: it needs --method " + fits_that(&MethodCapabilities::nx) + got);
-  if (has("initial") && !c.initial_model)
-    refuse("initial", "gives ssest its starting model: it needs --method " + fits_that(&MethodCapabilities::initial_model) + got);
   // --period: the FRF matrix of periodic records, fitted by the methods that take frequency data of several outputs.
   const auto periodic = [](const MethodInfo& x) { return x.capabilities.frequency_data && x.capabilities.several_outputs; };
   if (has("period") && !periodic(mi)) refuse("period", "fits the FRF of periodic records: it needs --method " + fits_that(periodic) + got);
@@ -120,29 +122,6 @@ void reject_flags_that_do_not_apply(const FitArgs& a) {
   if (!a.frequency)
     for (const char* f : {"w", "re", "im", "u-re", "u-im", "y-re", "y-im"})
       if (has(f)) refuse(f, "names a column of frequency data: it needs --frequency");
-}
-
-// The model simulated on the held-out record (the library's validation rule: for a linear model the initial state
-// that fits it best, as MATLAB's compare), its fit per output printed.
-void print_validation(const Result<AnyModel>& r, const std::pair<std::string, IdData>& v) {
-  const auto& [name, d] = v;
-  const SimulateOptions so = simulate_options(r, SimulationPurpose::Validation);
-  Simulation s;
-  try {
-    s = simulate(r.model, d, so);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(std::string("--validate: ") + e.what());
-  }
-  std::printf("\nvalidation on %s (%d samples, initial state: %s):", name.c_str(), d.size(),
-              so.initial == InitialCondition::Estimated ? "the one that fits them best" : to_string(so.initial));
-  if (!s.ok()) {
-    std::printf(" %s\n", s.problem.c_str());
-    return;
-  }
-  for (int j = 0; j < d.ny(); ++j)
-    std::printf("%s fit %s %%", d.ny() > 1 ? ("  " + channel_name(d.output_names(), j)).c_str() : "",
-                fit_percent_text(fit_percent(d.y().col(j), s.y.col(j))).c_str());
-  std::printf("\n");
 }
 
 // --nx N or A:B: the state dimension (and the upper end of an order range), 0 when not given.
@@ -311,7 +290,11 @@ int present(const Fitted& f, const FitArgs& a, const Provenance& prov) {
   if (a.data.detrend == "none" && is_linear(r.model)) cli::warn_offsets(d);
   std::vector<std::pair<std::string, IdData>> more = more_records_of(a, ds);
   if (a.validation) {
-    print_validation(r, *a.validation);
+    try {
+      std::fputs(held_out_text(r, a.validation->first, a.validation->second).c_str(), stdout);
+    } catch (const InvalidArgument& e) {
+      throw UsageError(std::string("--validate: ") + e.what());
+    }
     more.insert(more.begin(), {"validation, " + a.validation->first, a.validation->second});
   }
   write_json(a, out, prov);
@@ -489,7 +472,7 @@ int run(FitArgs a, Provenance& prov) {
   const MethodInfo& m = method_info(a.method);
   std::vector<std::string> inputs = a.paths;
   inputs.insert(inputs.end(), {a.narx, a.controller, a.initial, a.validate, m.capabilities.greybox_model ? a.model_expr : ""});
-  check_outputs({a.json, a.report, a.responses.empty() ? "" : a.responses + "_time.csv",
+  check_output_files({a.json, a.report, a.responses.empty() ? "" : a.responses + "_time.csv",
                  a.responses.empty() ? "" : a.responses + "_freq.csv"},
                 inputs, a.force);
   a.data.provenance = &prov;

@@ -33,7 +33,7 @@ struct PolesArgs {
 };
 
 int run_poles(PolesArgs a) {
-  check_outputs({a.json}, {a.data.path}, a.force);
+  check_output_files({a.json}, {a.data.path}, a.force);
   if (a.order < 1) throw UsageError("--order must be >= 1");
   if (a.data.outputs.empty()) {
     const CsvTable tab = read_csv(a.data.path);
@@ -71,7 +71,7 @@ struct ResponseArgs {
 };
 
 int run_response(const ResponseArgs& a) {
-  check_outputs({a.out, a.json}, {a.data.path}, a.force);
+  check_output_files({a.out, a.json}, {a.data.path}, a.force);
   if (a.order < 1) throw UsageError("--order must be >= 1");
   const IdData d = a.data.load(true);
   if (d.nu() != 1 || d.ny() != 1) throw UsageError("response needs one --input and one --output");

@@ -20,7 +20,7 @@ struct GfrfArgs {
 };
 
 int run_gfrf(const GfrfArgs& a) {
-  check_outputs({a.out, a.json}, {a.model, a.points}, a.force);
+  check_output_files({a.out, a.json}, {a.model, a.points}, a.force);
   if (a.order < 1 || a.order > 3) throw UsageError(detail::format("--order must be 1, 2 or 3 (got {})", a.order));
   if (a.w.empty() == a.points.empty())
     throw UsageError("give either the frequencies with --w w1,w2,.. (rad/s) or the points with --points FILE");

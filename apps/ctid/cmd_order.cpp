@@ -37,7 +37,7 @@ int run(const OrderArgs& a) {
   OrderSelectionOptions o;
   o.rank_by = order_criterion_from_string(a.rank);
   const OrderRange nb = parse_range("--nb", a.nb), nf = parse_range("--nf", a.nf), nk = parse_range("--nk", a.nk);
-  check_outputs({a.json}, {a.data.path}, a.force);
+  check_output_files({a.json}, {a.data.path}, a.force);
   const IdData d = a.data.load(true);
   if (d.nu() != 1 || d.ny() != 1) throw UsageError("order selection needs one --input and one --output");
   const std::vector<OrderCandidate> c = select_order(d, nb, nf, nk, o);

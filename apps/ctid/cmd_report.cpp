@@ -38,7 +38,7 @@ int run(const ReportArgs& a) {
   if (a.out.empty()) throw UsageError("give the report file with --out REPORT.html");
   std::vector<std::string> inputs = a.paths;
   inputs.push_back(a.result);
-  check_outputs({a.out}, inputs, a.force);
+  check_output_files({a.out}, inputs, a.force);
   ResultFile file = read_result_file(a.result);
   const std::vector<IdData> ds = columns_of(a.data, file.result.model).load_each(a.paths, true);
   const IdData& d = ds.front();

@@ -21,7 +21,7 @@ struct SimArgs {
 
 
 int run(const SimArgs& a) {
-  check_outputs({a.out}, {a.data.path, a.model}, a.force);
+  check_output_files({a.out}, {a.data.path, a.model}, a.force);
   const ResultFile f = read_result_file(a.model);
   // The record's output is read where the initial condition needs it (a fitted x0 does not).
   const SimulateOptions so = simulate_options_of(f.result, SimulationPurpose::FreeRun, a.initial, a.initial_samples);

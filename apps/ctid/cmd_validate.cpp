@@ -41,7 +41,7 @@ std::vector<OutputScore> validate_record(const ValArgs& a, const ResultFile& fil
 int run(const ValArgs& a) {
   std::vector<std::string> inputs = a.paths;
   inputs.push_back(a.model);
-  check_outputs({a.json}, inputs, a.force);
+  check_output_files({a.json}, inputs, a.force);
   const ResultFile file = read_result_file(a.model);
   const AnyModel& model = file.result.model;
   const std::vector<IdData> ds = columns_of(a.data, model).load_each(a.paths, true);

@@ -5,8 +5,6 @@
 #include <cmath>
 #include <numbers>
 #include <cstdio>
-#include <filesystem>
-#include <unistd.h>
 #include <type_traits>
 
 namespace ctid::cli {
@@ -49,12 +47,8 @@ IdData DataArgs::load(bool need_output, TrendInfo* removed_trend, std::pair<int,
   } catch (const InvalidArgument& e) {
     throw InputError(path + ": " + e.what());  // the file's content
   }
-  if (!r.time_column.empty() && !quiet)
-    std::fprintf(stderr, "note: column '%s' is the time axis (no --time or --ts given)\n", r.time_column.c_str());
-  if (r.data.uniform_time_deviation() > 1e-9 && !quiet)
-    std::fprintf(stderr, "note: %s: the sample times are within %.2g Ts of a uniform grid (threshold %g Ts): read as "
-                 "uniform, Ts = %.10g s\n", path.c_str(), r.data.uniform_time_deviation(), IdData::kUniformTimeTolerance,
-                 r.data.ts());
+  for (const auto& note : r.notes)
+    if (!quiet) std::fprintf(stderr, "note: %s\n", note.c_str());
   if (rows) *rows = {r.first_row, r.last_row};
   if (removed_trend) *removed_trend = r.removed;
   if (provenance) {
@@ -75,36 +69,6 @@ std::vector<IdData> DataArgs::load_each(const std::vector<std::string>& paths, b
     ds.push_back(one.load(need_output));
   }
   return ds;
-}
-
-void check_outputs(const std::vector<std::string>& outs_in, const std::vector<std::string>& inputs, bool force) {
-  namespace fs = std::filesystem;
-  std::vector<std::string> outs;
-  for (const auto& o : outs_in)
-    if (!o.empty()) outs.push_back(o);
-  std::error_code ec;
-  // Where each output lands (a symlink is written through; a device, FIFO or directory is refused).
-  std::vector<fs::path> lands;
-  for (const auto& out : outs) {
-    std::string target;
-    try {
-      target = resolve_output_file(out);
-    } catch (const FileError& e) {
-      throw UsageError(e.what());
-    }
-    const fs::path abs = fs::weakly_canonical(fs::absolute(target, ec), ec);
-    for (size_t k = 0; k < lands.size(); ++k)
-      if (lands[k] == abs) throw UsageError("two outputs of this command name the same file '" + out + "' (and '" + outs[k] + "')");
-    lands.push_back(abs);
-    for (const auto& in : inputs)
-      if (!in.empty() && fs::exists(in, ec) && fs::exists(target, ec) && fs::equivalent(in, target, ec))
-        throw UsageError("refusing to write '" + out + "': it is the input file '" + in + "'");
-    if (fs::exists(target, ec) && !force) throw UsageError("'" + out + "' exists; use --force to overwrite it");
-    const fs::path dir = abs.has_parent_path() ? abs.parent_path() : fs::path(".");
-    if (!fs::is_directory(dir, ec)) throw UsageError("cannot write '" + out + "': the directory '" + dir.string() + "' does not exist");
-    if (::access(dir.c_str(), W_OK) != 0)
-      throw UsageError("cannot write '" + out + "': the directory '" + dir.string() + "' is not writable");
-  }
 }
 
 std::map<std::string, std::string> parse_sets(const std::vector<std::string>& sets) {
@@ -176,15 +140,8 @@ double to_double(const std::string& key, const std::string& value) {
 }
 
 void warn_offsets(const IdData& d) {
-  auto check = [](const Eigen::VectorXd& x, const std::string& name) {
-    const double m = x.mean(), sd = std::sqrt((x.array() - m).square().mean());
-    if (std::abs(m) > 0.5 * sd && sd > 0)
-      std::fprintf(stderr, "warning: %s has a mean of %.4g, %.2g times its standard deviation: a linear model "
-                   "through the origin cannot fit that offset; add --detrend mean (or linear)\n", name.c_str(), m,
-                   std::abs(m) / sd);
-  };
-  for (int j = 0; j < d.nu(); ++j) check(d.u().col(j), "input " + channel_name(d.input_names(), j));
-  for (int j = 0; j < d.ny(); ++j) check(d.y().col(j), "output " + channel_name(d.output_names(), j));
+  for (const auto& w : offset_warnings(d))
+    std::fprintf(stderr, "warning: %s; add --detrend mean (or linear)\n", w.c_str());
 }
 
 }  // namespace ctid::cli

@@ -68,13 +68,6 @@ struct DataArgs {
   std::vector<IdData> load_each(const std::vector<std::string>& paths, bool need_output) const;
 };
 
-/// Output file guard, run before any computation; every failure is a UsageError (exit 2). Refuses an output
-/// that is one of `inputs` (data, model, controller, NARX, result files; compared after resolving symlinks), two
-/// outputs that name the same file, an existing file without --force, a device/FIFO/directory even with --force
-/// (a symlink is written through to its regular target), and a directory that does not exist or is not writable.
-/// Empty names are skipped.
-void check_outputs(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs, bool force);
-
 /// "KEY=VALUE" pairs from --set; UsageError for a pair without '=' or a key given twice.
 std::map<std::string, std::string> parse_sets(const std::vector<std::string>& sets);
 /// The same as the library's settings (text values, parsed by the method's tables).

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <utility>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -48,6 +49,36 @@ std::string resolve_output_file(const std::string& path) {
   if (::stat(target.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
     throw FileError(detail::format("refusing to write '{}': it is {}, not a regular file", path, kind_of(st.st_mode)));
   return target;
+}
+
+void check_output_files(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs, bool overwrite,
+                        const std::string& overwrite_flag) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  std::vector<std::pair<fs::path, std::string>> lands;  // where each output lands, and its name as given
+  for (const auto& out : outputs) {
+    if (out.empty()) continue;
+    std::string target;
+    try {
+      target = resolve_output_file(out);
+    } catch (const FileError& e) {
+      throw InvalidArgument(e.what());
+    }
+    const fs::path abs = fs::weakly_canonical(fs::absolute(target, ec), ec);
+    for (const auto& [where, name] : lands)
+      if (where == abs) throw InvalidArgument(detail::format("two outputs of this command name the same file '{}' (and '{}')", out, name));
+    lands.emplace_back(abs, out);
+    for (const auto& in : inputs)
+      if (!in.empty() && fs::exists(in, ec) && fs::exists(target, ec) && fs::equivalent(in, target, ec))
+        throw InvalidArgument(detail::format("refusing to write '{}': it is the input file '{}'", out, in));
+    if (fs::exists(target, ec) && !overwrite)
+      throw InvalidArgument(detail::format("'{}' exists; use {} to overwrite it", out, overwrite_flag));
+    const fs::path dir = abs.has_parent_path() ? abs.parent_path() : fs::path(".");
+    if (!fs::is_directory(dir, ec))
+      throw InvalidArgument(detail::format("cannot write '{}': the directory '{}' does not exist", out, dir.string()));
+    if (::access(dir.c_str(), W_OK) != 0)
+      throw InvalidArgument(detail::format("cannot write '{}': the directory '{}' is not writable", out, dir.string()));
+  }
 }
 
 void write_text_file(const std::string& out, const std::string& content) {

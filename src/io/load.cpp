@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "ctid/core/check.hpp"
+#include "io/appendf.hpp"
 #include "ctid/io/mat.hpp"
 
 namespace ctid {
@@ -258,6 +259,14 @@ ChosenRecord choose_record(const std::string& path, const RecordChoice& choice) 
   IdData d = tab ? iddata_from_table(*tab, spec) : load_iddata(path, spec);
   out.file_rows = d.size();
   out.last_row = d.size();
+  if (!out.time_column.empty())
+    out.notes.push_back(detail::format("column '{}' is the time axis (no time column or sampling period was given)", out.time_column));
+  if (d.uniform_time_deviation() > 1e-9) {
+    std::string note;
+    io_detail::appendf(note, "%s: the sample times are within %.2g Ts of a uniform grid (threshold %g Ts): read as "
+                       "uniform, Ts = %.10g s", path.c_str(), d.uniform_time_deviation(), IdData::kUniformTimeTolerance, d.ts());
+    out.notes.push_back(std::move(note));
+  }
   if (!choice.rows.empty()) {
     const auto [begin, end] = row_range(choice.rows_name, choice.rows, d.size());
     d = d.slice(begin, end);
@@ -276,6 +285,21 @@ ChosenRecord choose_record(const std::string& path, const RecordChoice& choice) 
   out.removed_text = removed_text(d, out.removed, *choice.detrend);
   out.preprocessing += detail::format("; {} removed ({})", *choice.detrend == Detrend::Mean ? "means" : "linear trends",
                                       out.removed_text);
+  return out;
+}
+
+std::vector<std::string> offset_warnings(const IdData& d) {
+  std::vector<std::string> out;
+  auto check = [&](const Eigen::VectorXd& x, const std::string& name) {
+    const double m = x.mean(), sd = std::sqrt((x.array() - m).square().mean());
+    if (std::abs(m) <= 0.5 * sd || sd <= 0) return;
+    std::string w;
+    io_detail::appendf(w, "%s has a mean of %.4g, %.2g times its standard deviation: a linear model through the origin "
+                       "cannot fit that offset", name.c_str(), m, std::abs(m) / sd);
+    out.push_back(std::move(w));
+  };
+  for (int j = 0; j < d.nu(); ++j) check(d.u().col(j), "input " + channel_name(d.input_names(), j));
+  for (int j = 0; j < d.ny(); ++j) check(d.y().col(j), "output " + channel_name(d.output_names(), j));
   return out;
 }
 

@@ -8,6 +8,7 @@
 #include "ctid/core/check.hpp"
 #include "ctid/core/names.hpp"
 #include "ctid/io/load.hpp"
+#include "ctid/simulate/simulate.hpp"
 #include "ctid/validate/metrics.hpp"
 #include "io/appendf.hpp"
 
@@ -115,6 +116,23 @@ std::string comparison_text(const IdData& d, const std::vector<ModelComparison>&
   const std::size_t best = best_comparison(cs);
   appendf(out, "best: %s (%s %%%s)\n", cs[best].name.c_str(), two_decimals(cs[best].mean_fit()).c_str(),
           d.ny() > 1 ? ", mean over the outputs" : "");
+  return out;
+}
+
+std::string held_out_text(const Result<AnyModel>& r, const std::string& name, const IdData& d) {
+  const SimulateOptions so = simulate_options(r, SimulationPurpose::Validation);
+  const Simulation s = simulate(r.model, d, so);
+  std::string out;
+  appendf(out, "\nvalidation on %s (%d samples, initial state: %s):", name.c_str(), d.size(),
+          so.initial == InitialCondition::Estimated ? "the one that fits them best" : to_string(so.initial));
+  if (!s.ok()) {
+    appendf(out, " %s\n", s.problem.c_str());
+    return out;
+  }
+  for (int j = 0; j < d.ny(); ++j)
+    appendf(out, "%s fit %s %%", d.ny() > 1 ? ("  " + channel_name(d.output_names(), j)).c_str() : "",
+            fit_percent_text(fit_percent(d.y().col(j), s.y.col(j))).c_str());
+  out += "\n";
   return out;
 }
 

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace ctid {
 
@@ -20,6 +21,14 @@ void require_readable_regular_file(const std::string& path);
 /// through the link and leaves it in place). Throws FileError when that target exists and is not a regular
 /// file (a device such as /dev/null, a FIFO, a directory): ctid never replaces such a file.
 std::string resolve_output_file(const std::string& path);
+
+/// The guard a command runs on its output files before computing anything, so that nothing the user gave is lost:
+/// refuses (InvalidArgument naming the file) an output that is one of `inputs` (compared after resolving symlinks),
+/// two outputs that name the same file, an existing file unless `overwrite` (the message names `overwrite_flag`, the
+/// front end's way to allow it), a target that is not a regular file even with `overwrite` (resolve_output_file),
+/// and a directory that does not exist or is not writable. Empty names are skipped.
+void check_output_files(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs, bool overwrite,
+                        const std::string& overwrite_flag = "--force");
 
 /// Write `content` to a temporary file beside the target of `path` (resolve_output_file), then rename it over
 /// the target. On failure nothing is left behind and FileError names the path and the reason.

@@ -64,6 +64,9 @@ struct ChosenRecord {
   /// What was done to the file's data: "all 1000 rows; no detrending", "rows 1..500 of 1000; means removed (input u
   /// 4.994, output y 4.84337)".
   std::string preprocessing;
+  /// What a user should be told about the reading (a front end shows each as a note): the time axis found by its
+  /// name; sample times read as uniform although they deviate from the grid (by how much).
+  std::vector<std::string> notes;
 };
 
 /// Loads `path` (load_iddata) with the defaults of RecordChoice, takes the rows and detrends. Throws FileError for
@@ -71,6 +74,10 @@ struct ChosenRecord {
 /// or as input and output, no column left for the input or the output, two columns or none that could be the time
 /// axis), InvalidOptions for bad rows or a negative or non-finite ts, InvalidArgument for the file's content.
 ChosenRecord choose_record(const std::string& path, const RecordChoice& choice);
+
+/// The channels of d whose mean exceeds half their standard deviation, one line each naming the channel, its mean and
+/// the ratio: a linear model through the origin cannot follow such an offset (remove the means or trends first).
+std::vector<std::string> offset_warnings(const IdData& d);
 
 /// The columns of a frequency-response table: the frequencies (rad/s) with the real and imaginary parts of G(jw),
 /// or, when any of the spectra columns is named, with the input and output spectra (all four needed).

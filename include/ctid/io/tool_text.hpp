@@ -12,6 +12,7 @@
 #include "ctid/data/iddata.hpp"
 #include "ctid/estimate/modal/modal.hpp"
 #include "ctid/io/json.hpp"
+#include "ctid/model/any_model.hpp"
 #include "ctid/validate/compare.hpp"
 
 namespace ctid {
@@ -39,6 +40,12 @@ std::string comparison_text(const IdData& data, const std::vector<ModelCompariso
 /// the fit with NRMSE, MSE and the sample count, the residual whiteness test and each input's independence test
 /// with their verdicts (`ctid validate`). Lines end in '\n'.
 std::string validation_text(const IdData& data, const std::vector<OutputScore>& scores);
+
+/// The model of r simulated on a held-out record `d` called `name`, from the initial state of the library's rule for
+/// validation (simulate_options(r, SimulationPurpose::Validation)): "validation on NAME (N samples, initial state:
+/// ...): fit X %" (per output with several), or the simulation's problem when it left the finite numbers. Starts
+/// with an empty line and ends in '\n'. InvalidArgument for data that do not fit the model.
+std::string held_out_text(const Result<AnyModel>& r, const std::string& name, const IdData& d);
 
 /// Models compared on one record (ctid compare --json): {"ctid_version", "data": data_name, "n_samples", "best": the
 /// name of the best by mean fit, "models": [{"name", "type", "initial", "outputs": [{"output", "fit_percent",
