@@ -143,8 +143,8 @@ TEST(Fsf, WindowingLemmaIsExactInDiscreteTimeAndTheSafeFormEqualsTheNaive) {
 TEST(Fsf, UnstableCircuitStandInCompressesToTheShiftedStepResponse) {
   // Gawthrop & Wang 2005, §5, simulated: 1/(s^2 - 1), ZOH at 10 ms, digital PD (k = 3, Td = 1, Tf = 0.1, backward
   // difference), set-point +-0.5 switched every 1.5 s at random, 40 s; a = 2, T = 8 s. The FSF
-  // step response must match that of G(s + 2) = 1/((s + 1)(s + 3)) within 4-8e-3 (spec's values;
-  // measured 3.9e-3 for n = 21 and 7.5e-3 for n = 11).
+  // step response must match that of G(s + 2) = 1/((s + 1)(s + 3)) within 4-8e-3 (an independent
+  // recomputation's range, not printed: the paper shows figures only; measured 3.9e-3 for n = 21 and 7.5e-3 for n = 11).
   const double Ts = 0.01;
   const int M = 4000;
   std::mt19937_64 rng(1);

@@ -42,6 +42,19 @@ TEST(Kia, LinearStageReproducesTable2) {
     EXPECT_GT(err(r, "D^2y"), err(r, "u"));
     EXPECT_GT(err(r, "u"), err(r, "Dy"));
     EXPECT_GT(r.diagnostics.get(diagnostic::err_sum), 99.9);
+    // The printed ERR (63.86 D^2y, 34.35 u, 1.79 Dy %) on the paper's random points, which are not published: ours
+    // over three point sets 64.8-69.5, 27.8-32.6, 2.50-2.71. Tolerances: the spread of our point sets plus 2.
+    EXPECT_NEAR(err(r, "D^2y"), 63.86, 8.0) << seed;
+    EXPECT_NEAR(err(r, "u"), 34.35, 8.5) << seed;
+    EXPECT_NEAR(err(r, "Dy"), 1.79, 1.5) << seed;
+    // The first iteration (plain least squares) is biased towards zero in D^2y, as printed (7.5832e-5 against the
+    // converged 9.951e-5): ours 8.84-9.17e-5, between the printed first iteration and the converged value. Its Dy
+    // and u (printed 1.8424e-3, -0.84392) are not reproduced: ours 2.17-2.22e-3 and -0.948 to -0.965 (the
+    // first iteration's bias depends on the points; billings-li.md).
+    const Eigen::VectorXd first = r.diagnostics.get(diagnostic::first_iteration);
+    const double first_d2y = first(r.parameters.index("D^2y"));
+    EXPECT_GT(first_d2y, 7.5832e-5) << seed;
+    EXPECT_LT(first_d2y, value(r, "D^2y")) << seed;
   }
 }
 
@@ -86,6 +99,21 @@ TEST(Kia, QuadraticStageReproducesTable3) {
   EXPECT_NEAR(value(q, "y^2"), 0.0990, 0.2 * 0.0990);
   EXPECT_NEAR(value(q, "y*Dy"), -0.0055, 0.05 * 0.0055);
   EXPECT_GT(err(q, "y*Dy"), err(q, "y^2"));
+  // Table 3's ERR split (yDy 82.471, y^2 17.184 %, sum 99.655) is not reproduced on our points: ours over three
+  // point sets yDy 93.4-96.1, y^2 3.9-5.5, sum 98.8-99.95 (the same ranking; the converged y^2 0.098-0.105 against
+  // the printed 0.0990). Its first iteration (y^2 0.0794, yDy -0.0056) neither: ours y^2 0.107-0.124 (above the
+  // converged value, where the print is below), yDy -0.00547 to -0.00549 (billings-li.md).
+  for (unsigned seed : {1u, 2u, 3u}) {
+    KiaQuadraticOptions qo{.candidates = {NdeTerm::parse("y^2"), NdeTerm::parse("y*Dy")}, .zoh = false};
+    qo.points.seed = seed;
+    const auto qs = kia_quadratic(m, lin.model, qo);
+    EXPECT_NEAR(value(qs, "y^2"), 0.0990, 0.1 * 0.0990) << seed;
+    EXPECT_NEAR(value(qs, "y*Dy"), -0.0055, 0.05 * 0.0055) << seed;
+    EXPECT_GT(err(qs, "y*Dy"), 90.0) << seed;  // printed 82.471: not reproduced
+    EXPECT_GT(qs.diagnostics.get(diagnostic::err_sum), 98.5) << seed;
+    const Eigen::VectorXd first = qs.diagnostics.get(diagnostic::first_iteration);
+    EXPECT_NEAR(first(qs.parameters.index("y*Dy")), -0.0056, 2e-4) << seed;
+  }
   // Four candidates: y*u and Dy^2 take little ERR (measured 0.30 % and 0.08 %) but distort y^2; pruning at 0.5 %
   // and re-estimating returns the two-term result (the paper's over-parameterise -> prune workflow).
   const std::vector<NdeTerm> four = {NdeTerm::parse("y^2"), NdeTerm::parse("y*Dy"), NdeTerm::parse("Dy^2"),

@@ -102,6 +102,10 @@ TEST(DeadbeatObserver, DataRouteEqualsTheModelRouteAndGivesTheMarkovParameters) 
   EXPECT_NEAR(bt(2), 26.0, 1e-8);
   const Eigen::VectorXd bd = data.markov_parameters(mj.model.P().row(3));
   EXPECT_LT((bd - Eigen::Vector3d(0.0, 6.5, 26.0)).cwiseAbs().maxCoeff(), 1e-4);
+  // Table 6.2's printed estimate (0.007399, 6.453, 26.24) is not reproduced: ours is the truth, from which the print
+  // lies 0.7 % (b~_1) and 0.9 % (b~_2) away — the size of the thesis' estimation error, which it does not itemise.
+  EXPECT_NEAR(bd(1) / 6.453 - 1, 0.0073, 5e-4);
+  EXPECT_NEAR(bd(2) / 26.24 - 1, -0.0091, 5e-4);
 }
 
 TEST(DeadbeatObserver, MarkovParametersOfAnUnstableSystemAndAnIntegratorRefused) {

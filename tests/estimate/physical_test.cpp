@@ -273,11 +273,11 @@ TEST(GawthropWang, RawRouteOnSeveralRecordsIsOneFitMoreAccurateThanEither) {
   }
 }
 
-TEST(GawthropWang, BallAndBeamWithinOnePercentAndBPositiveDegrades) {
+TEST(GawthropWang, BallAndBeamWithinOnePercentAlsoWithThePapersBWhereTheFsfSpansTheRecord) {
   // Gawthrop & Wang 2005, §5, simulated: 2.5/s^2 under PID u = sat(Kp(w-y) - Kd s/(1+Tf s) y + Ki int(w-y)), |u| <= 1.5,
   // Kp = 1, Kd = 0.8, Ki = 0.1, Tf = 0.05, Ts = 0.01, square-wave set-point +-0.5 (20 s period),
-  // measurement noise 0.02, 60 s; a = 1, T = 10 s, n = 21. Spec: b = 0 gives K = 2.488 +- 0.008
-  // (criterion: within 1 % of 2.5); b = 0.9 fails and is warned about.
+  // measurement noise 0.02, 60 s (a stand-in: the paper's data are not public); a = 1, T = 10 s, n = 21: b = 0
+  // gives K within 1 % of 2.5.
   const double Ts = 0.01;
   const int M = 6000;
   Eigen::VectorXd w(M);
@@ -295,10 +295,20 @@ TEST(GawthropWang, BallAndBeamWithinOnePercentAndBPositiveDegrades) {
   // Linear in K: the paper reports one LM step; LM needs a few more to meet its stopping test.
   EXPECT_LE(r0.summary.iterations, 6);
   EXPECT_NEAR(r0.diagnostics.get(diagnostic::cost_history)(1), r0.diagnostics.get(diagnostic::cost), 1e-3 * r0.diagnostics.get(diagnostic::cost_history)(0));
-  const auto c9 = fsf(data, {.T = 10.0, .n = 21, .a = 1.0, .b = 0.9});
-  ASSERT_FALSE(c9.diagnostics.warnings.empty());
+  // The paper's b = 0.9 ("K ~ 2.5 in exactly one step") holds where the FSF spans the record: on the first 10 s
+  // (one set-point level) with T = 10 s and n = 161 frequency samples (the saturated PID's edges need them: n = 21
+  // gives 1.955, 81 gives 2.468 noise-free), K is within 1 % of 2.5 and the first step reaches the final cost.
+  // The figure caption that gave the paper's T, n and record length is lost in the source.
+  const auto c9 = fsf(data.slice(0, 1000), {.T = 10.0, .n = 161, .a = 1.0, .b = 0.9});
   const auto r9 = fit_physical_step(m, {{"K", 1.0}}, c9.model);
-  EXPECT_GT(std::abs(r9.parameters.value("K") - 2.5), 0.25);  // spec: K ~ 0.57 with b = 0.9
+  EXPECT_NEAR(r9.parameters.value("K"), 2.5, 0.025);
+  EXPECT_NEAR(r9.diagnostics.get(diagnostic::cost_history)(1), r9.diagnostics.get(diagnostic::cost), 1e-3 * r9.diagnostics.get(diagnostic::cost_history)(0));
+  // On the whole 60 s record with T = 10 s, b = 0.9 weights the late data, where the windowed double integrator's
+  // response beyond T (K tau e^{-tau} u_a, growing like e^{(b - a) t} t^2 in the weighted residual) is not in the
+  // model: K collapses (0.57, noise-free 0.56) and ctid warns that b > 0 with a record longer than T.
+  const auto c9long = fsf(data, {.T = 10.0, .n = 21, .a = 1.0, .b = 0.9});
+  ASSERT_FALSE(c9long.diagnostics.warnings.empty());
+  EXPECT_LT(fit_physical_step(m, {{"K", 1.0}}, c9long.model).parameters.value("K"), 1.0);
   // Without a window (a = 0) the double integrator's poles at 0 are not covered: warned about.
   const auto r_nowin = fit_physical_step(m, {{"K", 1.0}}, fsf(data, {.T = 10.0, .n = 21}).model);
   bool warned = false;

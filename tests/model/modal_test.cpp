@@ -263,11 +263,17 @@ TEST(ModalModel, Table47WalshRowFollowsFromTables311And312) {
   EXPECT_NEAR(tw.num().coefficient_of_power(0), 51.81, 0.08);     // rounding spread 51.68 .. 51.89
   EXPECT_NEAR(tw.num().coefficient_of_power(1), 12.66, 0.008);    // 12.656 .. 12.672
   EXPECT_NEAR(tw.num().coefficient_of_power(2), -0.06689, 0.002);  // -0.0685 .. -0.0647
-  const TransferFunction tf = modal_theorems_tf(fourier);  // the same route: not the printed Fourier row
-  EXPECT_NEAR(tf.num().coefficient_of_power(0), 52.78, 0.1);
-  EXPECT_NEAR(tf.num().coefficient_of_power(1), 13.16, 0.01);
-  EXPECT_NEAR(tf.num().coefficient_of_power(2), -0.0211, 0.002);
-  EXPECT_GT(std::abs(tf.num().coefficient_of_power(0) - 51.91), 0.7);  // 1.7 % from the print: a misprint or another input
+  // The same route on the Fourier tables does not give the printed Fourier row (51.91, 12.91, -0.03879): asserted
+  // against the print, b0 lies 1.5-2.0 % above it and b1 1.5-2.5 % above (the rounding spread of the inputs moves
+  // b0 by 0.1 %); b2 is -0.0211 against the printed -0.03879. The values 52.78, 13.16, -0.0211 of the comment above
+  // are regression values, not printed.
+  const TransferFunction tf = modal_theorems_tf(fourier);
+  const double b0 = tf.num().coefficient_of_power(0), b1 = tf.num().coefficient_of_power(1);
+  EXPECT_GT(b0 / 51.91 - 1, 0.015);
+  EXPECT_LT(b0 / 51.91 - 1, 0.020);
+  EXPECT_GT(b1 / 12.91 - 1, 0.015);
+  EXPECT_LT(b1 / 12.91 - 1, 0.025);
+  EXPECT_NEAR(tf.num().coefficient_of_power(2), -0.0211, 0.002);  // regression value, not printed (-0.03879)
 }
 
 TEST(ModalParameters, BadInputs) {
