@@ -55,14 +55,9 @@ double max_rel(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return (a - b).cwiseAbs().maxCoeff() / b.cwiseAbs().maxCoeff();
 }
 
-// The fraction of v at or below x (where a printed single run falls in our Monte Carlo distribution), and the q-quantile.
+// The fraction of v at or below x: where a printed single run falls in our Monte Carlo distribution.
 double percentile_of(const std::vector<double>& v, double x) {
   return static_cast<double>(std::count_if(v.begin(), v.end(), [x](double e) { return e <= x; })) / static_cast<double>(v.size());
-}
-double quantile_of(std::vector<double> v, double q) {
-  const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), v.begin() + k, v.end());
-  return v[static_cast<std::size_t>(k)];
 }
 
 // The monic polynomial (descending coefficients) whose roots are the modes mapped by the trapezoid rule of step h,
@@ -245,7 +240,7 @@ TEST(FreeResponsePoles, Table49AugmentedWithTheGeneratorAndDeflated) {
     EXPECT_LT(max_rel(c, mapped), 1e-7) << "t_o1 = " << start << " Ts";
   }
   // The printed P_a = (3.992, 45.93, 115.5, 478.4, 827.1) is not reproduced: it lies below the truth in every
-  // coefficient, while the trapezoid (at any step) and Simpson lie on or above it; it is 0.17-0.63 % from our
+  // coefficient, while the trapezoid (at steps of 1 to 3 Ts) and Simpson lie on or above it; it is 0.17-0.63 % from our
   // trapezoid estimate (a_0: 827.1 against 832.30) (el-shafey.md).
   const Eigen::VectorXd printed{{3.992, 45.93, 115.5, 478.4, 827.1}};
   for (int j = 1; j <= 5; ++j) EXPECT_GT(c(j), truth(j)) << "coefficient " << j;
@@ -441,7 +436,7 @@ TEST(ModalEstimate, Tables41And42PrefiltersAndTheOutputModalFunctionRoute) {
                                        {s2, annihilator(g6 + g4, s2), g2},
                                        {s3, l3, g6}};
   const Eigen::MatrixXd P = modal_parameters(kS3, kShifts3, 0).P;
-  // Table 4.1's printed p^_0, one column per filter: within 0.3-0.5 % of the truth, which our estimates are.
+  // Table 4.1's printed p^_0, one column per filter: within 0.5 % of the truth, which our estimates are.
   const double p0_print[3][3] = {{-0.6586, 0.6087, -0.3016}, {-0.6597, 0.6120, -0.3034}, {-0.6572, 0.6092, -0.3030}};
   std::vector<ModalExperiment> ex;
   for (std::size_t k = 0; k < filters.size(); ++k) {
