@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <random>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -12,10 +14,12 @@
 #include "ctid/data/input_design.hpp"
 #include "ctid/io/json.hpp"
 #include "ctid/estimate/nonlinear/frols.hpp"
+#include "ctid/estimate/nonlinear/gfrf.hpp"
 #include "ctid/estimate/nonlinear/kia.hpp"
 #include "ctid/estimate/nonlinear/nde_oe.hpp"
 #include "ctid/io/load.hpp"
 #include "ctid/simulate/lsim.hpp"
+#include "ctid/validate/metrics.hpp"
 #include "estimate/billings_li_models.hpp"
 #include "test_util.hpp"
 
@@ -366,4 +370,149 @@ TEST(Kia, ThePapersCentredErrAndTheHoldFactorAreOptions) {
   EXPECT_NEAR(value(held, "Dy"), 0.002, 0.05 * 0.002);
   EXPECT_NEAR(value(held, "u"), -1.0, 0.02);
   EXPECT_LT(std::abs(value(held, "u") + 1.0), std::abs(value(plain, "u") + 1.0));
+}
+
+namespace {
+// Billings & Li (1999) §5, Figs 3-7: an electromagnetic suspension (force proportional to current squared)
+// in a stabilising loop with an added random excitation r(t), measured every 1.5e-4 s, decimated by 3 to
+// 4.5e-4 s, a quadratic NARMAX model, its continuous-time equation by KIA, and that equation simulated at the
+// original 1.5e-4 s against the measured output. The paper's data are not published and it prints no number,
+// so this is a simulated stand-in (its numbers are ours): a ball of gap x under a magnet,
+// x'' = g - g (x0 / i0)^2 i^2 / x^2 (the weight balanced by i0 at the gap x0 = 5 mm), with the current
+// i = i0 + kp (x - x0) + kd x' + r from a PD loop placing the linearised poles at wn = 250 rad/s, zeta = 0.4
+// (the open-loop pole is at +sqrt(2 g / x0) = 62.6 1/s). r is uniform in +-0.3 A, held for each decimated
+// sample; the gap is integrated by RK4 with 16 steps per 1.5e-4 s sample (well below the noise); 9000 samples
+// (1.35 s); white noise at 40 dB SNR on the measured gap. The input of the identified equation is r, the
+// output the gap deviation in mm: the loop is stable, so its equation can be simulated freely as in the paper's
+// Fig. 7 (the magnet alone, from i to x, is unstable).
+struct Suspension {
+  static constexpr double g = 9.81, x0 = 0.005, i0 = 1.0, wn = 250.0, zeta = 0.4, h = 1.5e-4;
+  static constexpr int decimation = 3;
+  double kd = 2 * zeta * wn * i0 / (2 * g);
+  double kp = (wn * wn + 2 * g / x0) * i0 / (2 * g);
+  Eigen::VectorXd r, gap_mm, measured_mm;  // at the original 1.5e-4 s
+  explicit Suspension(int n_decimated, unsigned seed) : r(n_decimated * decimation), gap_mm(r.size()) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> level(-0.3, 0.3);
+    for (int k = 0; k < n_decimated; ++k) r.segment(k * decimation, decimation).setConstant(level(rng));
+    const auto f = [&](const Eigen::Vector2d& s, double rk) {
+      const double i = i0 + kp * s(0) + kd * s(1) + rk, x = x0 + s(0);
+      return Eigen::Vector2d(s(1), g - g * (x0 * x0) / (i0 * i0) * i * i / (x * x));
+    };
+    Eigen::Vector2d s = Eigen::Vector2d::Zero();
+    const double dt = h / 16;
+    for (int k = 0; k < r.size(); ++k) {
+      gap_mm(k) = 1e3 * s(0);
+      for (int j = 0; j < 16; ++j) {
+        const Eigen::Vector2d k1 = f(s, r(k)), k2 = f(s + dt / 2 * k1, r(k)), k3 = f(s + dt / 2 * k2, r(k)),
+                              k4 = f(s + dt * k3, r(k));
+        s += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+      }
+    }
+    measured_mm = add_noise_snr(gap_mm, 40.0, 100 + seed);
+  }
+  IdData decimated() const {
+    const int n = static_cast<int>(r.size()) / decimation;
+    Eigen::VectorXd u(n), y(n);
+    for (int k = 0; k < n; ++k) {
+      u(k) = r(k * decimation);
+      y(k) = measured_mm(k * decimation);
+    }
+    return IdData(u, y, h * decimation);
+  }
+  /// The physics' equation to second order in y = x - x0 (mm), r and their derivatives, in the implicit form
+  /// y + .. = 0: from (1 + a)^2 (1 + b)^-2 = 1 + 2a - 2b + a^2 - 4ab + 3b^2 + O(3), a = (kp y + kd Dy + r) / i0,
+  /// b = y / x0 (metres), divided by -wn^2 / g and scaled to mm.
+  std::map<std::string, double> second_order_truth() const {
+    const double c = g / (wn * wn), m = 1e-3;  // quadratic terms in y (m) become m * (terms in y in mm)
+    return {{"Dy", 2 * zeta / wn},
+            {"D^2y", 1 / (wn * wn)},
+            {"u", 1e3 * 2 * g / i0 / (wn * wn)},
+            {"y^2", m * c * (kp * kp / (i0 * i0) - 4 * kp / (i0 * x0) + 3 / (x0 * x0))},
+            {"y*Dy", m * c * (2 * kp * kd / (i0 * i0) - 4 * kd / (i0 * x0))},
+            {"Dy^2", m * c * kd * kd / (i0 * i0)},
+            {"y*u", c * (2 * kp / (i0 * i0) - 4 / (i0 * x0))},
+            {"Dy*u", c * 2 * kd / (i0 * i0)},
+            {"u^2", 1e3 * c / (i0 * i0)}};
+  }
+};
+}  // namespace
+
+TEST(Kia, ElectromagneticSuspensionStandIn) {
+  const Suspension rig(3000, 1);
+  const IdData d = rig.decimated();
+  const double T = d.ts();
+  // Quadratic NARMAX, lags 1..4, no constant (deviations from the operating point), AIC, at most 16 process terms.
+  auto narmax_of = [&](bool output_only_nonlinear) {
+    std::vector<NarxTerm> cand;
+    for (const NarxTerm& t : narx_candidates(2, 4, 4, false))
+      if (!output_only_nonlinear || t.degree() < 2 ||
+          std::all_of(t.factors.begin(), t.factors.end(), [](const NarxFactor& f) { return f.signal == NarxSignal::Output; }))
+        cand.push_back(t);
+    return narmax(d, cand, {.frols = {.max_terms = 16, .criterion = InformationCriterion::Aic}}).model.process();
+  };
+  const NarxModel narx = narmax_of(false);
+  KiaOptions ko;
+  ko.linear = {.y_order = 2, .u_order = 0};  // the quadratic candidates: every product of y, Dy, u (the default)
+  const KiaRun run = kia(d, narx, ko);
+  ASSERT_TRUE(run.reconstructed.usable()) << run.reconstructed.why_not_usable();
+  const NdeModel equation = run.reconstructed.model.normalized();
+  // Fig. 5: the linear kernel of the equation against the NARX model's, 50 points on each axis up to 1/T
+  // (2222 rad/s, 0.32 of the Nyquist frequency): measured at most 0.80 % apart (seeds 2-4: 0.80, 0.87, 0.67 %).
+  double h1_gap = 0;
+  for (int k = 1; k <= 50; ++k)
+    for (const Complex s : {Complex(0, 0.02 * k / T), Complex(0.02 * k / T, 0)}) {
+      const Complex narx_h1 = narx_gfrf_ct(narx, {s});
+      h1_gap = std::max(h1_gap, std::abs(equation.h1(s) - narx_h1) / std::abs(narx_h1));
+    }
+  EXPECT_LT(h1_gap, 0.015);
+  // Fig. 6: the quadratic kernels on a 20 x 20 grid of the imaginary axis up to 0.5/T (the quadratic stage's range):
+  // measured largest difference 3.1 % of the largest |H_2| (seeds 2-4: 3.9, 12.7, 2.3 %).
+  double h2_gap = 0, h2_max = 0;
+  for (int k = 1; k <= 20; ++k)
+    for (int l = 1; l <= 20; ++l) {
+      const Complex s1(0, 0.025 * k / T), s2(0, 0.025 * l / T), narx_h2 = narx_gfrf_ct(narx, {s1, s2});
+      h2_gap = std::max(h2_gap, std::abs(equation.h2(s1, s2) - narx_h2));
+      h2_max = std::max(h2_max, std::abs(narx_h2));
+    }
+  EXPECT_LT(h2_gap, 0.10 * h2_max);
+  // Fig. 7: the equation simulated at the original 1.5e-4 s with the original input against the measured output.
+  // Measured: KIA's equation 96.4 % (seeds 2-4: 96.5, 96.6, 97.9), its linear part alone 67.9 % (the quadratic
+  // terms carry a quarter of the output), ctid's output-error refinement of the equation (on the decimated record)
+  // 99.0 %.
+  const Eigen::VectorXd t = time_grid(Suspension::h, static_cast<int>(rig.r.size()));
+  const NdeSimulation sim = equation.simulate(rig.r, t, Intersample::Zoh);
+  ASSERT_TRUE(sim.ok()) << sim.message;
+  EXPECT_GT(fit_percent(rig.measured_mm, sim.y), 94.0);
+  std::vector<NdeTerm> linear_terms;
+  Eigen::VectorXd linear_coefficients(4);
+  int i = 0;
+  for (const char* s : {"y", "Dy", "D^2y", "u"}) {
+    linear_terms.push_back(NdeTerm::parse(s));
+    linear_coefficients(i++) = equation.coefficient(s);
+  }
+  const NdeSimulation linear = NdeModel(linear_terms, linear_coefficients).simulate(rig.r, t, Intersample::Zoh);
+  EXPECT_LT(fit_percent(rig.measured_mm, linear.y), 72.0);
+  ASSERT_TRUE(run.refined.has_value() && run.refined->usable());
+  const NdeModel refined = run.refined->model.normalized();
+  const NdeSimulation refined_sim = refined.simulate(rig.r, t, Intersample::Zoh);
+  EXPECT_GT(fit_percent(rig.measured_mm, refined_sim.y), 98.5);
+  // Against the physics (not in the paper): the refined equation's coefficients and the second-order expansion
+  // of the magnet's force. Measured: linear terms 0.18-0.25 %, y^2, y*u, u^2 0.3 %, y*Dy 2.5 %, Dy*u 2.3 %,
+  // Dy^2 7.4 % (the expansion drops the third-order terms, which the fit partly absorbs).
+  for (const auto& [name, truth] : rig.second_order_truth()) {
+    const double tolerance = name == "Dy^2" ? 0.15 : name == "y*Dy" || name == "Dy*u" ? 0.05 : 0.01;
+    EXPECT_NEAR(refined.coefficient(name) / truth, 1.0, tolerance) << name;
+  }
+  // The paper kept only output nonlinear terms. Here the force is quadratic in the current, which the input
+  // drives directly, so such a model explains no more than the linear equation: measured 67.8 % at 1.5e-4 s.
+  const KiaRun output_only = kia(d, narmax_of(true), [] {
+    KiaOptions o;
+    o.linear = {.y_order = 2, .u_order = 0};
+    o.quadratic.candidates = {NdeTerm::parse("y^2"), NdeTerm::parse("y*Dy"), NdeTerm::parse("Dy^2")};
+    o.refine = false;
+    return o;
+  }());
+  const NdeSimulation output_only_sim = output_only.reconstructed.model.normalized().simulate(rig.r, t, Intersample::Zoh);
+  EXPECT_LT(fit_percent(rig.measured_mm, output_only_sim.y), 72.0);
 }
