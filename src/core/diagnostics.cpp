@@ -16,6 +16,8 @@ const std::vector<DiagnosticInfo>& diagnostic_catalogue() {
   static const std::vector<DiagnosticInfo> all = {
       info(diagnostic::experiments),
       info(diagnostic::noise_variance),
+      info(diagnostic::residual_ar_order),
+      info(diagnostic::white_noise_std),
       info(diagnostic::delay),
       info(diagnostic::time_scale),
       info(diagnostic::tau),

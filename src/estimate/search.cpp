@@ -52,14 +52,29 @@ MultiStartResult multi_start(const Search& search, const Eigen::VectorXd& v0, co
 }
 
 std::string set_covariance(ParameterSet& parameters, Diagnostics& diagnostics, const internal::LmResult& lm,
-                           const std::vector<int>& slots, double sigma2) {
+                           const std::vector<int>& slots, double sigma2,
+                           const std::vector<internal::ResidualSequence>& sequences) {
+  internal::ColouredCovariance coloured;
+  if (!sequences.empty() && std::isfinite(lm.cost) && lm.jacobian.rows() > 0)
+    coloured = internal::coloured_covariance(lm.jacobian, lm.residual, sequences, static_cast<int>(lm.jacobian.cols()));
+  return set_covariance(parameters, diagnostics, lm, slots, sigma2, coloured);
+}
+
+std::string set_covariance(ParameterSet& parameters, Diagnostics& diagnostics, const internal::LmResult& lm,
+                           const std::vector<int>& slots, double sigma2, const internal::ColouredCovariance& coloured) {
   const bool finite = std::isfinite(lm.cost);
   std::vector<std::string> names;
   for (int j : slots) names.push_back(parameters.names[static_cast<size_t>(j)]);
   const std::string unidentifiable = finite ? internal::unidentifiable(lm.jtj, lm.x, names) : std::string();
-  parameters.set_covariance(finite && unidentifiable.empty() ? internal::covariance(lm.jtj, sigma2) : Eigen::MatrixXd(),
-                            slots);
+  const Eigen::MatrixXd white =
+      finite && unidentifiable.empty() ? internal::covariance(lm.jtj, sigma2) : Eigen::MatrixXd();
   diagnostics.condition_number = finite ? internal::gram_condition(lm.jtj) : NAN;
+  parameters.set_covariance(white, slots);
+  const auto p = static_cast<Eigen::Index>(slots.size());
+  if (white.size() == 0 || coloured.covariance.rows() < p) return unidentifiable;
+  diagnostics.set(diagnostic::white_noise_std, parameters.std);
+  diagnostics.set(diagnostic::residual_ar_order, coloured.largest_order());
+  parameters.set_covariance(coloured.covariance.topLeftCorner(p, p), slots);
   return unidentifiable;
 }
 

@@ -1,5 +1,6 @@
 // ctid — what the output-error searches share (greybox, nde_oe, oe, physical; ssest draws its starts): the
-// multi-start driver and the covariance of a search's estimate, sigma^2 (J^T J)^{-1} (Ljung 1999 §9.3), with its identifiability check.
+// multi-start driver and the covariance of a search's estimate (Ljung 1999 §9.3: sigma^2 (J^T J)^{-1} for white
+// residuals, the sandwich of internal/coloured_covariance.hpp for coloured ones), with its identifiability check.
 #pragma once
 
 #include <cstdint>
@@ -12,6 +13,7 @@
 
 #include "ctid/core/diagnostics.hpp"
 #include "ctid/core/types.hpp"
+#include "internal/coloured_covariance.hpp"
 #include "internal/levenberg_marquardt.hpp"
 
 namespace ctid::search {
@@ -52,11 +54,20 @@ using Search = std::function<internal::LmResult(const Eigen::VectorXd& start)>;
 MultiStartResult multi_start(const Search& search, const Eigen::VectorXd& v0, const Eigen::VectorXd& lower,
                              const Eigen::VectorXd& upper, const MultiStart& options);
 
-/// The covariance sigma2 (J^T J)^{-1} of a search's estimate set on `parameters` at `slots` (the entries of the
-/// search vector, in order) and the scaled condition number of J on `diagnostics`. Returns "" when the data determine
-/// every direction, else internal::unidentifiable's message (the covariance is then unknown); a search that ended
-/// without a finite cost has neither (covariance unknown, condition NaN, message "").
+/// The covariance of a search's estimate set on `parameters` at `slots` (the first slots.size() entries of the
+/// search vector, in order) and the scaled condition number of J on `diagnostics`. With `sequences` (the layout of the
+/// residual vector) and a search that kept its Jacobian (LmOptions::keep_jacobian), the covariance allows for coloured
+/// residuals (internal/coloured_covariance.hpp; entries of the search vector beyond the slots, e.g. initial
+/// conditions, are estimated alongside and marginalised), with diagnostics "residual_ar_order" and "white_noise_std"
+/// (the white-noise figure sigma2 (J^T J)^{-1}); otherwise it is sigma2 (J^T J)^{-1}, J^T J = lm.jtj over the slots.
+/// Returns "" when the data determine every direction, else internal::unidentifiable's message (the covariance is then
+/// unknown); a search that ended without a finite cost has neither (covariance unknown, condition NaN, message "").
 std::string set_covariance(ParameterSet& parameters, Diagnostics& diagnostics, const internal::LmResult& lm,
-                           const std::vector<int>& slots, double sigma2);
+                           const std::vector<int>& slots, double sigma2,
+                           const std::vector<internal::ResidualSequence>& sequences = {});
+/// The same with the coloured-noise covariance already formed over the search vector (a streamed search's, which
+/// never holds J); an empty one gives sigma2 (J^T J)^{-1}.
+std::string set_covariance(ParameterSet& parameters, Diagnostics& diagnostics, const internal::LmResult& lm,
+                           const std::vector<int>& slots, double sigma2, const internal::ColouredCovariance& coloured);
 
 }  // namespace ctid::search

@@ -138,7 +138,8 @@ template <class Jacobian, class Evaluate>
 LmResult lm_residuals(const Evaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& lo, const Eigen::VectorXd& hi,
                       const LmOptions& o) {
   using Normal = std::conditional_t<std::is_same_v<Jacobian, Sparse>, Sparse, Eigen::MatrixXd>;
-  Eigen::VectorXd r;
+  Eigen::VectorXd r, r_at_J;
+  Eigen::VectorXd x_at_J;  // where J and r_at_J were evaluated (keep_jacobian)
   Jacobian J;
   auto normal = [&](const Eigen::VectorXd& xv, double& cost, Normal* A, Eigen::VectorXd* g) {
     if (!evaluate(xv, r, A ? &J : nullptr) || !r.allFinite() || (A && !finite(J))) return false;
@@ -147,10 +148,20 @@ LmResult lm_residuals(const Evaluate& evaluate, Eigen::VectorXd x, const Eigen::
       if constexpr (std::is_same_v<Jacobian, Sparse>) *A = Normal(J.transpose()) * J;
       else A->noalias() = J.transpose() * J;  // no transposed copy of J (N x p) per evaluation
       g->noalias() = J.transpose() * r;
+      if (o.keep_jacobian) {
+        r_at_J = r;
+        x_at_J = xv;
+      }
     }
     return true;
   };
-  return lm<Normal>(normal, std::move(x), lo, hi, o);
+  LmResult res = lm<Normal>(normal, std::move(x), lo, hi, o);
+  if constexpr (std::is_same_v<Jacobian, Eigen::MatrixXd>)
+    if (o.keep_jacobian && std::isfinite(res.cost) && x_at_J.size() == res.x.size() && x_at_J == res.x) {
+      res.residual = std::move(r_at_J);
+      res.jacobian = std::move(J);
+    }
+  return res;
 }
 }  // namespace
 

@@ -24,12 +24,17 @@ struct LmOptions {
   /// false: no J^T J at the final point (the result's jtj is then the last one evaluated) — for callers that compute
   /// their covariance themselves; a search that converges or reaches max_iterations then costs one Jacobian less.
   bool final_normal = true;
+  /// Residual form (LmEvaluate): keep the residuals and the Jacobian at the final point in the result (for a
+  /// covariance that needs more than J^T J, internal/coloured_covariance.hpp); needs final_normal.
+  bool keep_jacobian = false;
 };
 
 struct LmResult {
   Eigen::VectorXd x;
   double cost = 0.0;                // 1/2 ||r||^2 at x
   Eigen::MatrixXd jtj;              // J^T J at x
+  Eigen::VectorXd residual;         // r at x and ..
+  Eigen::MatrixXd jacobian;         // .. J at x, when LmOptions::keep_jacobian (else empty)
   int iterations = 0;
   int evaluations = 0;              // residual evaluations, each a pass over the data ..
   int jacobians = 0;                // .. of which with the Jacobian

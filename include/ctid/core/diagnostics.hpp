@@ -33,6 +33,14 @@ namespace diagnostic {
 inline constexpr ScalarDiagnostic experiments{"experiments", "", "number of records fitted jointly (only when > 1)"};
 inline constexpr ScalarDiagnostic noise_variance{"noise_variance", "y^2",
                                                  "variance of the output error (the noise estimate behind the covariance)"};
+inline constexpr ScalarDiagnostic residual_ar_order{
+    "residual_ar_order", "",
+    "order of the AR model of the output error behind the standard deviations (the largest over the outputs; 0: "
+    "white, the covariance is sigma^2 (J^T J)^-1)"};
+inline constexpr VectorDiagnostic white_noise_std{
+    "white_noise_std", "",
+    "standard deviation of each parameter if the output error were white, sigma (J^T J)^-1/2 (in the parameter's "
+    "unit; 0 for fixed ones); the reported ones allow for the error's colour"};
 inline constexpr ScalarDiagnostic delay{"delay", "s", "input-output delay of the model (estimated or given)"};
 inline constexpr ScalarDiagnostic time_scale{"time_scale", "s",
                                              "time unit the estimation ran in (its results are converted back to seconds)"};

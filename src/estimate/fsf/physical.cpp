@@ -46,10 +46,13 @@ using ResidualFn = std::function<void(const Eigen::VectorXd& theta, const std::v
 
 // target: the data the residuals are measured against (for the fit report); nuisance_at (when given): called once with
 // the starting Theta, the number of further quantities the residual function estimates itself (the raw route's
-// initial states), counted in the degrees of freedom.
+// initial states), counted in the degrees of freedom. sequences (when given): the residuals' layout in time order, for
+// a covariance that allows for coloured residuals (search::set_covariance); otherwise sigma^2 (J^T J)^-1 with a
+// warning that it is indicative.
 Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<PhysicalParameter>& params, double a,
                              const PhysicalFitOptions& opt, const ResidualFn& residual, const Eigen::VectorXd& target,
-                             const char* route, const std::function<int(const Eigen::VectorXd&)>& nuisance_at = {}) {
+                             const char* route, const std::function<int(const Eigen::VectorXd&)>& nuisance_at = {},
+                             const std::vector<internal::ResidualSequence>& sequences = {}) {
   const int n_data = static_cast<int>(target.size());
   const auto start = std::chrono::steady_clock::now();
   opt.validate();
@@ -132,6 +135,7 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
   internal::LmOptions lmo;
   lmo.max_iterations = opt.max_iterations;
   lmo.ftol = lmo.xtol = opt.tolerance;
+  lmo.keep_jacobian = !sequences.empty();
   const internal::LmResult lm = internal::levenberg_marquardt(evaluate, x0, lo, hi, lmo);
 
   Result<TransferFunction> res;
@@ -141,7 +145,7 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
   res.parameters.values = th;
   res.parameters.fixed = fixed;
   const double sigma2 = 2.0 * lm.cost / std::max(1, n_data - p - nuisance);
-  const std::string unidentifiable = search::set_covariance(res.parameters, res.diagnostics, lm, free, sigma2);
+  const std::string unidentifiable = search::set_covariance(res.parameters, res.diagnostics, lm, free, sigma2, sequences);
   {
     Eigen::VectorXd r;
     if (std::isfinite(lm.cost) && evaluate(lm.x, r, nullptr)) res.fit = fit_report_or_inf(target, target + r, p + nuisance);
@@ -150,8 +154,9 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
   res.diagnostics.set(diagnostic::shift_a, a);
   res.diagnostics.set(diagnostic::cost, lm.cost);
   res.diagnostics.set(diagnostic::cost_history, Eigen::Map<Eigen::VectorXd>(history.data(), static_cast<Eigen::Index>(history.size())));
-  res.diagnostics.warnings.push_back(detail::format(
-      "{} route: parameter standard deviations assume independent residuals; they are indicative", route));
+  if (!res.diagnostics.has(diagnostic::residual_ar_order))
+    res.diagnostics.warnings.push_back(detail::format(
+        "{} route: parameter standard deviations assume independent residuals; they are indicative", route));
   // The window must make G(s + a) stable: a > max Re(poles) of the fitted plant (GW-A2 step 1).
   const Eigen::VectorXcd poles = res.model.poles();
   double slowest = -INFINITY;
@@ -365,7 +370,12 @@ Result<TransferFunction> fit_physical_raw_records(const PhysicalModel& model, co
     nx = opt.estimate_initial_state ? model.realisation(theta0, a).model.nx() : 0;
     return nx * static_cast<int>(records.size());
   };
-  Result<TransferFunction> r = fit(model, params, a, opt, res, w.y, "raw", initial_states);
+  // Unwindowed residuals are stationary: their colour enters the covariance (each record a sequence).
+  std::vector<internal::ResidualSequence> sequences;
+  if (a == 0.0)
+    for (Eigen::Index e = 0, at = 0; e < static_cast<Eigen::Index>(records.size()); at += records[e].size(), ++e)
+      sequences.push_back({at, records[e].size(), 0});
+  Result<TransferFunction> r = fit(model, params, a, opt, res, w.y, "raw", initial_states, sequences);
   if (records.size() > 1) r.diagnostics.set(diagnostic::experiments, static_cast<double>(records.size()));
   if (nx > 0 && r.model.den().coefficients().allFinite()) {
     // Each record's initial state in the fitted transfer function's realisation (what simulate and validate start

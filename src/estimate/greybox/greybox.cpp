@@ -73,7 +73,10 @@ Result<GreyboxModel> result_of(Problem& P, const internal::LmResult& best, const
   std::vector<int> slot(P.free);
   for (int k = 0; k < E * nx0; ++k) slot.push_back(np + k);
   const double sigma2 = 2.0 * best.cost / std::max<double>(1.0, static_cast<double>(P.N) * P.ny - P.p);
-  const std::string unidentifiable = search::set_covariance(r.parameters, r.diagnostics, best, slot, sigma2);
+  std::vector<internal::ResidualSequence> sequences;  // each output of each record, in time order
+  for (const auto& d : P.rec)
+    for (int j = 0; j < P.ny; ++j) sequences.push_back({d.start + static_cast<Eigen::Index>(j) * d.n, d.n, j});
+  const std::string unidentifiable = search::set_covariance(r.parameters, r.diagnostics, best, slot, sigma2, sequences);
   for (int e = 0; e < E; ++e) r.diagnostics.set(diagnostic::x0, P.x0_of(fitted, best.x, e), e);
   if (E > 1) r.diagnostics.set(diagnostic::experiments, E);
   r.diagnostics.set(diagnostic::noise_variance, P.ny == 1 ? sigma2 : NAN);

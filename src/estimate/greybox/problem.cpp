@@ -157,6 +157,7 @@ internal::LmOptions Problem::lm_options() const {
   o.max_iterations = opt.max_iterations;
   o.ftol = opt.tolerance;
   o.xtol = opt.tolerance;
+  o.keep_jacobian = true;  // the covariance allows for coloured residuals (search::set_covariance)
   return o;
 }
 

@@ -271,7 +271,10 @@ Result<NdeModel> result_of(const Problem& P, const search::MultiStartResult& run
   std::vector<int> slot(P.free);
   for (int k = 0; k < E * nx; ++k) slot.push_back(m + k);
   const double sigma2 = 2.0 * lm.cost / std::max(1, P.N - P.p);
-  const std::string unidentifiable = search::set_covariance(r.parameters, r.diagnostics, lm, slot, sigma2);
+  std::vector<internal::ResidualSequence> sequences;  // each record, in time order
+  for (int e = 0; e < E; ++e)
+    sequences.push_back({P.starts[static_cast<size_t>(e)], P.ys[static_cast<size_t>(e)].size(), 0});
+  const std::string unidentifiable = search::set_covariance(r.parameters, r.diagnostics, lm, slot, sigma2, sequences);
   // The first record's initial state is "x0" (what simulate()'s estimated initial condition takes); further
   // records' are "x0_2", "x0_3", ...
   for (int e = 0; e < E; ++e)
@@ -308,6 +311,7 @@ Result<NdeModel> nde_oe_records(const internal::RecordRefs& records, const NdeMo
   lmo.max_iterations = opt.max_iterations;
   lmo.ftol = opt.tolerance;
   lmo.xtol = opt.tolerance;
+  lmo.keep_jacobian = true;  // the covariance allows for coloured residuals (search::set_covariance)
   const internal::LmEvaluate evaluate = [&P](const Eigen::VectorXd& x, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
     return P.evaluate(x, r, J);
   };

@@ -20,6 +20,7 @@
 #include "ctid/validate/uncertainty.hpp"
 #include "estimate/state_space/state_space_common.hpp"
 #include "estimate/search.hpp"
+#include "internal/coloured_covariance.hpp"
 #include "internal/levenberg_marquardt.hpp"
 
 namespace ctid {
@@ -178,8 +179,12 @@ Step step_of(const Point& m, const std::vector<Point>& dirs, double h, const std
 // predictor x_{k+1} = Phi x_k + Gamma_u u_k + GK e_k (predict() in simulate/lsim.hpp), and the sensitivities follow
 // dX_{k+1} = PhiK dX_k + F_k - GK (dC x_k + dD u_k), F_k the forcing by [u; e] (the recursion of the prediction
 // error's own sensitivity -(C dX_k + dC x_k + dD u_k)).
+// For the coloured-noise covariance (internal/coloured_covariance.hpp), `acov` collects each output's weighted residuals
+// and `grams` each output's Jacobian rows (needs JtJ), every record one sequence.
 bool evaluate(const Point& m0, const std::vector<Point>* dirs0, const std::vector<ScaledRecord>& recs, const Eigen::VectorXd& sw,
-              double& cost, Eigen::MatrixXd* JtJ, Eigen::VectorXd* Jtr, std::vector<Eigen::MatrixXd>* yhat = nullptr) {
+              double& cost, Eigen::MatrixXd* JtJ, Eigen::VectorXd* Jtr, std::vector<Eigen::MatrixXd>* yhat = nullptr,
+              std::vector<internal::ResidualAutocovariance>* acov = nullptr,
+              std::vector<internal::ColouredGram>* grams = nullptr) {
   const Eigen::Index nx = m0.A.rows(), nu = m0.B.cols(), ny = m0.C.rows(), nk = m0.K.size() ? ny : 0;
   const bool sens = dirs0 && JtJ && Jtr;
   const Eigen::Index P = sens ? static_cast<Eigen::Index>(dirs0->size()) : 0;
@@ -230,6 +235,10 @@ bool evaluate(const Point& m0, const std::vector<Point>* dirs0, const std::vecto
     auto h_at = [&](Eigen::Index k) { return rec.uniform ? rec.h : rec.t(k + 1) - rec.t(k); };
     x = m.x0[e];
     for (Eigen::Index d = 0; d < P; ++d) Delta.col(d) = (*dirs)[static_cast<size_t>(d)].x0[e];
+    if (acov)
+      for (auto& a : *acov) a.start_sequence();
+    if (grams)
+      for (auto& g : *grams) g.start_sequence();
     if (yhat) yhat->emplace_back(N, ny);
     for (Eigen::Index k0 = 0; k0 < N; k0 += kBatch) {
       const Eigen::Index n = std::min<Eigen::Index>(kBatch, N - k0);
@@ -244,6 +253,8 @@ bool evaluate(const Point& m0, const std::vector<Point>* dirs0, const std::vecto
         R.col(i) = rec.y.row(k).transpose() - yk;
         if (nk > 0) Eps.col(i) = R.col(i);
         R.col(i).array() *= sw.array();
+        if (acov)
+          for (Eigen::Index j = 0; j < ny; ++j) (*acov)[static_cast<size_t>(j)].add(R(j, i));
         if (k + 1 == N) {
           dU.col(i).setZero();
           break;
@@ -294,6 +305,9 @@ bool evaluate(const Point& m0, const std::vector<Point>* dirs0, const std::vecto
         Jb.middleRows(i * ny, ny).noalias() =
             -(sw.asDiagonal() * (CD.middleCols(i * P, P) + Eigen::Map<const Eigen::MatrixXd>(G.col(i).data(), ny, P)));
       const Eigen::Index rows = n * ny;
+      if (grams)
+        for (Eigen::Index i = 0; i < n; ++i)
+          for (Eigen::Index j = 0; j < ny; ++j) (*grams)[static_cast<size_t>(j)].add(Jb.row(i * ny + j));
       JtJ->selfadjointView<Eigen::Lower>().rankUpdate(Jb.topRows(rows).transpose());
       Jtr->noalias() += Jb.topRows(rows).transpose() * Eigen::Map<const Eigen::VectorXd>(R.data(), rows);
     }
@@ -520,13 +534,38 @@ void deliver(Result<StateSpace>& res, std::span<const IdData> ds, Point fin, boo
   Eigen::VectorXd Jtr;
   double cost = 0;
   std::vector<Eigen::MatrixXd> yhat;
-  const bool ok = var.allFinite() &&
-                  evaluate(fin, &cdirs, raw, var.cwiseMax(1e-300).cwiseInverse().cwiseSqrt(), cost, &JtJ, &Jtr, &yhat);
+  const Eigen::VectorXd sw = var.cwiseMax(1e-300).cwiseInverse().cwiseSqrt();
+  std::vector<internal::ResidualAutocovariance> acov(static_cast<size_t>(ny),
+                                                     internal::ResidualAutocovariance(internal::residual_ar_max_lag(total)));
+  const bool ok = var.allFinite() && evaluate(fin, &cdirs, raw, sw, cost, &JtJ, &Jtr, &yhat, &acov);
   Eigen::MatrixXd cov;
-  if (ok) {
-    cov = inverse_normal(JtJ, np);
-  }
+  if (ok) cov = inverse_normal(JtJ, np);
   res.parameters.set_covariance(cov, slots);
+  if (ok && cov.size() && !noise_variance) {
+    // The residuals' colour (each output's AR model, the degrees of freedom shared among the outputs): one more pass
+    // with the Jacobian rows filtered by it; the white-noise figure stays a diagnostic. (Given noise variances, as
+    // ssest_crlb's, declare the noise white.)
+    std::vector<internal::ColouredGram> grams;
+    int order = 0;
+    for (internal::ResidualAutocovariance& a : acov) {
+      const internal::ResidualAr ar = a.fit(static_cast<int>(std::lround(double(cdirs.size()) / double(ny))));
+      order = std::max(order, ar.order());
+      grams.emplace_back(ar, static_cast<int>(cdirs.size()));
+    }
+    Eigen::MatrixXd JtJ2;
+    Eigen::VectorXd Jtr2;
+    double cost2 = 0;
+    if (evaluate(fin, &cdirs, raw, sw, cost2, &JtJ2, &Jtr2, nullptr, nullptr, &grams)) {
+      Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(JtJ.rows(), JtJ.cols());
+      for (const internal::ColouredGram& g : grams) Q += g.gram();
+      const Eigen::MatrixXd S = internal::sandwich(JtJ, Q);
+      if (S.size()) {
+        res.diagnostics.set(diagnostic::white_noise_std, res.parameters.std);
+        res.diagnostics.set(diagnostic::residual_ar_order, order);
+        res.parameters.set_covariance(S.topLeftCorner(np, np), slots);
+      }
+    }
+  }
   if (user_coordinates && similar > 0 && res.summary.succeeded()) {
     res.summary.termination = Termination::Unidentifiable;
     res.summary.message = detail::format(

@@ -17,6 +17,7 @@
 #include "ctid/validate/metrics.hpp"
 #include "estimate/svf/svf_common.hpp"
 #include "estimate/transfer_function/tf_common.hpp"
+#include "internal/coloured_covariance.hpp"
 #include "internal/least_squares.hpp"
 #include "estimate/search.hpp"
 #include "internal/levenberg_marquardt.hpp"
@@ -101,10 +102,13 @@ bool stacked_residuals(const TransferFunction& g, const Records& ds, double tran
 // of u (its derivatives give the b-sensitivities and, combined by b, the simulated output) and B/A^2 of u (the
 // a-sensitivities) advance together — the recursions of output_sensitivities_into and lsim, so the Jacobian is the
 // same, but a pass reads u and y and writes nothing that grows with the record. theta = [a1..an, b0..b(nb-1)];
-// `free` are the columns of the Jacobian (indices into theta); A null: the cost alone.
+// `free` are the columns of the Jacobian (indices into theta); A null: the cost alone. For the coloured-noise
+// covariance, `acov` collects the residuals' autocovariance and `coloured` the filtered Jacobian rows (this record
+// one sequence of each).
 template <int n>
 void oe_stream_n(const Eigen::VectorXd& theta, int nb, const IdData& d, Eigen::Index first, const std::vector<int>& free,
-                 double& cost, Eigen::MatrixXd* A, Eigen::VectorXd* g) {
+                 double& cost, Eigen::MatrixXd* A, Eigen::VectorXd* g, internal::ResidualAutocovariance* acov = nullptr,
+                 internal::ColouredGram* coloured = nullptr) {
   Eigen::VectorXd den(n + 1);
   den(0) = 1.0;
   den.tail(n) = theta.head(n);
@@ -114,7 +118,8 @@ void oe_stream_n(const Eigen::VectorXd& theta, int nb, const IdData& d, Eigen::I
   const Intersample is = d.intersample(0);
   signal_detail::Bank<n> ub(derivative_recursion(TransferFunction(Polynomial{1.0}, F), nb - 1, h, is));
   std::optional<signal_detail::Bank<2 * n>> xb;  // none when B = 0 (the a-sensitivities vanish)
-  if (A && b.cwiseAbs().maxCoeff() > 0)
+  const bool rows = A || coloured;
+  if (rows && b.cwiseAbs().maxCoeff() > 0)
     xb.emplace(derivative_recursion(TransferFunction(Polynomial(b), F * F), n - 1, h, is));
   // Where each free column's sensitivity is read in the banks' rows (those arrays stay in place), with its sign.
   const int p = static_cast<int>(free.size());
@@ -131,6 +136,8 @@ void oe_stream_n(const Eigen::VectorXd& theta, int nb, const IdData& d, Eigen::I
   const auto y = d.y().col(0);
   const Eigen::Index N = d.size();
   double c = 0.0;
+  if (acov) acov->start_sequence();
+  if (coloured) coloured->start_sequence();
   for (Eigen::Index k = 0; k < N; ++k) {
     const double* ur = ub.at(u(k));
     if (xb) xb->at(u(k));
@@ -139,9 +146,12 @@ void oe_stream_n(const Eigen::VectorXd& theta, int nb, const IdData& d, Eigen::I
       for (int j = 0; j < nb; ++j) yhat += b(j) * ur[nb - 1 - j];
       const double r = y(k) - yhat;
       c += r * r;
-      if (A) {
+      if (acov) acov->add(r);
+      if (rows)
         for (int jj = 0; jj < p; ++jj)
           psi[static_cast<std::size_t>(jj)] = sign[static_cast<std::size_t>(jj)] * *src[static_cast<std::size_t>(jj)];
+      if (coloured) coloured->add(psi.data());
+      if (A) {
         for (int jj = 0; jj < p; ++jj) {
           const double s = psi[static_cast<std::size_t>(jj)];
           (*g)(jj) -= s * r;
@@ -190,6 +200,35 @@ internal::LmResult streamed_search(const Records& ds, const TfOrders& o, double 
     return std::isfinite(cost) && (!A || (A->allFinite() && g->allFinite()));
   };
   return internal::levenberg_marquardt(internal::LmNormalEvaluate(normal), v0, lo, hi, lmo);
+}
+
+// The coloured-noise covariance at a streamed search's estimate x (internal/coloured_covariance.hpp), by two more
+// streamed passes: the residuals' autocovariance, then the Jacobian rows filtered by the residuals' AR model.
+internal::ColouredCovariance streamed_coloured(const Records& ds, const TfOrders& o, double transient_time,
+                                               const Eigen::VectorXd& full, const std::vector<int>& free,
+                                               const internal::LmResult& lm) {
+  internal::ColouredCovariance out;
+  if (!std::isfinite(lm.cost)) return out;
+  const int p = static_cast<int>(free.size()), nt = o.nf + o.nb;
+  Eigen::VectorXd f = full;
+  for (int j = 0; j < p; ++j) f(free[j]) = lm.x(j);
+  const Eigen::VectorXd theta = f.head(nt);
+  long long n = 0;
+  for (const IdData& d : ds) n += d.size() - first_after(d, transient_time);
+  internal::ResidualAutocovariance acov(internal::residual_ar_max_lag(n));
+  double cost = 0.0;
+  for (const IdData& d : ds)
+    signal_detail::with_order(o.nf, [&]<int m>() {
+      oe_stream_n<m>(theta, o.nb, d, first_after(d, transient_time), free, cost, nullptr, nullptr, &acov);
+    });
+  out.noise.push_back(acov.fit(p));
+  internal::ColouredGram gram(out.noise.back(), p);
+  for (const IdData& d : ds)
+    signal_detail::with_order(o.nf, [&]<int m>() {
+      oe_stream_n<m>(theta, o.nb, d, first_after(d, transient_time), free, cost, nullptr, nullptr, nullptr, &gram);
+    });
+  out.covariance = internal::sandwich(lm.jtj, gram.gram());
+  return out;
 }
 
 Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const TransferFunction& start, const OeOptions& opt,
@@ -292,9 +331,13 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
   v_lo.head(p) = lo;
   v_hi.head(p) = hi;
   internal::LmResult lm;
-  if (streamable(ds, o, opt.estimate_delay || fixed_delay != 0.0, ni)) {
+  internal::ColouredCovariance streamed;  // the streamed search's coloured-noise covariance
+  const bool streams = streamable(ds, o, opt.estimate_delay || fixed_delay != 0.0, ni);
+  if (streams) {
     lm = streamed_search(ds, o, opt.transient_time, full, free, v0, v_lo, v_hi, lmo);
+    streamed = streamed_coloured(ds, o, opt.transient_time, full, free, lm);
   } else {
+    lmo.keep_jacobian = true;
     lm = internal::levenberg_marquardt(internal::LmEvaluate(evaluate), v0, v_lo, v_hi, lmo);
   }
   Eigen::VectorXd free_response;  // the estimated free responses, stacked (empty: from rest)
@@ -323,7 +366,16 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
   if (free_response.size()) sim_all += free_response;
   r.fit = fit_report_or_inf(y_all, sim_all, p + E * ni);
   const double sigma2 = 2.0 * lm.cost / double(std::max<Eigen::Index>(1, y_all.size() - p - E * ni));
-  const std::string unidentifiable = search::set_covariance(r.parameters, r.diagnostics, lm, free, sigma2);
+  std::vector<internal::ResidualSequence> sequences;  // each record after its transient, in time order
+  Eigen::Index row = 0;
+  for (const IdData& d : ds) {
+    const Eigen::Index m = d.size() - first_after(d, opt.transient_time);
+    sequences.push_back({row, m, 0});
+    row += m;
+  }
+  const std::string unidentifiable =
+      streams ? search::set_covariance(r.parameters, r.diagnostics, lm, free, sigma2, streamed)
+              : search::set_covariance(r.parameters, r.diagnostics, lm, free, sigma2, sequences);
   r.diagnostics.set(diagnostic::noise_variance, sigma2);
   r.diagnostics.set(diagnostic::delay, r.model.io_delay());
   r.diagnostics.set(diagnostic::evaluations, lm.evaluations);

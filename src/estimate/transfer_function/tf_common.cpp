@@ -201,6 +201,8 @@ void TfNormalisation::restore_common(ParameterSet& p, const Eigen::VectorXd& fac
   if (p.covariance.rows() == p.size() && p.covariance.cols() == p.size())
     p.covariance = f.asDiagonal() * p.covariance * f.asDiagonal();
   if (p.std.size() == p.size()) p.std = p.std.cwiseProduct(f.cwiseAbs());
+  if (dg.has(diagnostic::white_noise_std) && dg.get(diagnostic::white_noise_std).size() == p.size())
+    dg.set(diagnostic::white_noise_std, dg.get(diagnostic::white_noise_std).cwiseProduct(f.cwiseAbs()));
   const double v = sy * sy, lv = std::log(v) * fit.n_samples;
   fit.mse *= v;
   fit.fpe *= v;

@@ -8,7 +8,9 @@
 // With several outputs w_j = 1 / (RMS deviation of output j from its mean over all records), else w = 1.
 // Multi-start (`starts` > 1): the model's values, then starts - 1 points drawn (seeded) uniformly within finite
 // bounds, or log-uniformly within a decade of the value where a bound is open; the lowest cost wins.
-// Covariance sigma^2 (J^T J)^{-1} with sigma^2 = V / (N ny - p); a combination of parameters the data cannot
+// Covariance sigma^2 (J^T J)^{-1} with sigma^2 = V / (N ny - p) for white residuals; for coloured ones (single
+// shooting) the sandwich with each output's AR model of the residuals (Ljung 1999 §9.3; diagnostics
+// residual_ar_order and white_noise_std, the white figure); a combination of parameters the data cannot
 // separate makes the result not usable, naming the parameters (ParameterSet rules, core/types.hpp).
 // Unstable and integrating plants: multiple shooting (Bock & Plitt 1984; Bock 1983) — segments with free initial
 // states, continuity by penalty residuals raised until the defects are at rounding level, the block-sparse Jacobian

@@ -5,7 +5,8 @@
 // by Levenberg-Marquardt with exact forward sensitivities integrated alongside the state (Ljung 1999,
 // ch. 7: the prediction-error estimate for white output noise, consistent where equation-error estimates
 // such as the NARX/KIA chain are biased by noise). It plays the role of MATLAB's `pem`/`nlgreyest` refinement after an initial
-// estimate. Covariance sigma^2 (J^T J)^{-1} of the free parameters.
+// estimate. Covariance of the free parameters: sigma^2 (J^T J)^{-1} for white residuals, the sandwich with the
+// residuals' AR model for coloured ones (as oe.hpp; diagnostics residual_ar_order, white_noise_std).
 #pragma once
 
 #include <map>

@@ -6,7 +6,8 @@
 // w_j = 1/sigma_j^2 the inverse noise variance of output j, re-estimated from the residuals of the converged model
 // and the search repeated once when one moved by more than 10 % — the Gaussian maximum-likelihood estimate for
 // independent white output noise of unknown variances (Ljung 1999, "System Identification", §7.4 and §9.4:
-// asymptotic covariance (J^T W J)^-1). With estimate_k, yhat is instead the one-step prediction of the innovation
+// asymptotic covariance (J^T W J)^-1 for white noise; the sandwich with each output's AR model of the residuals when
+// they are coloured, §9.3, diagnostics residual_ar_order and white_noise_std). With estimate_k, yhat is instead the one-step prediction of the innovation
 // form dx/dt = A x + B u + K e, y = C x + D u + e (Ljung 1999, §4.3 eq. 4.84; predict() in simulate/lsim.hpp).
 //
 // Parametrisation: every entry of (A, B, C, D, x0_e) (the "full parametrisation" of McKelvey, Helmersson &

@@ -6,7 +6,9 @@
 // (dy/da_i = -s^{n-i} B/A^2 u, dy/db_j = s^{nb-1-j}/A u, dy/dT = -s B/A u; see
 // signal/prefilter.hpp), simple bounds and fixed parameters. Ljung (1999), System
 // Identification, ch. 7 and 10 (the continuous-time OE form of MATLAB's tfest refinement).
-// Covariance sigma^2 (S^T S)^{-1} with S the sensitivity matrix of the free parameters. With estimate_initial_state
+// Covariance: the prediction-error sandwich S^+ Q S^+T that allows for coloured output noise (Ljung 1999 §9.3; Q from
+// an AR model of the residuals, diagnostics residual_ar_order), sigma^2 (S^T S)^{-1} when they are white (S the
+// sensitivity matrix of the free parameters; that figure stays in diagnostics white_noise_std). With estimate_initial_state
 // each record's free response E_e(s)/A(s) is estimated with the model (the initial-condition polynomial of
 // Ljung 1999 §4.3 / the "estimate initial condition" of MATLAB's tfest), its coefficients eliminated from the
 // covariance by the Schur complement.
