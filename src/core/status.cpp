@@ -10,6 +10,7 @@ constexpr std::pair<Termination, const char*> kNames[] = {
     {Termination::MaxIterations, "max_iterations"}, {Termination::RankDeficient, "rank_deficient"},
     {Termination::Unstable, "unstable"},           {Termination::NumericalFailure, "numerical_failure"},
     {Termination::Interrupted, "interrupted"},     {Termination::Unidentifiable, "unidentifiable"},
+    {Termination::AtBound, "at_bound"},
 };
 }  // namespace
 

@@ -54,20 +54,45 @@ using Search = std::function<internal::LmResult(const Eigen::VectorXd& start)>;
 MultiStartResult multi_start(const Search& search, const Eigen::VectorXd& v0, const Eigen::VectorXd& lower,
                              const Eigen::VectorXd& upper, const MultiStart& options);
 
+/// Bounds of the first entries of a search vector that the user set (a model's declared bounds, bounds.NAME); a
+/// parameter the search leaves on one of them is reported (CovarianceVerdict::at_bound). Empty: none.
+struct UserBounds {
+  Eigen::VectorXd lower, upper;
+};
+
+/// A parameter left on a bound the data push it beyond, and the text that names such parameters ("fc is at its upper
+/// bound 0.1, and the data would move it further: ... (fixed.fc=0.1)").
+struct HeldAtBound {
+  std::string name;
+  bool lower = true;
+  double bound = 0.0;
+};
+std::string at_bound_text(const std::vector<HeldAtBound>& held);
+
+/// What set_covariance found besides the covariance.
+struct CovarianceVerdict {
+  std::string unidentifiable;  ///< internal::unidentifiable's message when a direction is not determined, else ""
+  /// When parameters end on a user bound with the cost's gradient pointing beyond it (the data would move them
+  /// further): "fv is at its lower bound 0, and the data would move it further: ..." naming each, else "".
+  std::string at_bound;
+};
+
 /// The covariance of a search's estimate set on `parameters` at `slots` (the first slots.size() entries of the
 /// search vector, in order) and the scaled condition number of J on `diagnostics`. With `sequences` (the layout of the
 /// residual vector) and a search that kept its Jacobian (LmOptions::keep_jacobian), the covariance allows for coloured
 /// residuals (internal/coloured_covariance.hpp; entries of the search vector beyond the slots, e.g. initial
 /// conditions, are estimated alongside and marginalised), with diagnostics "residual_ar_order" and "white_noise_std"
 /// (the white-noise figure sigma2 (J^T J)^{-1}); otherwise it is sigma2 (J^T J)^{-1}, J^T J = lm.jtj over the slots.
-/// Returns "" when the data determine every direction, else internal::unidentifiable's message (the covariance is then
-/// unknown); a search that ended without a finite cost has neither (covariance unknown, condition NaN, message "").
-std::string set_covariance(ParameterSet& parameters, Diagnostics& diagnostics, const internal::LmResult& lm,
-                           const std::vector<int>& slots, double sigma2,
-                           const std::vector<internal::ResidualSequence>& sequences = {});
-/// The same with the coloured-noise covariance already formed over the search vector (a streamed search's, which
-/// never holds J); an empty one gives sigma2 (J^T J)^{-1}.
-std::string set_covariance(ParameterSet& parameters, Diagnostics& diagnostics, const internal::LmResult& lm,
-                           const std::vector<int>& slots, double sigma2, const internal::ColouredCovariance& coloured);
+/// A parameter at a user bound has no standard deviation (NaN) and the others' are those with it held there. The
+/// covariance is unknown when a direction is not determined; a search that ended without a finite cost has neither
+/// (covariance unknown, condition NaN, verdict empty). Pass the verdict to internal::set_termination.
+CovarianceVerdict set_covariance(ParameterSet& parameters, Diagnostics& diagnostics, const internal::LmResult& lm,
+                                 const std::vector<int>& slots, double sigma2, const UserBounds& bounds = {},
+                                 const std::vector<internal::ResidualSequence>& sequences = {});
+/// The same with the score covariance already formed over the search vector (a streamed search's, which never holds
+/// J); an empty one gives sigma2 (J^T J)^{-1}.
+CovarianceVerdict set_covariance(ParameterSet& parameters, Diagnostics& diagnostics, const internal::LmResult& lm,
+                                 const std::vector<int>& slots, double sigma2, const UserBounds& bounds,
+                                 const internal::ColouredCovariance& coloured);
 
 }  // namespace ctid::search

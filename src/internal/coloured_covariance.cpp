@@ -139,7 +139,7 @@ ColouredCovariance coloured_covariance(const Eigen::MatrixXd& J, const Eigen::Ve
     }
     Q += gram.gram();
   }
-  out.covariance = sandwich(J.transpose() * J, Q);
+  if (Q.allFinite()) out.score = std::move(Q);
   return out;
 }
 

@@ -1,6 +1,6 @@
-// ctid internal — the covariance of an output-error estimate when the residuals are coloured (Ljung 1999,
-// §9.3, eqs 9.42-9.47 and Appendix 9B: the asymptotic covariance of a prediction-error estimate whose model does not
-// describe the noise, Cov = H^-1 Q H^-1 with H = J^T J and Q = Cov(J^T v), v the output noise).
+// ctid internal — the covariance of an output-error estimate when the residuals are coloured (Ljung 1999, §9.3: the
+// asymptotic covariance of a prediction-error estimate whose model does not describe the noise, Cov = H^-1 Q H^-1
+// with H = J^T J and Q = Cov(J^T v), v the output noise).
 //
 // Q needs the noise's autocovariance over all lags. It is estimated parametrically: an AR model A(q) v = w of each
 // output's residuals (Levinson-Durbin on their autocovariance pooled over the records, the order by AIC), so that
@@ -74,9 +74,11 @@ struct ResidualSequence {
   int group = 0;
 };
 
-/// The coloured-noise covariance of a search's estimate and the AR models behind it.
+/// The score covariance Q = Cov(J^T v) of a search's estimate (the sandwich's middle, over J's columns) and the AR
+/// models behind it; the covariance is sandwich(J^T J, score) (over a subset of the columns: the same rows and
+/// columns of both).
 struct ColouredCovariance {
-  Eigen::MatrixXd covariance;    ///< over J's columns; empty when it cannot be formed
+  Eigen::MatrixXd score;         ///< empty when it cannot be formed
   std::vector<ResidualAr> noise; ///< one per group
   int largest_order() const;
 };
@@ -84,8 +86,8 @@ struct ColouredCovariance {
 /// The most AR lags fitted: 40, at most a tenth of the shortest group's residuals.
 int residual_ar_max_lag(long long shortest_group);
 
-/// From the residuals r and the Jacobian J (rows as r) at the estimate, `parameters` the number of estimated
-/// quantities (degrees of freedom of the innovation variances).
+/// The score covariance from the residuals r and the Jacobian J (rows as r) at the estimate, `parameters` the number
+/// of estimated quantities (degrees of freedom of the innovation variances).
 ColouredCovariance coloured_covariance(const Eigen::MatrixXd& J, const Eigen::VectorXd& r,
                                        const std::vector<ResidualSequence>& sequences, int parameters);
 

@@ -10,7 +10,8 @@
 
 namespace ctid::internal {
 
-void set_termination(Summary& s, const LmResult& lm, const std::string& failure, const std::string& unidentifiable) {
+void set_termination(Summary& s, const LmResult& lm, const std::string& failure, const std::string& unidentifiable,
+                     const std::string& at_bound) {
   s.iterations = lm.iterations;
   if (!std::isfinite(lm.cost)) {
     s.termination = Termination::NumericalFailure;
@@ -25,6 +26,9 @@ void set_termination(Summary& s, const LmResult& lm, const std::string& failure,
   if (!unidentifiable.empty() && (s.succeeded() || s.termination == Termination::MaxIterations)) {
     s.termination = Termination::Unidentifiable;
     s.message = unidentifiable;
+  } else if (!at_bound.empty() && (s.succeeded() || s.termination == Termination::MaxIterations)) {
+    s.termination = Termination::AtBound;
+    s.message = at_bound;
   }
 }
 
@@ -130,6 +134,7 @@ LmResult lm(const Evaluate& evaluate, Eigen::VectorXd x, const Eigen::VectorXd& 
   res.cost = cost;
   res.lambda = lambda;
   res.jtj = Eigen::MatrixXd(A);
+  res.gradient = g;
   return res;
 }
 

@@ -33,6 +33,7 @@ struct LmResult {
   Eigen::VectorXd x;
   double cost = 0.0;                // 1/2 ||r||^2 at x
   Eigen::MatrixXd jtj;              // J^T J at x
+  Eigen::VectorXd gradient;         // J^T r at x (the cost's gradient)
   Eigen::VectorXd residual;         // r at x and ..
   Eigen::MatrixXd jacobian;         // .. J at x, when LmOptions::keep_jacobian (else empty)
   int iterations = 0;
@@ -55,9 +56,10 @@ using LmSparseEvaluate =
 /// How the search ended, with its iteration count: NumericalFailure with `failure` (or the search's own
 /// message when `failure` is empty) when it could not evaluate its start, else Interrupted, Converged or
 /// MaxIterations (with the message); a search that converged or ran out of iterations becomes Unidentifiable with
-/// `unidentifiable` when that is not empty (the message of internal::unidentifiable, least_squares.hpp).
+/// `unidentifiable` when that is not empty (the message of internal::unidentifiable, least_squares.hpp), else
+/// AtBound with `at_bound` when that is not empty (search::CovarianceVerdict).
 void set_termination(Summary& summary, const LmResult& lm, const std::string& failure = "",
-                     const std::string& unidentifiable = "");
+                     const std::string& unidentifiable = "", const std::string& at_bound = "");
 
 
 /// The same from the normal equations: evaluate(x, cost, JtJ, Jtr) sets cost = 1/2 ||r||^2 and, when the pointers are

@@ -203,13 +203,22 @@ TEST(OutputError, FixedParametersAndBounds) {
   const IdData d = rao_data(20.0, 3);
   OeOptions o;
   o.fixed = {{"a4", 1600.0}};
-  o.bounds = {{"a1", {0.0, 4.9}}};
+  o.bounds = {{"a1", {0.0, 6.0}}};
   const auto r = tfest(d, {2, 4, 0}, o);
   ASSERT_TRUE(r.usable()) << r.why_not_usable();
   EXPECT_EQ(r.parameters.value("a4"), 1600.0);
   EXPECT_TRUE(r.parameters.fixed[3]);
   EXPECT_EQ(r.parameters.std(3), 0.0);
-  EXPECT_LE(r.parameters.value("a1"), 4.9);
+  EXPECT_NEAR(r.parameters.value("a1"), 5.0, 0.1);
+  // A bound below the truth (a1 = 5) holds a1 there: named in the user's units, not usable, no standard deviation.
+  o.bounds = {{"a1", {0.0, 4.9}}};
+  const auto held = tfest(d, {2, 4, 0}, o);
+  EXPECT_EQ(held.summary.termination, Termination::AtBound);
+  EXPECT_EQ(held.parameters.value("a1"), 4.9);
+  EXPECT_TRUE(std::isnan(held.parameters.std(0)));
+  EXPECT_NE(held.why_not_usable().find("a1 is at its upper bound 4.9, and the data would move it further"),
+            std::string::npos)
+      << held.why_not_usable();
   EXPECT_THROW(tfest(d, {2, 4, 0}, OeOptions{.fixed = {{"q9", 1.0}}}), InvalidOptions);
 }
 

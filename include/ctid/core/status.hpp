@@ -16,6 +16,7 @@ enum class Termination {
   NumericalFailure,   ///< NaN/Inf appeared during the computation
   Interrupted,        ///< the progress callback asked to stop
   Unidentifiable,     ///< the estimate is not determined by the data (e.g. a pole-zero pair that cancels)
+  AtBound,            ///< a parameter ended on a bound the data push it beyond: the bound's value, not the data's
 };
 
 /// Lower-case identifier used in JSON files and the CLI ("converged", "max_iterations", ...).

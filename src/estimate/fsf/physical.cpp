@@ -145,7 +145,8 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
   res.parameters.values = th;
   res.parameters.fixed = fixed;
   const double sigma2 = 2.0 * lm.cost / std::max(1, n_data - p - nuisance);
-  const std::string unidentifiable = search::set_covariance(res.parameters, res.diagnostics, lm, free, sigma2, sequences);
+  const search::CovarianceVerdict verdict =
+      search::set_covariance(res.parameters, res.diagnostics, lm, free, sigma2, {lo, hi}, sequences);
   {
     Eigen::VectorXd r;
     if (std::isfinite(lm.cost) && evaluate(lm.x, r, nullptr)) res.fit = fit_report_or_inf(target, target + r, p + nuisance);
@@ -171,7 +172,8 @@ Result<TransferFunction> fit(const PhysicalModel& model, const std::vector<Physi
             ? "the windowed simulation e^(-a t) y(t) the fit compares grows over the record, so the record's end "
               "dominates the fit"
             : "the compressed response is not meaningful"));
-  internal::set_termination(res.summary, lm, "the model cannot be evaluated at the initial parameters", unidentifiable);
+  internal::set_termination(res.summary, lm, "the model cannot be evaluated at the initial parameters",
+                            verdict.unidentifiable, verdict.at_bound);
   res.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return res;
 }

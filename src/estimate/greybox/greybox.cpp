@@ -76,7 +76,8 @@ Result<GreyboxModel> result_of(Problem& P, const internal::LmResult& best, const
   std::vector<internal::ResidualSequence> sequences;  // each output of each record, in time order
   for (const auto& d : P.rec)
     for (int j = 0; j < P.ny; ++j) sequences.push_back({d.start + static_cast<Eigen::Index>(j) * d.n, d.n, j});
-  const std::string unidentifiable = search::set_covariance(r.parameters, r.diagnostics, best, slot, sigma2, sequences);
+  const search::CovarianceVerdict verdict =
+      search::set_covariance(r.parameters, r.diagnostics, best, slot, sigma2, {P.lo, P.hi}, sequences);
   for (int e = 0; e < E; ++e) r.diagnostics.set(diagnostic::x0, P.x0_of(fitted, best.x, e), e);
   if (E > 1) r.diagnostics.set(diagnostic::experiments, E);
   r.diagnostics.set(diagnostic::noise_variance, P.ny == 1 ? sigma2 : NAN);
@@ -87,7 +88,7 @@ Result<GreyboxModel> result_of(Problem& P, const internal::LmResult& best, const
   }
   const std::string failure = "the model cannot be simulated on these data from its start" +
                               std::string(P.opt.starts > 1 ? "s" : "") + (P.escape.empty() ? "" : ": " + P.escape);
-  internal::set_termination(r.summary, best, failure, unidentifiable);
+  internal::set_termination(r.summary, best, failure, verdict.unidentifiable, verdict.at_bound);
   // The fit: all outputs of all records stacked, each weighted (one output: the output itself).
   Eigen::VectorXd rr;
   Eigen::VectorXd yfit = Eigen::VectorXd::Constant(P.y.size(), NAN);

@@ -274,7 +274,8 @@ Result<NdeModel> result_of(const Problem& P, const search::MultiStartResult& run
   std::vector<internal::ResidualSequence> sequences;  // each record, in time order
   for (int e = 0; e < E; ++e)
     sequences.push_back({P.starts[static_cast<size_t>(e)], P.ys[static_cast<size_t>(e)].size(), 0});
-  const std::string unidentifiable = search::set_covariance(r.parameters, r.diagnostics, lm, slot, sigma2, sequences);
+  const search::CovarianceVerdict verdict =
+      search::set_covariance(r.parameters, r.diagnostics, lm, slot, sigma2, {P.lo, P.hi}, sequences);
   // The first record's initial state is "x0" (what simulate()'s estimated initial condition takes); further
   // records' are "x0_2", "x0_3", ...
   for (int e = 0; e < E; ++e)
@@ -288,7 +289,7 @@ Result<NdeModel> result_of(const Problem& P, const search::MultiStartResult& run
         "the starting model escapes on these data; the search started with its nonlinear coefficients times {}",
         start_scale));
   const std::string failure = "the model cannot be simulated on these data, even with its nonlinear terms removed";
-  internal::set_termination(r.summary, lm, failure, unidentifiable);
+  internal::set_termination(r.summary, lm, failure, verdict.unidentifiable, verdict.at_bound);
   Eigen::VectorXd yfit;
   if (!std::isfinite(lm.cost) || !P.simulate(lm.x, yfit)) {
     r.summary.termination = Termination::NumericalFailure;

@@ -227,7 +227,7 @@ internal::ColouredCovariance streamed_coloured(const Records& ds, const TfOrders
     signal_detail::with_order(o.nf, [&]<int m>() {
       oe_stream_n<m>(theta, o.nb, d, first_after(d, transient_time), free, cost, nullptr, nullptr, nullptr, &gram);
     });
-  out.covariance = internal::sandwich(lm.jtj, gram.gram());
+  out.score = gram.gram();
   return out;
 }
 
@@ -373,9 +373,14 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
     sequences.push_back({row, m, 0});
     row += m;
   }
-  const std::string unidentifiable =
-      streams ? search::set_covariance(r.parameters, r.diagnostics, lm, free, sigma2, streamed)
-              : search::set_covariance(r.parameters, r.diagnostics, lm, free, sigma2, sequences);
+  search::UserBounds user{Eigen::VectorXd(p), Eigen::VectorXd(p)};  // bounds.NAME (not the delay's search range)
+  for (int j = 0; j < p; ++j) {
+    user.lower(j) = c.lower(free[j]);
+    user.upper(j) = c.upper(free[j]);
+  }
+  const search::CovarianceVerdict verdict =
+      streams ? search::set_covariance(r.parameters, r.diagnostics, lm, free, sigma2, user, streamed)
+              : search::set_covariance(r.parameters, r.diagnostics, lm, free, sigma2, user, sequences);
   r.diagnostics.set(diagnostic::noise_variance, sigma2);
   r.diagnostics.set(diagnostic::delay, r.model.io_delay());
   r.diagnostics.set(diagnostic::evaluations, lm.evaluations);
@@ -385,7 +390,7 @@ Result<TransferFunction> refine(const Records& ds, const TfOrders& o, const Tran
       r.summary, lm,
       "the simulation of the starting model overflows on this record (its poles are far in the right half plane); "
       "fix or bound the coefficients (--set fixed.NAME=VALUE, bounds.NAME=LOWER,UPPER)",
-      unidentifiable);
+      verdict.unidentifiable, verdict.at_bound);
   r.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
@@ -471,6 +476,20 @@ Result<TransferFunction> in_normalised_units(const internal::RecordRefs& data, c
   for (const IdData& d : data) normalised_records.push_back(n.data(d));
   Result<TransferFunction> r = fit(normalised_records, normalised(options, n, orders), t0);
   n.restore(r, orders);
+  // A parameter left on a bound: named with the bound as the user gave it (the search ran in normalised units).
+  if (r.summary.termination == Termination::AtBound) {
+    std::vector<search::HeldAtBound> held;
+    for (const auto& [name, b] : options.bounds) {
+      const int i = r.parameters.index(name);
+      if (!std::isnan(r.parameters.std(i))) continue;
+      const double v = r.parameters.values(i);
+      const bool lower = std::abs(v - b.first) <= 1e-9 * std::max(1.0, std::abs(b.first));
+      if (!lower && !(std::abs(v - b.second) <= 1e-9 * std::max(1.0, std::abs(b.second)))) continue;
+      held.push_back({name, lower, lower ? b.first : b.second});
+      r.parameters.values(i) = held.back().bound;
+    }
+    if (!held.empty()) r.summary.message = search::at_bound_text(held);
+  }
   // The held parameters exactly as given (the round trip through the normalised units can change their last bit).
   if (!options.fixed.empty() && r.parameters.values.size() == static_cast<Eigen::Index>(r.parameters.names.size())) {
     for (const auto& [name, v] : options.fixed) r.parameters.values(r.parameters.index(name)) = v;
