@@ -57,9 +57,11 @@ void on_batch_sigint(int) { g_batch_stop = 1; }
 
 int run_batch(const BatchJob& job) {
   const std::vector<std::string> files = expand(job.patterns);
+  std::vector<std::string> inputs = files;
+  inputs.insert(inputs.end(), job.inputs.begin(), job.inputs.end());
+  check_output_files({job.out}, inputs, true);  // an input (a record, the model file) is never the rows file
   if (std::filesystem::exists(job.out) && !job.resume && !job.force)
     throw UsageError(job.out + " exists: --resume fits only the records not yet in it, --force replaces it");
-  check_output_files({job.out}, files, true);
   if (job.force && !job.resume) std::filesystem::remove(job.out);
   std::optional<BatchFile> opened;
   try {

@@ -467,11 +467,18 @@ Fitted fit_of(FitArgs& a) {
   return fit_records(a, {d});
 }
 
+// Every file a fit reads besides its records: the NARX model, the controller, the initial model, the validation
+// record, the grey-box model file (what an output must not overwrite).
+std::vector<std::string> other_input_files(const FitArgs& a) {
+  return {a.narx, a.controller, a.initial, a.validate,
+          method_info(a.method).capabilities.greybox_model ? a.model_expr : ""};
+}
+
 int run(FitArgs a, Provenance& prov) {
   reject_flags_that_do_not_apply(a);
-  const MethodInfo& m = method_info(a.method);
   std::vector<std::string> inputs = a.paths;
-  inputs.insert(inputs.end(), {a.narx, a.controller, a.initial, a.validate, m.capabilities.greybox_model ? a.model_expr : ""});
+  const std::vector<std::string> others = other_input_files(a);
+  inputs.insert(inputs.end(), others.begin(), others.end());
   check_output_files({a.json, a.report, a.responses.empty() ? "" : a.responses + "_time.csv",
                  a.responses.empty() ? "" : a.responses + "_freq.csv"},
                 inputs, a.force);
@@ -641,6 +648,7 @@ void setup_batch(CLI::App& app, Command& command) {
           throw UsageError("--" + std::string(f) + " is an option of ctid fit on one record, not of ctid batch (one "
                            "row per record in --out)");
       reject_flags_that_do_not_apply(*a);  // once, before any record
+      job->inputs = other_input_files(*a);
       job->fit_one = [a](const std::string& path) {
         FitArgs b = *a;
         b.paths = {path};

@@ -1,5 +1,6 @@
 // ctid simulate MODEL.json DATA [--out OUT.csv] [--initial rest|measured|estimated] [--snr DB --seed N]: any
 // result or model file ctid writes, simulated by simulate() (simulate/simulate.hpp).
+#include <cmath>
 #include <cstdio>
 #include <functional>
 
@@ -60,7 +61,14 @@ void setup_simulate(CLI::App& app, Command& command) {
   app.add_option("DATA", a->data.path, "Table with the input column(s) and a time axis")->required();
   a->data.add_to(app, true);  // --output: the record's output, read for --initial measured|estimated
   app.add_option("--out", a->out, "Write t, inputs and simulated outputs to this CSV (default: stdout)");
-  app.add_option("--snr", a->snr, "Add white Gaussian noise at this signal-to-noise ratio (dB)");
+  app.add_option("--snr", a->snr, "Add white Gaussian noise at this signal-to-noise ratio (dB)")
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            double x = 0;
+            try { x = std::stod(v); } catch (const std::exception&) {}  // not a number: the conversion says so
+            return std::isfinite(x) ? std::string() : "--snr must be a finite number of dB (got " + v + ")";
+          },
+          "DB"));
   add_initial_option(app, a->initial, &a->initial_samples, "rest; a grey-box result: its fitted initial state");
   app.add_option("--seed", a->seed, "Seed of the noise")->capture_default_str();
   app.add_flag("--force", a->force, "Overwrite an existing output file");

@@ -111,7 +111,13 @@ void add_initial_option(CLI::App& app, std::string& initial, int* initial_sample
   app.add_option("--initial-samples", *initial_samples,
                  "With --initial estimated, grey-box models: estimate the initial state from the first N samples of "
                  "this record only (the nonlinear-benchmark protocol), not the fitted x0")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            double x = 1;
+            try { x = std::stod(v); } catch (const std::exception&) {}  // not a number: the conversion says so
+            return x >= 1 ? std::string() : "--initial-samples must be at least 1 (got " + v + ")";
+          },
+          "N >= 1"));
 }
 
 SimulateOptions simulate_options_of(const Result<AnyModel>& r, SimulationPurpose purpose, const std::string& initial,

@@ -174,6 +174,7 @@ struct BatchJob {
   std::string method, out;
   int jobs = 0;  ///< 0: one per core
   bool resume = false, force = false;
+  std::vector<std::string> inputs;  ///< files every fit reads besides the records (models; --out must not be one)
   std::function<FitOutcome(const std::string& path)> fit_one;
 };
 int run_batch(const BatchJob& job);

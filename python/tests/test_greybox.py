@@ -87,3 +87,11 @@ def test_a_stiff_model_and_sign_friction():
     assert f.ok(), f.message
     assert np.abs(f.x[:101, 1]).max() < 1e-12  # at rest
     np.testing.assert_allclose(f.x[150, 0], 0.25 * 0.5 ** 2, rtol=1e-8)  # q = a t^2 / 2 with a = 0.5, t = 0.5 s
+
+
+def test_a_non_finite_initial_state_is_refused():
+    # Before: x0=[nan] simulated from 0, silently. The message names the state and the value.
+    m = ctid.greybox_model(MODEL)
+    u = np.zeros((10, 1))
+    with pytest.raises(ValueError, match=r"x0\[0\] \(x\(0\)\) is nan"):
+        m.simulate(u, np.arange(10) * 0.1, x0=[float("nan")])

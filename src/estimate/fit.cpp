@@ -320,6 +320,18 @@ void check_request(const MethodInfo& m, const FitRequest& r) {
       if (r.records[e].nu() != d.nu() || r.records[e].ny() != d.ny())
         throw InvalidArgument(detail::format("{}: record {} has {} inputs and {} outputs, record 1 has {} and {}",
                                              m.name, e + 1, r.records[e].nu(), r.records[e].ny(), d.nu(), d.ny()));
+    // Each record is an experiment: the same one twice would count its information twice (every standard deviation
+    // shrunk by sqrt(2)) without a second experiment.
+    for (std::size_t e = 1; e < r.records.size(); ++e)
+      for (std::size_t f = 0; f < e; ++f) {
+        const IdData& a = r.records[f];
+        const IdData& b = r.records[e];
+        if (a.size() == b.size() && a.u() == b.u() && a.y() == b.y() && a.times() == b.times())
+          throw InvalidArgument(detail::format("{}: records {} and {} are the same data (the same file given twice?); "
+                                               "each record counts as an experiment, so a repeated one would count its "
+                                               "information twice: give it once",
+                                               m.name, f + 1, e + 1));
+      }
   }
   if (!s.orders.empty() && !c.orders) refuse("has its own structure settings; it takes no transfer-function orders");
   if (s.orders.empty() && c.needs_orders) refuse("needs transfer-function orders (nb, nf, nk)");

@@ -245,6 +245,9 @@ Eigen::VectorXd checked_start(const GreyboxModel& m, const Eigen::MatrixXd& u, c
   }
   CTID_REQUIRE(x0.size() == 0 || x0.size() == m.nx(), "greybox simulate: x0 has {} entries, the model has {} states",
                x0.size(), m.nx());
+  for (Eigen::Index i = 0; i < x0.size(); ++i)  // a given state is used as given: NaN is not "the default"
+    CTID_REQUIRE(std::isfinite(x0(i)), "greybox simulate: x0[{}] ({}(0)) is {}; give a finite initial state (or none: "
+                 "the model's own, its unset states at 0)", i, m.spec().states[static_cast<size_t>(i)], x0(i));
   Eigen::VectorXd start = x0.size() ? x0 : m.initial_state();
   for (Eigen::Index i = 0; i < start.size(); ++i)
     if (std::isnan(start(i))) start(i) = 0.0;

@@ -293,8 +293,9 @@ ExampleData example_data(const std::string& name) {
   const std::vector<std::string> names = example_data_names();
   std::string list;
   for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-  CTID_REQUIRE(false, "example_data: no example record '{}'; did you mean '{}'? (known: {})", name,
-               closest_name(name, names), list);
+  const std::string near = closest_name(name, names);
+  CTID_REQUIRE(false, "example_data: no example record '{}'{} (known: {})", name,
+               near.empty() ? std::string() : "; did you mean '" + near + "'?", list);
   return {};
 }
 

@@ -161,6 +161,16 @@ TEST(Cli, BatchRefusesBadOptionsOnce) {
   const CliRun ext = ctid_run("batch '" + dir + "/r*.csv' --out " + dir + "/o.txt");
   EXPECT_EQ(ext.code, 2);
   EXPECT_NE(ext.err.find("--out must end in .csv or .jsonl"), std::string::npos) << ext.err;
+  // The rows file is never one of the inputs, even with --force: here the grey-box model file (before: replaced by
+  // the batch's rows).
+  const std::string model = dir + "/model.jsonl";
+  fs::copy_file(std::string(CTID_EXAMPLES_DATA_DIR) + "/spring_greybox.json", model);
+  const std::string model_text = read_text_file(model);
+  const CliRun same = ctid_run("batch '" + dir + "/r*.csv' --time t --method greybox --model " + model + " --out " +
+                               model + " --force");
+  EXPECT_EQ(same.code, 2) << same.err;
+  EXPECT_NE(same.err.find(model), std::string::npos) << same.err;
+  EXPECT_EQ(read_text_file(model), model_text);
   // Ctrl-C: the fits in progress stop, the rows written stay complete, exit 130; --resume completes the batch. The
   // records take seconds each (srivc-auto's structure and delay search on 2000 noisy samples of a second-order plant).
   {

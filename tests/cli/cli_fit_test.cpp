@@ -979,3 +979,11 @@ TEST(Cli, AFitThatIsNotUsableWritesItsFilesMarkedSo) {
   EXPECT_EQ(ctid_run(base + " --set max_iteration=3 --json " + json).code, 2);
   EXPECT_FALSE(fs::exists(json));
 }
+
+// The same record twice is not two experiments (before: accepted, every standard deviation shrunk by sqrt(2)).
+TEST(Cli, TheSameRecordTwiceIsRefused) {
+  const std::string data = good_csv(), cols = " --time time --input force --output position";
+  const CliRun r = ctid_run("fit " + data + " " + data + cols + " --method srivc --nb 1 --nf 2");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("records 1 and 2 are the same data (the same file given twice?)"), std::string::npos) << r.err;
+}

@@ -113,3 +113,25 @@ TEST(Cli, SimulateFollowsTheLibrarysInitialStateRuleForEveryModelType) {
     }
   }
 }
+
+// Values that cannot mean anything are refused with one line naming the value (exit 2), not taken silently or
+// answered with a computed range: --snr nan (before: no noise added, exit 0), --initial-samples 0 (before: a 300-digit
+// range), an unknown example record with no near name (before: "did you mean ''?").
+TEST(Cli, MeaninglessValuesAreNamed) {
+  const std::string data = good_csv(), cols = " --time time --input force --output position";
+  const std::string fit = test::temp_path("snr_srivc.json"), out = test::temp_path("snr_sim.csv");
+  fs::remove(fit);
+  ASSERT_EQ(ctid_run("fit " + data + cols + " --method srivc --nb 1 --nf 2 --json " + fit).code, 0);
+  CliRun r = ctid_run("simulate " + fit + " " + data + cols + " --snr nan --out " + out + " --force");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--snr must be a finite number of dB (got nan)"), std::string::npos) << r.err;
+  r = ctid_run("simulate " + fit + " " + data + cols + " --initial estimated --initial-samples 0 --out " + out +
+               " --force");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--initial-samples must be at least 1 (got 0)"), std::string::npos) << r.err;
+  EXPECT_LT(r.err.size(), 200u) << r.err;
+  r = ctid_run("example-data qqqqqqqqqqqq " + test::temp_path("none.csv"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("no example record 'qqqqqqqqqqqq' (known: "), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("did you mean"), std::string::npos) << r.err;
+}

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "ctid/core/progress.hpp"
 #include "ctid/core/error.hpp"
 #include "ctid/data/frequency_data.hpp"
 #include "ctid/estimate/state_space/ssest.hpp"
@@ -473,4 +474,36 @@ TEST(Ssest, InnovationGainSurvivesJsonAndIsRefusedOnFrequencyData) {
   EXPECT_NE(error_of([&] { ssest(FrequencyData(w, frequency_response(m0, w)), o); })
                 .find("estimate_k with frequency data"),
             std::string::npos);
+}
+
+// An order search interrupted after its first order is interrupted as a whole, whatever order it keeps (before:
+// Ctrl-C during --nx 1:8 ended "converged", exit 0, with the best of the orders fitted so far). The callback lets the
+// nx = 1 fit finish (its Levenberg-Marquardt iterations counted on a run of nx = 1 alone) and stops three
+// iterations into nx = 2.
+TEST(Ssest, AnInterruptedOrderSearchIsInterrupted) {
+  const StateSpace m = two_modes();
+  const IdData clean = record(m, levels(2000, 2, 7, 1), uniform_times(2000), Eigen::Vector4d::Zero(), INFINITY, 0);
+  const IdData d = with_noise(clean, variances_for_10db(clean), 5, true);
+  int first = 0;
+  {
+    ProgressScope count([&](const ProgressEvent& e) {
+      first += std::string(e.stage) == "levenberg_marquardt";
+      return true;
+    });
+    ASSERT_EQ(ssest(d, {.nx = 1}).summary.termination, Termination::Converged);
+  }
+  ASSERT_GT(first, 0);
+  int seen = 0;
+  Result<StateSpace> r;
+  {
+    ProgressScope stop([&](const ProgressEvent& e) {
+      return std::string(e.stage) != "levenberg_marquardt" || ++seen <= first + 3;
+    });
+    r = ssest(d, {.nx = 1, .nx_max = 3});
+  }
+  EXPECT_EQ(r.summary.termination, Termination::Interrupted);
+  EXPECT_FALSE(r.usable());
+  EXPECT_NE(r.summary.message.find("the order search was interrupted while fitting nx = 2"), std::string::npos)
+      << r.summary.message;
+  EXPECT_EQ(r.diagnostics.get(diagnostic::nx_grid).size(), 2);
 }

@@ -131,7 +131,7 @@ class GreyboxModel {
   /// driven by the inputs u (N x nu) at the increasing times t (seconds; the expressions' t), the inputs held,
   /// linear or band-limited (windowed-sinc interpolation, uniform times only) between samples, with relative tolerance rtol (absolute tolerance rtol times 1e-3) by `integrator`. An escaping
   /// solution (|x| > 1e12, non-finite, step-size collapse) ends with NumericalFailure, a message naming the time,
-  /// and NaN from there. Throws InvalidArgument for size mismatches or non-increasing times.
+  /// and NaN from there. Throws InvalidArgument for size mismatches, non-increasing times or a non-finite x0 entry.
   GreyboxSimulation simulate(const Eigen::MatrixXd& u, const Eigen::VectorXd& t, Intersample intersample = Intersample::Zoh,
                              const Eigen::VectorXd& x0 = {}, double rtol = 1e-8,
                              GreyboxIntegrator integrator = GreyboxIntegrator::Auto) const;

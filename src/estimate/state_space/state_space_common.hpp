@@ -12,6 +12,7 @@
 
 #include <Eigen/Dense>
 
+#include "ctid/core/check.hpp"
 #include "ctid/core/diagnostics.hpp"
 #include "ctid/core/error.hpp"
 #include "ctid/core/types.hpp"
@@ -149,7 +150,8 @@ Rounds lm_rounds(const Layout& L, Eigen::VectorXd theta, const std::vector<bool>
 
 /// The order search of ssest (time and frequency data): fit(n) for n = lo..hi and keep the least BIC among the usable
 /// fits (all fits when none is usable), with diagnostics nx_grid and nx_grid_bic. An order the data cannot support
-/// (fit throws InvalidArgument) ends the search; at lo it is rethrown.
+/// (fit throws InvalidArgument) ends the search; at lo it is rethrown. An interrupted fit ends the search too, and
+/// the result is interrupted whatever order it keeps (the search did not see every order).
 template <class Fit>
 Result<StateSpace> order_search(int lo, int hi, Fit&& fit) {
   Eigen::VectorXd grid(hi - lo + 1), bic(hi - lo + 1);
@@ -168,6 +170,17 @@ Result<StateSpace> order_search(int lo, int hi, Fit&& fit) {
     }
     grid(n - lo) = n;
     bic(n - lo) = r.fit.n_samples > 0 ? r.fit.bic : INFINITY;
+    if (r.summary.termination == Termination::Interrupted) {
+      const std::string why = r.summary.message;
+      if (best.model.nx() == 0) best = std::move(r);
+      best.summary.termination = Termination::Interrupted;
+      best.summary.message = detail::format("the order search was interrupted while fitting nx = {} ({}); nx = {} is the "
+                                            "best of the orders fitted before, not of {}..{}",
+                                            n, why, best.model.nx(), lo, hi);
+      grid.conservativeResize(n - lo + 1);
+      bic.conservativeResize(n - lo + 1);
+      break;
+    }
     const bool usable = r.usable();
     if ((usable && !best_usable) || (usable == best_usable && bic(n - lo) < best_bic) || best.model.nx() == 0) {
       best_usable = usable;
