@@ -124,17 +124,19 @@ void reject_flags_that_do_not_apply(const FitArgs& a) {
       if (has(f)) refuse(f, "names a column of frequency data: it needs --frequency");
 }
 
-// --nx N or A:B: the state dimension (and the upper end of an order range), 0 when not given.
+// --nx N or A:B: the state dimension (and the upper end of an order range); 0 (as when not given): the subspace
+// start's choice, the library's nx = 0.
 std::pair<int, int> nx_of(const FitArgs& a) {
   if (a.nx.empty()) return {0, 0};
   const auto colon = a.nx.find(':');
-  auto number = [&](const std::string& t) {
-    if (t.empty() || t.find_first_not_of("0123456789") != std::string::npos || t.size() > 4 || std::stoi(t) < 1)
-      throw UsageError("--nx must be a state dimension N >= 1 or a range A:B (got '" + a.nx + "')");
+  auto number = [&](const std::string& t, int least) {
+    if (t.empty() || t.find_first_not_of("0123456789") != std::string::npos || t.size() > 4 || std::stoi(t) < least)
+      throw UsageError("--nx must be a state dimension N >= 1, 0 (chosen from the singular values) or a range A:B "
+                       "(got '" + a.nx + "')");
     return std::stoi(t);
   };
-  if (colon == std::string::npos) return {number(a.nx), 0};
-  const int lo = number(a.nx.substr(0, colon)), hi = number(a.nx.substr(colon + 1));
+  if (colon == std::string::npos) return {number(a.nx, 0), 0};
+  const int lo = number(a.nx.substr(0, colon), 1), hi = number(a.nx.substr(colon + 1), 1);
   if (hi < lo) throw UsageError("--nx A:B needs A <= B (got '" + a.nx + "')");
   return {lo, hi};
 }
@@ -583,7 +585,8 @@ std::shared_ptr<FitArgs> add_fit_options(CLI::App& app) {
                  "with --period: a frequency is used where an input's amplitude is at least this fraction of its "
                  "largest")
       ->capture_default_str();
-  app.add_option("--nx", a->nx, "subspace, ssest: state dimension N, or ssest: a range A:B (the least BIC is kept)");
+  app.add_option("--nx", a->nx, "subspace, ssest: state dimension N (0: where the singular values drop most, as when "
+                 "not given), or ssest: a range A:B (the least BIC is kept)");
   app.add_option("--initial", a->initial, "ssest: starting model, a state-space JSON file (a result of ctid fit --json); "
                  "fixed.A1_2=.. entries refer to its coordinates");
   app.add_option("--validate", a->validate,

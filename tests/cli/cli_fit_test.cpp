@@ -906,6 +906,14 @@ TEST(Cli, SsestRefinesWithUncertaintyOrderRangeAndAStartingModel) {
   const CliRun bad = ctid_run("fit " + io + " --nx 5:3");
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("--nx A:B needs A <= B (got '5:3')"), std::string::npos) << bad.err;
+  // --nx 0 is the library's nx = 0, the order where the singular values drop most (as without --nx; before: refused).
+  const CliRun chosen = ctid_run("fit " + csv + " --ts 0.05 --input u1 --input u2 --output y1 --output y2 "
+                                 "--method subspace --nx 0");
+  EXPECT_EQ(chosen.code, 0) << chosen.err;
+  const std::string unset = ctid_run("fit " + csv + " --ts 0.05 --input u1 --input u2 --output y1 --output y2 "
+                                     "--method subspace").out;
+  EXPECT_EQ(chosen.out.substr(0, chosen.out.find("termination:")), unset.substr(0, unset.find("termination:")));
+  EXPECT_NE(chosen.out.find("4 states"), std::string::npos) << chosen.out;
   const CliRun other = ctid_run("fit " + csv + " --ts 0.05 --input u1 --output y1 --method srivc --nx 2");
   EXPECT_EQ(other.code, 2);
   EXPECT_NE(other.err.find("--nx sets a state dimension"), std::string::npos) << other.err;
