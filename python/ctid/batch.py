@@ -99,6 +99,12 @@ def _show(label, done, total, errors, final=False):
     _sys.stderr.flush()
 
 
+def _check_jobs(who, jobs):
+    """ValueError for a thread count that is not a whole number >= 1 (None: every core)."""
+    if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1):
+        raise ValueError(f"{who}: jobs must be a whole number >= 1 (got {jobs!r}); None uses every core")
+
+
 def _threads(client, jobs):
     """Threads the work runs on: `jobs` (default every core) locally, the cluster's worker threads on Dask."""
     if client is None:
@@ -233,6 +239,7 @@ def fit_many(records, method=None, client=None, *, out=None, resume=False, progr
     import ctid
 
     method = _check_method("fit_many", method, options)
+    _check_jobs("fit_many", jobs)
     if chunk is not None and not (isinstance(chunk, int) and chunk >= 1):
         raise ValueError(f"fit_many: chunk must be a whole number >= 1 (got {chunk!r})")
     pairs = _records(records)
@@ -354,6 +361,7 @@ def monte_carlo(model, u, ts=None, *, t=None, intersample="zoh", runs=100, snr_d
         dict(methods) if isinstance(methods, dict) else {m: {} for m in methods}
     for m in per_method:
         _check_method("monte_carlo", m, {})
+    _check_jobs("monte_carlo", jobs)
     clean = _experiment(model, u, ts, t, intersample)  # checks the design here, before any task is sent
     x = np.asarray(clean.y)[:, 0]
     sigma2 = noise_std ** 2 if noise_std is not None else float(np.mean((x - x.mean()) ** 2)) / 10 ** (snr_db / 10)

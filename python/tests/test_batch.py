@@ -152,6 +152,9 @@ def test_records_in_memory_pairs_and_bad_arguments(client):
         ctid.batch.fit_many([("x", d), ("x", d)])
     with pytest.raises(TypeError, match="record 0 is a int"):
         ctid.batch.fit_many([3])
+    for jobs in (0, -1, 1.5, True):  # before: jobs=0 was accepted
+        with pytest.raises(ValueError, match=r"fit_many: jobs must be a whole number >= 1 \(got "):
+            ctid.batch.fit_many([d], method="oe", nb=1, nf=1, jobs=jobs)
     row = ctid.batch.fit_many([d], method="oe", nb=1, nf=1, bogus=3, progress=False).iloc[0]
     assert not row["usable"] and "unknown option 'bogus'" in row["error"]
 
