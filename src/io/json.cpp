@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <cmath>
 #include <limits>
+#include <set>
 #include <type_traits>
 
 #include <nlohmann/json.hpp>
@@ -130,11 +131,27 @@ LinearModel model_from(const json& root, const Reader& rd) {
 }
 
 json parse_text(const std::string& text, const Reader& rd) {
+  // A key twice in one object: JSON parsers keep one of the values (nlohmann the last) without a word; refused.
+  std::vector<std::set<std::string>> open;  // the keys of each object being read
+  std::string repeated;
+  const json::parser_callback_t keys = [&](int, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::object_start) open.emplace_back();
+    else if (event == json::parse_event_t::object_end && !open.empty()) open.pop_back();
+    else if (event == json::parse_event_t::key && !open.empty() && !open.back().insert(parsed.get<std::string>()).second &&
+             repeated.empty())
+      repeated = parsed.get<std::string>();
+    return true;
+  };
+  json j;
   try {
-    return json::parse(text);
+    j = json::parse(text, keys);
   } catch (const json::exception& e) {  // parse_error, or out_of_range for a number like 1e99999
     rd.fail(std::string("not valid JSON: ") + e.what());
   }
+  if (!repeated.empty())
+    rd.fail(detail::format("the key \"{}\" appears twice in one object; a JSON reader would silently keep one of the "
+                           "values: keep the one you mean", repeated));
+  return j;
 }
 
 }  // namespace

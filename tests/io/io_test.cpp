@@ -222,6 +222,15 @@ TEST(Json, MalformedFilesAreFileErrors) {
   EXPECT_NE(error_of([] { parse_model_json(R"({"type": "transfer_function", "num": [1e99999], "den": [1, 2]})", "m.json"); })
                 .find("m.json: not valid JSON: [json.exception.out_of_range.406] number overflow"),
             std::string::npos);
+  // A key twice in one object (before: the last value won silently, k = 50 instead of 2); the same key in two
+  // objects is fine.
+  const std::string twice = R"({"type": "greybox", "inputs": ["u"], "states": ["x"], "outputs": {"y": "x"},
+      "parameters": {"k": 2, "k": 50}, "equations": {"x": "-k*x + u"}})";
+  EXPECT_EQ(error_of([&] { parse_greybox_json(twice, "g.json"); }),
+            "g.json: the key \"k\" appears twice in one object; a JSON reader would silently keep one of the values: "
+            "keep the one you mean");
+  EXPECT_EQ(parse_greybox_json(R"({"type": "greybox", "inputs": ["u"], "states": ["x"], "outputs": {"x": "x"},
+      "parameters": {"k": 2}, "equations": {"x": "-k*x + u"}})").parameter_values()(0), 2.0);
 }
 
 TEST(Mat, WriteReadAndLoad) {
