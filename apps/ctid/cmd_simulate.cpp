@@ -26,7 +26,17 @@ int run(const SimArgs& a) {
   const ResultFile f = read_result_file(a.model);
   // The record's output is read where the initial condition needs it (a fitted x0 does not).
   const SimulateOptions so = simulate_options_of(f.result, SimulationPurpose::FreeRun, a.initial, a.initial_samples);
-  const IdData d = columns_of(a.data, f.result.model).load(so.initial != InitialCondition::Rest && so.x0.size() == 0);
+  const bool reads_output = so.initial != InitialCondition::Rest && so.x0.size() == 0;
+  const IdData d = [&] {
+    try {
+      return columns_of(a.data, f.result.model).load(reads_output);
+    } catch (const ColumnSelectionError& e) {
+      if (!reads_output) throw;
+      throw ColumnSelectionError(std::string(e.what()) + "; --initial " + to_string(so.initial) +
+                                 " reads the record's measured output to find the initial state: name its column "
+                                 "with --output");
+    }
+  }();
   Eigen::MatrixXd y = simulate_result(f.result, d, SimulationPurpose::FreeRun, a.initial, a.initial_samples);
   std::vector<std::string> ynames;
   for (Eigen::Index j = 0; j < y.cols(); ++j) ynames.push_back(y.cols() == 1 ? "y" : "y" + std::to_string(j + 1));

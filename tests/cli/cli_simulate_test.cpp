@@ -135,3 +135,23 @@ TEST(Cli, MeaninglessValuesAreNamed) {
   EXPECT_NE(r.err.find("no example record 'qqqqqqqqqqqq' (known: "), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("did you mean"), std::string::npos) << r.err;
 }
+
+// A grey-box simulation from an estimated initial state reads the record's output; when the record names it
+// otherwise the message says why the output is needed and how to name it (before: only "no column named 'position'").
+TEST(Cli, AnEstimatedInitialStateSaysItNeedsTheOutput) {
+  const std::string data = test::temp_path("spring_for_x0.csv"), fit = test::temp_path("spring_for_x0.json");
+  fs::remove(data);
+  fs::remove(fit);
+  ASSERT_EQ(ctid_run("example-data spring " + data).code, 0);
+  ASSERT_EQ(ctid_run("fit " + data + " --time t --method greybox --model " + std::string(CTID_EXAMPLES_DATA_DIR) +
+                     "/spring_greybox.json --json " + fit).code, 0);
+  std::string text = read_text_file(data);
+  text.replace(text.find("position"), 8, "pos");
+  const std::string renamed = write("spring_renamed.csv", text);
+  const CliRun r = ctid_run("simulate " + fit + " " + renamed + " --time t --input force --initial estimated "
+                            "--initial-samples 20 --out " + test::temp_path("x0_sim.csv") + " --force");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("no column named 'position'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--initial estimated reads the record's measured output to find the initial state: name its "
+                       "column with --output"), std::string::npos) << r.err;
+}
