@@ -66,8 +66,9 @@ GreyboxModel::GreyboxModel(GreyboxSpec spec) : spec_(std::move(spec)) {
   auto declare = [&](const std::string& name, const char* kind) {
     CTID_REQUIRE(is_identifier(name), "greybox model: {} name '{}' is not a name (letters, digits, _; not starting with a digit)",
                  kind, name);
-    CTID_REQUIRE(name != "t" && !Expression::is_function(name),
-                 "greybox model: {} name '{}' is reserved (t is the time; {} is a function)", kind, name, name);
+    CTID_REQUIRE(name != "t", "greybox model: {} name 't' is reserved: t is the time in the equations", kind);
+    CTID_REQUIRE(!Expression::is_function(name), "greybox model: {} name '{}' is reserved: {} is a function", kind,
+                 name, name);
     CTID_REQUIRE(seen.insert(name).second, "greybox model: the name '{}' is declared twice", name);
   };
   for (const auto& n : s.states) declare(n, "state");

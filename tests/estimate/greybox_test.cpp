@@ -100,6 +100,11 @@ TEST(Greybox, ModelFileRoundTripsAndNamesItsProblems) {
   EXPECT_NE(with("\"value\": 0.05, \"lower\": 0}, \"k2\"", "\"value\": -1, \"lower\": 0}, \"k2\"").find("outside its bounds"),
             std::string::npos);
   EXPECT_NE(with("\"states\"", "\"stats\"").find("\"states\""), std::string::npos);
+  // Reserved names, each with its own reason (before: "t is the time; t is a function" for both).
+  EXPECT_EQ(with("\"k4\": {\"value\": 0.1}", "\"t\": {\"value\": 0.1}"),
+            "m.json: greybox model: parameter name 't' is reserved: t is the time in the equations");
+  EXPECT_EQ(with("\"k4\": {\"value\": 0.1}", "\"sqrt\": {\"value\": 0.1}"),
+            "m.json: greybox model: parameter name 'sqrt' is reserved: sqrt is a function");
 }
 
 TEST(Greybox, SensitivitiesMatchCentralDifferences) {
