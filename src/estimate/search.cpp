@@ -139,11 +139,11 @@ CovarianceVerdict set_covariance(ParameterSet& parameters, Diagnostics& diagnost
   const auto p = static_cast<Eigen::Index>(slots.size());
   std::vector<Eigen::Index> keep;
   std::vector<int> keep_slots, held_slots;
-  for (Eigen::Index i = 0; i < p; ++i)
-    (std::find(held.begin(), held.end(), i) == held.end() ? keep_slots : held_slots)
-        .push_back(slots[static_cast<size_t>(i)]);
-  for (Eigen::Index i = 0; i < p; ++i)
-    if (std::find(held.begin(), held.end(), i) == held.end()) keep.push_back(i);
+  for (Eigen::Index i = 0; i < p; ++i) {
+    const bool free = std::find(held.begin(), held.end(), i) == held.end();
+    (free ? keep_slots : held_slots).push_back(slots[static_cast<size_t>(i)]);
+    if (free) keep.push_back(i);
+  }
   const Eigen::MatrixXd white = internal::covariance(held.empty() ? lm.jtj : sub(lm.jtj, keep), sigma2);
   set_with_held(parameters, white, keep_slots, held_slots);
   // The coloured sandwich over the free slots and every nuisance entry (q > p), then the free slots' block. J^T J over
