@@ -69,7 +69,7 @@ void ColouredGram::add(const double* row) {
   add_row(Eigen::Map<const Eigen::RowVectorXd>(row, sum_.cols()));
 }
 
-void ColouredGram::add_row(const Eigen::Ref<const Eigen::RowVectorXd>& row) {
+void ColouredGram::add_row(const Row& row) {
   // j~_t = j_t - sum_i a_i j~_{t-i}; past_ row (head_ - i) mod n holds j~_{t-i}.
   const int n = ar_.order();
   now_ = row;

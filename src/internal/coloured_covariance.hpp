@@ -50,13 +50,14 @@ class ColouredGram {
  public:
   ColouredGram(const ResidualAr& ar, int columns);
   void start_sequence();
+  using Row = Eigen::Ref<const Eigen::RowVectorXd, 0, Eigen::InnerStride<>>;  // a row of a column-major J: no copy
   void add(const double* row);
-  void add(const Eigen::Ref<const Eigen::RowVectorXd>& row) { add_row(row); }
+  void add(const Row& row) { add_row(row); }
   /// lambda sum j~ j~^T (both triangles).
   Eigen::MatrixXd gram() const;
 
  private:
-  void add_row(const Eigen::Ref<const Eigen::RowVectorXd>& row);
+  void add_row(const Row& row);
   ResidualAr ar_;
   Eigen::MatrixXd past_;  // order x columns, the last filtered rows (ring)
   Eigen::MatrixXd sum_;
